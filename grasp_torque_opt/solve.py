@@ -1,0 +1,108 @@
+"""One entry point for every method: kinematics, build, solve, certify, decide.
+
+The status of a :class:`Solution` is decided here, never by a solver alone:
+``optimal`` needs the certificate; ``infeasible`` from a polygon method needs
+the independent LP of :mod:`grasp_torque_opt.feasibility` to agree.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from grasp_torque_opt.certificate import DEFAULT_TOLERANCE, certify
+from grasp_torque_opt.exact_nlp import solve_exact_nlp
+from grasp_torque_opt.exact_socp import solve_exact_socp
+from grasp_torque_opt.feasibility import linearized_feasible
+from grasp_torque_opt.force_qp import solve_force_qp
+from grasp_torque_opt.grasp_maps import GraspMaps
+from grasp_torque_opt.grasp_setup import GraspSetup
+from grasp_torque_opt.solution import FAILED, INFEASIBLE, OPTIMAL, Solution
+from grasp_torque_opt.tau_qp import TauQPSolver, build_tau_qp
+
+#: Methods: the product's (``tau-qp``) and the references.
+METHODS = ("tau-qp", "force-qp", "socp", "nlp")
+#: Methods whose feasible set is the linearized (polygon) one.
+LINEARIZED = ("tau-qp", "force-qp")
+
+
+def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
+          solver: TauQPSolver | None = None,
+          tolerance: float = DEFAULT_TOLERANCE) -> Solution:
+    """Solve one grasp with one method and certify the result.
+
+    Args:
+        setup: the grasp.
+        method: one of :data:`METHODS`.
+        maps: G and J if already computed (else computed here).
+        solver: a ProxSuite solver to reuse across calls (tau-qp only).
+        tolerance: certificate tolerance, SI units.
+
+    Returns:
+        A solution whose status is ``optimal`` only if certified.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    timings = {}
+    t0 = time.perf_counter()
+    if maps is None:
+        maps = setup.maps()
+    t1 = time.perf_counter()
+    timings["maps"] = t1 - t0
+    args = (maps, setup.friction, setup.external_wrench, setup.hand.torque_limits,
+            setup.weights)
+    J = maps.J
+    if method == "tau-qp":
+        qp = build_tau_qp(*args)
+        t2 = time.perf_counter()
+        raw = (solver or TauQPSolver()).solve(qp)
+        tau, f = (None, None) if raw.x is None else (qp.split(raw.x)[0], qp.wrenches(raw.x))
+    else:
+        t2 = time.perf_counter()
+        if method == "force-qp":
+            raw = solve_force_qp(*args, objective="force")
+        elif method == "socp":
+            raw = solve_exact_socp(*args)
+        else:
+            raw = solve_exact_nlp(*args)
+        f = None if raw.x is None else raw.x[:J.shape[0]]
+        tau = None if f is None else J.T @ f
+    t3 = time.perf_counter()
+    timings["build"] = t2 - t1
+    timings["solve"] = t3 - t2
+
+    cert = None
+    if f is not None:
+        cert = certify(maps.G, J, setup.external_wrench, setup.friction,
+                       setup.hand.torque_limits, tau, f, tolerance)
+    timings["certify"] = time.perf_counter() - t3
+
+    out = Solution(status=FAILED, method=method, joints=list(setup.hand.joints),
+                   iterations=raw.iterations, solve_time_s=raw.solve_time_s,
+                   certificate=cert, timings=timings)
+    if raw.status == "solved" and cert is not None and cert.ok:
+        out.status, out.tau, out.wrenches = OPTIMAL, tau, f.reshape(-1, 4)
+        out.message = f"certified (solver: {raw.message})"
+        return out
+    why = (f"solver: {raw.message}" if cert is None or cert.ok or raw.status != "solved"
+           else f"solver: {raw.message}, certificate failed (worst residual {cert.worst:.3g})")
+    if method in LINEARIZED:
+        feasible = linearized_feasible(maps, setup.friction, setup.external_wrench,
+                                       setup.hand.torque_limits)
+        if feasible is False:
+            out.status, out.message = INFEASIBLE, f"infeasible, confirmed by LP ({why})"
+        elif feasible:
+            out.message = f"not certified although an LP finds the load holdable ({why})"
+        else:
+            out.message = f"not certified, LP undecided ({why})"
+    elif method == "socp" and raw.status == "infeasible":
+        out.status, out.message = INFEASIBLE, f"infeasible ({why})"
+    else:
+        out.message = f"not certified ({why})"
+    return out
+
+
+def torque_norm(tau: np.ndarray, weights: np.ndarray) -> float:
+    """The objective's norm sqrt(tau^T W tau) [N m]."""
+    return float(np.sqrt(tau @ (weights * tau)))

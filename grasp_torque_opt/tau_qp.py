@@ -1,0 +1,209 @@
+"""The tau-space QP (DESIGN.md section 2): build it, then solve it with ProxSuite.
+
+With A = [G; J^T] (shape (6 + m) x 4p), every wrench that balances the load and
+produces tau is
+
+    f = M1 w + M2 tau + N z,    w = -w_ext,  [M1 M2] = pinv(A),  N = null(A),
+
+provided [w; tau] lies in the range of A (the compatibility equalities
+U_perp^T [w; tau] = 0, U_perp a basis of A's left null space). The QP over
+x = [tau; z]:
+
+    minimize    tau^T W tau + eps_z ||z||^2
+    subject to  S (M1 w + M2 tau + N z) <= b       linearized cones, f_z >= f_min
+                U_perp^T [w; tau] = 0              compatibility
+                -tau_max <= tau <= tau_max         box constraints
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import proxsuite
+
+from grasp_torque_opt.exceptions import SolverError
+from grasp_torque_opt.friction import friction_matrix
+from grasp_torque_opt.grasp_maps import GraspMaps
+from grasp_torque_opt.scenario import Friction
+
+#: Relative singular-value threshold for the rank of A.
+RANK_RTOL = 1e-10
+#: Weight of the null-space regularization relative to the smallest joint weight.
+Z_REGULARIZATION = 1e-10
+
+
+@dataclass(frozen=True)
+class TauQP:
+    """A built tau-space QP: 1/2 x^T H x + g^T x, A x = b, C x <= u, box on x.
+
+    Attributes:
+        H: Hessian, shape (n, n), n = m + k.
+        g: linear term, shape (n,).
+        A: compatibility equalities, shape (n_eq, n).
+        b: their right-hand side, shape (n_eq,).
+        C: linearized cone rows in x, shape (n_in, n).
+        u: their upper bound, shape (n_in,); no lower bound.
+        l_box: lower bounds on x (-tau_max, then -inf for z), shape (n,).
+        u_box: upper bounds on x, shape (n,).
+        M1: f's dependence on w, shape (4p, 6).
+        M2: f's dependence on tau, shape (4p, m).
+        N: null-space basis of A (internal forces the joints cannot feel), shape (4p, k).
+        w: the wrench the grasp must produce, -w_ext, shape (6,).
+    """
+
+    H: np.ndarray
+    g: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    C: np.ndarray
+    u: np.ndarray
+    l_box: np.ndarray
+    u_box: np.ndarray
+    M1: np.ndarray
+    M2: np.ndarray
+    N: np.ndarray
+    w: np.ndarray
+
+    @property
+    def m(self) -> int:
+        """Number of joint torques."""
+        return self.M2.shape[1]
+
+    def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(tau, z) from x."""
+        return x[:self.m], x[self.m:]
+
+    def wrenches(self, x: np.ndarray) -> np.ndarray:
+        """Stacked contact wrenches f = M1 w + M2 tau + N z, shape (4p,)."""
+        tau, z = self.split(x)
+        return self.M1 @ self.w + self.M2 @ tau + self.N @ z
+
+
+def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
+                 torque_limits: np.ndarray, weights: np.ndarray) -> TauQP:
+    """Build the tau-space QP of one grasp.
+
+    Args:
+        maps: G and J of the grasp.
+        friction: friction model and polygon.
+        external_wrench: w_ext, load on the object about c, base axes [N, N m].
+        torque_limits: |tau_i| bound, shape (m,) [N m].
+        weights: W's diagonal, shape (m,).
+    """
+    G, J = maps.G, maps.J
+    m = J.shape[1]
+    A_full = np.vstack((G, J.T))
+    U, s, Vt = np.linalg.svd(A_full)
+    r = int(np.sum(s > RANK_RTOL * s[0])) if s.size else 0
+    pinv = (Vt[:r].T / s[:r]) @ U[:, :r].T
+    M1, M2 = pinv[:, :6], pinv[:, 6:]
+    N = Vt[r:].T
+    U_perp = U[:, r:]
+    w = -np.asarray(external_wrench, dtype=float)
+
+    S, b_S = friction_matrix(maps.p, friction.mu1, friction.mu2, friction.sides,
+                             friction.min_normal_force)
+    k = N.shape[1]
+    C = np.hstack((S @ M2, S @ N))
+    u = b_S - S @ (M1 @ w)
+    A = np.hstack((U_perp[6:].T, np.zeros((U_perp.shape[1], k))))
+    b = -U_perp[:6].T @ w
+    H = np.zeros((m + k, m + k))
+    H[:m, :m] = 2.0 * np.diag(weights)
+    H[m:, m:] = 2.0 * Z_REGULARIZATION * float(np.min(weights)) * np.eye(k)
+    inf = np.full(k, np.inf)
+    return TauQP(H=H, g=np.zeros(m + k), A=A, b=b, C=C, u=u,
+                 l_box=np.concatenate((-torque_limits, -inf)),
+                 u_box=np.concatenate((torque_limits, inf)),
+                 M1=M1, M2=M2, N=N, w=w)
+
+
+@dataclass(frozen=True)
+class ProxSuiteSettings:
+    """ProxSuite dense settings used for the tau-QP.
+
+    Attributes:
+        eps_abs: absolute stopping tolerance.
+        eps_rel: relative stopping tolerance.
+        max_iter: cap on outer iterations (one cycle can never stall).
+        max_iter_in: cap on inner iterations.
+    """
+
+    eps_abs: float = 1e-9
+    eps_rel: float = 0.0
+    max_iter: int = 1000
+    max_iter_in: int = 200
+
+
+@dataclass(frozen=True)
+class RawResult:
+    """What a solver said, before certification.
+
+    Attributes:
+        status: ``solved``, ``infeasible`` or ``error``.
+        x: the solver's primal variables (None if it gave none).
+        iterations: iterations it reported.
+        solve_time_s: wall time of the solver call [s].
+        message: the solver's own status text.
+    """
+
+    status: str
+    x: np.ndarray | None
+    iterations: int
+    solve_time_s: float
+    message: str
+
+
+class TauQPSolver:
+    """ProxSuite dense solver for tau-QPs, allocated once per problem size."""
+
+    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+        self.settings = settings or ProxSuiteSettings()
+        self._qp = None
+        self._dims: tuple[int, int, int] | None = None
+
+    def solve(self, qp: TauQP) -> RawResult:
+        """Solve a built tau-QP from a cold start.
+
+        Returns:
+            The raw result; the caller certifies it.
+
+        Raises:
+            SolverError: ProxSuite raised (chained).
+        """
+        data = (qp.H, qp.g, qp.A, qp.b, qp.C, qp.u)
+        if not all(np.all(np.isfinite(a)) for a in data) or np.any(qp.l_box > qp.u_box):
+            return RawResult("error", None, 0, 0.0, "QP data not finite or bounds inverted")
+        n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
+        A = qp.A if n_eq else None
+        b = qp.b if n_eq else None
+        l = np.full(n_in, -np.inf)
+        t0 = time.perf_counter()
+        try:
+            if self._dims != (n, n_eq, n_in):
+                self._qp = proxsuite.proxqp.dense.QP(n, n_eq, n_in, True)
+                s = self._qp.settings
+                s.eps_abs = self.settings.eps_abs
+                s.eps_rel = self.settings.eps_rel
+                s.max_iter = self.settings.max_iter
+                s.max_iter_in = self.settings.max_iter_in
+                s.initial_guess = proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS
+                self._qp.init(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=l, u=qp.u,
+                              l_box=qp.l_box, u_box=qp.u_box)
+                self._dims = (n, n_eq, n_in)
+            else:
+                self._qp.update(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=l, u=qp.u,
+                                l_box=qp.l_box, u_box=qp.u_box)
+            self._qp.solve()
+        except (RuntimeError, ValueError, TypeError) as e:
+            self._dims = None
+            raise SolverError(f"ProxSuite failed: {e}") from e
+        elapsed = time.perf_counter() - t0
+        info = self._qp.results.info
+        out = proxsuite.proxqp.QPSolverOutput
+        status = {out.PROXQP_SOLVED: "solved",
+                  out.PROXQP_PRIMAL_INFEASIBLE: "infeasible"}.get(info.status, "error")
+        return RawResult(status, np.array(self._qp.results.x), int(info.iter), elapsed,
+                         str(info.status).rsplit(".", 1)[-1])

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Create .venv/ at the repository root and install grasp_torque_opt into it
+# (editable), with ROS 2 Jazzy from the registry's ros-jazzy-* wheels, Pinocchio,
+# ProxSuite and the test tools. Idempotent: a second run only checks.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PYTHON="${PYTHON:-python3}"
+if ! "$PYTHON" -c 'import sys; assert (3, 10) <= sys.version_info[:2] <= (3, 13)' 2>/dev/null; then
+    echo "setup: need Python 3.10 to 3.13 as '$PYTHON' (set PYTHON=...)" >&2
+    exit 1
+fi
+if [ ! -x .venv/bin/python ]; then
+    if ! "$PYTHON" -m venv .venv 2>/dev/null; then
+        # Debian and Ubuntu ship venv separately.
+        rm -rf .venv
+        if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+            apt-get update -qq
+            ver="$("$PYTHON" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')"
+            apt-get install -y -qq "python${ver}-venv" || apt-get install -y -qq python3-venv
+            "$PYTHON" -m venv .venv
+        else
+            echo "setup: '$PYTHON -m venv' failed; install python3-venv" >&2
+            exit 1
+        fi
+    fi
+fi
+stamp=.venv/.installed
+if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ]; then
+    .venv/bin/python -m pip install -q --upgrade pip
+    .venv/bin/python -m pip install -q -e '.[ros,test]'
+    touch "$stamp"
+fi

@@ -1,0 +1,55 @@
+"""ament_python package; also installs with plain pip on a machine without ROS."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = "grasp_torque_opt"
+
+setup(
+    name=package_name,
+    version="0.1.0",
+    packages=find_packages(exclude=["test", "bench"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", ["resource/" + package_name]),
+        ("share/" + package_name, ["package.xml"]),
+        ("share/" + package_name + "/config", glob("config/*.yaml")),
+        ("share/" + package_name + "/urdf", glob("urdf/*.urdf")),
+    ],
+    python_requires=">=3.10",
+    # In a colcon workspace these come from the distribution (rosdep keys in
+    # package.xml); with pip they come from the registry.
+    install_requires=[
+        "numpy",
+        "scipy",
+        "pyyaml",
+        "pin",
+        "proxsuite",
+        "clarabel",
+        "example-robot-data",
+    ],
+    extras_require={
+        # ROS 2 Jazzy from the registry's ros-jazzy-* wheels; optional so that the
+        # core installs (and a colcon build works) without them.
+        "ros": [
+            "ros-jazzy-rclpy[fastrtps]",
+            "ros-jazzy-std-msgs",
+            "ros-jazzy-sensor-msgs",
+            "ros-jazzy-geometry-msgs",
+            "ros-jazzy-std-srvs",
+            "ros-jazzy-visualization-msgs",
+            "ros-jazzy-diagnostic-msgs",
+        ],
+        "test": ["pytest", "hypothesis"],
+    },
+    zip_safe=True,
+    maintainer="grasp_torque_opt developers",
+    maintainer_email="dev@grasp-torque-opt.invalid",
+    description="Minimum-effort grasp joint torques with linearized soft-finger cones.",
+    license="BSD-3-Clause",
+    entry_points={
+        "console_scripts": [
+            "grasp-torque-opt = grasp_torque_opt.cli:main",
+        ],
+    },
+)
