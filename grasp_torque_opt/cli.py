@@ -1,0 +1,88 @@
+"""Command line: ``grasp-torque-opt solve|compare SCENARIO``.
+
+Exit codes: 0 optimal, 3 infeasible, 2 bad input (one line on stderr naming
+the field), 4 the solver gave nothing certifiable (no torque is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from grasp_torque_opt.compare import compare, format_table
+from grasp_torque_opt.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.grasp_setup import GraspSetup
+from grasp_torque_opt.report import solution_dict
+from grasp_torque_opt.solution import INFEASIBLE, OPTIMAL
+from grasp_torque_opt.solve import METHODS, solve
+
+EXIT_OPTIMAL, EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_FAILED = 0, 2, 3, 4
+PROG = "grasp-torque-opt"
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=PROG, description=(
+        "Minimum-effort joint torques for a grasp (linearized soft-finger cones, "
+        "certified against the exact cone)."))
+    sub = parser.add_subparsers(dest="command", required=True)
+    p_solve = sub.add_parser("solve", help="solve one scenario with one method")
+    p_solve.add_argument("scenario", help="scenario YAML file")
+    p_solve.add_argument("--method", choices=METHODS, default="tau-qp")
+    p_solve.add_argument("--json", action="store_true", help="print one JSON object")
+    p_cmp = sub.add_parser("compare", help="every method side by side (the paper's Table 2)")
+    p_cmp.add_argument("scenario", help="scenario YAML file")
+    p_cmp.add_argument("--json", action="store_true", help="print one JSON object")
+    return parser
+
+
+def _exit_code(status: str) -> int:
+    return {OPTIMAL: EXIT_OPTIMAL, INFEASIBLE: EXIT_INFEASIBLE}.get(status, EXIT_FAILED)
+
+
+def _print_solution(d: dict) -> None:
+    print(f"status: {d['status']} ({d['method']}; {d['message']})")
+    if d["tau"] is not None:
+        width = max(len(j) for j in d["joints"])
+        for name, t in zip(d["joints"], d["tau"]):
+            print(f"  {name:<{width}}  {t:+.6f} N m")
+        print(f"  ||tau||_2 = {d['torque_norm']:.6f} N m")
+    print(f"solve time: {1e3 * d['solve_time_s']:.3f} ms, iterations: {d['iterations']}")
+    if d["certificate"] is not None:
+        c = d["certificate"]
+        print("certificate: " + ", ".join(
+            f"{k} {c[k]:.1e}" for k in ("equilibrium", "torque", "cone", "normal_force",
+                                        "torque_limit")) + f" (tolerance {c['tolerance']:.0e})")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        setup = GraspSetup.from_file(args.scenario)
+        if args.command == "solve":
+            sol = solve(setup, args.method)
+            d = solution_dict(sol, setup.maps())
+            if args.json:
+                print(json.dumps(d))
+            else:
+                _print_solution(d)
+            return _exit_code(sol.status)
+        comparison = compare(setup)
+        if args.json:
+            print(json.dumps({"scenario": args.scenario, **comparison.as_dict()}))
+        else:
+            print(f"{args.scenario}: {len(setup.hand.joints)} joints, "
+                  f"{len(setup.contacts)} contacts, N = {setup.friction.sides}")
+            print(format_table(comparison))
+        return _exit_code(comparison.solutions["tau-qp"].status)
+    except InputError as e:
+        print(f"{PROG}: error: {args.scenario}: {e}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except GraspTorqueError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return EXIT_FAILED
+
+
+if __name__ == "__main__":
+    sys.exit(main())
