@@ -1,0 +1,62 @@
+"""Shared fixtures: the bundled scenarios and small variations of them."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from grasp_torque_opt.grasp_setup import GraspSetup
+from grasp_torque_opt.scenario import parse_scenario
+
+ROOT = Path(__file__).resolve().parent.parent
+CONFIG = ROOT / "config"
+PLANAR = CONFIG / "planar_two_finger.yaml"
+ALLEGRO = CONFIG / "allegro_right.yaml"
+
+
+def scenario_doc(path: Path) -> dict:
+    """A bundled scenario as plain data, to vary in a test."""
+    return yaml.safe_load(path.read_text())
+
+
+def setup_from_doc(doc: dict, base: Path = CONFIG) -> GraspSetup:
+    """Bind a scenario document whose relative paths are relative to ``base``."""
+    return GraspSetup.from_scenario(parse_scenario(copy.deepcopy(doc), base))
+
+
+@pytest.fixture(scope="session")
+def planar_doc() -> dict:
+    return scenario_doc(PLANAR)
+
+
+@pytest.fixture(scope="session")
+def allegro_doc() -> dict:
+    return scenario_doc(ALLEGRO)
+
+
+@pytest.fixture(scope="session")
+def planar(planar_doc) -> GraspSetup:
+    return setup_from_doc(planar_doc)
+
+
+@pytest.fixture(scope="session")
+def allegro(allegro_doc) -> GraspSetup:
+    return setup_from_doc(allegro_doc)
+
+
+def with_contacts(doc: dict, contacts: list[dict]) -> dict:
+    """A copy of a scenario document with other contacts."""
+    out = copy.deepcopy(doc)
+    out["grasp"]["contacts"] = contacts
+    return out
+
+
+@pytest.fixture(scope="session")
+def hyperstatic(planar_doc) -> GraspSetup:
+    """The planar hand with two contacts on finger 1 (distal link and tip) and one on finger 2."""
+    contacts = copy.deepcopy(planar_doc["grasp"]["contacts"])
+    contacts.insert(1, {"link": "finger1_distal", "position": [0.0, 0.03, 0.0]})
+    return setup_from_doc(with_contacts(planar_doc, contacts))

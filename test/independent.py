@@ -1,0 +1,49 @@
+"""Checks written from the paper and DESIGN.md, without the package's own builders."""
+
+import numpy as np
+from scipy.optimize import linprog
+
+
+def polygon_rows(mu1: float, mu2: float, N: int, fmin: float) -> tuple[np.ndarray, np.ndarray]:
+    """One contact's 2N paper inequalities and -fz <= -fmin, on [fx, fy, fz, mz]."""
+    j = np.arange(1, N + 1)
+    ang, ang1 = 2 * np.pi * j / N, 2 * np.pi * (j % N + 1) / N
+    sN = np.sin(2 * np.pi / N)
+    rows = [[mu2 * (np.sin(b) - np.sin(a)), mu2 * (np.cos(a) - np.cos(b)), -mu1 * mu2 * sN,
+             sg * mu1 * sN] for sg in (1, -1) for a, b in zip(ang, ang1)]
+    rows.append([0, 0, -1, 0])
+    rhs = np.zeros(2 * N + 1)
+    rhs[-1] = -fmin
+    return np.array(rows, float), rhs
+
+
+def lp_feasible(setup, maps) -> bool:
+    """HiGHS on: G f + w_ext = 0, polygon cones, |J^T f| <= limits."""
+    fr = setup.friction
+    S_i, b_i = polygon_rows(fr.mu1, fr.mu2, fr.sides, fr.min_normal_force)
+    p = maps.p
+    S = np.kron(np.eye(p), S_i)
+    lim = setup.hand.torque_limits
+    res = linprog(np.zeros(4 * p), A_ub=np.vstack((S, maps.J.T, -maps.J.T)),
+                  b_ub=np.concatenate((np.tile(b_i, p), lim, lim)), A_eq=maps.G,
+                  b_eq=-setup.external_wrench, bounds=(None, None), method="highs")
+    assert res.status in (0, 2), res.message
+    return res.status == 0
+
+
+def assert_holds(setup, maps, tau, wrenches, tol=1e-6):
+    """Equilibrium, tau = J^T f, exact cone, normal bound and limits, from scratch."""
+    fr = setup.friction
+    force, moment = np.zeros(3), np.zeros(3)
+    tau_from_f = np.zeros(setup.hand.m)
+    for i, (frame, w) in enumerate(zip(maps.contacts, wrenches)):
+        F = frame.rotation @ w[:3]
+        force += F
+        moment += np.cross(frame.position - maps.object_origin, F) + w[3] * frame.normal
+        tau_from_f += maps.J[4 * i:4 * i + 4].T @ w
+        assert np.hypot(w[0], w[1]) / fr.mu1 + abs(w[3]) / fr.mu2 <= w[2] + tol
+        assert w[2] >= fr.min_normal_force - tol
+    np.testing.assert_allclose(force + setup.external_wrench[:3], 0, atol=tol)
+    np.testing.assert_allclose(moment + setup.external_wrench[3:], 0, atol=tol)
+    np.testing.assert_allclose(tau, tau_from_f, atol=tol)
+    assert np.all(np.abs(tau) <= setup.hand.torque_limits + tol)

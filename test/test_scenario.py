@@ -1,0 +1,100 @@
+"""Scenario validation: each kind of bad input names its field."""
+
+import copy
+import math
+from pathlib import Path
+
+import pytest
+from conftest import CONFIG, setup_from_doc
+
+from grasp_torque_opt.exceptions import InputError
+from grasp_torque_opt.scenario import load_scenario, parse_scenario
+
+
+def mutated(doc, path, value):
+    """A copy of ``doc`` with the item at ``path`` (keys and indices) set, or removed if None."""
+    out = copy.deepcopy(doc)
+    node = out
+    for key in path[:-1]:
+        node = node[key]
+    if value is None:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+    return out
+
+
+BAD = [
+    # (path, value, field named, problem)
+    (("hand", "urdf"), None, "hand.urdf", "missing required field"),
+    (("load",), None, "load", "missing required field"),
+    (("grasp", "object_origin"), None, "grasp.object_origin", "missing required field"),
+    (("friction", "mu_torsional"), None, "friction.mu_torsional", "missing required field"),
+    (("grasp", "contacts", 0, "link"), None, r"grasp.contacts\[0\].link", "missing"),
+    (("hand", "joints", 1), "joint9", r"hand.joints\[1\]", "unknown joint 'joint9'"),
+    (("hand", "joints", 1), "joint1", r"hand.joints\[1\]", "duplicate name 'joint1'"),
+    (("grasp", "joint_positions", "jointX"), 0.1, "grasp.joint_positions.jointX",
+     "unknown joint 'jointX'"),
+    (("grasp", "contacts", 1, "link"), "finger3_tip", r"grasp.contacts\[1\].link",
+     "unknown frame 'finger3_tip'"),
+    (("load", "external_wrench", 2), math.nan, r"load.external_wrench\[2\]", "must be finite"),
+    (("grasp", "object_origin", 0), math.inf, r"grasp.object_origin\[0\]", "must be finite"),
+    (("load", "external_wrench"), [0, 1, 2], "load.external_wrench", "must have 6 entries"),
+    (("hand", "torque_limits"), [1, 2, 3], "hand.torque_limits", "must have 4 entries"),
+    (("hand", "torque_limits"), -1.0, "hand.torque_limits", "must be > 0"),
+    (("grasp", "contacts", 0, "position"), [0, 0], r"grasp.contacts\[0\].position",
+     "must have 3 entries"),
+    (("friction", "polygon_sides"), 2, "friction.polygon_sides", "must be >= 3"),
+    (("friction", "polygon_sides"), 3.5, "friction.polygon_sides", "must be an integer"),
+    (("friction", "mu_tangential"), 0.0, "friction.mu_tangential", "must be > 0"),
+    (("friction", "mu_torsional"), -0.1, "friction.mu_torsional", "must be > 0"),
+    (("friction", "min_normal_force"), -1.0, "friction.min_normal_force", "must be >= 0"),
+    (("grasp", "contacts", 0, "normal"), [0, 0, 0], r"grasp.contacts\[0\].normal",
+     "must not be zero"),
+    (("grasp", "contacts", 1, "tangent"), [-1.99626, 0.122256, 0], r"grasp.contacts\[1\].tangent",
+     "is parallel to the normal"),
+    (("objective",), {"weights": [1, 1]}, "objective.weights", "must have 4 entries"),
+    (("friction", "mu"), 0.5, "friction.mu", "unknown field"),
+    (("grasp", "contacts"), [], "grasp.contacts", "must be a non-empty list"),
+]
+
+
+@pytest.mark.parametrize("path,value,field,problem", BAD,
+                         ids=[".".join(map(str, b[0])) + f"={b[1]!r}" for b in BAD])
+def test_bad_input_names_its_field(planar_doc, path, value, field, problem):
+    with pytest.raises(InputError, match=rf"^{field}: .*{problem}|^{field}: {problem}"):
+        setup_from_doc(mutated(planar_doc, path, value))
+
+
+def test_default_normal_at_the_origin_is_refused(planar_doc):
+    doc = mutated(planar_doc, ("grasp", "contacts", 0, "normal"), None)
+    doc["grasp"]["object_origin"] = [-0.0344682714, 0.1186824089, 0.0]  # finger1_tip itself
+    doc["grasp"]["contacts"][0]["position"] = [0.0, 0.0, 0.0]
+    with pytest.raises(InputError, match=r"grasp.contacts\[0\].normal: cannot default"):
+        setup_from_doc(doc)
+
+
+def test_urdf_not_found(planar_doc):
+    with pytest.raises(InputError, match="^hand.urdf: file not found: .*nowhere.urdf"):
+        setup_from_doc(mutated(planar_doc, ("hand", "urdf"), "nowhere.urdf"))
+
+
+def test_file_errors(tmp_path):
+    with pytest.raises(InputError, match="^scenario: cannot read"):
+        load_scenario(tmp_path / "missing.yaml")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("hand: [unclosed\n")
+    with pytest.raises(InputError, match="^scenario: .* is not valid YAML"):
+        load_scenario(bad)
+
+
+def test_bundled_scenarios_load():
+    for path in sorted(CONFIG.glob("*.yaml")):
+        s = load_scenario(path)
+        assert s.friction.sides >= 3 and s.contacts
+
+
+def test_defaults(planar_doc):
+    doc = mutated(planar_doc, ("friction", "min_normal_force"), None)
+    s = parse_scenario(doc, Path(CONFIG))
+    assert s.friction.min_normal_force == 0.0 and s.weights is None

@@ -1,0 +1,83 @@
+"""Every method, certified; infeasible verdicts confirmed by an independent LP."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from independent import assert_holds, lp_feasible
+
+from grasp_torque_opt.solve import METHODS, solve
+
+CASES = ["planar", "hyperstatic", "allegro"]
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("name", CASES)
+def test_every_result_holds_the_load(name, method, request):
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    sol = solve(setup, method, maps=maps)
+    assert sol.status == "optimal", sol.message
+    assert sol.certificate.ok and sol.tau.shape == (setup.hand.m,)
+    assert_holds(setup, maps, sol.tau, sol.wrenches)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_exact_methods_agree(name, request):
+    """SOCP (interior point) and SLSQP reach the same exact-cone optimum."""
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    socp, nlp = solve(setup, "socp", maps=maps), solve(setup, "nlp", maps=maps)
+    assert socp.torque_norm == pytest.approx(nlp.torque_norm, rel=1e-4)
+
+
+def test_heavy_load_is_infeasible_and_the_lp_agrees(planar):
+    heavy = dataclasses.replace(planar, external_wrench=planar.external_wrench * 200.0)
+    maps = heavy.maps()
+    for method in ("tau-qp", "force-qp", "socp"):
+        sol = solve(heavy, method, maps=maps)
+        assert sol.status == "infeasible", (method, sol.message)
+        assert sol.tau is None and sol.wrenches is None
+    assert not lp_feasible(heavy, maps)
+    assert lp_feasible(planar, planar.maps())
+
+
+def test_torque_limits_alone_make_it_infeasible(allegro):
+    weak = dataclasses.replace(allegro, hand=dataclasses.replace(
+        allegro.hand, torque_limits=np.full(allegro.hand.m, 1e-3)))
+    maps = weak.maps()
+    assert not lp_feasible(weak, maps)
+    assert solve(weak, maps=maps).status == "infeasible"
+
+
+def test_min_normal_force_is_respected(planar):
+    free = solve(planar)
+    fmin = 1.5 * float(np.max(free.wrenches[:, 2]))
+    squeeze = dataclasses.replace(planar, friction=dataclasses.replace(
+        planar.friction, min_normal_force=fmin))
+    sol = solve(squeeze)
+    assert sol.status == "optimal"
+    assert np.all(sol.wrenches[:, 2] >= fmin - 1e-6)
+    assert sol.torque_norm > free.torque_norm
+
+
+def test_a_result_that_fails_its_certificate_is_not_returned(planar):
+    """An impossible tolerance: the solver succeeds, the certificate does not, no torque."""
+    sol = solve(planar, tolerance=-1.0)
+    assert sol.status == "failed"
+    assert sol.tau is None and sol.wrenches is None
+    assert "certificate failed" in sol.message and "LP finds the load holdable" in sol.message
+
+
+def test_unknown_method_is_refused(planar):
+    with pytest.raises(ValueError, match="method must be one of tau-qp, force-qp, socp, nlp"):
+        solve(planar, "lp")
+
+
+@pytest.mark.parametrize("N", [3, 4, 8, 16, 32])
+def test_finer_polygons_approach_the_exact_optimum(planar, N):
+    setup = dataclasses.replace(planar, friction=dataclasses.replace(planar.friction, sides=N))
+    ours, exact = solve(setup), solve(setup, "socp")
+    assert exact.torque_norm <= ours.torque_norm + 1e-9
+    # The inscribed N-gon shrinks the cone by at most cos(pi/N).
+    assert ours.torque_norm <= exact.torque_norm / np.cos(np.pi / N) ** 2 + 1e-6

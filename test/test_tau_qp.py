@@ -1,0 +1,123 @@
+"""The tau-space QP: its pieces, and its optimum against independent formulations and solvers."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from independent import assert_holds
+
+from grasp_torque_opt.exact_socp import solve_exact_socp
+from grasp_torque_opt.force_qp import solve_force_qp
+from grasp_torque_opt.solve import solve
+from grasp_torque_opt.tau_qp import TauQPSolver, build_tau_qp
+
+CASES = ["planar", "hyperstatic", "allegro"]
+
+
+def built(setup):
+    maps = setup.maps()
+    return maps, build_tau_qp(maps, setup.friction, setup.external_wrench,
+                              setup.hand.torque_limits, setup.weights)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_parametrization_balances_the_load(name, request):
+    setup = request.getfixturevalue(name)
+    maps, qp = built(setup)
+    A = np.vstack((maps.G, maps.J.T))
+    np.testing.assert_allclose(A @ qp.N, 0, atol=1e-12)
+    # Any tau that meets the compatibility rows gives f with G f = w, J^T f = tau.
+    rng = np.random.default_rng(2)
+    tau = rng.normal(size=qp.m)
+    if qp.A.shape[0]:
+        Aeq = qp.A[:, :qp.m]
+        tau -= np.linalg.lstsq(Aeq, Aeq @ tau - qp.b, rcond=None)[0]
+    x = np.concatenate((tau, rng.normal(size=qp.N.shape[1])))
+    np.testing.assert_allclose(A @ qp.wrenches(x), np.concatenate((qp.w, tau)), atol=1e-9)
+
+
+def test_planar_grasp_is_rank_deficient_and_solves(planar):
+    maps, qp = built(planar)
+    assert np.linalg.matrix_rank(np.vstack((maps.G, maps.J.T))) < 4 * maps.p
+    assert qp.N.shape[1] >= 1, "internal forces the joints cannot feel need z"
+    assert qp.A.shape[0] >= 1, "the compatibility equalities are needed"
+    sol = solve(planar)
+    assert sol.status == "optimal"
+    assert_holds(planar, maps, sol.tau, sol.wrenches)
+
+
+def test_hyperstatic_grasp_solves(hyperstatic):
+    maps = hyperstatic.maps()
+    assert maps.p == 3 and [c.link for c in maps.contacts][:2] == ["finger1_tip",
+                                                                   "finger1_distal"]
+    sol = solve(hyperstatic)
+    assert sol.status == "optimal"
+    assert_holds(hyperstatic, maps, sol.tau, sol.wrenches)
+
+
+def torque_objective(setup, tau):
+    return float(tau @ (setup.weights * tau))
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_optimum_equals_force_space_qp_with_torque_objective(name, request):
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    ours = solve(setup, maps=maps)
+    raw = solve_force_qp(maps, setup.friction, setup.external_wrench,
+                         setup.hand.torque_limits, setup.weights, objective="torque")
+    assert raw.status == "solved"
+    tau_f = maps.J.T @ raw.x
+    assert ours.status == "optimal"
+    assert torque_objective(setup, ours.tau) == pytest.approx(
+        torque_objective(setup, tau_f), rel=1e-6, abs=1e-9)
+    np.testing.assert_allclose(ours.tau, tau_f, atol=1e-5)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_never_below_the_exact_cone_optimum(name, request):
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    ours = solve(setup, maps=maps)
+    raw = solve_exact_socp(maps, setup.friction, setup.external_wrench,
+                           setup.hand.torque_limits, setup.weights)
+    exact = maps.J.T @ raw.x[:4 * maps.p]
+    assert torque_objective(setup, ours.tau) >= torque_objective(setup, exact) - 1e-8
+
+
+def test_random_allegro_grasps_agree_with_independent_solvers(allegro):
+    """Seeded loads on the Allegro grasp: same optimum as the force-space QP, above the SOCP."""
+    rng = np.random.default_rng(42)
+    solver = TauQPSolver()
+    maps = allegro.maps()
+    base = allegro.external_wrench
+    checked = 0
+    for _ in range(25):
+        w = base * rng.uniform(0.3, 1.5) + np.concatenate(
+            (rng.normal(scale=0.3, size=3), rng.normal(scale=0.01, size=3)))
+        setup = dataclasses.replace(allegro, external_wrench=w)
+        ours = solve(setup, maps=maps, solver=solver)
+        raw = solve_force_qp(maps, setup.friction, w, setup.hand.torque_limits,
+                             setup.weights, objective="torque")
+        if ours.status != "optimal":
+            assert ours.status == "infeasible" and raw.status == "infeasible"
+            continue
+        checked += 1
+        assert_holds(setup, maps, ours.tau, ours.wrenches)
+        tau_f = maps.J.T @ raw.x
+        assert torque_objective(setup, ours.tau) == pytest.approx(
+            torque_objective(setup, tau_f), rel=1e-6, abs=1e-9)
+        exact = solve_exact_socp(maps, setup.friction, w, setup.hand.torque_limits,
+                                 setup.weights)
+        tau_x = maps.J.T @ exact.x[:4 * maps.p]
+        assert torque_objective(setup, ours.tau) >= torque_objective(setup, tau_x) - 1e-8
+    assert checked >= 15
+
+
+def test_weights_shift_effort(planar):
+    """A heavier weight on a joint lowers its share of the effort, still certified."""
+    heavy = dataclasses.replace(planar, weights=np.array([10.0, 1.0, 1.0, 1.0]))
+    a, b = solve(planar), solve(heavy)
+    assert b.status == "optimal"
+    assert abs(b.tau[0]) <= abs(a.tau[0]) + 1e-9
+    assert_holds(heavy, heavy.maps(), b.tau, b.wrenches)
