@@ -10,6 +10,8 @@ fz >= f_min.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 import scipy.linalg
 
@@ -51,15 +53,20 @@ def contact_block(mu1: float, mu2: float, sides: int,
     return S_i, b_i
 
 
+@lru_cache(maxsize=64)
 def friction_matrix(p: int, mu1: float, mu2: float, sides: int,
                     min_normal_force: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The paper's S for p contacts (block diagonal) and its right-hand side.
+
+    Cached: the same friction gives the same (read-only) arrays every cycle.
 
     Returns:
         S, shape ((2N + 1) p, 4p), and b, shape ((2N + 1) p,): S f <= b.
     """
     S_i, b_i = contact_block(mu1, mu2, sides, min_normal_force)
-    return scipy.linalg.block_diag(*([S_i] * p)), np.tile(b_i, p)
+    S, b = scipy.linalg.block_diag(*([S_i] * p)), np.tile(b_i, p)
+    S.flags.writeable = b.flags.writeable = False
+    return S, b
 
 
 def cone_margin(wrenches: np.ndarray, mu1: float, mu2: float) -> np.ndarray:

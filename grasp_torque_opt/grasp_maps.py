@@ -128,7 +128,7 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
         InputError: a normal cannot be defaulted, or a tangent is parallel.
     """
     model = hand.model
-    data = model.createData()
+    data = hand.data
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     c = np.asarray(object_origin, dtype=float)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 
@@ -70,6 +70,7 @@ class Hand:
     Attributes:
         model: Pinocchio model; its world frame is the base frame.
         joints: actuated joint names in command order (m of them).
+        data: Pinocchio workspace of ``model``.
         idx_q: index of each actuated joint in q, shape (m,).
         idx_v: index of each actuated joint in v (columns of the Jacobians), shape (m,).
         torque_limits: |tau_i| <= torque_limits[i] [N m], shape (m,).
@@ -80,6 +81,11 @@ class Hand:
     idx_q: np.ndarray
     idx_v: np.ndarray
     torque_limits: np.ndarray
+    data: pin.Data = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # Kinematics workspace, allocated once; a Hand is not shared across threads.
+        object.__setattr__(self, "data", self.model.createData())
 
     @property
     def m(self) -> int:

@@ -129,12 +129,17 @@ class ProxSuiteSettings:
         eps_rel: relative stopping tolerance.
         max_iter: cap on outer iterations (one cycle can never stall).
         max_iter_in: cap on inner iterations.
+        eps_primal_inf: primal infeasibility threshold. ProxSuite's default (1e-4)
+            declared the feasible Allegro grasp of config/allegro_right.yaml
+            PRIMAL_INFEASIBLE after 24 iterations (M2 = pinv(A) has entries of
+            1/sigma_min ~ 150 there); 1e-8 solves it in 27.
     """
 
     eps_abs: float = 1e-9
     eps_rel: float = 0.0
     max_iter: int = 1000
     max_iter_in: int = 200
+    eps_primal_inf: float = 1e-8
 
 
 @dataclass(frozen=True)
@@ -189,6 +194,7 @@ class TauQPSolver:
                 s.eps_rel = self.settings.eps_rel
                 s.max_iter = self.settings.max_iter
                 s.max_iter_in = self.settings.max_iter_in
+                s.eps_primal_inf = self.settings.eps_primal_inf
                 s.initial_guess = proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS
                 self._qp.init(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=l, u=qp.u,
                               l_box=qp.l_box, u_box=qp.u_box)
