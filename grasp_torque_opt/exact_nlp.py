@@ -5,7 +5,7 @@ form of the exact cone:
 
     minimize    f^T J W J^T f
     subject to  G f + w_ext = 0
-                mu1^2 s_i^2 - fx_i^2 - fy_i^2 >= 0,  s_i >= 0
+                mu1 s_i - ||(fx_i, fy_i)|| >= 0,      s_i >= 0
                 mu2 (fz_i - s_i) -+ mz_i >= 0,        fz_i >= f_min
                 tau_max -+ J^T f >= 0
 
@@ -23,6 +23,9 @@ from scipy.optimize import minimize
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.scenario import Friction
 from grasp_torque_opt.tau_qp import RawResult
+
+#: Smoothing of ||(fx, fy)|| at 0 [N]; the smoothed cone is inside the exact one.
+EPS = 1e-9
 
 
 def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
@@ -44,7 +47,7 @@ def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.nda
     def ineq(x):
         fx, fy, fz, mz, s = x[ix], x[iy], x[iz], x[im], x[i_s]
         tau = J.T @ x[:4 * p]
-        return np.concatenate((mu1 ** 2 * s ** 2 - fx ** 2 - fy ** 2, s,
+        return np.concatenate((mu1 * s - np.sqrt(fx ** 2 + fy ** 2 + EPS ** 2) + EPS, s,
                                mu2 * (fz - s) - mz, mu2 * (fz - s) + mz,
                                fz - friction.min_normal_force,
                                torque_limits - tau, torque_limits + tau))
@@ -52,7 +55,8 @@ def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.nda
     def ineq_jac(x):
         rows = np.zeros((5 * p, n))
         r = np.arange(p)
-        rows[r, ix], rows[r, iy], rows[r, i_s] = -2 * x[ix], -2 * x[iy], 2 * mu1 ** 2 * x[i_s]
+        norm = np.sqrt(x[ix] ** 2 + x[iy] ** 2 + EPS ** 2)
+        rows[r, ix], rows[r, iy], rows[r, i_s] = -x[ix] / norm, -x[iy] / norm, mu1
         rows[p + r, i_s] = 1.0
         rows[2 * p + r, iz], rows[2 * p + r, i_s], rows[2 * p + r, im] = mu2, -mu2, -1.0
         rows[3 * p + r, iz], rows[3 * p + r, i_s], rows[3 * p + r, im] = mu2, -mu2, 1.0
@@ -69,7 +73,7 @@ def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.nda
                    constraints=[{"type": "eq", "fun": lambda x: Gx @ x + external_wrench,
                                  "jac": lambda x: Gx},
                                 {"type": "ineq", "fun": ineq, "jac": ineq_jac}],
-                   options={"ftol": 1e-14, "maxiter": max_iter})
+                   options={"ftol": 1e-10, "maxiter": max_iter})
     elapsed = time.perf_counter() - t0
     return RawResult("solved" if res.success else "error", np.array(res.x), int(res.nit),
                      elapsed, str(res.message))

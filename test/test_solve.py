@@ -74,10 +74,24 @@ def test_unknown_method_is_refused(planar):
         solve(planar, "lp")
 
 
-@pytest.mark.parametrize("N", [3, 4, 8, 16, 32])
-def test_finer_polygons_approach_the_exact_optimum(planar, N):
-    setup = dataclasses.replace(planar, friction=dataclasses.replace(planar.friction, sides=N))
-    ours, exact = solve(setup), solve(setup, "socp")
-    assert exact.torque_norm <= ours.torque_norm + 1e-9
-    # The inscribed N-gon shrinks the cone by at most cos(pi/N).
-    assert ours.torque_norm <= exact.torque_norm / np.cos(np.pi / N) ** 2 + 1e-6
+@pytest.mark.parametrize("name", ["planar", "allegro"])
+@pytest.mark.parametrize("N", [3, 4, 6, 8, 16, 32])
+def test_polygon_optimum_is_sandwiched_by_exact_cones(name, N, request):
+    """The inscribed N-gon contains the exact cone with mu1 cos(pi/N) and is inside the one
+    with mu1: its optimum lies between the two exact (SOCP) optima."""
+    setup = request.getfixturevalue(name)
+    fr = dataclasses.replace(setup.friction, sides=N)
+    shrunk = dataclasses.replace(fr, mu1=fr.mu1 * np.cos(np.pi / N))
+    maps = setup.maps()
+    ours = solve(dataclasses.replace(setup, friction=fr), maps=maps)
+    lower = solve(dataclasses.replace(setup, friction=fr), "socp", maps=maps)
+    upper = solve(dataclasses.replace(setup, friction=shrunk), "socp", maps=maps)
+    assert ours.optimal and lower.optimal and upper.optimal
+    assert lower.torque_norm - 1e-7 <= ours.torque_norm <= upper.torque_norm + 1e-7
+
+
+def test_nested_polygons_never_increase_the_optimum(planar):
+    """Vertices at 2 pi j / N: the 2N-gon contains the N-gon."""
+    norms = [solve(dataclasses.replace(planar, friction=dataclasses.replace(
+        planar.friction, sides=N))).torque_norm for N in (4, 8, 16, 32)]
+    assert all(b <= a + 1e-9 for a, b in zip(norms, norms[1:]))
