@@ -26,7 +26,7 @@ class Certificate:
         torque: ||J^T f - tau||_inf [N m].
         cone: largest exact-cone violation, max(0, -margin) [N].
         normal_force: largest shortfall below the minimum normal force [N].
-        torque_limit: largest excess of |tau_i| over its limit [N m].
+        torque_limit: largest excess of tau_i beyond its bounds [N m].
         finite: every entry of tau and f is finite.
         tolerance: bound that every residual must meet.
     """
@@ -56,7 +56,7 @@ class Certificate:
 
 
 def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction: Friction,
-            torque_limits: np.ndarray, tau: np.ndarray, f: np.ndarray,
+            tau_min: np.ndarray, tau_max: np.ndarray, tau: np.ndarray, f: np.ndarray,
             tolerance: float = DEFAULT_TOLERANCE) -> Certificate:
     """Check a candidate (tau, f) against the exact problem.
 
@@ -65,7 +65,8 @@ def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction:
         J: hand Jacobian, shape (4p, m).
         external_wrench: w_ext, shape (6,) [N, N m].
         friction: friction model (exact cone, minimum normal force).
-        torque_limits: shape (m,) [N m].
+        tau_min: lower torque bound, shape (m,) [N m].
+        tau_max: upper torque bound, shape (m,) [N m].
         tau: joint torques, shape (m,) [N m].
         f: stacked contact wrenches, shape (4p,), contact frames.
         tolerance: bound on every residual, in SI units.
@@ -82,7 +83,7 @@ def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction:
         torque=float(np.max(np.abs(J.T @ f - tau))),
         cone=float(max(0.0, -np.min(cone_margin(wrenches, friction.mu1, friction.mu2)))),
         normal_force=float(max(0.0, np.max(friction.min_normal_force - wrenches[:, 2]))),
-        torque_limit=float(max(0.0, np.max(np.abs(tau) - torque_limits))),
+        torque_limit=float(max(0.0, np.max(tau_min - tau), np.max(tau - tau_max))),
         finite=True,
         tolerance=tolerance,
     )

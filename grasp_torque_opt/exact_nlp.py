@@ -7,7 +7,7 @@ form of the exact cone:
     subject to  G f + w_ext = 0
                 mu1 s_i - ||(fx_i, fy_i)|| >= 0,      s_i >= 0
                 mu2 (fz_i - s_i) -+ mz_i >= 0,        fz_i >= f_min
-                tau_max -+ J^T f >= 0
+                tau_max - J^T f >= 0,  J^T f - tau_min >= 0
 
 It starts from the least-norm balancing wrench with every normal force raised
 to f_min + 1 N, not from another method's answer.
@@ -29,7 +29,7 @@ EPS = 1e-9
 
 
 def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
-                    torque_limits: np.ndarray, weights: np.ndarray,
+                    tau_min: np.ndarray, tau_max: np.ndarray, weights: np.ndarray,
                     max_iter: int = 500) -> RawResult:
     """Solve the exact-cone problem with SLSQP; ``x`` of the result is [f (4p); s (p)]."""
     G, J = maps.G, maps.J
@@ -50,7 +50,7 @@ def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.nda
         return np.concatenate((mu1 * s - np.sqrt(fx ** 2 + fy ** 2 + EPS ** 2) + EPS, s,
                                mu2 * (fz - s) - mz, mu2 * (fz - s) + mz,
                                fz - friction.min_normal_force,
-                               torque_limits - tau, torque_limits + tau))
+                               tau_max - tau, tau - tau_min))
 
     def ineq_jac(x):
         rows = np.zeros((5 * p, n))

@@ -7,7 +7,7 @@ sqrt(fx^2 + fy^2)/mu1 + |mz|/mu2 <= fz holds iff some s_i satisfies
     subject to  G f + w_ext = 0
                 (mu1 s_i, fx_i, fy_i) in the second-order cone
                 |mz_i| <= mu2 (fz_i - s_i),  fz_i >= f_min
-                -tau_max <= J^T f <= tau_max
+                tau_min <= J^T f <= tau_max
 
 Its optimum is a lower bound for every polygon method (the inscribed polygon
 is an inner approximation of the cone).
@@ -25,7 +25,8 @@ from grasp_torque_opt.tau_qp import RawResult
 
 
 def solve_exact_socp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
-                     torque_limits: np.ndarray, weights: np.ndarray) -> RawResult:
+                     tau_min: np.ndarray, tau_max: np.ndarray,
+                     weights: np.ndarray) -> RawResult:
     """Solve the exact-cone SOCP; ``x`` of the result is [f (4p); s (p)]."""
     G, J = maps.G, maps.J
     p, m = maps.p, J.shape[1]
@@ -51,7 +52,7 @@ def solve_exact_socp(maps: GraspMaps, friction: Friction, external_wrench: np.nd
         soc_rows.append(block)
     JT = np.hstack((J.T, np.zeros((m, p))))
     A = np.vstack([np.hstack((G, np.zeros((6, p)))), *lin_rows, JT, -JT, *soc_rows])
-    b = np.concatenate((-external_wrench, lin_rhs, torque_limits, torque_limits,
+    b = np.concatenate((-external_wrench, lin_rhs, tau_max, -tau_min,
                         np.zeros(3 * p)))
     cones = ([clarabel.ZeroConeT(6), clarabel.NonnegativeConeT(3 * p + 2 * m)]
              + [clarabel.SecondOrderConeT(3) for _ in range(p)])

@@ -2,7 +2,7 @@
 
 A solver's "infeasible" is never trusted alone: before a polygon method
 reports ``infeasible``, this LP must agree that no f satisfies
-G f + w_ext = 0, S f <= b and |J^T f| <= tau_max.
+G f + w_ext = 0, S f <= b and tau_min <= J^T f <= tau_max.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from grasp_torque_opt.scenario import Friction
 
 
 def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
-                        torque_limits: np.ndarray) -> bool | None:
+                        tau_min: np.ndarray, tau_max: np.ndarray) -> bool | None:
     """Whether some contact wrench holds the load within the polygon and the limits.
 
     Returns:
@@ -26,6 +26,6 @@ def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np
     S, b_S = friction_matrix(maps.p, friction.mu1, friction.mu2, friction.sides,
                              friction.min_normal_force)
     res = linprog(np.zeros(G.shape[1]), A_ub=np.vstack((S, J.T, -J.T)),
-                  b_ub=np.concatenate((b_S, torque_limits, torque_limits)),
+                  b_ub=np.concatenate((b_S, tau_max, -tau_min)),
                   A_eq=G, b_eq=-external_wrench, bounds=(None, None), method="highs")
     return {0: True, 2: False}.get(res.status)

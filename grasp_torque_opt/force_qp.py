@@ -2,7 +2,7 @@
 
     minimize    f^T f            (objective "force": the classic method)
            or   f^T J W J^T f    (objective "torque": same optimum as the tau-QP)
-    subject to  G f + w_ext = 0,  S f <= b,  -tau_max <= J^T f <= tau_max
+    subject to  G f + w_ext = 0,  S f <= b,  tau_min <= J^T f <= tau_max
 
 The polygon, the normal bound and the torque limits are the tau-QP's, so the
 two methods search the same set; only the objective (and the solver,
@@ -24,7 +24,7 @@ OBJECTIVES = ("force", "torque")
 
 
 def solve_force_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
-                   torque_limits: np.ndarray, weights: np.ndarray,
+                   tau_min: np.ndarray, tau_max: np.ndarray, weights: np.ndarray,
                    objective: str = "force") -> RawResult:
     """Solve the force-space QP; ``x`` of the result is f, shape (4p,)."""
     if objective not in OBJECTIVES:
@@ -35,6 +35,6 @@ def solve_force_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndar
                              friction.min_normal_force)
     P = 2.0 * (np.eye(n) if objective == "force" else J @ np.diag(weights) @ J.T)
     A = np.vstack((G, S, J.T, -J.T))
-    b = np.concatenate((-external_wrench, b_S, torque_limits, torque_limits))
+    b = np.concatenate((-external_wrench, b_S, tau_max, -tau_min))
     cones = [clarabel.ZeroConeT(6), clarabel.NonnegativeConeT(len(b) - 6)]
     return solve_conic(P, np.zeros(n), A, b, cones)

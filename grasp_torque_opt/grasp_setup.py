@@ -25,6 +25,9 @@ class GraspSetup:
         friction: friction model and linearization.
         external_wrench: w_ext, load on the object about c, base axes [N, N m].
         weights: W's diagonal, shape (m,), > 0.
+        torque_offset: torque added to the solution before it is commanded, e.g.
+            the fingers' own gravity torques g(q), shape (m,) [N m], or None.
+            The torque limits then bound the sum: -limit <= tau + offset <= limit.
     """
 
     hand: Hand
@@ -34,6 +37,14 @@ class GraspSetup:
     friction: Friction
     external_wrench: np.ndarray
     weights: np.ndarray
+    torque_offset: np.ndarray | None = None
+
+    @property
+    def tau_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(tau_min, tau_max) on the optimized torque [N m], after the offset."""
+        lim = self.hand.torque_limits
+        off = 0.0 if self.torque_offset is None else self.torque_offset
+        return -lim - off, lim - off
 
     @classmethod
     def from_scenario(cls, scenario: Scenario) -> GraspSetup:

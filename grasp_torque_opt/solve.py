@@ -50,8 +50,8 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         maps = setup.maps()
     t1 = time.perf_counter()
     timings["maps"] = t1 - t0
-    args = (maps, setup.friction, setup.external_wrench, setup.hand.torque_limits,
-            setup.weights)
+    tau_min, tau_max = setup.tau_bounds
+    args = (maps, setup.friction, setup.external_wrench, tau_min, tau_max, setup.weights)
     J = maps.J
     if method == "tau-qp":
         qp = build_tau_qp(*args)
@@ -75,7 +75,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     cert = None
     if f is not None:
         cert = certify(maps.G, J, setup.external_wrench, setup.friction,
-                       setup.hand.torque_limits, tau, f, tolerance)
+                       tau_min, tau_max, tau, f, tolerance)
     timings["certify"] = time.perf_counter() - t3
 
     out = Solution(status=FAILED, method=method, joints=list(setup.hand.joints),
@@ -89,7 +89,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
            else f"solver: {raw.message}, certificate failed (worst residual {cert.worst:.3g})")
     if method in LINEARIZED:
         feasible = linearized_feasible(maps, setup.friction, setup.external_wrench,
-                                       setup.hand.torque_limits)
+                                       tau_min, tau_max)
         if feasible is False:
             out.status, out.message = INFEASIBLE, f"infeasible, confirmed by LP ({why})"
         elif feasible:

@@ -12,7 +12,7 @@ x = [tau; z]:
     minimize    tau^T W tau + eps_z ||z||^2
     subject to  S (M1 w + M2 tau + N z) <= b       linearized cones, f_z >= f_min
                 U_perp^T [w; tau] = 0              compatibility
-                -tau_max <= tau <= tau_max         box constraints
+                tau_min <= tau <= tau_max          box constraints
 """
 
 from __future__ import annotations
@@ -32,6 +32,8 @@ from grasp_torque_opt.scenario import Friction
 RANK_RTOL = 1e-10
 #: Weight of the null-space regularization relative to the smallest joint weight.
 Z_REGULARIZATION = 1e-10
+#: Distance kept inside the torque bounds [N m] (ProxSuite meets them to eps_abs).
+BOX_MARGIN = 1e-8
 
 
 @dataclass(frozen=True)
@@ -82,14 +84,17 @@ class TauQP:
 
 
 def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
-                 torque_limits: np.ndarray, weights: np.ndarray) -> TauQP:
+                 tau_min: np.ndarray, tau_max: np.ndarray, weights: np.ndarray) -> TauQP:
     """Build the tau-space QP of one grasp.
 
     Args:
         maps: G and J of the grasp.
         friction: friction model and polygon.
         external_wrench: w_ext, load on the object about c, base axes [N, N m].
-        torque_limits: |tau_i| bound, shape (m,) [N m].
+        tau_min: lower torque bound, shape (m,) [N m].
+        tau_max: upper torque bound, shape (m,) [N m]. The box keeps
+            :data:`BOX_MARGIN` inside both, so that the solver's own tolerance
+            never carries a torque across a limit.
         weights: W's diagonal, shape (m,).
     """
     G, J = maps.G, maps.J
@@ -115,8 +120,8 @@ def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarra
     H[m:, m:] = 2.0 * Z_REGULARIZATION * float(np.min(weights)) * np.eye(k)
     inf = np.full(k, np.inf)
     return TauQP(H=H, g=np.zeros(m + k), A=A, b=b, C=C, u=u,
-                 l_box=np.concatenate((-torque_limits, -inf)),
-                 u_box=np.concatenate((torque_limits, inf)),
+                 l_box=np.concatenate((tau_min + BOX_MARGIN, -inf)),
+                 u_box=np.concatenate((tau_max - BOX_MARGIN, inf)),
                  M1=M1, M2=M2, N=N, w=w)
 
 

@@ -18,21 +18,22 @@ def polygon_rows(mu1: float, mu2: float, N: int, fmin: float) -> tuple[np.ndarra
 
 
 def lp_feasible(setup, maps) -> bool:
-    """HiGHS on: G f + w_ext = 0, polygon cones, |J^T f| <= limits."""
+    """HiGHS on: G f + w_ext = 0, polygon cones, |J^T f + offset| <= limits."""
     fr = setup.friction
     S_i, b_i = polygon_rows(fr.mu1, fr.mu2, fr.sides, fr.min_normal_force)
     p = maps.p
     S = np.kron(np.eye(p), S_i)
     lim = setup.hand.torque_limits
+    off = np.zeros(setup.hand.m) if setup.torque_offset is None else setup.torque_offset
     res = linprog(np.zeros(4 * p), A_ub=np.vstack((S, maps.J.T, -maps.J.T)),
-                  b_ub=np.concatenate((np.tile(b_i, p), lim, lim)), A_eq=maps.G,
+                  b_ub=np.concatenate((np.tile(b_i, p), lim - off, lim + off)), A_eq=maps.G,
                   b_eq=-setup.external_wrench, bounds=(None, None), method="highs")
     assert res.status in (0, 2), res.message
     return res.status == 0
 
 
 def assert_holds(setup, maps, tau, wrenches, tol=1e-6):
-    """Equilibrium, tau = J^T f, exact cone, normal bound and limits, from scratch."""
+    """Equilibrium, tau = J^T f, exact cone, normal bound and limits (on tau + offset)."""
     fr = setup.friction
     force, moment = np.zeros(3), np.zeros(3)
     tau_from_f = np.zeros(setup.hand.m)
@@ -46,4 +47,5 @@ def assert_holds(setup, maps, tau, wrenches, tol=1e-6):
     np.testing.assert_allclose(force + setup.external_wrench[:3], 0, atol=tol)
     np.testing.assert_allclose(moment + setup.external_wrench[3:], 0, atol=tol)
     np.testing.assert_allclose(tau, tau_from_f, atol=tol)
-    assert np.all(np.abs(tau) <= setup.hand.torque_limits + tol)
+    off = 0.0 if setup.torque_offset is None else setup.torque_offset
+    assert np.all(np.abs(tau + off) <= setup.hand.torque_limits + tol)

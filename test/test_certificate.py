@@ -18,7 +18,8 @@ def good(planar):
 def check(good, tau=None, f=None):
     setup, maps, tau0, f0 = good
     return certify(maps.G, maps.J, setup.external_wrench, setup.friction,
-                   setup.hand.torque_limits, tau0 if tau is None else tau,
+                   -setup.hand.torque_limits, setup.hand.torque_limits,
+                   tau0 if tau is None else tau,
                    f0 if f is None else f)
 
 
@@ -48,7 +49,7 @@ def test_outside_the_exact_cone_fails(good):
 def test_over_the_limit_fails(good):
     setup, maps, tau, f = good
     c = certify(maps.G, maps.J, setup.external_wrench, setup.friction,
-                np.abs(tau) * 0.5, tau, f)
+                -np.abs(tau) * 0.5, np.abs(tau) * 0.5, tau, f)
     assert not c.ok and c.torque_limit > 0
 
 

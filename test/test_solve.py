@@ -95,3 +95,20 @@ def test_nested_polygons_never_increase_the_optimum(planar):
     norms = [solve(dataclasses.replace(planar, friction=dataclasses.replace(
         planar.friction, sides=N))).torque_norm for N in (4, 8, 16, 32)]
     assert all(b <= a + 1e-9 for a, b in zip(norms, norms[1:]))
+
+
+def test_torque_offset_shifts_the_limits(planar):
+    """With an offset (gravity compensation), the limits bound tau + offset."""
+    free = solve(planar)
+    lim = planar.hand.torque_limits
+    # Push joint 1 against its limit: only lim - |tau_1| - 1e-3 of headroom remains.
+    off = np.zeros(4)
+    off[0] = -np.sign(free.tau[0]) * (lim[0] - abs(free.tau[0]) - 1e-3)
+    shifted = dataclasses.replace(planar, torque_offset=off)
+    sol = solve(shifted)
+    assert sol.status == "optimal"
+    assert_holds(shifted, shifted.maps(), sol.tau, sol.wrenches)
+    off[0] = 1.5 * lim[0]  # the offset alone is over the limit
+    over = dataclasses.replace(planar, torque_offset=off)
+    assert solve(over).status == "infeasible"
+    assert not lp_feasible(over, over.maps())

@@ -17,7 +17,7 @@ CASES = ["planar", "hyperstatic", "allegro"]
 def built(setup):
     maps = setup.maps()
     return maps, build_tau_qp(maps, setup.friction, setup.external_wrench,
-                              setup.hand.torque_limits, setup.weights)
+                              *setup.tau_bounds, setup.weights)
 
 
 @pytest.mark.parametrize("name", CASES)
@@ -65,7 +65,7 @@ def test_optimum_equals_force_space_qp_with_torque_objective(name, request):
     maps = setup.maps()
     ours = solve(setup, maps=maps)
     raw = solve_force_qp(maps, setup.friction, setup.external_wrench,
-                         setup.hand.torque_limits, setup.weights, objective="torque")
+                         *setup.tau_bounds, setup.weights, objective="torque")
     assert raw.status == "solved"
     tau_f = maps.J.T @ raw.x
     assert ours.status == "optimal"
@@ -80,7 +80,7 @@ def test_never_below_the_exact_cone_optimum(name, request):
     maps = setup.maps()
     ours = solve(setup, maps=maps)
     raw = solve_exact_socp(maps, setup.friction, setup.external_wrench,
-                           setup.hand.torque_limits, setup.weights)
+                           *setup.tau_bounds, setup.weights)
     exact = maps.J.T @ raw.x[:4 * maps.p]
     assert torque_objective(setup, ours.tau) >= torque_objective(setup, exact) - 1e-8
 
@@ -97,8 +97,8 @@ def test_random_allegro_grasps_agree_with_independent_solvers(allegro):
             (rng.normal(scale=0.3, size=3), rng.normal(scale=0.01, size=3)))
         setup = dataclasses.replace(allegro, external_wrench=w)
         ours = solve(setup, maps=maps, solver=solver)
-        raw = solve_force_qp(maps, setup.friction, w, setup.hand.torque_limits,
-                             setup.weights, objective="torque")
+        raw = solve_force_qp(maps, setup.friction, w, *setup.tau_bounds, setup.weights,
+                             objective="torque")
         if ours.status != "optimal":
             assert ours.status == "infeasible" and raw.status == "infeasible"
             continue
@@ -107,8 +107,7 @@ def test_random_allegro_grasps_agree_with_independent_solvers(allegro):
         tau_f = maps.J.T @ raw.x
         assert torque_objective(setup, ours.tau) == pytest.approx(
             torque_objective(setup, tau_f), rel=1e-6, abs=1e-9)
-        exact = solve_exact_socp(maps, setup.friction, w, setup.hand.torque_limits,
-                                 setup.weights)
+        exact = solve_exact_socp(maps, setup.friction, w, *setup.tau_bounds, setup.weights)
         tau_x = maps.J.T @ exact.x[:4 * maps.p]
         assert torque_objective(setup, ours.tau) >= torque_objective(setup, tau_x) - 1e-8
     assert checked >= 15
