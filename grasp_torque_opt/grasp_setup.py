@@ -47,14 +47,22 @@ class GraspSetup:
         return -lim - off, lim - off
 
     @classmethod
-    def from_scenario(cls, scenario: Scenario) -> GraspSetup:
+    def from_scenario(cls, scenario: Scenario, urdf_xml: str | None = None) -> GraspSetup:
         """Load the hand of a scenario and bind the scenario to it.
+
+        Args:
+            scenario: the validated scenario.
+            urdf_xml: a URDF document to use instead of the scenario's
+                ``hand.urdf`` (e.g. the node's ``robot_description``).
 
         Raises:
             InputError: naming the field (file, joint or frame not found, ...).
         """
-        hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
-                              scenario.joints, scenario.torque_limits)
+        if urdf_xml:
+            hand = Hand.from_urdf_string(urdf_xml, scenario.joints, scenario.torque_limits)
+        else:
+            hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
+                                  scenario.joints, scenario.torque_limits)
         if isinstance(scenario.torque_limits, list) and len(scenario.torque_limits) != hand.m:
             raise InputError("hand.torque_limits",
                              f"must have {hand.m} entries (one per joint), "

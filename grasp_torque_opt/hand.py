@@ -92,6 +92,12 @@ class Hand:
         """Number of actuated joints."""
         return len(self.joints)
 
+    @property
+    def base_frame(self) -> str:
+        """Name of the root link: the base frame."""
+        return next(f.name for f in self.model.frames
+                    if f.type == pin.FrameType.BODY and f.parentJoint == 0)
+
     @staticmethod
     def one_dof_joints(model: pin.Model) -> list[str]:
         """Names of the model's one-degree-of-freedom joints, in model order."""

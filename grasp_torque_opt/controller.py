@@ -1,0 +1,399 @@
+"""The control cycle, free of ROS: inputs checked and timed, solve, certify, gate, fault policy.
+
+The node (:mod:`grasp_torque_opt.node`) only converts messages to the plain
+arrays taken here and publishes what :meth:`TorqueController.cycle` and
+:meth:`TorqueController.watchdog` return.
+
+Fault policy (README, "Faults"): a command is published only from a certified
+solution that passes the gate (finite, one value per joint, within the torque
+limits). When a cycle cannot produce one (stale or invalid input, failed solve
+or certificate), nothing new is published: the effort controller keeps the
+last certified command. Once ``hold_time`` has passed since that command, the
+policy applies: ``hold`` keeps publishing nothing (the hand keeps its last
+certified torques), ``zero`` publishes zero torques. The first certified
+solution after a fault is published at once (recovery).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from grasp_torque_opt.certificate import DEFAULT_TOLERANCE
+from grasp_torque_opt.exceptions import FrameNotFound, InputError
+from grasp_torque_opt.grasp_maps import GraspMaps
+from grasp_torque_opt.grasp_setup import GraspSetup
+from grasp_torque_opt.scenario import ContactSpec
+from grasp_torque_opt.solution import Solution
+from grasp_torque_opt.solve import solve
+from grasp_torque_opt.tau_qp import ProxSuiteSettings, TauQPSolver
+
+POLICIES = ("hold", "zero")
+#: A quaternion is accepted when | ||q|| - 1 | is at most this, then normalized.
+QUATERNION_TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class CycleConfig:
+    """Timing and safety settings of the cycle.
+
+    Attributes:
+        joint_state_timeout: joint states older than this stop commands [s] (> 0).
+        contacts_timeout: once contacts have arrived on the topic, older than this
+            stop commands [s]; 0 disables the check.
+        wrench_timeout: the same for the external wrench [s]; 0 disables it.
+        hold_time: how long after the last certified command a fault may last
+            before the policy applies [s].
+        fault_policy: ``hold`` or ``zero``.
+        gravity_compensation: add the fingers' own gravity torques g(q).
+        gravity: gravity in the base frame [m/s^2], shape (3,).
+        certificate_tolerance: tolerance of the certificate (SI units).
+    """
+
+    joint_state_timeout: float = 0.1
+    contacts_timeout: float = 0.5
+    wrench_timeout: float = 0.5
+    hold_time: float = 0.1
+    fault_policy: str = "hold"
+    gravity_compensation: bool = False
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    certificate_tolerance: float = DEFAULT_TOLERANCE
+
+
+@dataclass(frozen=True)
+class ContactPoses:
+    """Contact frames as estimated: pose i is contact i's frame in frame ``frame``.
+
+    Attributes:
+        frame: model frame the poses are expressed in ('' = the base frame).
+        positions: contact points, shape (p, 3) [m].
+        rotations: contact frame axes (columns x, y, z = inward normal), shape (p, 3, 3).
+    """
+
+    frame: str
+    positions: np.ndarray
+    rotations: np.ndarray
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """A snapshot of the latest valid inputs and their monotonic receipt times [s].
+
+    ``contacts`` and ``wrench`` are None until one arrives (then the scenario's
+    defaults are used); ``q`` is None until the first joint state. ``wrench`` is
+    (frame, [F, M]) in that frame's axes.
+    """
+
+    q: np.ndarray | None = None
+    q_time: float | None = None
+    contacts: ContactPoses | None = None
+    contacts_time: float | None = None
+    wrench: tuple[str, np.ndarray] | None = None
+    wrench_time: float | None = None
+
+
+@dataclass
+class CycleResult:
+    """What one cycle decided.
+
+    Attributes:
+        command: effort command to publish now, in ``joints`` order [N m], or None.
+        kind: ``solution`` (a certified command), ``zero`` (the zero policy) or
+            ``none`` (nothing published).
+        solution: the solve, if one ran.
+        maps: its kinematic maps.
+        gravity_torque: g(q) added to the solution, or None.
+        fault: why no certified command was published ('' when healthy).
+    """
+
+    command: np.ndarray | None
+    kind: str
+    solution: Solution | None = None
+    maps: GraspMaps | None = None
+    gravity_torque: np.ndarray | None = None
+    fault: str = ""
+
+
+@dataclass
+class Counters:
+    """Running totals, for diagnostics."""
+
+    cycles: int = 0
+    commands: int = 0
+    zero_commands: int = 0
+    faults: int = 0
+    recoveries: int = 0
+    rejected: dict[str, int] = field(default_factory=lambda: {
+        "joint_states": 0, "contacts": 0, "external_wrench": 0})
+
+
+def _finite(a: np.ndarray, name: str) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise InputError(name, "must be finite (NaN or Inf found)")
+    return a
+
+
+def quaternion_matrix(xyzw: np.ndarray, name: str) -> np.ndarray:
+    """Rotation matrix of a unit quaternion (x, y, z, w).
+
+    Raises:
+        InputError: not finite, or its norm is off 1 by more than
+            :data:`QUATERNION_TOLERANCE`.
+    """
+    q = _finite(xyzw, name)
+    norm = float(np.linalg.norm(q))
+    if abs(norm - 1.0) > QUATERNION_TOLERANCE:
+        raise InputError(name, f"is not a unit quaternion (norm {norm:.6g})")
+    x, y, z, w = q / norm
+    return pin.Quaternion(w, x, y, z).toRotationMatrix()
+
+
+class TorqueController:
+    """The cycle of the node, on plain arrays.
+
+    Args:
+        setup: the grasp of the scenario: hand, default contacts and load,
+            friction, limits, weights. Its hand is owned by this controller.
+        config: timing and safety settings.
+        solver_settings: ProxSuite settings.
+    """
+
+    def __init__(self, setup: GraspSetup, config: CycleConfig | None = None,
+                 solver_settings: ProxSuiteSettings | None = None) -> None:
+        self.setup = setup
+        self.config = config or CycleConfig()
+        self.solver = TauQPSolver(solver_settings)
+        self.inputs = Inputs()
+        self.counters = Counters()
+        self.last_command: np.ndarray | None = None
+        self.last_command_time: float | None = None
+        self.last: CycleResult | None = None
+        self.fault = ""
+        self.last_rejection = ""
+        self._names = {n: i for i, n in enumerate(self.setup.hand.joints)}
+        model = self.setup.hand.model
+        self._model_joints = {model.names[j]: model.joints[j].idx_q
+                              for j in range(1, model.njoints) if model.joints[j].nq == 1}
+
+    # -- inputs ---------------------------------------------------------------------------
+
+    def update_joint_state(self, names: list[str], positions: list[float], now: float) -> None:
+        """Take a joint state: names and positions, any order, extra joints ignored.
+
+        Only the positions of model joints are used, so NaN elsewhere (velocity,
+        effort, unknown joints) is accepted.
+
+        Raises:
+            InputError: length mismatch, empty or duplicate name, a commanded
+                joint missing, a used position not finite. The state is not kept.
+        """
+        try:
+            if len(names) != len(positions):
+                raise InputError("joint_states", f"{len(names)} names but "
+                                 f"{len(positions)} positions")
+            if len(set(names)) != len(names):
+                dup = next(n for n in names if names.count(n) > 1)
+                raise InputError("joint_states", f"duplicate joint name '{dup}'")
+            if any(not n for n in names):
+                raise InputError("joint_states", "empty joint name")
+            missing = [n for n in self.setup.hand.joints if n not in names]
+            if missing:
+                raise InputError("joint_states", f"missing commanded joint(s) "
+                                 f"{', '.join(missing[:4])}")
+            q = (self.setup.q if self.inputs.q is None else self.inputs.q).copy()
+            for name, value in zip(names, positions):
+                iq = self._model_joints.get(name)
+                if iq is None:
+                    continue
+                if not math.isfinite(value):
+                    raise InputError("joint_states", f"position of '{name}' is not finite")
+                q[iq] = value
+        except InputError as e:
+            self._reject("joint_states", e)
+            raise
+        self.inputs = dataclasses.replace(self.inputs, q=q, q_time=now)
+
+    def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
+                        now: float) -> None:
+        """Take contact frames: one pose per scenario contact, in model frame ``frame``.
+
+        Raises:
+            InputError: wrong count, unknown frame, non-finite values or a
+                non-unit quaternion. The contacts are not kept.
+        """
+        try:
+            p = len(self.setup.contacts)
+            positions = np.asarray(positions, dtype=float).reshape(-1, 3)
+            quaternions = np.asarray(quaternions, dtype=float).reshape(-1, 4)
+            if positions.shape[0] != p:
+                raise InputError("contacts", f"{positions.shape[0]} poses for {p} contacts")
+            model = self.setup.hand.model
+            if frame and not model.existFrame(frame):
+                raise FrameNotFound("contacts.header.frame_id", frame,
+                                    {f.name for f in model.frames})
+            _finite(positions, "contacts.poses.position")
+            rotations = np.array([quaternion_matrix(quaternions[i],
+                                                    f"contacts.poses[{i}].orientation")
+                                  for i in range(p)])
+        except InputError as e:
+            self._reject("contacts", e)
+            raise
+        self.inputs = dataclasses.replace(
+            self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
+
+    def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
+                      now: float) -> None:
+        """Take the load on the object (about its origin), axes of model frame ``frame``.
+
+        Raises:
+            InputError: unknown frame or non-finite values. The load is not kept.
+        """
+        try:
+            model = self.setup.hand.model
+            if frame and not model.existFrame(frame):
+                raise FrameNotFound("external_wrench.header.frame_id", frame,
+                                    {f.name for f in model.frames})
+            w = np.concatenate((_finite(force, "external_wrench.wrench.force"),
+                                _finite(torque, "external_wrench.wrench.torque")))
+        except InputError as e:
+            self._reject("external_wrench", e)
+            raise
+        # Kept in the given axes; turned into base axes at the cycle's configuration.
+        self.inputs = dataclasses.replace(self.inputs, wrench=(frame, w), wrench_time=now)
+
+    def _reject(self, source: str, error: InputError) -> None:
+        self.counters.rejected[source] += 1
+        self.last_rejection = f"{source}: {error}"
+
+    # -- the cycle ------------------------------------------------------------------------
+
+    def stale(self, now: float, inputs: Inputs | None = None) -> str:
+        """Why the inputs cannot be used at time ``now`` ('' if they can)."""
+        i = inputs or self.inputs
+        c = self.config
+        if i.q is None:
+            return "no joint state yet"
+        if now - i.q_time > c.joint_state_timeout:
+            return f"joint_states stale ({now - i.q_time:.3f} s > {c.joint_state_timeout} s)"
+        if i.contacts_time is not None and c.contacts_timeout > 0 and \
+                now - i.contacts_time > c.contacts_timeout:
+            return f"contacts stale ({now - i.contacts_time:.3f} s > {c.contacts_timeout} s)"
+        if i.wrench_time is not None and c.wrench_timeout > 0 and \
+                now - i.wrench_time > c.wrench_timeout:
+            return f"external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)"
+        return ""
+
+    def grasp_at(self, inputs: Inputs) -> tuple[GraspSetup, np.ndarray | None]:
+        """The grasp of a snapshot of inputs, and g(q) if compensated.
+
+        Raises:
+            InputError: the contacts cannot be placed on their links.
+        """
+        setup = self.setup
+        hand = setup.hand
+        q = inputs.q
+        model, data = hand.model, hand.data
+        pin.framesForwardKinematics(model, data, q)
+        contacts = setup.contacts
+        if inputs.contacts is not None:
+            cp = inputs.contacts
+            oMF = data.oMf[model.getFrameId(cp.frame)] if cp.frame else pin.SE3.Identity()
+            contacts = []
+            for spec, p, R in zip(setup.contacts, cp.positions, cp.rotations):
+                R_base = oMF.rotation @ R
+                oMl = data.oMf[model.getFrameId(spec.link)]
+                contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(oMF.act(p)),
+                                            normal=R_base[:, 2], tangent=R_base[:, 0]))
+        wrench = setup.external_wrench
+        if inputs.wrench is not None:
+            frame, w = inputs.wrench
+            R = data.oMf[model.getFrameId(frame)].rotation if frame else np.eye(3)
+            wrench = np.concatenate((R @ w[:3], R @ w[3:]))
+        g = None
+        if self.config.gravity_compensation:
+            model.gravity.linear = np.asarray(self.config.gravity, dtype=float)
+            g = pin.computeGeneralizedGravity(model, data, q)[hand.idx_v].copy()
+        return dataclasses.replace(setup, q=q, contacts=contacts, external_wrench=wrench,
+                                   torque_offset=g), g
+
+    def solve_inputs(self, inputs: Inputs) -> tuple[Solution, GraspMaps, np.ndarray | None]:
+        """Solve the grasp of a snapshot of inputs with the tau-QP (certified).
+
+        Raises:
+            InputError: the inputs do not make a grasp (e.g. a tangent parallel to
+                its normal).
+        """
+        setup, g = self.grasp_at(inputs)
+        maps = setup.maps()
+        sol = solve(setup, maps=maps, solver=self.solver,
+                    tolerance=self.config.certificate_tolerance)
+        return sol, maps, g
+
+    def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
+        """The last check before a command leaves: certified, finite, sized, within limits."""
+        if not solution.optimal:
+            return None, f"no certified solution ({solution.status}: {solution.message})"
+        cmd = solution.tau + (0.0 if g is None else g)
+        lim = self.setup.hand.torque_limits
+        if cmd.shape != lim.shape:
+            return None, f"command has {cmd.size} values for {lim.size} joints"
+        if not np.all(np.isfinite(cmd)):
+            return None, "command not finite"
+        if np.any(np.abs(cmd) > lim):
+            k = int(np.argmax(np.abs(cmd) - lim))
+            return None, f"command over the limit at {self.setup.hand.joints[k]}"
+        return cmd, ""
+
+    def cycle(self, now: float) -> CycleResult:
+        """One cycle on the latest inputs (run it on each new joint state)."""
+        self.counters.cycles += 1
+        reason = self.stale(now)
+        if reason:
+            return self._faulted(now, reason)
+        try:
+            sol, maps, g = self.solve_inputs(self.inputs)
+        except InputError as e:
+            return self._faulted(now, f"inputs do not make a grasp: {e}")
+        cmd, why = self.gate(sol, g)
+        if cmd is None:
+            return self._faulted(now, why, sol, maps, g)
+        if self.fault:
+            self.counters.recoveries += 1
+        self.fault = ""
+        self.last_command, self.last_command_time = cmd, now
+        self.counters.commands += 1
+        self.last = CycleResult(cmd, "solution", sol, maps, g)
+        return self.last
+
+    def watchdog(self, now: float) -> CycleResult | None:
+        """Between cycles: notice stale joint states and apply the policy.
+
+        Returns:
+            A result when there is a fault (its command may be the zero policy's),
+            None when the inputs are fresh or no joint state has arrived yet.
+        """
+        if self.inputs.q is None:
+            return None  # not started: nothing was ever commanded
+        reason = self.stale(now)
+        return self._faulted(now, reason) if reason else None
+
+    def _faulted(self, now: float, reason: str, sol: Solution | None = None,
+                 maps: GraspMaps | None = None, g: np.ndarray | None = None) -> CycleResult:
+        if not self.fault:
+            self.counters.faults += 1
+        self.fault = reason
+        held = (self.last_command_time is not None
+                and now - self.last_command_time <= self.config.hold_time)
+        if not held and self.config.fault_policy == "zero":
+            cmd = np.zeros(self.setup.hand.m)
+            self.counters.zero_commands += 1
+            result = CycleResult(cmd, "zero", sol, maps, g, reason)
+        else:
+            result = CycleResult(None, "none", sol, maps, g, reason)
+        self.last = result
+        return result

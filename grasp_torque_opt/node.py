@@ -1,0 +1,410 @@
+"""ROS 2 node ``grasp_torque_node``: certified grasp torques every cycle, and a solve service.
+
+A thin adapter over :class:`grasp_torque_opt.controller.TorqueController`:
+messages in, plain arrays to the controller, its decisions out. Interface
+pinned in DESIGN.md section 4; parameters, units and defaults in the README.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import Point, PoseArray, WrenchStamped
+from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
+                                SetParametersResult)
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.task import Future
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+from visualization_msgs.msg import Marker, MarkerArray
+
+from grasp_torque_opt import diagnostics
+from grasp_torque_opt.controller import POLICIES, CycleConfig, CycleResult, TorqueController
+from grasp_torque_opt.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.grasp_setup import GraspSetup
+from grasp_torque_opt.report import solution_dict
+from grasp_torque_opt.resources import find_config
+from grasp_torque_opt.scenario import load_scenario
+from grasp_torque_opt.tau_qp import ProxSuiteSettings
+
+NODE_NAME = "grasp_torque_node"
+#: Commands: reliable, only the newest matters.
+COMMAND_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One parameter: description (with unit), range, and whether it can change at run time."""
+
+    description: str
+    low: float | None = None
+    high: float | None = None
+    read_only: bool = False
+    length: str | None = None  # "joints" or a number, for arrays
+
+
+#: Every parameter, declared in this order. Defaults come from the scenario.
+PARAMETERS: dict[str, Spec] = {
+    "scenario": Spec("Scenario file (DESIGN.md section 4): hand, default contacts and load. "
+                     "A path, or the name of a bundled file in the package's config/.",
+                     read_only=True),
+    "robot_description": Spec("URDF document of the hand (the ROS convention); empty: the "
+                              "scenario's hand.urdf.", read_only=True),
+    "joints": Spec("Actuated joints in command order (default: the scenario's).",
+                   read_only=True),
+    "object_origin": Spec("Object origin c in the base frame [m].", length="3"),
+    "mu_tangential": Spec("Tangential friction coefficient mu1 [-].", 1e-6, 10.0),
+    "mu_torsional": Spec("Torsional friction coefficient mu2 [m].", 1e-9, 1.0),
+    "polygon_sides": Spec("Sides N of the inscribed friction polygon [-].", 3, 64),
+    "min_normal_force": Spec("Minimum normal force per contact [N].", 0.0, 1000.0),
+    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint.",
+                          length="joints"),
+    "weights": Spec("Objective weights W (diagonal), per joint [-].", length="joints"),
+    "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
+                                 "limits then bound the sum."),
+    "gravity": Spec("Gravity in the base frame [m/s^2].", length="3"),
+    "joint_state_timeout": Spec("Joint states older than this stop commands [s].", 1e-4, 10.0),
+    "contacts_timeout": Spec("Once contacts arrived, older than this stop commands [s]; "
+                             "0: never stale.", 0.0, 60.0),
+    "wrench_timeout": Spec("Once a load arrived, older than this stops commands [s]; "
+                           "0: never stale.", 0.0, 60.0),
+    "hold_time": Spec("How long a fault may hold the last certified command before the "
+                      "fault policy applies [s].", 0.0, 60.0),
+    "fault_policy": Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
+                         "controller keeps the last certified command) or 'zero' (publish "
+                         "zero torques)."),
+    "solver.eps_abs": Spec("ProxSuite absolute tolerance [-].", 1e-12, 1e-4),
+    "solver.max_iter": Spec("ProxSuite outer iteration cap [-].", 1, 100000),
+    "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
+    "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
+                                  1e-12, 1e-2),
+    "diagnostics_period": Spec("Period of /diagnostics and ~/contact_wrenches [s].",
+                               1e-3, 60.0, read_only=True),
+    "watchdog_period": Spec("Period of the staleness check between joint states [s].",
+                            1e-4, 1.0, read_only=True),
+    "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
+}
+
+
+def descriptor(name: str) -> ParameterDescriptor:
+    """The ParameterDescriptor of a parameter of :data:`PARAMETERS`."""
+    spec = PARAMETERS[name]
+    d = ParameterDescriptor(name=name, description=spec.description, read_only=spec.read_only)
+    if spec.low is not None and isinstance(spec.low, int) and isinstance(spec.high, int):
+        d.integer_range = [IntegerRange(from_value=spec.low, to_value=spec.high, step=1)]
+    elif spec.low is not None:
+        d.floating_point_range = [FloatingPointRange(from_value=float(spec.low),
+                                                     to_value=float(spec.high), step=0.0)]
+    return d
+
+
+def check(name: str, value: Any, m: int) -> str:
+    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too."""
+    spec = PARAMETERS[name]
+    if name == "fault_policy":
+        return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
+    if spec.length is not None:
+        n = m if spec.length == "joints" else int(spec.length)
+        values = list(value)
+        if len(values) != n:
+            return f"{name}: must have {n} entries, got {len(values)}"
+        if not all(math.isfinite(v) for v in values):
+            return f"{name}: must be finite"
+        if name in ("torque_limits", "weights") and not all(v > 0 for v in values):
+            return f"{name}: every entry must be > 0"
+        return ""
+    if isinstance(value, float) and not math.isfinite(value):
+        return f"{name}: must be finite"
+    if spec.low is not None and not (spec.low <= value <= spec.high):
+        return f"{name}: must be in [{spec.low}, {spec.high}], got {value}"
+    return ""
+
+
+class GraspTorqueNode(Node):
+    """Publishes certified effort commands on each joint state; answers ``~/solve``."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self._lock = threading.Lock()
+        setup = self._load_setup()
+        self._m = setup.hand.m
+        defaults = {
+            "object_origin": [float(x) for x in setup.object_origin],
+            "mu_tangential": setup.friction.mu1,
+            "mu_torsional": setup.friction.mu2,
+            "polygon_sides": setup.friction.sides,
+            "min_normal_force": setup.friction.min_normal_force,
+            "torque_limits": [float(x) for x in setup.hand.torque_limits],
+            "weights": [float(x) for x in setup.weights],
+            "gravity_compensation": False,
+            "gravity": [0.0, 0.0, -9.81],
+            "joint_state_timeout": 0.1,
+            "contacts_timeout": 0.5,
+            "wrench_timeout": 0.5,
+            "hold_time": 0.1,
+            "fault_policy": "hold",
+            "solver.eps_abs": ProxSuiteSettings.eps_abs,
+            "solver.max_iter": ProxSuiteSettings.max_iter,
+            "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
+            "certificate_tolerance": CycleConfig.certificate_tolerance,
+            "diagnostics_period": 0.1,
+            "watchdog_period": 0.01,
+            "marker_scale": 0.02,
+        }
+        for name, value in defaults.items():
+            self.declare_parameter(name, value, descriptor(name))
+        for name in defaults:
+            reason = check(name, self.get_parameter(name).value, self._m)
+            if reason:
+                raise InputError(name, reason.split(": ", 1)[1])
+        self._base_setup = setup
+        self.controller = TorqueController(*self._configure(setup, self._params()))
+        self._service_controller = TorqueController(*self._configure(
+            dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()))
+        self.add_on_set_parameters_callback(self._validate_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+
+        self.create_subscription(JointState, "joint_states", self._on_joint_state,
+                                 qos_profile_sensor_data)
+        self.create_subscription(PoseArray, "contacts", self._on_contacts,
+                                 qos_profile_sensor_data)
+        self.create_subscription(WrenchStamped, "external_wrench", self._on_wrench,
+                                 qos_profile_sensor_data)
+        self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
+                                                  COMMAND_QOS)
+        self._marker_pub = self.create_publisher(MarkerArray, "~/contact_wrenches", 1)
+        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        # The service solves in a worker thread while the executor goes on with the loop.
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
+        self.create_service(Trigger, "~/solve", self._on_solve)
+        self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
+        self.create_timer(self.get_parameter("diagnostics_period").value,
+                          self._on_diagnostics)
+        self.get_logger().info(
+            f"{self._m} joints, {len(setup.contacts)} default contacts; "
+            f"commands on {self._command_pub.topic_name}")
+
+    # -- configuration --------------------------------------------------------------------
+
+    def _load_setup(self) -> GraspSetup:
+        name = self.declare_parameter("scenario", "", descriptor("scenario")).value
+        urdf = self.declare_parameter("robot_description", "",
+                                      descriptor("robot_description")).value
+        if not name:
+            raise InputError("scenario", "parameter not set (a scenario file gives the "
+                             "default contacts and load)")
+        scenario = load_scenario(find_config(name))
+        setup = GraspSetup.from_scenario(scenario, urdf or None)
+        joints = self.declare_parameter("joints", list(setup.hand.joints),
+                                        descriptor("joints")).value
+        if list(joints) != list(setup.hand.joints):
+            setup = GraspSetup.from_scenario(dataclasses.replace(scenario, joints=list(joints)),
+                                             urdf or None)
+        return setup
+
+    def _params(self) -> dict[str, Any]:
+        return {name: self.get_parameter(name).value for name in PARAMETERS}
+
+    def _configure(self, setup: GraspSetup, p: dict[str, Any]
+                   ) -> tuple[GraspSetup, CycleConfig, ProxSuiteSettings]:
+        """The controller's setup, cycle settings and solver settings from parameter values."""
+        hand = setup.hand
+        if not np.array_equal(hand.torque_limits, p["torque_limits"]):
+            hand = dataclasses.replace(hand, torque_limits=np.array(p["torque_limits"]))
+        setup = dataclasses.replace(
+            setup, hand=hand, object_origin=np.array(p["object_origin"]),
+            weights=np.array(p["weights"]),
+            friction=dataclasses.replace(setup.friction, mu1=p["mu_tangential"],
+                                         mu2=p["mu_torsional"], sides=p["polygon_sides"],
+                                         min_normal_force=p["min_normal_force"]))
+        config = CycleConfig(
+            joint_state_timeout=p["joint_state_timeout"],
+            contacts_timeout=p["contacts_timeout"], wrench_timeout=p["wrench_timeout"],
+            hold_time=p["hold_time"], fault_policy=p["fault_policy"],
+            gravity_compensation=p["gravity_compensation"], gravity=tuple(p["gravity"]),
+            certificate_tolerance=p["certificate_tolerance"])
+        solver = ProxSuiteSettings(eps_abs=p["solver.eps_abs"], max_iter=p["solver.max_iter"],
+                                   max_iter_in=p["solver.max_iter_in"])
+        return setup, config, solver
+
+    def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        for param in params:
+            if param.name in PARAMETERS:
+                reason = check(param.name, param.value, self._m)
+                if reason:
+                    return SetParametersResult(successful=False, reason=reason)
+        return SetParametersResult(successful=True)
+
+    def _apply_parameters(self, params: list[Parameter]) -> None:
+        p = self._params()
+        with self._lock:
+            for ctrl in (self.controller, self._service_controller):
+                setup, config, solver = self._configure(ctrl.setup, p)
+                ctrl.setup, ctrl.config = setup, config
+                if solver != ctrl.solver.settings:
+                    ctrl.solver = type(ctrl.solver)(solver)
+
+    # -- inputs and cycle -----------------------------------------------------------------
+
+    def _on_joint_state(self, msg: JointState) -> None:
+        now = time.monotonic()
+        with self._lock:
+            try:
+                self.controller.update_joint_state(list(msg.name), list(msg.position), now)
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                return
+            self._publish(self.controller.cycle(now))
+
+    def _on_contacts(self, msg: PoseArray) -> None:
+        positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
+        quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
+                 for p in msg.poses]
+        with self._lock:
+            try:
+                self.controller.update_contacts(msg.header.frame_id, np.array(positions),
+                                                np.array(quats), time.monotonic())
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+
+    def _on_wrench(self, msg: WrenchStamped) -> None:
+        f, t = msg.wrench.force, msg.wrench.torque
+        with self._lock:
+            try:
+                self.controller.update_wrench(msg.header.frame_id, [f.x, f.y, f.z],
+                                              [t.x, t.y, t.z], time.monotonic())
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+
+    def _on_watchdog(self) -> None:
+        with self._lock:
+            result = self.controller.watchdog(time.monotonic())
+            if result is not None:
+                self._publish(result)
+
+    def _publish(self, result: CycleResult) -> None:
+        if result.fault:
+            self.get_logger().warn(f"no command: {result.fault}", throttle_duration_sec=1.0)
+        if result.command is None:
+            return
+        cmd = result.command
+        # The node's own promise, whatever the controller decided.
+        if cmd.shape != (self._m,) or not np.all(np.isfinite(cmd)) or \
+                np.any(np.abs(cmd) > self.controller.setup.hand.torque_limits):
+            self.get_logger().error("refused to publish a malformed command")
+            return
+        self._command_pub.publish(Float64MultiArray(data=[float(x) for x in cmd]))
+
+    # -- outputs between cycles -----------------------------------------------------------
+
+    def _on_diagnostics(self) -> None:
+        with self._lock:
+            rep = diagnostics.report(self.controller, time.monotonic())
+            last = self.controller.last
+            base = self.controller.setup.hand.base_frame
+        stamp = self.get_clock().now().to_msg()
+        status = DiagnosticStatus(level=bytes([rep.level]), name=f"{self.get_name()}: grasp "
+                                  "torques", message=rep.message, hardware_id=base,
+                                  values=[KeyValue(key=k, value=v) for k, v in rep.values])
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = stamp
+        self._diag_pub.publish(msg)
+        self._marker_pub.publish(self._markers(last, base, stamp))
+
+    def _markers(self, last: CycleResult | None, base: str, stamp) -> MarkerArray:
+        clear = Marker(action=Marker.DELETEALL)
+        if last is None or last.kind != "solution":
+            return MarkerArray(markers=[clear])
+        scale = self.get_parameter("marker_scale").value
+        markers = [clear]
+        for i, (frame, w) in enumerate(zip(last.maps.contacts, last.solution.wrenches)):
+            force = frame.rotation @ w[:3]
+            start, end = frame.position, frame.position + scale * force
+            m = Marker(type=Marker.ARROW, action=Marker.ADD, ns="contact_force", id=i)
+            m.header.frame_id, m.header.stamp = base, stamp
+            m.points = [Point(x=float(start[0]), y=float(start[1]), z=float(start[2])),
+                        Point(x=float(end[0]), y=float(end[1]), z=float(end[2]))]
+            m.pose.orientation.w = 1.0
+            m.scale.x, m.scale.y, m.scale.z = 0.002, 0.004, 0.004
+            m.color.g, m.color.a = 0.8, 1.0
+            markers.append(m)
+        return MarkerArray(markers=markers)
+
+    # -- the service ----------------------------------------------------------------------
+
+    async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
+                        ) -> Trigger.Response:
+        with self._lock:
+            inputs = self.controller.inputs
+        done = Future(executor=self.executor)
+        done.add_done_callback(lambda _: None)  # completion wakes the executor
+        self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
+        await done
+        response.success, response.message = done.result()
+        return response
+
+    def _solve_for_service(self, inputs: Any, now: float, done: Future) -> None:
+        """One solve on a snapshot of the inputs, with the service's own controller
+        (own Pinocchio data and ProxSuite workspace): (success, CLI JSON or reason)."""
+        ctrl = self._service_controller
+        try:
+            stale = ctrl.stale(now, inputs)
+            if stale:
+                done.set_result((False, f"cannot solve: {stale}"))
+                return
+            sol, maps, g = ctrl.solve_inputs(inputs)
+            cmd, _ = ctrl.gate(sol, g)
+            d = solution_dict(sol, maps)
+            d["command"] = None if cmd is None else [float(x) for x in cmd]
+            d["gravity_torque"] = None if g is None else [float(x) for x in g]
+            done.set_result((cmd is not None, json.dumps(d)))
+        except Exception as e:  # noqa: BLE001 -- the caller gets the reason, the node lives on
+            done.set_result((False, f"cannot solve: {type(e).__name__}: {e}"))
+
+    def destroy_node(self) -> None:
+        """Stop the service worker, then the node."""
+        self._worker.shutdown(wait=True, cancel_futures=True)
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the node (Jazzy pattern): spin, then destroy and shut down."""
+    rclpy.init(args=args)
+    node = None
+    code = 0
+    try:
+        node = GraspTorqueNode()
+        # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
+        # the single-threaded one keeps up (the service runs in its own worker).
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except GraspTorqueError as e:
+        print(f"{NODE_NAME}: error: {e}", file=sys.stderr)
+        code = 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())
