@@ -268,7 +268,7 @@ class TorqueController:
 
     def _reject(self, source: str, error: InputError) -> None:
         self.counters.rejected[source] += 1
-        self.last_rejection = f"{source}: {error}"
+        self.last_rejection = str(error)  # names the field, e.g. contacts.poses[0]...
 
     # -- the cycle ------------------------------------------------------------------------
 

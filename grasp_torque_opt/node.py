@@ -45,6 +45,8 @@ from grasp_torque_opt.tau_qp import ProxSuiteSettings
 NODE_NAME = "grasp_torque_node"
 #: Commands: reliable, only the newest matters.
 COMMAND_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+#: ~/solve: reliable, up to 100 queued requests (the default 10 dropped a planner's burst).
+SERVICE_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 
 
 @dataclass(frozen=True)
@@ -191,7 +193,7 @@ class GraspTorqueNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         # The service solves in a worker thread while the executor goes on with the loop.
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
-        self.create_service(Trigger, "~/solve", self._on_solve)
+        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS)
         self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
         self.create_timer(self.get_parameter("diagnostics_period").value,
                           self._on_diagnostics)

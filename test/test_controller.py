@@ -1,0 +1,192 @@
+"""The control cycle on plain arrays: inputs, gate, staleness, fault policy, gravity."""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from independent import assert_holds
+from test_hand import ALLEGRO_URDF
+
+from grasp_torque_opt.controller import CycleConfig, TorqueController
+from grasp_torque_opt.exceptions import InputError
+from grasp_torque_opt.hand import resolve_urdf
+from grasp_torque_opt.solve import solve
+
+
+def joint_state(setup, q=None, names=None):
+    q = setup.q if q is None else q
+    hand = setup.hand
+    names = names or hand.one_dof_joints(hand.model)
+    return names, [float(q[hand.model.joints[hand.model.getJointId(n)].idx_q]) for n in names]
+
+
+def fresh(setup, **config):
+    return TorqueController(dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)),
+                            CycleConfig(**config))
+
+
+def base_poses(setup, q=None):
+    """The default contact frames at q, as (positions, xyzw quaternions) in the base frame."""
+    maps = dataclasses.replace(setup, q=setup.q if q is None else q).maps()
+    pos = np.array([f.position for f in maps.contacts])
+    quat = np.array([pin.Quaternion(f.rotation).coeffs() for f in maps.contacts])
+    return pos, quat
+
+
+@pytest.mark.parametrize("name", ["planar", "allegro"])
+def test_command_is_the_cores_solution(name, request):
+    setup = request.getfixturevalue(name)
+    ctrl = fresh(setup)
+    ctrl.update_joint_state(*joint_state(setup), now=0.0)
+    r = ctrl.cycle(0.0)
+    assert r.kind == "solution" and r.fault == ""
+    ref = solve(setup)
+    np.testing.assert_allclose(r.command, ref.tau, atol=1e-9)
+
+
+def test_joint_order_and_extra_joints_do_not_matter(allegro):
+    names, pos = joint_state(allegro)
+    order = np.random.default_rng(3).permutation(len(names))
+    a, b = fresh(allegro), fresh(allegro)
+    a.update_joint_state(names, pos, 0.0)
+    b.update_joint_state([names[i] for i in order] + ["conveyor"],
+                         [pos[i] for i in order] + [float("nan")], 0.0)
+    np.testing.assert_allclose(a.cycle(0.0).command, b.cycle(0.0).command, atol=1e-12)
+
+
+@pytest.mark.parametrize("names,positions,match", [
+    (["joint1", "joint2", "joint3"], [0.1, 0.2], "3 names but 2 positions"),
+    (["joint1", "joint1", "joint2", "joint3", "joint4"], [0.0] * 5, "duplicate joint name"),
+    (["joint1", "joint2", "joint3"], [0.0] * 3, "missing commanded joint.* joint4"),
+    (["joint1", "joint2", "joint3", "joint4"], [0.0, float("nan"), 0.0, 0.0],
+     "position of 'joint2' is not finite"),
+    (["joint1", "", "joint3", "joint4"], [0.0] * 4, "empty joint name"),
+])
+def test_malformed_joint_states_are_rejected(planar, names, positions, match):
+    ctrl = fresh(planar)
+    with pytest.raises(InputError, match=match):
+        ctrl.update_joint_state(names, positions, 0.0)
+    assert ctrl.inputs.q is None and ctrl.counters.rejected["joint_states"] == 1
+    assert ctrl.last_rejection.startswith("joint_states: ") and match.split(".")[0][:8] in \
+        ctrl.last_rejection
+
+
+def test_contacts_in_any_model_frame_give_the_same_grasp(allegro):
+    q = allegro.q.copy()
+    q[allegro.hand.idx_q[1]] += 0.02
+    ref = fresh(allegro)
+    ref.update_joint_state(*joint_state(allegro, q), 0.0)
+    expected = ref.cycle(0.0).command
+    pos, quat = base_poses(allegro, q)
+    in_base = fresh(allegro)
+    in_base.update_joint_state(*joint_state(allegro, q), 0.0)
+    in_base.update_contacts("", pos, quat, 0.0)
+    np.testing.assert_allclose(in_base.cycle(0.0).command, expected, atol=1e-9)
+    # The same frames expressed in the thumb's distal link.
+    model = allegro.hand.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    oMl = data.oMf[model.getFrameId("link_15.0")]
+    local_pos = [oMl.actInv(p) for p in pos]
+    local_quat = [pin.Quaternion(oMl.rotation.T @ pin.Quaternion(*np.roll(qt, 1)).matrix()
+                                 ).coeffs() for qt in quat]
+    in_link = fresh(allegro)
+    in_link.update_joint_state(*joint_state(allegro, q), 0.0)
+    in_link.update_contacts("link_15.0", np.array(local_pos), np.array(local_quat), 0.0)
+    np.testing.assert_allclose(in_link.cycle(0.0).command, expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("frame,change,match", [
+    ("palm_link", lambda p, q: (p[:3], q[:3]), "3 poses for 4 contacts"),
+    ("no_such_link", lambda p, q: (p, q), "unknown frame 'no_such_link'"),
+    ("", lambda p, q: (p, q * 1.01), r"poses\[0\].orientation: is not a unit quaternion"),
+    ("", lambda p, q: (p, np.zeros_like(q)), "is not a unit quaternion"),
+    ("", lambda p, q: (p + np.array([0, np.nan, 0]), q), "must be finite"),
+])
+def test_malformed_contacts_are_rejected(allegro, frame, change, match):
+    ctrl = fresh(allegro)
+    pos, quat = change(*base_poses(allegro))
+    with pytest.raises(InputError, match=match):
+        ctrl.update_contacts(frame, pos, quat, 0.0)
+    assert ctrl.inputs.contacts is None and ctrl.counters.rejected["contacts"] == 1
+
+
+def test_wrench_axes_follow_its_frame(allegro):
+    model = allegro.hand.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, allegro.q)
+    R = data.oMf[model.getFrameId("link_13.0")].rotation
+    w = allegro.external_wrench * 1.3
+    a, b = fresh(allegro), fresh(allegro)
+    for c in (a, b):
+        c.update_joint_state(*joint_state(allegro), 0.0)
+    a.update_wrench("", w[:3], w[3:], 0.0)
+    b.update_wrench("link_13.0", R.T @ w[:3], R.T @ w[3:], 0.0)
+    np.testing.assert_allclose(a.cycle(0.0).command, b.cycle(0.0).command, atol=1e-9)
+    with pytest.raises(InputError, match="external_wrench.wrench.force: must be finite"):
+        a.update_wrench("", [0, np.inf, 0], [0, 0, 0], 0.0)
+
+
+@pytest.mark.parametrize("policy", ["hold", "zero"])
+def test_stale_contacts_stop_commands_then_policy(planar, policy):
+    ctrl = fresh(planar, contacts_timeout=0.2, joint_state_timeout=0.1, hold_time=0.3,
+                 fault_policy=policy)
+    pos, quat = base_poses(planar)
+    ctrl.update_contacts("", pos, quat, 0.0)
+    js = joint_state(planar)
+    t, kinds = 0.0, []
+    while t < 1.0:
+        ctrl.update_joint_state(*js, t)
+        kinds.append((t, ctrl.cycle(t).kind))
+        t += 0.01
+    last_solution = max(tt for tt, k in kinds if k == "solution")
+    assert last_solution <= 0.2 + 1e-9
+    assert all(k != "solution" for tt, k in kinds if tt > 0.2 + 1e-9)
+    # Held (nothing published) until hold_time after the last command, then the policy.
+    after = [k for tt, k in kinds if tt > last_solution + 0.3 + 1e-9]
+    assert after and set(after) == ({"zero"} if policy == "zero" else {"none"})
+    assert all(k == "none" for tt, k in kinds if last_solution < tt < last_solution + 0.3 - 1e-9)
+    # Fresh contacts: the next joint state recovers at once.
+    ctrl.update_contacts("", pos, quat, t)
+    ctrl.update_joint_state(*js, t)
+    assert ctrl.cycle(t).kind == "solution"
+    assert ctrl.counters.recoveries == 1 and ctrl.fault == ""
+
+
+def test_watchdog_sees_stale_joint_states(planar):
+    ctrl = fresh(planar, joint_state_timeout=0.05, hold_time=0.0, fault_policy="zero")
+    assert ctrl.watchdog(0.0) is None  # not started
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    assert ctrl.cycle(0.0).kind == "solution"
+    assert ctrl.watchdog(0.04) is None
+    r = ctrl.watchdog(0.06)
+    assert r.kind == "zero" and "joint_states stale" in r.fault
+    np.testing.assert_array_equal(r.command, np.zeros(4))
+
+
+def test_infeasible_load_gives_no_command(planar):
+    ctrl = fresh(planar)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.update_wrench("", [0.0, -500.0, 0.0], [0.0, 0.0, 0.0], 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None and r.solution.status == "infeasible"
+    assert "no certified solution (infeasible" in r.fault
+
+
+def test_gravity_compensation_adds_g(allegro):
+    gravity = np.array([9.81, 0.0, 0.0])
+    ctrl = fresh(allegro, gravity_compensation=True, gravity=tuple(gravity))
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.kind == "solution"
+    model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path("."))))
+    model.gravity.linear = gravity
+    g = pin.computeGeneralizedGravity(model, model.createData(), allegro.q)[allegro.hand.idx_v]
+    np.testing.assert_allclose(r.gravity_torque, g, atol=1e-12)
+    assert np.linalg.norm(g) > 1e-3
+    np.testing.assert_allclose(r.command, r.solution.tau + g, atol=1e-12)
+    shifted = dataclasses.replace(allegro, torque_offset=g)
+    assert_holds(shifted, r.maps, r.solution.tau, r.solution.wrenches)
+    assert np.all(np.abs(r.command) <= allegro.hand.torque_limits)

@@ -1,0 +1,56 @@
+"""The diagnostic report is a pure function of the controller's state."""
+
+import numpy as np
+import pytest
+from test_controller import fresh, joint_state
+
+from grasp_torque_opt.diagnostics import ERROR, OK, STALE, WARN, report
+from grasp_torque_opt.exceptions import InputError
+
+
+def values(rep):
+    return dict(rep.values)
+
+
+def test_levels_follow_the_cycle(planar):
+    ctrl = fresh(planar, joint_state_timeout=0.05, hold_time=0.1, fault_policy="zero")
+    rep = report(ctrl, 0.0)
+    assert rep.level == STALE and rep.message == "waiting for joint_states"
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.cycle(0.0)
+    rep = report(ctrl, 0.01)
+    v = values(rep)
+    assert rep.level == OK and v["status"] == "optimal" and v["certificate.ok"] == "true"
+    assert float(v["torque_norm"]) > 0 and int(v["iterations"]) > 0
+    for i, c in enumerate(planar.contacts):
+        usage = float(v[f"contact{i}.{c.link}.tangential_usage"])
+        assert 0.0 <= usage <= 1.0 + 1e-6
+        assert float(v[f"contact{i}.{c.link}.torsional_usage"]) <= 1.0 + 1e-6
+    ctrl.watchdog(0.08)
+    rep = report(ctrl, 0.08)
+    assert rep.level == WARN and rep.message.startswith("holding last certified command")
+    ctrl.watchdog(0.2)
+    rep = report(ctrl, 0.2)
+    assert rep.level == ERROR and rep.message.startswith("zero torques published")
+    assert values(rep)["zero_commands"] == "1" and values(rep)["faults"] == "1"
+
+
+def test_rejections_are_reported(planar):
+    ctrl = fresh(planar)
+    with pytest.raises(InputError):
+        ctrl.update_joint_state(["joint1"], [0.0, 1.0], 0.0)
+    v = values(report(ctrl, 0.0))
+    assert v["rejected.joint_states"] == "1"
+    assert v["last_rejection"] == "joint_states: 1 names but 2 positions"
+
+
+def test_friction_usage_matches_the_wrenches(allegro):
+    ctrl = fresh(allegro)
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    r = ctrl.cycle(0.0)
+    v = values(report(ctrl, 0.0))
+    mu1 = allegro.friction.mu1
+    for i, (c, w) in enumerate(zip(allegro.contacts, r.solution.wrenches)):
+        expected = np.hypot(w[0], w[1]) / (mu1 * w[2])
+        assert float(v[f"contact{i}.{c.link}.tangential_usage"]) == \
+            float(f"{expected:.4f}")
