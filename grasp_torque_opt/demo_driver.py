@@ -8,6 +8,8 @@ rate, solve time, torque norm, status), then a summary.
 
 ``--with-node`` starts ``grasp_torque_node`` in a child process first, on a
 private ROS domain with localhost-only discovery, and stops it at the end.
+``--watch`` publishes nothing and prints the live line of a node already
+running: a way to see what it does without RViz.
 """
 
 from __future__ import annotations
@@ -39,6 +41,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--amplitude", type=float, default=0.01, help="joint motion [rad]")
     p.add_argument("--with-node", action="store_true",
                    help="start grasp_torque_node in a child process")
+    p.add_argument("--watch", action="store_true",
+                   help="publish nothing: only print what a running node does "
+                        "(on the current ROS_DOMAIN_ID)")
     return p
 
 
@@ -52,7 +57,12 @@ def _scenario_of(params: Path) -> str:
 def main(argv: list[str] | None = None) -> int:
     """Run the demo; exit code 0 when certified commands flowed and all were well-formed."""
     args = _parser().parse_args(argv)
-    _isolate()
+    if args.with_node and args.watch:
+        print("grasp-torque-demo: error: --watch and --with-node exclude each other",
+              file=sys.stderr)
+        return 2
+    if not args.watch:
+        _isolate()
     from grasp_torque_opt.exceptions import InputError
     from grasp_torque_opt.resources import find_config
 
@@ -128,13 +138,17 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     node.create_subscription(Float64MultiArray, "effort_commands", on_command, COMMAND_QOS)
     node.create_subscription(DiagnosticArray, "/diagnostics", on_diagnostics, 10)
 
-    print(f"grasp-torque-demo: {scenario.name}, {hand.m} joints, joint states at "
-          f"{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID "
-          f"{os.environ['ROS_DOMAIN_ID']})")
+    domain = os.environ.get("ROS_DOMAIN_ID", "0")
+    if args.watch:
+        print(f"grasp-torque-demo: watching effort_commands and /diagnostics for "
+              f"{args.duration:g} s (ROS_DOMAIN_ID {domain})")
+    else:
+        print(f"grasp-torque-demo: {scenario.name}, {hand.m} joints, joint states at "
+              f"{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID {domain})")
     deadline = time.monotonic() + 30.0
     while node.count_subscribers("joint_states") == 0 and time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.1)
-    if node.count_subscribers("joint_states") == 0:
+    if node.count_subscribers("joint_states") == 0 and not args.watch:
         print("grasp-torque-demo: no grasp_torque_node is listening on joint_states",
               file=sys.stderr)
         node.destroy_node()
@@ -147,7 +161,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     last_count = 0
     q = setup.q.copy()
     while (now := time.monotonic()) < t0 + args.duration:
-        if now >= next_tick:
+        if now >= next_tick and not args.watch:
             next_tick += period
             t = now - t0
             for k, iq in enumerate(idx_q):
@@ -182,18 +196,22 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
             last_count = len(received)
             norm = np.linalg.norm(received[-1][1]) if received else float("nan")
             solve_ms = 1e3 * float(diag.get("solve_time_s", "nan"))
+            if args.watch:
+                next_tick = next_print
             print(f"t={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  "
                   f"|command| {norm:.4f} N m  status {diag.get('status', '-')}  "
                   f"fault {diag.get('fault', '-')}")
         rclpy.spin_once(node, timeout_sec=max(0.0, min(next_tick, next_print)
                                                    - time.monotonic()))
-    end = time.monotonic() + 0.2
+    played = dict(diag)  # the node's state while joint states flowed
+    end = time.monotonic() + 0.2  # the last commands in flight
     while time.monotonic() < end:
         rclpy.spin_once(node, timeout_sec=0.02)
+    diag = played
 
-    sent = int(args.duration * args.rate)
+    sent = "" if args.watch else f" for about {int(args.duration * args.rate)} joint states"
     norms = [np.linalg.norm(c) for _, c in received]
-    print(f"summary: {len(received)} commands for about {sent} joint states "
+    print(f"summary: {len(received)} commands{sent} "
           f"({len(received) / args.duration:.1f}/s); malformed {bad}; "
           + (f"|command| {min(norms):.4f} to {max(norms):.4f} N m; " if norms else "")
           + (f"solve time median {1e3 * np.median(solve_times):.3f} ms (diagnostics); "
@@ -203,7 +221,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
           f"last status {diag.get('status', '-')}")
     node.destroy_node()
     rclpy.try_shutdown()
-    return 0 if received and bad == 0 else 1
+    return 0 if (received or args.watch) and bad == 0 else 1
 
 
 if __name__ == "__main__":

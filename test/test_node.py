@@ -310,3 +310,11 @@ def test_qos_of_every_endpoint(planar_node):
     assert mk.topic_type == "visualization_msgs/msg/MarkerArray"
     services = dict(t.get_service_names_and_types())
     assert services["/grasp_torque_node/solve"] == ["std_srvs/srv/Trigger"]
+
+
+def test_readme_documents_every_parameter():
+    from grasp_torque_opt.node import PARAMETERS
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    for name in PARAMETERS:
+        assert f"| `{name}` |" in readme, name
