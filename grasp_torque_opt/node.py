@@ -65,8 +65,8 @@ PARAMETERS: dict[str, Spec] = {
     "scenario": Spec("Scenario file (DESIGN.md section 4): hand, default contacts and load. "
                      "A path, or the name of a bundled file in the package's config/.",
                      read_only=True),
-    "robot_description": Spec("URDF document of the hand (the ROS convention); empty: the "
-                              "scenario's hand.urdf.", read_only=True),
+    "robot_description": Spec("URDF document of the hand (the ROS convention) or a path to "
+                              "one; empty: the scenario's hand.urdf.", read_only=True),
     "joints": Spec("Actuated joints in command order (default: the scenario's).",
                    read_only=True),
     "object_origin": Spec("Object origin c in the base frame [m].", length="3"),
@@ -211,6 +211,8 @@ class GraspTorqueNode(Node):
             raise InputError("scenario", "parameter not set (a scenario file gives the "
                              "default contacts and load)")
         scenario = load_scenario(find_config(name))
+        if urdf and not urdf.lstrip().startswith("<"):
+            urdf = find_config(urdf, "robot_description").read_text()
         setup = GraspSetup.from_scenario(scenario, urdf or None)
         joints = self.declare_parameter("joints", list(setup.hand.joints),
                                         descriptor("joints")).value

@@ -23,6 +23,7 @@ from test_controller import base_poses, joint_state
 from test_hand import ALLEGRO_URDF
 from visualization_msgs.msg import Marker, MarkerArray
 
+from grasp_torque_opt.exceptions import InputError
 from grasp_torque_opt.grasp_setup import GraspSetup
 from grasp_torque_opt.hand import resolve_urdf
 from grasp_torque_opt.node import COMMAND_QOS, SERVICE_QOS, GraspTorqueNode
@@ -318,3 +319,28 @@ def test_readme_documents_every_parameter():
     readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
     for name in PARAMETERS:
         assert f"| `{name}` |" in readme, name
+
+
+@pytest.mark.parametrize("as_path", [False, True])
+def test_robot_description_gives_the_hand(planar, as_path):
+    urdf = PLANAR.parent.parent / "urdf" / "planar_two_finger.urdf"
+    h = Harness(PLANAR, robot_description=str(urdf) if as_path else urdf.read_text())
+    try:
+        h.send_joint_state(*joint_state(planar))
+        np.testing.assert_allclose(h.next_command(), solve(planar).tau, atol=1e-9)
+    finally:
+        h.close()
+
+
+def test_startup_errors_name_the_parameter():
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=DOMAIN)
+    try:
+        with pytest.raises(InputError, match="^scenario: parameter not set"):
+            GraspTorqueNode(context=ctx)
+        with pytest.raises(InputError, match="^torque_limits: must have 4 entries, got 1"):
+            GraspTorqueNode(context=ctx, parameter_overrides=[
+                Parameter("scenario", value=str(PLANAR)),
+                Parameter("torque_limits", value=[1.0])])
+    finally:
+        rclpy.try_shutdown(context=ctx)
