@@ -33,7 +33,8 @@ class FrameNotFound(InputError):
     def __init__(self, field: str, name: str, available: Iterable[str]) -> None:
         self.name = name
         self.available = sorted(available)
-        super().__init__(field, f"unknown frame '{name}' (model frames: {_choices(self.available)})")
+        super().__init__(field,
+                         f"unknown frame '{name}' (model frames: {_choices(self.available)})")
 
 
 class JointNotFound(InputError):

@@ -195,7 +195,7 @@ class TauQPSolver:
         n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
         A = qp.A if n_eq else None
         b = qp.b if n_eq else None
-        l = np.full(n_in, -np.inf)
+        lower = np.full(n_in, -np.inf)
         t0 = time.perf_counter()
         try:
             if self._dims != (n, n_eq, n_in):
@@ -210,11 +210,11 @@ class TauQPSolver:
                 s.eps_duality_gap_abs = self.settings.eps_abs
                 s.eps_duality_gap_rel = 0.0
                 s.initial_guess = proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS
-                self._qp.init(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=l, u=qp.u,
+                self._qp.init(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=lower, u=qp.u,
                               l_box=qp.l_box, u_box=qp.u_box)
                 self._dims = (n, n_eq, n_in)
             else:
-                self._qp.update(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=l, u=qp.u,
+                self._qp.update(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=lower, u=qp.u,
                                 l_box=qp.l_box, u_box=qp.u_box)
             self._qp.solve()
         except (RuntimeError, ValueError, TypeError) as e:

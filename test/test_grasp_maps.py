@@ -1,4 +1,4 @@
-"""G and J against first principles: moments summed by hand, finite differences of the kinematics."""
+"""G and J from first principles: moments summed by hand, finite differences of kinematics."""
 
 import numpy as np
 import pinocchio as pin
