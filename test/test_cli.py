@@ -1,7 +1,7 @@
 """The command line: its JSON contract, exit codes and one-line errors."""
 
 import json
-import math
+import re
 import subprocess
 import sys
 
@@ -10,6 +10,7 @@ import pytest
 import yaml
 from conftest import ALLEGRO, PLANAR
 from independent import assert_holds
+from test_scenario import BAD, mutated
 
 from grasp_torque_opt.cli import main
 
@@ -53,22 +54,20 @@ def test_infeasible_exits_3_without_torques(tmp_path, capsys):
     assert d["tau"] is None and all(c["wrench"] is None for c in d["contacts"])
 
 
-@pytest.mark.parametrize("field,value,named", [
-    (("friction", "polygon_sides"), 2, "friction.polygon_sides"),
-    (("load", "external_wrench"), [0, 0, math.nan, 0, 0, 0], r"load.external_wrench\[2\]"),
-    (("hand", "joints"), ["joint1", "joint2", "joint3", "nope"], r"hand.joints\[3\]"),
-])
-def test_bad_input_exits_2_with_one_line(tmp_path, capsys, field, value, named):
-    doc = yaml.safe_load(PLANAR.read_text())
-    doc[field[0]][field[1]] = value
-    doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
-    path = tmp_path / "bad.yaml"
-    path.write_text(yaml.dump(doc))
-    code, out, err = run(["solve", str(path)], capsys)
+@pytest.mark.parametrize("path,value,field,problem", BAD,
+                         ids=[".".join(map(str, b[0])) + f"={b[1]!r}" for b in BAD])
+def test_bad_scenario_file_exits_2_with_one_line(tmp_path, capsys, planar_doc, path, value,
+                                                 field, problem):
+    doc = mutated(planar_doc, path, value)
+    if "urdf" in doc["hand"]:
+        doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.dump(doc))
+    code, out, err = run(["solve", str(bad), "--json"], capsys)
     assert code == 2 and out == ""
     assert len(err.splitlines()) == 1
-    assert err.startswith("grasp-torque-opt: error: ")
-    assert __import__("re").search(named, err)
+    assert re.match(rf"grasp-torque-opt: error: {re.escape(str(bad))}: {field}: ", err), err
+    assert re.search(problem, err)
 
 
 def test_compare_table_and_json(capsys):
