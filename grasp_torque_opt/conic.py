@@ -9,7 +9,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from grasp_torque_opt.exceptions import SolverError
-from grasp_torque_opt.tau_qp import RawResult
+from grasp_torque_opt.solution import RawResult
 
 #: Clarabel's feasibility and gap tolerances (tighter than its defaults, so that
 #: its optima pass the 1e-6 certificate with room to spare).

@@ -175,7 +175,6 @@ class TorqueController:
         self.last: CycleResult | None = None
         self.fault = ""
         self.last_rejection = ""
-        self._names = {n: i for i, n in enumerate(self.setup.hand.joints)}
         model = self.setup.hand.model
         self._model_joints = {model.names[j]: model.joints[j].idx_q
                               for j in range(1, model.njoints) if model.joints[j].nq == 1}

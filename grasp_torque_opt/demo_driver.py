@@ -207,7 +207,6 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     end = time.monotonic() + 0.2  # the last commands in flight
     while time.monotonic() < end:
         rclpy.spin_once(node, timeout_sec=0.02)
-    diag = played
 
     sent = "" if args.watch else f" for about {int(args.duration * args.rate)} joint states"
     norms = [np.linalg.norm(c) for _, c in received]
@@ -216,9 +215,9 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
           + (f"|command| {min(norms):.4f} to {max(norms):.4f} N m; " if norms else "")
           + (f"solve time median {1e3 * np.median(solve_times):.3f} ms (diagnostics); "
              if solve_times else "")
-          + f"node cycles {diag.get('cycles', '-')}, faults {diag.get('faults', '-')}, "
-          f"rejected joint states {diag.get('rejected.joint_states', '-')}, "
-          f"last status {diag.get('status', '-')}")
+          + f"node cycles {played.get('cycles', '-')}, faults {played.get('faults', '-')}, "
+          f"rejected joint states {played.get('rejected.joint_states', '-')}, "
+          f"last status {played.get('status', '-')}")
     node.destroy_node()
     rclpy.try_shutdown()
     return 0 if (received or args.watch) and bad == 0 else 1

@@ -22,7 +22,7 @@ from scipy.optimize import minimize
 
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.scenario import Friction
-from grasp_torque_opt.tau_qp import RawResult
+from grasp_torque_opt.solution import RawResult
 
 #: Smoothing of ||(fx, fy)|| at 0 [N]; the smoothed cone is inside the exact one.
 EPS = 1e-9

@@ -21,7 +21,7 @@ import numpy as np
 from grasp_torque_opt.conic import solve_conic
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.scenario import Friction
-from grasp_torque_opt.tau_qp import RawResult
+from grasp_torque_opt.solution import RawResult
 
 
 def solve_exact_socp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,

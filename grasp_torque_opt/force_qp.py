@@ -18,7 +18,7 @@ from grasp_torque_opt.conic import solve_conic
 from grasp_torque_opt.friction import friction_matrix
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.scenario import Friction
-from grasp_torque_opt.tau_qp import RawResult
+from grasp_torque_opt.solution import RawResult
 
 OBJECTIVES = ("force", "torque")
 

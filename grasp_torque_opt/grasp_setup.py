@@ -63,10 +63,6 @@ class GraspSetup:
         else:
             hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
                                   scenario.joints, scenario.torque_limits)
-        if isinstance(scenario.torque_limits, list) and len(scenario.torque_limits) != hand.m:
-            raise InputError("hand.torque_limits",
-                             f"must have {hand.m} entries (one per joint), "
-                             f"got {len(scenario.torque_limits)}")
         weights = np.ones(hand.m) if scenario.weights is None else np.asarray(scenario.weights)
         if weights.shape != (hand.m,):
             raise InputError("objective.weights",

@@ -136,9 +136,12 @@ class Hand:
                                      f"the URDF gives no effort limit for joint '{name}'; "
                                      "set hand.torque_limits")
         else:
-            limits = np.broadcast_to(np.asarray(torque_limits, dtype=float), (len(joints),))
-            if limits.shape != (len(joints),):
-                raise InputError("hand.torque_limits", f"must have {len(joints)} entries")
+            limits = np.asarray(torque_limits, dtype=float)
+            if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):
+                raise InputError("hand.torque_limits",
+                                 f"must have {len(joints)} entries (one per joint), "
+                                 f"got {limits.size}")
+            limits = np.broadcast_to(limits, (len(joints),))
             if not np.all(np.isfinite(limits) & (limits > 0.0)):
                 raise InputError("hand.torque_limits", "must be finite and > 0")
         return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,

@@ -55,3 +55,22 @@ class Solution:
     def torque_norm(self) -> float | None:
         """||tau||_2 [N m], or None."""
         return None if self.tau is None else float(np.linalg.norm(self.tau))
+
+
+@dataclass(frozen=True)
+class RawResult:
+    """What a solver said, before certification.
+
+    Attributes:
+        status: ``solved``, ``infeasible`` or ``error``.
+        x: the solver's primal variables (None if it gave none).
+        iterations: iterations it reported.
+        solve_time_s: wall time of the solver call [s].
+        message: the solver's own status text.
+    """
+
+    status: str
+    x: np.ndarray | None
+    iterations: int
+    solve_time_s: float
+    message: str

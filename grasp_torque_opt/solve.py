@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 
 from grasp_torque_opt.certificate import DEFAULT_TOLERANCE, certify
 from grasp_torque_opt.exact_nlp import solve_exact_nlp
@@ -101,8 +100,3 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     else:
         out.message = f"not certified ({why})"
     return out
-
-
-def torque_norm(tau: np.ndarray, weights: np.ndarray) -> float:
-    """The objective's norm sqrt(tau^T W tau) [N m]."""
-    return float(np.sqrt(tau @ (weights * tau)))

@@ -33,6 +33,7 @@ from grasp_torque_opt.exceptions import SolverError
 from grasp_torque_opt.friction import friction_matrix
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.scenario import Friction
+from grasp_torque_opt.solution import RawResult
 
 #: Relative singular-value threshold for the rank of A.
 RANK_RTOL = 1e-10
@@ -151,25 +152,6 @@ class ProxSuiteSettings:
     max_iter: int = 1000
     max_iter_in: int = 200
     eps_primal_inf: float = 1e-8
-
-
-@dataclass(frozen=True)
-class RawResult:
-    """What a solver said, before certification.
-
-    Attributes:
-        status: ``solved``, ``infeasible`` or ``error``.
-        x: the solver's primal variables (None if it gave none).
-        iterations: iterations it reported.
-        solve_time_s: wall time of the solver call [s].
-        message: the solver's own status text.
-    """
-
-    status: str
-    x: np.ndarray | None
-    iterations: int
-    solve_time_s: float
-    message: str
 
 
 class TauQPSolver:

@@ -96,3 +96,15 @@ def test_console_script_runs_as_installed():
                           timeout=120)
     assert done.returncode == 2
     assert done.stderr.strip().startswith("grasp-torque-opt: error: /nonexistent.yaml: scenario:")
+
+
+def test_wrong_limit_count_without_joints_exits_2(tmp_path, capsys, planar_doc):
+    """With hand.joints omitted the count is only known from the URDF (4 joints)."""
+    doc = mutated(mutated(planar_doc, ("hand", "joints"), None),
+                  ("hand", "torque_limits"), [10.0, 5.0, 10.0])
+    doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.dump(doc))
+    code, out, err = run(["solve", str(bad)], capsys)
+    assert code == 2 and out == ""
+    assert err.endswith("hand.torque_limits: must have 4 entries (one per joint), got 3\n")
