@@ -7,6 +7,7 @@ pinned in DESIGN.md section 4; parameters, units and defaults in the README.
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -24,10 +25,12 @@ from geometry_msgs.msg import Point, PoseArray, WrenchStamped
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.task import Future
+from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
@@ -100,6 +103,9 @@ PARAMETERS: dict[str, Spec] = {
     "watchdog_period": Spec("Period of the staleness check between joint states [s].",
                             1e-4, 1.0, read_only=True),
     "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
+    "publish_stamped_command": Spec("Also publish each command on ~/effort_commands_stamped "
+                                    "(sensor_msgs/JointState: joints, effort, and the stamp of "
+                                    "the joint state it was computed from).", read_only=True),
 }
 
 
@@ -167,6 +173,7 @@ class GraspTorqueNode(Node):
             "diagnostics_period": 0.1,
             "watchdog_period": 0.01,
             "marker_scale": 0.02,
+            "publish_stamped_command": False,
         }
         for name, value in defaults.items():
             self.declare_parameter(name, value, descriptor(name))
@@ -189,6 +196,10 @@ class GraspTorqueNode(Node):
                                  qos_profile_sensor_data)
         self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
                                                   COMMAND_QOS)
+        self._stamped_pub = None
+        if self.get_parameter("publish_stamped_command").value:
+            self._stamped_pub = self.create_publisher(JointState, "~/effort_commands_stamped",
+                                                      COMMAND_QOS)
         self._marker_pub = self.create_publisher(MarkerArray, "~/contact_wrenches", 1)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         # The service solves in a worker thread while the executor goes on with the loop.
@@ -273,7 +284,7 @@ class GraspTorqueNode(Node):
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
                 return
-            self._publish(self.controller.cycle(now))
+            self._publish(self.controller.cycle(now), msg.header.stamp)
 
     def _on_contacts(self, msg: PoseArray) -> None:
         positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
@@ -301,7 +312,7 @@ class GraspTorqueNode(Node):
             if result is not None:
                 self._publish(result)
 
-    def _publish(self, result: CycleResult) -> None:
+    def _publish(self, result: CycleResult, stamp: Any = None) -> None:
         if result.fault:
             self.get_logger().warn(f"no command: {result.fault}", throttle_duration_sec=1.0)
         if result.command is None:
@@ -312,7 +323,13 @@ class GraspTorqueNode(Node):
                 np.any(np.abs(cmd) > self.controller.setup.hand.torque_limits):
             self.get_logger().error("refused to publish a malformed command")
             return
-        self._command_pub.publish(Float64MultiArray(data=[float(x) for x in cmd]))
+        data = [float(x) for x in cmd]
+        self._command_pub.publish(Float64MultiArray(data=data))
+        if self._stamped_pub is not None:
+            msg = JointState(name=list(self.controller.setup.hand.joints), effort=data)
+            msg.header.stamp = stamp if stamp is not None else self.get_clock().now().to_msg()
+            msg.header.frame_id = self.controller.setup.hand.base_frame
+            self._stamped_pub.publish(msg)
 
     # -- outputs between cycles -----------------------------------------------------------
 
@@ -386,16 +403,28 @@ class GraspTorqueNode(Node):
         super().destroy_node()
 
 
+#: Executors ``main`` can spin: rclpy's default and its experimental events executor.
+EXECUTORS = {"single": SingleThreadedExecutor, "events": EventsExecutor}
+
+
 def main(args: list[str] | None = None) -> int:
-    """Run the node (Jazzy pattern): spin, then destroy and shut down."""
-    rclpy.init(args=args)
+    """Run the node (Jazzy pattern): spin, then destroy and shut down.
+
+    Besides the ROS arguments, ``--executor single|events`` picks the executor.
+    """
+    argv = sys.argv if args is None else args
+    parser = argparse.ArgumentParser(prog=NODE_NAME)
+    parser.add_argument("--executor", choices=sorted(EXECUTORS), default="single",
+                        help="rclpy executor to spin (default: single)")
+    opts = parser.parse_args(remove_ros_args(argv)[1:])
+    rclpy.init(args=argv)
     node = None
     code = 0
     try:
         node = GraspTorqueNode()
         # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
         # the single-threaded one keeps up (the service runs in its own worker).
-        executor = SingleThreadedExecutor()
+        executor = EXECUTORS[opts.executor]()
         executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -344,3 +344,24 @@ def test_startup_errors_name_the_parameter():
                 Parameter("torque_limits", value=[1.0])])
     finally:
         rclpy.try_shutdown(context=ctx)
+
+
+def test_stamped_command_carries_the_joint_states_stamp(planar):
+    h = Harness(PLANAR, publish_stamped_command=True)
+    try:
+        stamped = []
+        h.tester.create_subscription(JointState, "grasp_torque_node/effort_commands_stamped",
+                                     stamped.append, COMMAND_QOS)
+        h.spin_until(lambda: h.node.count_subscribers(
+            "grasp_torque_node/effort_commands_stamped") > 0, 5.0)
+        msg = JointState(name=list(planar.hand.joints),
+                         position=[float(planar.q[i]) for i in planar.hand.idx_q])
+        msg.header.stamp.sec, msg.header.stamp.nanosec = 1234, 5678
+        h.js_pub.publish(msg)
+        assert h.spin_until(lambda: stamped and h.commands, 5.0)
+        out = stamped[-1]
+        assert (out.header.stamp.sec, out.header.stamp.nanosec) == (1234, 5678)
+        assert list(out.name) == list(planar.hand.joints)
+        np.testing.assert_array_equal(out.effort, h.commands[-1][1])
+    finally:
+        h.close()
