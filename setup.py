@@ -27,6 +27,9 @@ setup(
         "proxsuite",
         "clarabel",
         "example-robot-data",
+        # Selectable QP backends (grasp_torque_opt.backends).
+        "daqp",
+        "quadprog",
     ],
     extras_require={
         # ROS 2 Jazzy from the registry's ros-jazzy-* wheels; optional so that the
@@ -41,6 +44,8 @@ setup(
             "ros-jazzy-diagnostic-msgs",
         ],
         "test": ["pytest", "hypothesis"],
+        # bench/: the other solvers compared, and process memory.
+        "bench": ["osqp", "psutil"],
     },
     zip_safe=True,
     maintainer="grasp_torque_opt developers",

@@ -10,6 +10,7 @@ import argparse
 import json
 import sys
 
+from grasp_torque_opt.backends import BACKENDS
 from grasp_torque_opt.compare import compare, format_table
 from grasp_torque_opt.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.grasp_setup import GraspSetup
@@ -29,6 +30,8 @@ def _parser() -> argparse.ArgumentParser:
     p_solve = sub.add_parser("solve", help="solve one scenario with one method")
     p_solve.add_argument("scenario", help="scenario YAML file")
     p_solve.add_argument("--method", choices=METHODS, default="tau-qp")
+    p_solve.add_argument("--backend", choices=BACKENDS, default="proxsuite",
+                         help="QP solver of the tau-qp method (default: proxsuite)")
     p_solve.add_argument("--json", action="store_true", help="print one JSON object")
     p_cmp = sub.add_parser("compare", help="every method side by side (the paper's Table 2)")
     p_cmp.add_argument("scenario", help="scenario YAML file")
@@ -61,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         setup = GraspSetup.from_file(args.scenario)
         if args.command == "solve":
-            sol = solve(setup, args.method)
+            sol = solve(setup, args.method, backend=args.backend)
             d = solution_dict(sol, setup.maps())
             if args.json:
                 print(json.dumps(d))

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 
-
+from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.certificate import DEFAULT_TOLERANCE, certify
 from grasp_torque_opt.exact_nlp import solve_exact_nlp
 from grasp_torque_opt.exact_socp import solve_exact_socp
@@ -27,7 +27,7 @@ LINEARIZED = ("tau-qp", "force-qp")
 
 
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
-          solver: TauQPSolver | None = None,
+          solver: TauQPSolver | None = None, backend: str = "proxsuite",
           tolerance: float = DEFAULT_TOLERANCE) -> Solution:
     """Solve one grasp with one method and certify the result.
 
@@ -35,7 +35,9 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         setup: the grasp.
         method: one of :data:`METHODS`.
         maps: G and J if already computed (else computed here).
-        solver: a ProxSuite solver to reuse across calls (tau-qp only).
+        solver: a tau-QP solver to reuse across calls (tau-qp only), any backend
+            of :mod:`grasp_torque_opt.backends`.
+        backend: the backend to use when no solver is given (tau-qp only).
         tolerance: certificate tolerance, SI units.
 
     Returns:
@@ -55,7 +57,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     if method == "tau-qp":
         qp = build_tau_qp(*args)
         t2 = time.perf_counter()
-        raw = (solver or TauQPSolver()).solve(qp)
+        raw = (solver or make_solver(backend)).solve(qp)
         tau, f = (None, None) if raw.x is None else (qp.split(raw.x)[0], qp.wrenches(raw.x))
     else:
         t2 = time.perf_counter()

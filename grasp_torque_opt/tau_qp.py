@@ -154,8 +154,24 @@ class ProxSuiteSettings:
     eps_primal_inf: float = 1e-8
 
 
+def check_data(qp: TauQP) -> str:
+    """Why a QP must not reach a solver ('' if it may): non-finite data, NaN or inverted bounds.
+
+    One NaN in its data made ProxSuite run for 84 s uncapped and return NaN.
+    """
+    data = (qp.H, qp.g, qp.A, qp.b, qp.C, qp.u)
+    if not all(np.all(np.isfinite(a)) for a in data):
+        return "QP data not finite"
+    if np.any(np.isnan(qp.l_box)) or np.any(np.isnan(qp.u_box)) or \
+            np.any(qp.l_box > qp.u_box):
+        return "QP bounds NaN or inverted (lower > upper)"
+    return ""
+
+
 class TauQPSolver:
     """ProxSuite dense solver for tau-QPs, allocated once per problem size."""
+
+    name = "proxsuite"
 
     def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
         self.settings = settings or ProxSuiteSettings()
@@ -171,9 +187,9 @@ class TauQPSolver:
         Raises:
             SolverError: ProxSuite raised (chained).
         """
-        data = (qp.H, qp.g, qp.A, qp.b, qp.C, qp.u)
-        if not all(np.all(np.isfinite(a)) for a in data) or np.any(qp.l_box > qp.u_box):
-            return RawResult("error", None, 0, 0.0, "QP data not finite or bounds inverted")
+        why = check_data(qp)
+        if why:
+            return RawResult("error", None, 0, 0.0, why)
         n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
         A = qp.A if n_eq else None
         b = qp.b if n_eq else None

@@ -108,3 +108,14 @@ def test_wrong_limit_count_without_joints_exits_2(tmp_path, capsys, planar_doc):
     code, out, err = run(["solve", str(bad)], capsys)
     assert code == 2 and out == ""
     assert err.endswith("hand.torque_limits: must have 4 entries (one per joint), got 3\n")
+
+
+@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+def test_backend_option_gives_the_same_certified_torques(allegro, capsys, backend):
+    code, out, _ = run(["solve", str(ALLEGRO), "--json"], capsys)
+    default = json.loads(out)
+    code, out, err = run(["solve", str(ALLEGRO), "--backend", backend, "--json"], capsys)
+    assert code == 0 and err == ""
+    d = json.loads(out)
+    assert d["certificate"]["ok"] is True and backend.upper()[:4] in d["message"].upper()
+    np.testing.assert_allclose(d["tau"], default["tau"], atol=1e-6)

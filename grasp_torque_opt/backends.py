@@ -1,0 +1,127 @@
+"""QP backends for the tau-QP: ProxSuite (the default), DAQP and quadprog.
+
+Every backend takes a built :class:`~grasp_torque_opt.tau_qp.TauQP` and returns
+a :class:`~grasp_torque_opt.solution.RawResult`; none is trusted: the caller
+certifies whatever comes back (:func:`grasp_torque_opt.solve.solve`). Each
+refuses non-finite data and inverted bounds before calling its solver, and each
+has its iterations capped, so one cycle can never stall.
+
+- ``proxsuite``: :class:`~grasp_torque_opt.tau_qp.TauQPSolver`, dense ProxQP,
+  the design's choice.
+- ``daqp``: DAQP, a dual active-set method, exact to its tolerances on small
+  dense QPs. A positive semidefinite Hessian (the internal-force variables z
+  carry no cost) is handled by DAQP's proximal-point iterations.
+- ``quadprog``: Goldfarb-Idnani; needs a positive definite Hessian, so only
+  grasps without internal-force variables (k = 0, e.g. the Allegro's four
+  fingertips); otherwise it returns an error, never a regularized answer.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from grasp_torque_opt.solution import RawResult
+from grasp_torque_opt.tau_qp import ProxSuiteSettings, TauQP, TauQPSolver, check_data
+
+#: Selectable backends; the first is the default.
+BACKENDS = ("proxsuite", "daqp", "quadprog")
+#: DAQP's "infinite" bound.
+DAQP_INF = 1e30
+
+
+class DaqpSolver:
+    """DAQP on the tau-QP: bounds on x, then the equalities, then the cone rows.
+
+    Args:
+        settings: ``eps_abs`` is DAQP's primal tolerance, ``max_iter`` its
+            iteration cap; the rest does not apply.
+    """
+
+    name = "daqp"
+
+    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+        import daqp  # imported here: the core runs without the optional backends
+
+        self._daqp = daqp
+        self.settings = settings or ProxSuiteSettings()
+
+    def solve(self, qp: TauQP) -> RawResult:
+        """Solve a built tau-QP from a cold start."""
+        why = check_data(qp)
+        if why:
+            return RawResult("error", None, 0, 0.0, why)
+        n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
+        A = np.vstack((qp.A, qp.C))
+        upper = np.concatenate((np.minimum(qp.u_box, DAQP_INF), qp.b, qp.u))
+        lower = np.concatenate((np.maximum(qp.l_box, -DAQP_INF), qp.b, np.full(n_in, -DAQP_INF)))
+        sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
+        sense[n:n + n_eq] = 5  # equality
+        t0 = time.perf_counter()
+        x, _, flag, info = self._daqp.solve(
+            qp.H, qp.g, A, upper, lower, sense, primal_tol=self.settings.eps_abs,
+            iter_limit=self.settings.max_iter, eps_prox=0.0 if n == qp.m else -1e-6)
+        elapsed = time.perf_counter() - t0
+        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
+        return RawResult(status, np.asarray(x, dtype=float), int(info["iterations"]), elapsed,
+                         f"DAQP exit flag {int(flag)}")
+
+
+class QuadprogSolver:
+    """quadprog (Goldfarb-Idnani) on the tau-QP; grasps with k = 0 only.
+
+    Args:
+        settings: unused (quadprog has no tolerances; its active-set method
+            ends after finitely many steps).
+    """
+
+    name = "quadprog"
+
+    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+        import quadprog
+
+        self._quadprog = quadprog
+        self.settings = settings or ProxSuiteSettings()
+
+    def solve(self, qp: TauQP) -> RawResult:
+        """Solve a built tau-QP."""
+        why = check_data(qp)
+        if why:
+            return RawResult("error", None, 0, 0.0, why)
+        if qp.H.shape[0] != qp.m:
+            return RawResult("error", None, 0, 0.0, "quadprog needs a positive definite "
+                             f"Hessian; this grasp has {qp.H.shape[0] - qp.m} internal-force "
+                             "variables")
+        n = qp.m
+        lo, hi = np.isfinite(qp.l_box), np.isfinite(qp.u_box)
+        eye = np.eye(n)
+        # quadprog: C^T x >= b, the first meq rows equalities.
+        C = np.vstack((qp.A, -qp.C, eye[lo], -eye[hi])).T
+        b = np.concatenate((qp.b, -qp.u, qp.l_box[lo], -qp.u_box[hi]))
+        t0 = time.perf_counter()
+        try:
+            x, _, _, _, iterations, _ = self._quadprog.solve_qp(qp.H, -qp.g, C, b,
+                                                                meq=qp.A.shape[0])
+        except ValueError as e:
+            elapsed = time.perf_counter() - t0
+            status = "infeasible" if "inconsistent" in str(e) else "error"
+            return RawResult(status, None, 0, elapsed, f"quadprog: {e}")
+        elapsed = time.perf_counter() - t0
+        return RawResult("solved", np.asarray(x, dtype=float), int(iterations[0]), elapsed,
+                         "quadprog solved")
+
+
+def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None):
+    """A tau-QP solver by backend name (one of :data:`BACKENDS`).
+
+    Raises:
+        ValueError: an unknown backend, naming the known ones.
+    """
+    if backend == "proxsuite":
+        return TauQPSolver(settings)
+    if backend == "daqp":
+        return DaqpSolver(settings)
+    if backend == "quadprog":
+        return QuadprogSolver(settings)
+    raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")

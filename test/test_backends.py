@@ -1,0 +1,90 @@
+"""Every QP backend: the same certified optimum as an independent solver, and no stall on bad data."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from independent import assert_holds
+
+from grasp_torque_opt.backends import BACKENDS, make_solver
+from grasp_torque_opt.force_qp import solve_force_qp
+from grasp_torque_opt.solve import solve
+from grasp_torque_opt.tau_qp import build_tau_qp
+
+
+def force_space_optimum(setup, maps):
+    """tau of the force-space QP with the torque objective (Clarabel), or None if infeasible."""
+    raw = solve_force_qp(maps, setup.friction, setup.external_wrench, *setup.tau_bounds,
+                         setup.weights, objective="torque")
+    return None if raw.status != "solved" else maps.J.T @ raw.x
+
+
+@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+def test_allegro_backends_match_clarabel_on_seeded_loads(backend, allegro):
+    rng = np.random.default_rng(7)
+    solver = make_solver(backend)
+    maps = allegro.maps()
+    checked = 0
+    for _ in range(20):
+        w = allegro.external_wrench * rng.uniform(0.3, 1.5) + np.concatenate(
+            (rng.normal(scale=0.3, size=3), rng.normal(scale=0.01, size=3)))
+        setup = dataclasses.replace(allegro, external_wrench=w)
+        ours = solve(setup, maps=maps, solver=solver)
+        ref = force_space_optimum(setup, maps)
+        if ref is None:
+            assert ours.status == "infeasible"
+            continue
+        assert ours.status == "optimal", ours.message
+        assert_holds(setup, maps, ours.tau, ours.wrenches)
+        np.testing.assert_allclose(ours.tau, ref, atol=1e-5)
+        checked += 1
+    assert checked >= 15
+
+
+@pytest.mark.parametrize("name", ["planar", "hyperstatic"])
+def test_daqp_handles_internal_force_variables(name, request):
+    """z has no cost there (semidefinite Hessian): DAQP's proximal iterations still find tau*."""
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    ours = solve(setup, maps=maps, backend="daqp")
+    assert ours.status == "optimal", ours.message
+    np.testing.assert_allclose(ours.tau, force_space_optimum(setup, maps), atol=1e-5)
+
+
+def test_quadprog_refuses_a_semidefinite_qp(planar):
+    sol = solve(planar, backend="quadprog")
+    assert sol.status == "failed" and sol.tau is None
+    assert "positive definite" in sol.message
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_infeasible_load_is_not_passed_through(backend, allegro):
+    heavy = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * 1e4)
+    sol = solve(heavy, backend=backend)
+    assert sol.status == "infeasible" and sol.tau is None
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("defect", ["nan_in_C", "inf_in_u", "inverted_box", "nan_box"])
+def test_bad_qp_data_never_reaches_the_solver(backend, defect, allegro):
+    maps = allegro.maps()
+    qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
+                      allegro.weights)
+    if defect == "nan_in_C":
+        C = qp.C.copy()
+        C[3, 2] = np.nan
+        qp = dataclasses.replace(qp, C=C)
+    elif defect == "inf_in_u":
+        qp = dataclasses.replace(qp, u=np.where(np.arange(qp.u.size) == 0, np.inf, qp.u))
+    elif defect == "inverted_box":
+        qp = dataclasses.replace(qp, l_box=qp.u_box + 0.1)
+    else:
+        qp = dataclasses.replace(qp, u_box=np.full_like(qp.u_box, np.nan))
+    raw = make_solver(backend).solve(qp)
+    assert raw.status == "error" and raw.x is None
+    assert "QP" in raw.message
+
+
+def test_unknown_backend_is_named():
+    with pytest.raises(ValueError, match="proxsuite, daqp, quadprog.*'osqp'"):
+        make_solver("osqp")
