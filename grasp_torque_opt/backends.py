@@ -59,8 +59,9 @@ class DaqpSolver:
         sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
         sense[n:n + n_eq] = 5  # equality
         t0 = time.perf_counter()
+        # DAQP wants writable buffers; H is shared read-only.
         x, _, flag, info = self._daqp.solve(
-            qp.H, qp.g, A, upper, lower, sense, primal_tol=self.settings.eps_abs,
+            qp.H.copy(), qp.g, A, upper, lower, sense, primal_tol=self.settings.eps_abs,
             iter_limit=self.settings.max_iter, eps_prox=0.0 if n == qp.m else -1e-6)
         elapsed = time.perf_counter() - t0
         status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
@@ -101,7 +102,7 @@ class QuadprogSolver:
         b = np.concatenate((qp.b, -qp.u, qp.l_box[lo], -qp.u_box[hi]))
         t0 = time.perf_counter()
         try:
-            x, _, _, _, iterations, _ = self._quadprog.solve_qp(qp.H, -qp.g, C, b,
+            x, _, _, _, iterations, _ = self._quadprog.solve_qp(qp.H.copy(), -qp.g, C, b,
                                                                 meq=qp.A.shape[0])
         except ValueError as e:
             elapsed = time.perf_counter() - t0

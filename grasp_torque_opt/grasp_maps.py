@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from grasp_torque_opt.contact_frame import contact_rotation
-from grasp_torque_opt.exceptions import FrameNotFound, InputError
+from grasp_torque_opt.contact_frame import contact_rotations
+from grasp_torque_opt.exceptions import InputError
 from grasp_torque_opt.hand import Hand
 from grasp_torque_opt.scenario import ContactSpec
 
@@ -73,48 +73,24 @@ class GraspMaps:
         return len(self.contacts)
 
 
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def frame_id(model: pin.Model, name: str, field: str) -> int:
-    """Index of a model frame by name.
-
-    Raises:
-        FrameNotFound: naming ``field``.
-    """
-    if not model.existFrame(name):
-        raise FrameNotFound(field, name, {f.name for f in model.frames})
-    return model.getFrameId(name)
-
-
-def grasp_block(frame: ContactFrame, object_origin: np.ndarray) -> np.ndarray:
-    """G_i, shape (6, 4): wrench on the object about c of f_i = [fx, fy, fz, mz]."""
-    R = frame.rotation
-    G_i = np.zeros((6, 4))
-    G_i[:3, :3] = R
-    G_i[3:, :3] = _skew(frame.position - object_origin) @ R
-    G_i[3:, 3] = R[:, 2]
-    return G_i
-
-
-def jacobian_block(frame: ContactFrame, J6: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """J_i, shape (4, nv): contact-frame rows of the contact point's Jacobian.
-
-    Args:
-        frame: the contact frame.
-        J6: 6 x nv Jacobian of the link frame, pinocchio.LOCAL_WORLD_ALIGNED
-            (linear velocity of the frame origin, angular velocity; base axes).
-        origin: the link frame origin, base frame [m].
-    """
-    lin = J6[:3] - _skew(frame.position - origin) @ J6[3:]
-    R = frame.rotation
-    return np.vstack((R.T @ lin, R[:, 2] @ J6[3:]))
+def _skews(v: np.ndarray) -> np.ndarray:
+    """skew(v_i) for rows v_i of v, shape (n, 3, 3)."""
+    out = np.zeros((len(v), 3, 3))
+    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
+    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = v[:, 2], -v[:, 1], v[:, 0]
+    return out
 
 
 def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
                        object_origin: np.ndarray) -> GraspMaps:
     """Contact frames, G and J at configuration q.
+
+    All contacts at once (batched numpy, no per-element Python loops):
+
+    - G_i = [[R_i, 0], [skew(p_i - c) R_i, z_i]] on [fx, fy, fz, mz];
+    - J_i = [R_i^T (J_v - skew(p_i - o_i) J_w); z_i^T J_w], with J_v, J_w the
+      linear and angular rows of the link frame's Jacobian
+      (pinocchio.LOCAL_WORLD_ALIGNED) at its origin o_i, actuated columns only.
 
     Args:
         hand: the hand.
@@ -127,29 +103,46 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
         FrameNotFound: an unknown link (``grasp.contacts[i].link``).
         InputError: a normal cannot be defaulted, or a tangent is parallel.
     """
-    model = hand.model
-    data = hand.data
+    model, data = hand.model, hand.data
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     c = np.asarray(object_origin, dtype=float)
-    frames, G_blocks, J_blocks = [], [], []
-    for i, spec in enumerate(contacts):
-        field = f"grasp.contacts[{i}]"
-        fid = frame_id(model, spec.link, f"{field}.link")
+    p = len(contacts)
+    fields = [f"grasp.contacts[{i}]" for i in range(p)]
+    fids = [hand.frame_index(spec.link, f"{field}.link")
+            for spec, field in zip(contacts, fields)]
+    origins, points, normals = [], [], []
+    for spec, fid, field in zip(contacts, fids, fields):
         oMf = data.oMf[fid]
-        p = oMf.act(np.asarray(spec.position, dtype=float))
+        o = oMf.translation
+        pt = oMf.act(np.asarray(spec.position, dtype=float))
         normal = spec.normal
         if normal is None:
-            d = c - p
-            if np.linalg.norm(d) < 1e-9:
+            normal = c - pt
+            if normal @ normal < 1e-18:
                 raise InputError(f"{field}.normal", "cannot default: the contact point "
                                  "coincides with grasp.object_origin")
-            normal = d
-        frame = ContactFrame(link=spec.link, frame_id=fid, position=p,
-                             rotation=contact_rotation(normal, spec.tangent, field))
-        J6 = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-        frames.append(frame)
-        G_blocks.append(grasp_block(frame, c))
-        J_blocks.append(jacobian_block(frame, J6, oMf.translation)[:, hand.idx_v])
-    return GraspMaps(G=np.hstack(G_blocks), J=np.vstack(J_blocks), contacts=frames,
-                     object_origin=c)
+        origins.append(o)
+        points.append(pt)
+        normals.append(normal)
+    points = np.array(points)
+    R = contact_rotations(np.array(normals), [spec.tangent for spec in contacts], fields)
+    # skew(v) rows for r_i = p_i - c (moments) and d_i = p_i - o_i (point velocity).
+    sk = _skews(np.concatenate((points - c, points - np.array(origins))))
+    Gb = np.zeros((p, 6, 4))
+    Gb[:, :3, :3] = R
+    Gb[:, 3:, :3] = sk[:p] @ R
+    Gb[:, 3:, 3] = R[:, :, 2]
+
+    J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+                   for fid in fids])[:, :, hand.idx_v]
+    ang = J6[:, 3:]
+    Jb = np.empty((p, 4, hand.m))
+    # Velocity of the contact point: v_o + w x (p - o) = J_v - skew(p - o) J_w.
+    Jb[:, :3] = R.transpose(0, 2, 1) @ (J6[:, :3] - sk[p:] @ ang)
+    Jb[:, 3] = (R[:, :, 2:].transpose(0, 2, 1) @ ang)[:, 0]
+
+    frames = [ContactFrame(link=spec.link, frame_id=fid, position=points[i], rotation=R[i])
+              for i, (spec, fid) in enumerate(zip(contacts, fids))]
+    return GraspMaps(G=Gb.transpose(1, 0, 2).reshape(6, 4 * p), J=Jb.reshape(4 * p, hand.m),
+                     contacts=frames, object_origin=c)

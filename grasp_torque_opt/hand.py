@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from grasp_torque_opt.exceptions import InputError, JointNotFound
+from grasp_torque_opt.exceptions import FrameNotFound, InputError, JointNotFound
 
 ERD_PREFIX = "example-robot-data:"
 
@@ -82,10 +82,25 @@ class Hand:
     idx_v: np.ndarray
     torque_limits: np.ndarray
     data: pin.Data = field(init=False, repr=False, compare=False)
+    _frame_ids: dict[str, int] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         # Kinematics workspace, allocated once; a Hand is not shared across threads.
         object.__setattr__(self, "data", self.model.createData())
+        object.__setattr__(self, "_frame_ids", {})
+
+    def frame_index(self, name: str, field_name: str) -> int:
+        """Index of a model frame by name, looked up once per name.
+
+        Raises:
+            FrameNotFound: naming ``field_name`` and listing close matches.
+        """
+        fid = self._frame_ids.get(name)
+        if fid is None:
+            if not self.model.existFrame(name):
+                raise FrameNotFound(field_name, name, {f.name for f in self.model.frames})
+            fid = self._frame_ids[name] = self.model.getFrameId(name)
+        return fid
 
     @property
     def m(self) -> int:

@@ -25,9 +25,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import proxsuite
+from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
 
 from grasp_torque_opt.exceptions import SolverError
 from grasp_torque_opt.friction import friction_matrix
@@ -37,6 +39,8 @@ from grasp_torque_opt.solution import RawResult
 
 #: Relative singular-value threshold for the rank of A.
 RANK_RTOL = 1e-10
+#: The QR path is taken when min |R_ii| exceeds this times max |R_ii|.
+QR_RTOL = 1e-6
 #: Distance kept inside the torque bounds [N m] (ProxSuite meets them to eps_abs).
 BOX_MARGIN = 1e-8
 
@@ -88,9 +92,50 @@ class TauQP:
         return self.M1 @ self.w + self.M2 @ tau + self.N @ z
 
 
+def decompose(A_full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """pinv(A), an orthonormal basis of null(A), and one of A's left null space.
+
+    A full-column-rank A with at least as many rows as columns (the Allegro's
+    four fingertips: 22 x 16) takes a Householder QR, A = [Q1 Q2] [R; 0]:
+    pinv(A) = R^-1 Q1^T, null(A) = {0}, left null space Q2. Anything else, or
+    an R whose diagonal spans more than 1/:data:`QR_RTOL`, takes the SVD with
+    rank threshold :data:`RANK_RTOL`. The QR costs a fifth of the SVD here.
+
+    Returns:
+        (pinv, shape (cols, rows); N, shape (cols, k); U_perp, shape (rows, rows - rank)).
+    """
+    rows, cols = A_full.shape
+    if rows >= cols > 0:
+        qr, tau, _, info = dgeqrf(A_full)
+        d = np.abs(qr.diagonal())
+        if info == 0 and d.min() > QR_RTOL * d.max():
+            padded = np.zeros((rows, rows))
+            padded[:, :cols] = qr
+            Q, _, info_q = dorgqr(padded, tau)
+            pinv, info_r = dtrtrs(qr[:cols], Q[:, :cols].T)  # R X = Q1^T, R upper
+            if info_q == 0 and info_r == 0:
+                return pinv, np.zeros((cols, 0)), Q[:, cols:]
+    U, sv, Vt = np.linalg.svd(A_full)
+    r = int(np.sum(sv > RANK_RTOL * sv[0])) if sv.size else 0
+    return (Vt[:r].T / sv[:r]) @ U[:, :r].T, Vt[r:].T, U[:, r:]
+
+
+@lru_cache(maxsize=16)
+def _hessian(weights: tuple[float, ...], k: int) -> np.ndarray:
+    """2 diag(W) on tau, zero on z (read-only; the same every cycle)."""
+    m = len(weights)
+    H = np.zeros((m + k, m + k))
+    H[:m, :m] = 2.0 * np.diag(weights)
+    H.flags.writeable = False
+    return H
+
+
 def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
                  tau_min: np.ndarray, tau_max: np.ndarray, weights: np.ndarray) -> TauQP:
     """Build the tau-space QP of one grasp.
+
+    What does not change between cycles (S for the friction and contact count,
+    H for the weights) is cached; the rest is a few array operations.
 
     Args:
         maps: G and J of the grasp.
@@ -104,29 +149,23 @@ def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarra
     """
     G, J = maps.G, maps.J
     m = J.shape[1]
-    A_full = np.vstack((G, J.T))
-    U, s, Vt = np.linalg.svd(A_full)
-    r = int(np.sum(s > RANK_RTOL * s[0])) if s.size else 0
-    pinv = (Vt[:r].T / s[:r]) @ U[:, :r].T
+    pinv, N, U_perp = decompose(np.vstack((G, J.T)))
     M1, M2 = pinv[:, :6], pinv[:, 6:]
-    N = Vt[r:].T
-    U_perp = U[:, r:]
     w = -np.asarray(external_wrench, dtype=float)
-
     S, b_S = friction_matrix(maps.p, friction.mu1, friction.mu2, friction.sides,
                              friction.min_normal_force)
     k = N.shape[1]
-    C = np.hstack((S @ M2, S @ N))
-    u = b_S - S @ (M1 @ w)
-    A = np.hstack((U_perp[6:].T, np.zeros((U_perp.shape[1], k))))
-    b = -U_perp[:6].T @ w
-    H = np.zeros((m + k, m + k))
-    H[:m, :m] = 2.0 * np.diag(weights)
-    inf = np.full(k, np.inf)
-    return TauQP(H=H, g=np.zeros(m + k), A=A, b=b, C=C, u=u,
-                 l_box=np.concatenate((tau_min + BOX_MARGIN, -inf)),
-                 u_box=np.concatenate((tau_max - BOX_MARGIN, inf)),
-                 M1=M1, M2=M2, N=N, w=w)
+    n_eq = U_perp.shape[1]
+    C = S @ np.hstack((M2, N)) if k else S @ M2
+    A = np.zeros((n_eq, m + k))
+    A[:, :m] = U_perp[6:].T
+    H = _hessian(tuple(float(x) for x in weights), k)
+    l_box = np.full(m + k, -np.inf)
+    u_box = np.full(m + k, np.inf)
+    l_box[:m] = tau_min + BOX_MARGIN
+    u_box[:m] = tau_max - BOX_MARGIN
+    return TauQP(H=H, g=np.zeros(m + k), A=A, b=-U_perp[:6].T @ w, C=C,
+                 u=b_S - S @ (M1 @ w), l_box=l_box, u_box=u_box, M1=M1, M2=M2, N=N, w=w)
 
 
 @dataclass(frozen=True)
@@ -159,11 +198,12 @@ def check_data(qp: TauQP) -> str:
 
     One NaN in its data made ProxSuite run for 84 s uncapped and return NaN.
     """
-    data = (qp.H, qp.g, qp.A, qp.b, qp.C, qp.u)
-    if not all(np.all(np.isfinite(a)) for a in data):
+    # One sum per array: NaN or Inf anywhere makes it non-finite (so does an
+    # overflow of huge finite entries, which is refused as well).
+    total = qp.H.sum() + qp.g.sum() + qp.A.sum() + qp.b.sum() + qp.C.sum() + qp.u.sum()
+    if not np.isfinite(total):
         return "QP data not finite"
-    if np.any(np.isnan(qp.l_box)) or np.any(np.isnan(qp.u_box)) or \
-            np.any(qp.l_box > qp.u_box):
+    if not (qp.l_box <= qp.u_box).all():  # False for NaN as well
         return "QP bounds NaN or inverted (lower > upper)"
     return ""
 

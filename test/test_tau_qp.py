@@ -9,7 +9,7 @@ from independent import assert_holds
 from grasp_torque_opt.exact_socp import solve_exact_socp
 from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.solve import solve
-from grasp_torque_opt.tau_qp import TauQPSolver, build_tau_qp
+from grasp_torque_opt.tau_qp import TauQPSolver, build_tau_qp, decompose
 
 CASES = ["planar", "hyperstatic", "allegro"]
 
@@ -120,3 +120,18 @@ def test_weights_shift_effort(planar):
     assert b.status == "optimal"
     assert abs(b.tau[0]) <= abs(a.tau[0]) + 1e-9
     assert_holds(heavy, heavy.maps(), b.tau, b.wrenches)
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_decomposition_against_numpy_pinv(name, request):
+    """QR path (full column rank) or SVD path: pinv, null space and left null space are right."""
+    maps = request.getfixturevalue(name).maps()
+    A = np.vstack((maps.G, maps.J.T))
+    pinv, N, U_perp = decompose(A)
+    rank = np.linalg.matrix_rank(A)
+    np.testing.assert_allclose(pinv, np.linalg.pinv(A, rcond=1e-10), atol=1e-9)
+    assert N.shape == (A.shape[1], A.shape[1] - rank)
+    assert U_perp.shape == (A.shape[0], A.shape[0] - rank)
+    np.testing.assert_allclose(A @ N, 0, atol=1e-12)
+    np.testing.assert_allclose(U_perp.T @ A, 0, atol=1e-12)
+    np.testing.assert_allclose(U_perp.T @ U_perp, np.eye(U_perp.shape[1]), atol=1e-12)
