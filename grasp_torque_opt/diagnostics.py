@@ -54,7 +54,7 @@ def report(controller: TorqueController, now: float) -> Report:
     if sol is not None:
         values += [("status", sol.status), ("solver_message", sol.message),
                    ("solve_time_s", f"{sol.solve_time_s:.6f}"),
-                   ("cycle_time_s", f"{sum(sol.timings.values()):.6f}"),
+                   ("cycle_time_s", f"{last.cycle_time or sum(sol.timings.values()):.6f}"),
                    ("iterations", str(sol.iterations))]
         if sol.certificate is not None:
             cert = sol.certificate.as_dict()
@@ -76,7 +76,9 @@ def report(controller: TorqueController, now: float) -> Report:
     n = c.counters
     values += [("cycles", str(n.cycles)), ("commands", str(n.commands)),
                ("zero_commands", str(n.zero_commands)), ("faults", str(n.faults)),
-               ("recoveries", str(n.recoveries))]
+               ("recoveries", str(n.recoveries)), ("solver_failures", str(n.solver_failures)),
+               ("overruns", str(n.overruns)), ("max_cycle_time_s", f"{n.max_cycle_time:.6f}"),
+               ("cycle_budget_s", f"{cfg.cycle_budget:.6f}")]
     values += [(f"rejected.{k}", str(v)) for k, v in n.rejected.items()]
     values.append(("last_rejection", c.last_rejection or "none"))
     values += [("age.joint_states_s", _ago(now, c.inputs.q_time)),

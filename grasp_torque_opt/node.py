@@ -37,7 +37,8 @@ from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
 from grasp_torque_opt import diagnostics
-from grasp_torque_opt.controller import POLICIES, CycleConfig, CycleResult, TorqueController
+from grasp_torque_opt.controller import (POLICIES, CycleConfig, CycleResult, TorqueController,
+                                         stamp_seconds)
 from grasp_torque_opt.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.grasp_setup import GraspSetup
 from grasp_torque_opt.report import solution_dict
@@ -93,6 +94,18 @@ PARAMETERS: dict[str, Spec] = {
     "fault_policy": Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
                          "controller keeps the last certified command) or 'zero' (publish "
                          "zero torques)."),
+    "max_joint_state_entries": Spec("A joint state with more names or positions than this is "
+                                    "rejected unread [-].", 1, 100000),
+    "max_wrench_force": Spec("A load whose force norm exceeds this is rejected [N].",
+                             1e-6, 1e6),
+    "max_wrench_torque": Spec("A load whose moment norm exceeds this is rejected [N m].",
+                              1e-6, 1e6),
+    "max_contact_distance": Spec("A contact point farther than this from the base origin "
+                                 "stops commands [m].", 1e-3, 100.0),
+    "stamp_future_tolerance": Spec("A header stamp more than this ahead of the node's clock "
+                                   "is rejected [s].", 0.0, 3600.0),
+    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun) [s].",
+                         1e-4, 10.0),
     "solver.eps_abs": Spec("ProxSuite absolute tolerance [-].", 1e-12, 1e-4),
     "solver.max_iter": Spec("ProxSuite outer iteration cap [-].", 1, 100000),
     "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
@@ -166,6 +179,12 @@ class GraspTorqueNode(Node):
             "wrench_timeout": 0.5,
             "hold_time": 0.1,
             "fault_policy": "hold",
+            "max_joint_state_entries": CycleConfig.max_joint_state_entries,
+            "max_wrench_force": CycleConfig.max_wrench_force,
+            "max_wrench_torque": CycleConfig.max_wrench_torque,
+            "max_contact_distance": CycleConfig.max_contact_distance,
+            "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
+            "cycle_budget": CycleConfig.cycle_budget,
             "solver.eps_abs": ProxSuiteSettings.eps_abs,
             "solver.max_iter": ProxSuiteSettings.max_iter,
             "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
@@ -252,7 +271,12 @@ class GraspTorqueNode(Node):
             contacts_timeout=p["contacts_timeout"], wrench_timeout=p["wrench_timeout"],
             hold_time=p["hold_time"], fault_policy=p["fault_policy"],
             gravity_compensation=p["gravity_compensation"], gravity=tuple(p["gravity"]),
-            certificate_tolerance=p["certificate_tolerance"])
+            certificate_tolerance=p["certificate_tolerance"],
+            max_joint_state_entries=p["max_joint_state_entries"],
+            max_wrench_force=p["max_wrench_force"], max_wrench_torque=p["max_wrench_torque"],
+            max_contact_distance=p["max_contact_distance"],
+            stamp_future_tolerance=p["stamp_future_tolerance"],
+            cycle_budget=p["cycle_budget"])
         solver = ProxSuiteSettings(eps_abs=p["solver.eps_abs"], max_iter=p["solver.max_iter"],
                                    max_iter_in=p["solver.max_iter_in"])
         return setup, config, solver
@@ -276,33 +300,47 @@ class GraspTorqueNode(Node):
 
     # -- inputs and cycle -----------------------------------------------------------------
 
+    def _clock_now(self) -> float:
+        """Now on the node's clock (ROS time), the clock of header stamps [s]."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
     def _on_joint_state(self, msg: JointState) -> None:
         now = time.monotonic()
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
-                self.controller.update_joint_state(list(msg.name), list(msg.position), now)
+                # Sizes first: an oversized message is not even copied.
+                self.controller.check_size("joint_states",
+                                           max(len(msg.name), len(msg.position)))
+                self.controller.update_joint_state(list(msg.name), list(msg.position), now,
+                                                   stamp, self._clock_now())
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
                 return
             self._publish(self.controller.cycle(now), msg.header.stamp)
 
     def _on_contacts(self, msg: PoseArray) -> None:
-        positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
-        quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
-                 for p in msg.poses]
+        now = time.monotonic()
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
+                self.controller.check_size("contacts", len(msg.poses))
+                positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
+                quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
+                         for p in msg.poses]
                 self.controller.update_contacts(msg.header.frame_id, np.array(positions),
-                                                np.array(quats), time.monotonic())
+                                                np.array(quats), now, stamp, self._clock_now())
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
+        now = time.monotonic()
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         f, t = msg.wrench.force, msg.wrench.torque
         with self._lock:
             try:
                 self.controller.update_wrench(msg.header.frame_id, [f.x, f.y, f.z],
-                                              [t.x, t.y, t.z], time.monotonic())
+                                              [t.x, t.y, t.z], now, stamp, self._clock_now())
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
 

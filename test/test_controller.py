@@ -23,6 +23,9 @@ def joint_state(setup, q=None, names=None):
 
 
 def fresh(setup, **config):
+    """A controller of its own; the cycle budget is generous unless a test is about it
+    (other processes may load this machine)."""
+    config.setdefault("cycle_budget", 10.0)
     return TorqueController(dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)),
                             CycleConfig(**config))
 

@@ -40,6 +40,9 @@ class Harness:
     def __init__(self, scenario: Path, **params):
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=DOMAIN)
+        # A generous cycle budget unless a test is about it: other processes may load
+        # this machine, and an overrun drops the command by design.
+        params.setdefault("cycle_budget", 5.0)
         overrides = [Parameter("scenario", value=str(scenario))]
         overrides += [Parameter(k.replace("__", "."), value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
