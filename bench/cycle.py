@@ -1,9 +1,18 @@
-"""Time the full cycle (kinematics, build, solve, certificate) on the bundled scenarios.
+"""Time the full control cycle on the bundled scenarios, per QP backend.
 
-Usage: .venv/bin/python bench/cycle.py [--repeats 2000] [--json FILE]
+Usage: .venv/bin/python bench/cycle.py [--repeats 3000] [--backends proxsuite,daqp,quadprog]
+       [--out FILE]
 
-Prints, per scenario and per stage, the median and p99 over the repeats, with
-the machine it ran on. Speed is measured here, never asserted in a test.
+Two paths, median and p99 over the repeats, with the machine it ran on:
+
+- ``core``: kinematics and maps, build, solve, certificate (``solve.solve`` with
+  the maps computed in the loop and a solver reused across cycles), with each
+  stage's share of the total;
+- ``controller``: what the node runs on each joint state, without ROS: the joint
+  state checked and taken, then ``TorqueController.cycle`` (kinematics, gravity
+  torques when compensated, maps, build, solve, certificate, gate).
+
+Speed is measured here, never asserted in a test.
 """
 
 from __future__ import annotations
@@ -19,9 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
+from grasp_torque_opt.backends import BACKENDS, make_solver
+from grasp_torque_opt.controller import CycleConfig, TorqueController
 from grasp_torque_opt.grasp_setup import GraspSetup
 from grasp_torque_opt.solve import solve
-from grasp_torque_opt.tau_qp import TauQPSolver
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ["planar_two_finger.yaml", "allegro_right.yaml"]
@@ -38,49 +48,121 @@ def machine() -> dict:
                 break
     except OSError:
         pass
-    versions = {p: metadata.version(p) for p in ("numpy", "pin", "proxsuite", "scipy",
-                                                  "clarabel")}
+    versions = {}
+    for p in ("numpy", "pin", "proxsuite", "daqp", "quadprog", "scipy", "clarabel"):
+        try:
+            versions[p] = metadata.version(p)
+        except metadata.PackageNotFoundError:
+            versions[p] = None
     return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
             "system": platform.platform(), "versions": versions,
             "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")}
 
 
-def bench(setup: GraspSetup, repeats: int) -> dict:
-    """Median and p99 [s] of each stage and the whole cycle, ProxSuite reused across cycles."""
-    solver = TauQPSolver()
-    for _ in range(50):
-        solve(setup, solver=solver)
+def machine_line(m: dict) -> str:
+    """One line naming the machine and the date."""
+    return (f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}, "
+            f"ProxSuite {m['versions']['proxsuite']}, DAQP {m['versions']['daqp']}, "
+            f"Pinocchio {m['versions']['pin']}; {m['date']}")
+
+
+def summary(samples: list[float]) -> dict:
+    """Median and p99 [s]."""
+    return {"median_s": float(np.median(samples)), "p99_s": float(np.percentile(samples, 99))}
+
+
+def bench_core(setup: GraspSetup, backend: str, repeats: int) -> dict:
+    """The core cycle: maps, build, solve, certify; per stage and in total."""
+    solver = make_solver(backend)
+    sol = solve(setup, solver=solver)
+    if not sol.optimal:
+        return {"skipped": sol.message}
     samples = {k: [] for k in STAGES + ["total"]}
-    for _ in range(repeats):
+    for i in range(repeats + 50):
         t0 = time.perf_counter()
         sol = solve(setup, solver=solver)
-        samples["total"].append(time.perf_counter() - t0)
-        assert sol.status == "optimal", sol.message
-        for k in STAGES:
-            samples[k].append(sol.timings[k])
-    return {k: {"median_s": float(np.median(v)), "p99_s": float(np.percentile(v, 99))}
-            for k, v in samples.items()}
+        total = time.perf_counter() - t0
+        if not sol.optimal:
+            raise RuntimeError(f"{backend}: {sol.message}")
+        if i >= 50:  # warm-up
+            samples["total"].append(total)
+            for k in STAGES:
+                samples[k].append(sol.timings[k])
+    out = {k: summary(v) for k, v in samples.items()}
+    total = sum(out[k]["median_s"] for k in STAGES)
+    for k in STAGES:
+        out[k]["share"] = out[k]["median_s"] / total
+    return out
+
+
+def bench_controller(setup: GraspSetup, backend: str, repeats: int) -> dict:
+    """The node's cycle without ROS: take a joint state, then run the cycle."""
+    ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True))
+    ctrl.solver = make_solver(backend)
+    names = list(setup.hand.joints)
+    q0 = setup.q[setup.hand.idx_q]
+    rng = np.random.default_rng(0)
+    samples, published = [], 0
+    for i in range(repeats + 50):
+        positions = (q0 + rng.normal(scale=1e-3, size=q0.size)).tolist()
+        now = time.monotonic()
+        t0 = time.perf_counter()
+        ctrl.update_joint_state(names, positions, now)
+        result = ctrl.cycle(now)
+        elapsed = time.perf_counter() - t0
+        if i >= 50:
+            samples.append(elapsed)
+            published += result.kind == "solution"
+    return {"total": summary(samples), "certified_commands": published, "cycles": repeats}
+
+
+def run(repeats: int = 3000, backends: tuple[str, ...] = BACKENDS) -> dict:
+    """Every scenario and backend, both paths."""
+    out = {"machine": machine(), "repeats": repeats, "scenarios": {}}
+    for name in SCENARIOS:
+        setup = GraspSetup.from_file(ROOT / "config" / name)
+        res = out["scenarios"][name] = {}
+        for b in backends:
+            core = bench_core(setup, b, repeats)
+            res[b] = {"core": core}
+            if "skipped" not in core:
+                res[b]["controller"] = bench_controller(setup, b, repeats)
+    return out
+
+
+def table(results: dict) -> str:
+    """A markdown table: per scenario and backend, stage medians [us] and the totals."""
+    head = ("| scenario | backend | maps | build | solve | certify | core median | core p99 "
+            "| node cycle median | node cycle p99 |")
+    lines = [head, "|" + "---|" * 10]
+    for name, res in results["scenarios"].items():
+        for b, r in res.items():
+            core = r["core"]
+            if "skipped" in core:
+                lines.append(f"| {name} | {b} | - | - | - | - | skipped: {core['skipped']} "
+                             "| | | |")
+                continue
+            stages = " | ".join(f"{1e6 * core[k]['median_s']:.0f} ({100 * core[k]['share']:.0f}%)"
+                                for k in STAGES)
+            ctl = r["controller"]["total"]
+            lines.append(f"| {name} | {b} | {stages} | {1e6 * core['total']['median_s']:.0f} | "
+                         f"{1e6 * core['total']['p99_s']:.0f} | {1e6 * ctl['median_s']:.0f} | "
+                         f"{1e6 * ctl['p99_s']:.0f} |")
+    return "\n".join(lines) + "\n\n(times in us; share of the core cycle in parentheses)"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=2000)
-    parser.add_argument("--json", type=Path, help="also write the results here")
+    parser.add_argument("--repeats", type=int, default=3000)
+    parser.add_argument("--backends", default=",".join(BACKENDS))
+    parser.add_argument("--out", type=Path, help="also write the results here (JSON)")
     args = parser.parse_args()
-    out = {"machine": machine(), "repeats": args.repeats, "scenarios": {}}
-    m = out["machine"]
-    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}, "
-          f"ProxSuite {m['versions']['proxsuite']}, Pinocchio {m['versions']['pin']}; "
-          f"{m['date']}")
-    print(f"{'scenario':<24}{'stage':<10}{'median [us]':>12}{'p99 [us]':>12}")
-    for name in SCENARIOS:
-        res = bench(GraspSetup.from_file(ROOT / "config" / name), args.repeats)
-        out["scenarios"][name] = res
-        for k in STAGES + ["total"]:
-            print(f"{name:<24}{k:<10}{1e6 * res[k]['median_s']:>12.1f}"
-                  f"{1e6 * res[k]['p99_s']:>12.1f}")
-    if args.json:
-        args.json.write_text(json.dumps(out, indent=2))
+    results = run(args.repeats, tuple(args.backends.split(",")))
+    print(machine_line(results["machine"]))
+    print(table(results))
+    if args.out:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(json.dumps(results, indent=2))
 
 
 if __name__ == "__main__":

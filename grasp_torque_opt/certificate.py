@@ -73,17 +73,18 @@ def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction:
     """
     tau = np.asarray(tau, dtype=float)
     f = np.asarray(f, dtype=float)
-    finite = bool(np.all(np.isfinite(tau)) and np.all(np.isfinite(f)))
-    if not finite:
+    if not (np.isfinite(tau).all() and np.isfinite(f).all()):
         inf = float("inf")
         return Certificate(inf, inf, inf, inf, inf, False, tolerance)
-    wrenches = f.reshape(-1, 4)
+    w = f.reshape(-1, 4)
+    fz = w[:, 2]
+    margin = cone_margin(w, friction.mu1, friction.mu2)
     return Certificate(
-        equilibrium=float(np.max(np.abs(G @ f + external_wrench))),
-        torque=float(np.max(np.abs(J.T @ f - tau))),
-        cone=float(max(0.0, -np.min(cone_margin(wrenches, friction.mu1, friction.mu2)))),
-        normal_force=float(max(0.0, np.max(friction.min_normal_force - wrenches[:, 2]))),
-        torque_limit=float(max(0.0, np.max(tau_min - tau), np.max(tau - tau_max))),
+        equilibrium=float(np.abs(G @ f + external_wrench).max()),
+        torque=float(np.abs(J.T @ f - tau).max()),
+        cone=max(0.0, -float(margin.min())),
+        normal_force=max(0.0, friction.min_normal_force - float(fz.min())),
+        torque_limit=max(0.0, float((tau_min - tau).max()), float((tau - tau_max).max())),
         finite=True,
         tolerance=tolerance,
     )
