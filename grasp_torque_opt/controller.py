@@ -414,9 +414,11 @@ class TorqueController:
             for part, v, bound, key, unit in ((
                     "force", w[:3], c.max_wrench_force, "max_wrench_force", "N"), (
                     "torque", w[3:], c.max_wrench_torque, "max_wrench_torque", "N m")):
-                if np.linalg.norm(v) > bound:
+                with np.errstate(over="ignore"):  # 1e308 entries: an infinite norm
+                    norm = float(np.linalg.norm(v))
+                if norm > bound:
                     raise InputError(f"external_wrench.wrench.{part}",
-                                     f"norm {np.linalg.norm(v):.6g} {unit} exceeds {key} "
+                                     f"norm {norm:.6g} {unit} exceeds {key} "
                                      f"({bound} {unit})")
             self._check_stamp("external_wrench", stamp, clock, now)
         except InputError as e:

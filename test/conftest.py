@@ -60,3 +60,13 @@ def hyperstatic(planar_doc) -> GraspSetup:
     contacts = copy.deepcopy(planar_doc["grasp"]["contacts"])
     contacts.insert(1, {"link": "finger1_distal", "position": [0.0, 0.03, 0.0]})
     return setup_from_doc(with_contacts(planar_doc, contacts))
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The adversarial campaign's counts (test_campaign*.py), printed even without -s."""
+    from campaign import COUNTS
+
+    if COUNTS["inputs"]:
+        terminalreporter.write_line(
+            f"campaign: {COUNTS['inputs']} inputs tried, {COUNTS['commands']} commands "
+            f"published, {COUNTS['broken']} invariants broken")

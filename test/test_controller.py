@@ -1,6 +1,7 @@
 """The control cycle on plain arrays: inputs, gate, staleness, fault policy, gravity."""
 
 import dataclasses
+import time
 from pathlib import Path
 
 import numpy as np
@@ -10,9 +11,11 @@ from independent import assert_holds
 from test_hand import ALLEGRO_URDF
 
 from grasp_torque_opt.controller import CycleConfig, TorqueController
-from grasp_torque_opt.exceptions import InputError
+from grasp_torque_opt.exceptions import InputError, SolverError
 from grasp_torque_opt.hand import resolve_urdf
+from grasp_torque_opt.solution import RawResult
 from grasp_torque_opt.solve import solve
+from grasp_torque_opt.tau_qp import TauQPSolver
 
 
 def joint_state(setup, q=None, names=None):
@@ -193,3 +196,172 @@ def test_gravity_compensation_adds_g(allegro):
     shifted = dataclasses.replace(allegro, torque_offset=g)
     assert_holds(shifted, r.maps, r.solution.tau, r.solution.wrenches)
     assert np.all(np.abs(r.command) <= allegro.hand.torque_limits)
+
+
+# -- bounds, stamps, budget -----------------------------------------------------------------
+
+
+def test_oversized_joint_state_is_rejected_unread(planar):
+    ctrl = fresh(planar, max_joint_state_entries=8)
+    names, pos = joint_state(planar)
+    extra = [f"j{i}" for i in range(5)]
+    with pytest.raises(InputError, match=r"^joint_states: 9 entries, more than "
+                       r"max_joint_state_entries \(8\)$"):
+        ctrl.update_joint_state(names + extra, pos + [0.0] * 5, 0.0)
+    ctrl.update_joint_state(names + extra[:4], pos + [0.0] * 4, 0.0)  # 8 is within
+    assert ctrl.counters.rejected["joint_states"] == 1
+
+
+def test_absurd_joint_position_is_rejected(planar):
+    names, pos = joint_state(planar)
+    pos[2] = 1e6
+    with pytest.raises(InputError, match="position of 'joint3' is 1e\\+06, beyond"):
+        fresh(planar).update_joint_state(names, pos, 0.0)
+
+
+@pytest.mark.parametrize("force,torque,match", [
+    ([0.0, 0.0, 2000.0], [0.0] * 3, r"wrench.force: norm 2000 N exceeds max_wrench_force"),
+    ([0.0] * 3, [0.0, 300.0, 400.0], r"wrench.torque: norm 500 N m exceeds max_wrench_torque"),
+    ([0.0, 0.0], [0.0] * 3, "5 values, expected 6"),
+])
+def test_wrench_magnitude_is_bounded(planar, force, torque, match):
+    ctrl = fresh(planar)
+    with pytest.raises(InputError, match=match):
+        ctrl.update_wrench("", force, torque, 0.0)
+    assert ctrl.inputs.wrench is None and ctrl.counters.rejected["external_wrench"] == 1
+
+
+def test_far_contact_stops_commands_until_good_contacts_return(planar):
+    ctrl = fresh(planar, max_contact_distance=0.5)
+    pos, quat = base_poses(planar)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    far = pos.copy()
+    far[1] = [0.0, 0.6, 0.0]
+    ctrl.update_contacts("", far, quat, 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None
+    assert "contacts.poses[1].position: is 0.6 m from the base origin, beyond " \
+           "max_contact_distance (0.5 m)" in r.fault
+    ctrl.update_contacts("", pos, quat, 0.01)
+    assert ctrl.cycle(0.01).kind == "solution"
+
+
+def test_contacts_of_the_wrong_shape_are_rejected(planar):
+    pos, quat = base_poses(planar)
+    with pytest.raises(InputError, match=r"quaternions of shape \(2, 3\), expected"):
+        fresh(planar).update_contacts("", pos, quat[:, :3], 0.0)
+
+
+def test_long_names_are_cut_in_messages(planar):
+    names, pos = joint_state(planar)
+    pos, quat = base_poses(planar)
+    with pytest.raises(InputError) as e:
+        fresh(planar).update_contacts("x" * 100000, pos, quat, 0.0)
+    assert "'" + "x" * 64 + "...'" in str(e.value) and len(str(e.value)) < 1000
+
+
+def test_stamp_rule(planar):
+    """Zero: unstamped, accepted. Ahead of the clock beyond the tolerance: rejected.
+    Backwards: rejected while the last accepted one is fresh, accepted once it is stale."""
+    ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
+    js = joint_state(planar)
+    ctrl.update_joint_state(*js, now=0.0, stamp=0.0, clock=100.0)
+    ctrl.update_joint_state(*js, now=0.01, stamp=100.4, clock=100.0)  # within tolerance
+    with pytest.raises(InputError, match=r"^joint_states.header.stamp: is 0.600 s ahead of "
+                       r"the clock \(stamp_future_tolerance 0.5 s\)$"):
+        ctrl.update_joint_state(*js, now=0.02, stamp=100.6, clock=100.0)
+    with pytest.raises(InputError, match="header.stamp: goes backwards by 0.100000 s"):
+        ctrl.update_joint_state(*js, now=0.05, stamp=100.3, clock=100.05)
+    assert ctrl.inputs.q_time == 0.01  # the rejected states were not kept
+    ctrl.update_joint_state(*js, now=0.05, stamp=0.0, clock=100.05)  # unstamped: not compared
+    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the last stamp is stale
+    ctrl.update_joint_state(*js, now=0.21, stamp=50.01, clock=100.21)
+    with pytest.raises(InputError, match="is negative"):
+        ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=-1.0)
+    ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=5.0, clock=0.0)  # clock not running
+    assert ctrl.counters.rejected == {"joint_states": 2, "contacts": 0, "external_wrench": 1}
+
+
+def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar):
+    ctrl = fresh(planar, cycle_budget=1e-4, hold_time=1.0)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None and r.fault.startswith("cycle overrun (") and r.cycle_time > 1e-4
+    assert ctrl.counters.overruns == 1 and ctrl.counters.commands == 0
+    assert ctrl.last_command is None and ctrl.counters.max_cycle_time == r.cycle_time
+    ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=10.0)
+    ctrl.update_joint_state(*joint_state(planar), 0.01)
+    r = ctrl.cycle(0.01)
+    assert r.kind == "solution" and ctrl.counters.recoveries == 1 and ctrl.fault == ""
+
+
+# -- fault injection: solvers that fail in every way ----------------------------------------
+
+
+class Injected:
+    """A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose:
+    ``mode`` says how; ``healthy`` makes it the real one again."""
+
+    def __init__(self, mode: str):
+        self.inner = TauQPSolver()
+        self.settings = self.inner.settings
+        self.mode = mode
+        self.healthy = False
+
+    def solve(self, qp):
+        if self.healthy:
+            return self.inner.solve(qp)
+        if self.mode == "raise-solver":
+            raise SolverError("injected: ProxSuite failed")
+        if self.mode == "raise-other":
+            raise ZeroDivisionError("injected")
+        if self.mode == "nan-data":  # the real solver must refuse it at once
+            return self.inner.solve(dataclasses.replace(qp, H=qp.H * np.nan))
+        if self.mode == "inverted-bounds":
+            return self.inner.solve(dataclasses.replace(qp, l_box=qp.u_box + 1.0))
+        good = self.inner.solve(qp)
+        if self.mode == "max-iter":
+            return RawResult("error", good.x, 1000, 0.01, "PROXQP_MAX_ITER_REACHED")
+        if self.mode == "wrong-x":  # finite, claimed solved, but not a solution
+            return RawResult("solved", good.x + 0.05, good.iterations, good.solve_time_s,
+                             "PROXQP_SOLVED")
+        if self.mode == "nan-x":
+            return RawResult("solved", good.x * np.nan, 1, 0.0, "PROXQP_SOLVED")
+        if self.mode == "wrong-size-x":
+            return RawResult("solved", good.x[:-1], 1, 0.0, "PROXQP_SOLVED")
+        raise AssertionError(self.mode)
+
+
+FAULT_MODES = ["raise-solver", "raise-other", "nan-data", "inverted-bounds", "max-iter",
+               "wrong-x", "nan-x", "wrong-size-x"]
+
+
+@pytest.mark.parametrize("mode", FAULT_MODES)
+@pytest.mark.parametrize("policy", ["hold", "zero"])
+def test_a_failing_solver_never_passes_through(planar, mode, policy):
+    ctrl = fresh(planar, hold_time=0.05, fault_policy=policy)
+    js = joint_state(planar)
+    ctrl.update_joint_state(*js, 0.0)
+    good = ctrl.cycle(0.0)
+    assert good.kind == "solution"
+    ctrl.solver = Injected(mode)
+    kinds = []
+    for k in range(1, 11):
+        t = 0.01 * k
+        ctrl.update_joint_state(*js, t)
+        t0 = time.perf_counter()
+        r = ctrl.cycle(t)
+        assert time.perf_counter() - t0 < 1.0  # refused or capped, never a stall
+        assert r.kind != "solution" and r.fault
+        if mode in ("nan-data", "inverted-bounds"):  # refused before ProxSuite ran
+            assert r.solution.iterations == 0 and "solver: QP " in r.solution.message
+        kinds.append((t, r.kind))
+        if r.command is not None:
+            np.testing.assert_array_equal(r.command, np.zeros(4))
+    assert all(k == "none" for t, k in kinds if t <= 0.05 + 1e-9)
+    assert all(k == ("zero" if policy == "zero" else "none") for t, k in kinds if t > 0.05 + 1e-9)
+    assert ctrl.counters.solver_failures == 10
+    assert ctrl.last_command is good.command  # the last certified command is what is held
+    ctrl.solver.healthy = True
+    ctrl.update_joint_state(*js, 0.2)
+    assert ctrl.cycle(0.2).kind == "solution" and ctrl.counters.recoveries == 1
