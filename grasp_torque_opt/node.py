@@ -11,6 +11,7 @@ import argparse
 import dataclasses
 import json
 import math
+import signal
 import sys
 import threading
 import time
@@ -24,11 +25,13 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, PoseArray, WrenchStamped
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
+from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 from rclpy.utilities import remove_ros_args
 from sensor_msgs.msg import JointState
@@ -435,10 +438,35 @@ class GraspTorqueNode(Node):
         except Exception as e:  # noqa: BLE001 -- the caller gets the reason, the node lives on
             done.set_result((False, f"cannot solve: {type(e).__name__}: {e}"))
 
+    def safe_stop(self) -> bool:
+        """The safe action when the node stops, per ``fault_policy``.
+
+        ``zero``: publish zero torques once and wait (up to 0.5 s) for the
+        subscribers to acknowledge them, since the effort controller would keep
+        the last command forever. ``hold``: nothing (the last certified command
+        stays, as during a fault). Nothing either before the first command.
+
+        Returns:
+            True if zero torques were published.
+        """
+        with self._lock:
+            if self.controller.config.fault_policy != "zero" or \
+                    self.controller.counters.commands == 0 or not self.context.ok():
+                return False
+            self._command_pub.publish(Float64MultiArray(data=[0.0] * self._m))
+        self._command_pub.wait_for_all_acked(Duration(seconds=0.5))
+        self.get_logger().info("stopped: zero torques published (fault_policy zero)")
+        return True
+
     def destroy_node(self) -> None:
-        """Stop the service worker, then the node."""
+        """The safe action, then stop the service worker and the node."""
+        self.safe_stop()
         self._worker.shutdown(wait=True, cancel_futures=True)
         super().destroy_node()
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
 
 
 #: Executors ``main`` can spin: rclpy's default and its experimental events executor.
@@ -455,7 +483,10 @@ def main(args: list[str] | None = None) -> int:
     parser.add_argument("--executor", choices=sorted(EXECUTORS), default="single",
                         help="rclpy executor to spin (default: single)")
     opts = parser.parse_args(remove_ros_args(argv)[1:])
-    rclpy.init(args=argv)
+    # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the safe
+    # action could publish; here both interrupt the spin and the context stays valid.
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    signal.signal(signal.SIGTERM, _interrupt)
     node = None
     code = 0
     try:

@@ -3,6 +3,9 @@
 import dataclasses
 import json
 import os
+import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -368,3 +371,66 @@ def test_stamped_command_carries_the_joint_states_stamp(planar):
         np.testing.assert_array_equal(out.effort, h.commands[-1][1])
     finally:
         h.close()
+
+
+def test_stopping_applies_the_policy_in_process(planar):
+    for policy, expect_zero in (("zero", True), ("hold", False)):
+        # Long timeouts: the only zero command can come from the stop.
+        h = Harness(PLANAR, fault_policy=policy, joint_state_timeout=5.0, hold_time=5.0)
+        try:
+            assert h.node.safe_stop() is False  # never commanded: nothing to undo
+            h.send_joint_state(*joint_state(planar))
+            assert h.next_command() is not None
+            n = len(h.commands)
+            assert h.node.safe_stop() is expect_zero
+            h.spin_for(0.2)
+            received = [c for _, c in h.commands[n:]]
+            assert len(received) == (1 if expect_zero else 0)
+            assert all(np.all(c == 0.0) for c in received)
+        finally:
+            h.close()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig):
+    """grasp_torque_node as users run it: a signal stops it, and with fault_policy zero
+    the effort controller is left with zero torques, not the last command."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.node", "--ros-args",
+                              "-p", f"scenario:={PLANAR}", "-p", "fault_policy:=zero",
+                              "-p", "joint_state_timeout:=5.0", "-p", "hold_time:=5.0"],
+                             env=env, stderr=subprocess.PIPE, text=True)
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=DOMAIN)
+    tester = rclpy.create_node("stop_tester", context=ctx)
+    executor = SingleThreadedExecutor(context=ctx)
+    executor.add_node(tester)
+    commands = []
+    tester.create_subscription(Float64MultiArray, "effort_commands",
+                               lambda m: commands.append(np.array(m.data)), COMMAND_QOS)
+    pub = tester.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+
+    def spin_until(pred, timeout):
+        end = time.monotonic() + timeout
+        while not pred() and time.monotonic() < end:
+            executor.spin_once(timeout_sec=0.01)
+        return pred()
+
+    try:
+        names, pos = joint_state(planar)
+        assert spin_until(lambda: pub.get_subscription_count() > 0, 20.0)
+        end = time.monotonic() + 10.0
+        while not commands and time.monotonic() < end:
+            pub.publish(JointState(name=names, position=pos))
+            spin_until(lambda: bool(commands), 0.1)
+        assert commands and np.linalg.norm(commands[-1]) > 0
+        child.send_signal(sig)
+        assert spin_until(lambda: np.all(commands[-1] == 0.0), 10.0), commands[-3:]
+        assert child.wait(timeout=10) == 0
+        assert "Traceback" not in child.stderr.read()
+    finally:
+        if child.poll() is None:
+            child.kill()
+        tester.destroy_node()
+        executor.shutdown()
+        rclpy.try_shutdown(context=ctx)
