@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.certificate import DEFAULT_TOLERANCE
 from grasp_torque_opt.exceptions import FrameNotFound, GraspTorqueError, InputError
 from grasp_torque_opt.grasp_maps import GraspMaps
@@ -40,7 +41,7 @@ from grasp_torque_opt.grasp_setup import GraspSetup
 from grasp_torque_opt.scenario import ContactSpec
 from grasp_torque_opt.solution import Solution
 from grasp_torque_opt.solve import solve
-from grasp_torque_opt.tau_qp import ProxSuiteSettings, TauQPSolver
+from grasp_torque_opt.tau_qp import ProxSuiteSettings
 
 POLICIES = ("hold", "zero")
 #: A quaternion is accepted when | ||q|| - 1 | is at most this, then normalized.
@@ -210,14 +211,16 @@ class TorqueController:
         setup: the grasp of the scenario: hand, default contacts and load,
             friction, limits, weights. Its hand is owned by this controller.
         config: timing and safety settings.
-        solver_settings: ProxSuite settings.
+        solver_settings: solver tolerance and iteration caps.
+        backend: QP backend, one of :data:`grasp_torque_opt.backends.BACKENDS`.
     """
 
     def __init__(self, setup: GraspSetup, config: CycleConfig | None = None,
-                 solver_settings: ProxSuiteSettings | None = None) -> None:
+                 solver_settings: ProxSuiteSettings | None = None,
+                 backend: str = "proxsuite") -> None:
         self.setup = setup
         self.config = config or CycleConfig()
-        self.solver = TauQPSolver(solver_settings)
+        self.solver = make_solver(backend, solver_settings)
         self.inputs = Inputs()
         self.counters = Counters()
         self.last_command: np.ndarray | None = None

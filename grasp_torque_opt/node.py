@@ -40,6 +40,7 @@ from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
 from grasp_torque_opt import diagnostics
+from grasp_torque_opt.backends import BACKENDS, make_solver
 from grasp_torque_opt.controller import (POLICIES, CycleConfig, CycleResult, TorqueController,
                                          stamp_seconds)
 from grasp_torque_opt.exceptions import GraspTorqueError, InputError
@@ -109,8 +110,12 @@ PARAMETERS: dict[str, Spec] = {
                                    "is rejected [s].", 0.0, 3600.0),
     "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun) [s].",
                          1e-4, 10.0),
-    "solver.eps_abs": Spec("ProxSuite absolute tolerance [-].", 1e-12, 1e-4),
-    "solver.max_iter": Spec("ProxSuite outer iteration cap [-].", 1, 100000),
+    "solver.backend": Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
+                           "without internal-force variables only); every result is "
+                           "certified whichever solves it."),
+    "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
+                           "[-].", 1e-12, 1e-4),
+    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 100000),
     "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
     "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
                                   1e-12, 1e-2),
@@ -142,6 +147,8 @@ def check(name: str, value: Any, m: int) -> str:
     spec = PARAMETERS[name]
     if name == "fault_policy":
         return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
+    if name == "solver.backend":
+        return "" if value in BACKENDS else f"{name}: must be one of {', '.join(BACKENDS)}"
     if spec.length is not None:
         n = m if spec.length == "joints" else int(spec.length)
         values = list(value)
@@ -188,6 +195,7 @@ class GraspTorqueNode(Node):
             "max_contact_distance": CycleConfig.max_contact_distance,
             "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
             "cycle_budget": CycleConfig.cycle_budget,
+            "solver.backend": BACKENDS[0],
             "solver.eps_abs": ProxSuiteSettings.eps_abs,
             "solver.max_iter": ProxSuiteSettings.max_iter,
             "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
@@ -204,9 +212,11 @@ class GraspTorqueNode(Node):
             if reason:
                 raise InputError(name, reason.split(": ", 1)[1])
         self._base_setup = setup
-        self.controller = TorqueController(*self._configure(setup, self._params()))
+        backend = self.get_parameter("solver.backend").value
+        self.controller = TorqueController(*self._configure(setup, self._params()), backend)
         self._service_controller = TorqueController(*self._configure(
-            dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()))
+            dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
+            backend)
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
@@ -298,8 +308,9 @@ class GraspTorqueNode(Node):
             for ctrl in (self.controller, self._service_controller):
                 setup, config, solver = self._configure(ctrl.setup, p)
                 ctrl.setup, ctrl.config = setup, config
-                if solver != ctrl.solver.settings:
-                    ctrl.solver = type(ctrl.solver)(solver)
+                if solver != ctrl.solver.settings or \
+                        p["solver.backend"] != getattr(ctrl.solver, "name", None):
+                    ctrl.solver = make_solver(p["solver.backend"], solver)
 
     # -- inputs and cycle -----------------------------------------------------------------
 

@@ -434,3 +434,24 @@ def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, si
         tester.destroy_node()
         executor.shutdown()
         rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, backend):
+    h = Harness(ALLEGRO)
+    try:
+        names = list(allegro.hand.joints)
+        positions = allegro.q[allegro.hand.idx_q]
+        h.send_joint_state(names, positions)
+        before = h.next_command(5.0)
+        assert before is not None
+        assert h.node.set_parameters([Parameter("solver.backend", value=backend)])[0].successful
+        assert h.node.controller.solver.name == backend
+        h.send_joint_state(names, positions)
+        after = h.next_command(5.0)
+        assert after is not None
+        np.testing.assert_allclose(after, before, atol=1e-6)
+        refused = h.node.set_parameters([Parameter("solver.backend", value="osqp")])[0]
+        assert not refused.successful and "solver.backend" in refused.reason
+    finally:
+        h.close()
