@@ -133,12 +133,14 @@ def test_input_publisher_dies_and_comes_back(planar, policy):
         h.js_pub = h.tester.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
         assert h.spin_until(lambda: h.js_pub.get_subscription_count() > 0, 5.0)
         n = len(h.commands)
+        recoveries = h.node.controller.counters.recoveries
         for _ in range(10):
             COUNTS["inputs"] += 1
             h.send_joint_state(names, pos)
             h.spin_for(0.01)
         assert any(np.allclose(c, tau, atol=1e-9) for _, c in h.commands[n:])
-        assert h.node.controller.counters.recoveries == 1
+        # At least this one (a loaded machine can add a stale gap and its recovery).
+        assert h.node.controller.counters.recoveries >= recoveries + 1
         check_all(h, [tau], zero_allowed=policy == "zero")
     finally:
         h.close()
