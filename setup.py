@@ -30,6 +30,8 @@ setup(
         # Selectable QP backends (grasp_torque_opt.backends).
         "daqp",
         "quadprog",
+        # One BLAS thread in the node and the CLI (grasp_torque_opt.backends).
+        "threadpoolctl",
     ],
     extras_require={
         # ROS 2 Jazzy from the registry's ros-jazzy-* wheels; optional so that the

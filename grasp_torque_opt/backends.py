@@ -113,6 +113,20 @@ class QuadprogSolver:
                          "quadprog solved")
 
 
+def single_threaded_math() -> None:
+    """Limit BLAS and OpenMP to one thread in this process (the node's and CLI's mains call it).
+
+    The matrices of one grasp are tiny; with OpenBLAS's default threads, a
+    triangular solve in the QP build took 8 to 16 ms instead of tens of
+    microseconds whenever the other core was busy, and SLSQP 387 ms instead of
+    8 ms. A library user running the cycle in a loop should do the same
+    (``threadpoolctl.threadpool_limits(1)`` or ``OPENBLAS_NUM_THREADS=1``).
+    """
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(1)
+
+
 def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None):
     """A tau-QP solver by backend name (one of :data:`BACKENDS`).
 

@@ -10,7 +10,7 @@ import argparse
 import json
 import sys
 
-from grasp_torque_opt.backends import BACKENDS
+from grasp_torque_opt.backends import BACKENDS, single_threaded_math
 from grasp_torque_opt.compare import compare, format_table
 from grasp_torque_opt.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.grasp_setup import GraspSetup
@@ -61,6 +61,7 @@ def _print_solution(d: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
     args = _parser().parse_args(argv)
+    single_threaded_math()
     try:
         setup = GraspSetup.from_file(args.scenario)
         if args.command == "solve":

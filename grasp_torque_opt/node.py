@@ -40,7 +40,7 @@ from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
 from grasp_torque_opt import diagnostics
-from grasp_torque_opt.backends import BACKENDS, make_solver
+from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.controller import (POLICIES, CycleConfig, CycleResult, TorqueController,
                                          stamp_seconds)
 from grasp_torque_opt.exceptions import GraspTorqueError, InputError
@@ -494,6 +494,7 @@ def main(args: list[str] | None = None) -> int:
     parser.add_argument("--executor", choices=sorted(EXECUTORS), default="single",
                         help="rclpy executor to spin (default: single)")
     opts = parser.parse_args(remove_ros_args(argv)[1:])
+    single_threaded_math()
     # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the safe
     # action could publish; here both interrupt the spin and the context stays valid.
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)

@@ -50,6 +50,9 @@ class Recorder:
         ctrl = self.node.controller  # publish follows the cycle at once: same inputs
         self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs))
 
+    def __getattr__(self, name: str):
+        return getattr(self.real, name)  # e.g. wait_for_all_acked in the safe stop
+
 
 class Rig:
     """A real node on a private domain; the campaign calls its callbacks directly."""

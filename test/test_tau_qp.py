@@ -4,7 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from independent import assert_holds
+from independent import assert_holds, lp_feasible
 
 from grasp_torque_opt.exact_socp import solve_exact_socp
 from grasp_torque_opt.force_qp import solve_force_qp
@@ -135,3 +135,15 @@ def test_decomposition_against_numpy_pinv(name, request):
     np.testing.assert_allclose(A @ N, 0, atol=1e-12)
     np.testing.assert_allclose(U_perp.T @ A, 0, atol=1e-12)
     np.testing.assert_allclose(U_perp.T @ U_perp, np.eye(U_perp.shape[1]), atol=1e-12)
+
+
+def test_feasible_load_is_not_declared_infeasible(allegro):
+    """A load that ProxSuite called PRIMAL_INFEASIBLE with eps_primal_inf 1e-8 (the LP holds it)."""
+    th = 2 * np.pi * 3 / 500
+    w = np.array([1.4715 * np.cos(th), 0.0, 1.4715 * np.sin(th), 0.0, 0.0, 0.0])
+    setup = dataclasses.replace(allegro, external_wrench=w)
+    maps = setup.maps()
+    assert lp_feasible(setup, maps)
+    sol = solve(setup, maps=maps)
+    assert sol.status == "optimal", sol.message
+    assert_holds(setup, maps, sol.tau, sol.wrenches)
