@@ -1,0 +1,411 @@
+"""The node under load: latency and dropped cycles of grasp_torque_node beside a trivial echo node.
+
+Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
+       [--hands allegro planar] [--executors single events events-once] [--out FILE]
+
+For each hand, joint-state rate and rclpy executor, two answering processes
+are measured in turn with the same load process:
+
+- ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
+  ``publish_stamped_command:=true``);
+- an echo node written here, named ``grasp_torque_node`` too, that answers each
+  joint state with zero torques on ``effort_commands`` and the stamped copy on
+  ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
+  its executor as the node's main does (``spin()``); ``events-once`` (echo
+  only) serves the EventsExecutor with a ``spin_once`` loop instead.
+
+The load process (a separate process, the same for every case) publishes joint
+states with sensor-data QoS on absolute deadlines (the scenario's grasp with a
+1 mrad motion), each stamped with its send time, and receives both command
+topics (reliable, depth ``RECEIVER_DEPTH``: deeper than the node's 1, so that
+the receiver never drops). A command is matched to its joint state by stamp;
+a joint state of the measured window without a stamped command within the
+drain time is a dropped cycle. Latency is stamp-to-receipt on the system clock.
+Every process runs on its own private ROS domain, localhost only; discovery,
+the first command and 1 s of warm-up come before the measured window.
+
+Speed is measured here, never asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  # noqa: E402
+                      Pacer, UniqueClock, isolated_env, node_command, percentiles_ms,
+                      private_domains, raise_on_sigterm, set_stamp, stamp_ns)
+
+HANDS = {"allegro": ("allegro_right.yaml", "allegro_right_node.yaml"),
+         "planar": ("planar_two_finger.yaml", "planar_two_finger_node.yaml")}
+TARGETS = ("echo", "grasp_torque_node")
+WARMUP_S = 1.0
+#: After the last joint state, how long commands in flight are still awaited [s].
+DRAIN_S = 0.5
+#: Longest wait for the answering node to be discovered, then to answer once [s].
+READY_TIMEOUT_S = 20.0
+#: Executors of the answering node. ``events-once`` is the echo node only (the node's
+#: main offers single and events): EventsExecutor served by a spin_once loop rather
+#: than spin(), to show what that executor gives when its spin() does not deliver.
+EXECUTORS = ("single", "events", "events-once")
+#: Amplitude of the joint motion around the scenario's grasp [rad].
+AMPLITUDE = 1e-3
+
+
+def _executor(name: str):
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.experimental import EventsExecutor
+    return {"single": SingleThreadedExecutor, "events": EventsExecutor,
+            "events-once": EventsExecutor}[name]()
+
+
+# -- the echo node ---------------------------------------------------------------------------
+
+def echo_main(args: argparse.Namespace) -> int:
+    """A minimal rclpy node: each joint state is answered with zero torques, stamped."""
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.node import Node
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from grasp_torque_opt.node import COMMAND_QOS, NODE_NAME
+
+    joints = args.joints.split(",")
+    zeros = [0.0] * len(joints)
+    rclpy.init()
+    node = None
+    try:
+        node = Node(NODE_NAME)
+        command_pub = node.create_publisher(Float64MultiArray, "effort_commands", COMMAND_QOS)
+        stamped_pub = node.create_publisher(JointState, "~/effort_commands_stamped",
+                                            COMMAND_QOS)
+
+        def on_joint_state(msg: JointState) -> None:
+            command_pub.publish(Float64MultiArray(data=zeros))
+            out = JointState(name=joints, effort=zeros)
+            out.header.stamp = msg.header.stamp
+            stamped_pub.publish(out)
+
+        node.create_subscription(JointState, "joint_states", on_joint_state,
+                                 qos_profile_sensor_data)
+        executor = _executor(args.executor)
+        executor.add_node(node)
+        if args.executor == "events-once":
+            while rclpy.ok():
+                executor.spin_once(timeout_sec=1.0)
+        else:
+            executor.spin()  # as grasp_torque_node's main does
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+# -- the load process ------------------------------------------------------------------------
+
+def load_main(args: argparse.Namespace) -> int:
+    """Publish joint states at a fixed rate, receive the commands, write the figures as JSON."""
+    import numpy as np
+    import rclpy
+    from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from grasp_torque_opt.grasp_setup import GraspSetup
+
+    setup = GraspSetup.from_file(CONFIG / HANDS[args.hand][0])
+    names = list(setup.hand.joints)
+    q0 = setup.q[setup.hand.idx_q].astype(float)
+    phase = 0.4 * np.arange(len(names))
+
+    rclpy.init(args=[sys.argv[0]])
+    node = rclpy.create_node("grasp_load")
+    pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+    command_times: list[float] = []  # perf_counter at receipt of each effort_commands
+    bad_length = 0
+    stamped: dict[int, int] = {}  # joint-state stamp -> receipt [ns, system clock]
+    duplicates = 0
+
+    def on_command(msg: Float64MultiArray) -> None:
+        nonlocal bad_length
+        command_times.append(time.perf_counter())
+        if len(msg.data) != len(names):
+            bad_length += 1
+
+    def on_stamped(msg: JointState) -> None:
+        nonlocal duplicates
+        now = time.time_ns()
+        s = stamp_ns(msg.header.stamp)
+        if s in stamped:
+            duplicates += 1
+        else:
+            stamped[s] = now
+
+    node.create_subscription(Float64MultiArray, "effort_commands", on_command, receiver_qos)
+    node.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
+    executor = _executor(args.load_executor)
+    executor.add_node(node)
+    pacer = Pacer(executor, args.rate)
+
+    def ready() -> bool:
+        return (node.count_subscribers("joint_states") >= 1
+                and node.count_publishers(STAMPED_TOPIC) >= 1
+                and node.count_publishers("effort_commands") >= 1)
+
+    t_ready = time.perf_counter() + READY_TIMEOUT_S
+    while not ready() and time.perf_counter() < t_ready:
+        pacer.spin_for(0.05)
+    if not ready():
+        print("load: nobody answers on joint_states", file=sys.stderr)
+        return 1
+
+    clock = UniqueClock()
+    sent: list[tuple[int, float]] = []  # (stamp [ns], perf_counter at publish), measured only
+    lateness: list[float] = []  # of the measured ticks [s]
+    window: dict[str, float] = {}
+    t_start = time.perf_counter()
+
+    def tick(k: int, now: float) -> bool:
+        if "warm" not in window:
+            if stamped:
+                window["warm"] = now
+                window["start"] = now + WARMUP_S
+                window["end"] = window["start"] + args.duration
+            elif now - t_start > READY_TIMEOUT_S:
+                return False
+        if "end" in window and now >= window["end"]:
+            return False
+        msg = JointState(name=names,
+                         position=(q0 + AMPLITUDE * np.sin(np.pi * k * pacer.period + phase)
+                                   ).tolist())
+        s = clock()
+        set_stamp(msg.header, s)
+        pub.publish(msg)
+        if "start" in window and now >= window["start"]:
+            sent.append((s, now))
+            lateness.append(pacer.lateness[-1])
+        return True
+
+    pacer.run(tick)
+    pacer.spin_for(DRAIN_S)
+    foreign = {"joint_states_publishers": node.count_publishers("joint_states"),
+               "joint_states_subscribers": node.count_subscribers("joint_states")}
+    node.destroy_node()
+    rclpy.try_shutdown()
+    if "start" not in window:
+        print("load: no command came back", file=sys.stderr)
+        return 1
+
+    n_pub = len(sent)
+    span = sent[-1][1] - sent[0][1] if n_pub > 1 else float("nan")
+    latencies = [1e-9 * (stamped[s] - s) for s, _ in sent if s in stamped]
+    dropped = n_pub - len(latencies)
+    t0, t1 = window["start"], window["end"]
+    n_cmd = sum(t0 <= t <= t1 for t in command_times)
+    result = {
+        "published": n_pub,
+        "publish_rate_hz": (n_pub - 1) / span if n_pub > 1 else None,
+        "publish_lateness": percentiles_ms(lateness),
+        "commands": n_cmd,
+        "command_rate_hz": n_cmd / (t1 - t0),
+        "answered": len(latencies),
+        "dropped": dropped,
+        "dropped_pct": 100.0 * dropped / n_pub if n_pub else None,
+        "latency": percentiles_ms(latencies),
+        "duplicate_stamps": duplicates,
+        "wrong_length_commands": bad_length,
+        "time_to_first_command_s": window["warm"] - t_start,
+        "graph_at_end": foreign,
+    }
+    Path(args.result).write_text(json.dumps(result))
+    return 0
+
+
+# -- the run ---------------------------------------------------------------------------------
+
+def run_case(hand: str, target: str, rate: float, executor: str, duration: float,
+             load_executor: str, domain: int, tmp: Path) -> dict:
+    """One case: start the answering node, run the load process against it, stop both."""
+    from grasp_torque_opt.grasp_setup import GraspSetup
+
+    env = isolated_env(domain)
+    tag = f"{hand}-{target}-{int(rate)}-{executor}"
+    me = [sys.executable, str(Path(__file__).resolve())]
+    if target == "echo":
+        joints = GraspSetup.from_file(CONFIG / HANDS[hand][0]).hand.joints
+        cmd = me + ["--role", "echo", "--executor", executor, "--joints", ",".join(joints)]
+    else:
+        cmd = node_command(CONFIG / HANDS[hand][1], executor, ["--log-level", "error"])
+    result_file = tmp / f"{tag}.json"
+    load_cmd = me + ["--role", "load", "--hand", hand, "--rate", str(rate),
+                     "--duration", str(duration), "--load-executor", load_executor,
+                     "--result", str(result_file)]
+    children: list[Child] = []
+    with open(tmp / f"{tag}.target.log", "w") as tlog, open(tmp / f"{tag}.load.log", "w") as llog:
+        try:
+            load_before = os.getloadavg()[0]
+            share = CpuShare()
+            answering = Child(cmd, env, tlog)
+            children.append(answering)
+            load = Child(load_cmd, env, llog)
+            children.append(load)
+            timeout = READY_TIMEOUT_S * 2 + duration + 30
+            try:
+                code = load.proc.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                code = None
+            target_alive = answering.alive()
+        finally:
+            for c in reversed(children):
+                c.stop()
+    out = {"hand": hand, "target": target, "rate_hz": rate, "executor": executor,
+           "ros_domain_id": domain, "loadavg_1min_before": load_before,
+           "other_processes_cores": share.others_cores(), "target_alive_at_end": target_alive}
+    if code == 0 and result_file.exists():
+        out.update(json.loads(result_file.read_text()))
+    else:
+        out["error"] = (f"load process exit {code}: "
+                        + (tmp / f"{tag}.load.log").read_text()[-500:]
+                        + " | target: " + (tmp / f"{tag}.target.log").read_text()[-500:])
+    return out
+
+
+def _fmt(x: float | None, spec: str) -> str:
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
+
+
+def table(cases: list[dict]) -> str:
+    """The markdown tables: every case, then the node against the echo node."""
+    lines = ["| hand | rate [Hz] | executor | answering node | published [Hz] | "
+             "commands [Hz] | dropped | dropped [%] | p50 [ms] | p99 [ms] | max [ms] | "
+             "other work [cores] |",
+             "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for c in cases:
+        if "error" in c:
+            lines.append(f"| {c['hand']} | {c['rate_hz']:g} | {c['executor']} | {c['target']} "
+                         f"| failed: {c['error'][:80]} ||||||||")
+            continue
+        lat = c["latency"]
+        lines.append(
+            f"| {c['hand']} | {c['rate_hz']:g} | {c['executor']} | {c['target']} | "
+            f"{_fmt(c['publish_rate_hz'], '.1f')} | {c['command_rate_hz']:.1f} | "
+            f"{c['dropped']} | {_fmt(c['dropped_pct'], '.2f')} | "
+            f"{_fmt(lat['p50_ms'], '.3f')} | {_fmt(lat['p99_ms'], '.3f')} | "
+            f"{_fmt(lat['max_ms'], '.3f')} | {_fmt(c['other_processes_cores'], '.2f')} |")
+    lines += ["", "| hand | rate [Hz] | executor | p99 node / echo | "
+              "dropped node - echo [pp] | p50 node / echo |", "|---|---:|---|---:|---:|---:|"]
+    for r in ratios(cases):
+        lines.append(f"| {r['hand']} | {r['rate_hz']:g} | {r['executor']} | "
+                     f"{_fmt(r['p99_ratio'], '.2f')} | {_fmt(r['dropped_diff_pp'], '+.2f')} | "
+                     f"{_fmt(r['p50_ratio'], '.2f')} |")
+    return "\n".join(lines)
+
+
+def ratios(cases: list[dict]) -> list[dict]:
+    """The node against the echo node at the same hand, rate and executor."""
+    by_key = {(c["hand"], c["rate_hz"], c["executor"], c["target"]): c for c in cases}
+    out = []
+    for (hand, rate, executor, target), node in by_key.items():
+        echo = by_key.get((hand, rate, executor, "echo"))
+        if target == "echo" or echo is None:
+            continue
+        r = {"hand": hand, "rate_hz": rate, "executor": executor, "p99_ratio": None,
+             "p50_ratio": None, "dropped_diff_pp": None}
+        if "error" not in node and "error" not in echo:
+            for q in ("p50", "p99"):
+                a, b = node["latency"][f"{q}_ms"], echo["latency"][f"{q}_ms"]
+                r[f"{q}_ratio"] = a / b if a is not None and b else None
+            if node["dropped_pct"] is not None and echo["dropped_pct"] is not None:
+                r["dropped_diff_pp"] = node["dropped_pct"] - echo["dropped_pct"]
+        out.append(r)
+    return out
+
+
+def main_run(args: argparse.Namespace) -> int:
+    from cycle import machine
+
+    raise_on_sigterm()
+    keys = [k for k in itertools.product(args.hands, args.rates, args.executors, TARGETS)
+            if not (k[2] == "events-once" and k[3] == "grasp_torque_node")]
+    domains = private_domains(len(keys))
+    m = machine()
+    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}")
+    print(f"{len(keys)} cases, {args.duration:g} s each after {WARMUP_S:g} s of warm-up; "
+          f"load process executor: {args.load_executor}; receiver depth {RECEIVER_DEPTH}",
+          flush=True)
+    cases = []
+    logs = Path(tempfile.mkdtemp(prefix="node_load_"))
+    print(f"logs of the child processes: {logs}")
+    for (hand, rate, executor, target), domain in zip(keys, domains):
+        c = run_case(hand, target, rate, executor, args.duration, args.load_executor,
+                     domain, logs)
+        cases.append(c)
+        if "error" in c:
+            print(f"  {hand} {target} {rate:g} Hz {executor}: {c['error']}", flush=True)
+        else:
+            print(f"  {hand:8} {target:18} {rate:6g} Hz {executor:11} "
+                  f"commands {c['command_rate_hz']:7.1f}/s  dropped {c['dropped_pct']:6.2f}%"
+                  f"  p50 {_fmt(c['latency']['p50_ms'], '.3f')} ms"
+                  f"  p99 {_fmt(c['latency']['p99_ms'], '.3f')} ms"
+                  f"  (other work: {_fmt(c['other_processes_cores'], '.2f')} cores)",
+                  flush=True)
+    print()
+    print(table(cases))
+    out = {"machine": m, "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+           "duration_s": args.duration, "warmup_s": WARMUP_S, "drain_s": DRAIN_S,
+           "load_executor": args.load_executor, "receiver_depth": RECEIVER_DEPTH,
+           "cases": cases, "node_vs_echo": ratios(cases)}
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(out, indent=2))
+    print(f"\nwritten: {args.out}")
+    return 0 if all("error" not in c for c in cases) else 1
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=10.0,
+                        help="measured seconds per case [s]")
+    parser.add_argument("--rates", type=float, nargs="+", default=[500.0, 1000.0],
+                        help="joint-state rates [Hz]")
+    parser.add_argument("--hands", nargs="+", choices=sorted(HANDS), default=list(HANDS))
+    parser.add_argument("--executors", nargs="+", choices=EXECUTORS, default=list(EXECUTORS),
+                        help="executors of the answering nodes (events-once: echo only)")
+    parser.add_argument("--load-executor", choices=["single", "events"], default="events",
+                        help="executor of the load process itself (the same in every case)")
+    parser.add_argument("--out", type=Path,
+                        default=Path(__file__).resolve().parent / "results" / "node_load.json")
+    # Roles of the child processes.
+    parser.add_argument("--role", choices=["run", "echo", "load"], default="run",
+                        help=argparse.SUPPRESS)
+    parser.add_argument("--executor", choices=EXECUTORS, default="single",
+                        help=argparse.SUPPRESS)
+    parser.add_argument("--joints", help=argparse.SUPPRESS)
+    parser.add_argument("--hand", choices=sorted(HANDS), help=argparse.SUPPRESS)
+    parser.add_argument("--rate", type=float, help=argparse.SUPPRESS)
+    parser.add_argument("--result", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.role == "echo":
+        return echo_main(args)
+    if args.role == "load":
+        return load_main(args)
+    return main_run(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
