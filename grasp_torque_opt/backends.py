@@ -29,26 +29,71 @@ from grasp_torque_opt.tau_qp import ProxSuiteSettings, TauQP, TauQPSolver, check
 BACKENDS = ("proxsuite", "daqp", "quadprog")
 #: DAQP's "infinite" bound.
 DAQP_INF = 1e30
+#: Largest KKT violation (:func:`kkt_violation`) of an answer taken as optimal.
+KKT_TOLERANCE = 1e-6
+
+
+def kkt_violation(H: np.ndarray, g: np.ndarray, M: np.ndarray, lower: np.ndarray,
+                  upper: np.ndarray, equality: np.ndarray, x: np.ndarray,
+                  lam: np.ndarray) -> float:
+    """How far (x, lam) is from a KKT point of min 1/2 x'Hx + g'x, lower <= M x <= upper.
+
+    Sign convention (DAQP's): H x + g + M' lam = 0, lam > 0 on an active upper
+    bound, lam < 0 on an active lower one; equality rows take any sign.
+
+    Returns:
+        The largest of: the stationarity residual relative to the size of its
+        terms, the primal infeasibility, and each inequality's multiplier
+        times its slack (complementarity, which also catches a wrong sign).
+    """
+    Mx = M @ x
+    grad = H @ x + g
+    dual = M.T @ lam
+    scale = max(1.0, float(np.abs(grad).max()), float(np.abs(dual).max()))
+    stationarity = float(np.abs(grad + dual).max()) / scale
+    primal = max(0.0, float((Mx - upper).max()), float((lower - Mx).max()))
+    ineq = ~equality
+    comp = max(float((np.maximum(lam, 0.0) * (upper - Mx))[ineq].max(initial=0.0)),
+               float((np.maximum(-lam, 0.0) * (Mx - lower))[ineq].max(initial=0.0)))
+    return max(stationarity, primal, comp)
 
 
 class DaqpSolver:
     """DAQP on the tau-QP: bounds on x, then the equalities, then the cone rows.
 
+    One DAQP workspace is kept per problem size. Every answer is checked for
+    optimality (:func:`kkt_violation` with DAQP's multipliers, to
+    :data:`KKT_TOLERANCE`) before it is returned as solved, on top of the
+    caller's certificate.
+
+    With ``warm_start``, a cycle starts from the previous cycle's active set
+    (DAQP keeps it across updates); an answer that is not optimal by DAQP's
+    flag and the KKT check is dropped and the QP solved again from a cold
+    start within the same call. ``warm_solves`` and ``fallbacks`` count them.
+
     Args:
         settings: ``eps_abs`` is DAQP's primal tolerance, ``max_iter`` its
             iteration cap; the rest does not apply.
+        warm_start: start from the previous active set.
     """
 
     name = "daqp"
 
-    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+    def __init__(self, settings: ProxSuiteSettings | None = None,
+                 warm_start: bool = False) -> None:
         import daqp  # imported here: the core runs without the optional backends
 
         self._daqp = daqp
         self.settings = settings or ProxSuiteSettings()
+        self.warm_start = warm_start
+        self.warm_solves = 0
+        self.fallbacks = 0
+        self._model = None
+        self._dims: tuple[int, int, int] | None = None
+        self._keep: tuple = ()
 
     def solve(self, qp: TauQP) -> RawResult:
-        """Solve a built tau-QP from a cold start."""
+        """Solve a built tau-QP (warm if enabled and verified, else cold)."""
         why = check_data(qp)
         if why:
             return RawResult("error", None, 0, 0.0, why)
@@ -58,15 +103,48 @@ class DaqpSolver:
         lower = np.concatenate((np.maximum(qp.l_box, -DAQP_INF), qp.b, np.full(n_in, -DAQP_INF)))
         sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
         sense[n:n + n_eq] = 5  # equality
+        H = qp.H.copy()  # DAQP wants writable buffers; H is shared read-only
         t0 = time.perf_counter()
-        # DAQP wants writable buffers; H is shared read-only.
-        x, _, flag, info = self._daqp.solve(
-            qp.H.copy(), qp.g, A, upper, lower, sense, primal_tol=self.settings.eps_abs,
-            iter_limit=self.settings.max_iter, eps_prox=0.0 if n == qp.m else -1e-6)
+        if self._dims != (n, n_eq, n_in):
+            self._model = self._daqp.Model()
+            self._model.setup(H, qp.g, A, upper, lower, sense)
+            s = self._model.settings
+            s.update(primal_tol=self.settings.eps_abs, iter_limit=self.settings.max_iter,
+                     eps_prox=0.0 if n == qp.m else -1e-6)
+            self._model.settings = s
+            self._dims = (n, n_eq, n_in)
+            warm = False
+        else:
+            warm = self.warm_start
+            # Without sense, DAQP keeps the previous active set: a warm start.
+            self._model.update(H=H, f=qp.g, A=A, bupper=upper, blower=lower,
+                               sense=None if warm else sense)
+        self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
+        M = np.vstack((np.eye(n), A))
+        x, _, flag, info = self._model.solve()
+        iterations = int(info["iterations"])
+        kkt = self._kkt(flag, H, qp.g, M, lower, upper, sense, x, info)
+        if warm:
+            self.warm_solves += 1
+            if not kkt <= KKT_TOLERANCE:
+                self.fallbacks += 1
+                self._model.update(sense=sense)  # the same data, cold
+                x, _, flag, info = self._model.solve()
+                iterations += int(info["iterations"])
+                kkt = self._kkt(flag, H, qp.g, M, lower, upper, sense, x, info)
         elapsed = time.perf_counter() - t0
         status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
-        return RawResult(status, np.asarray(x, dtype=float), int(info["iterations"]), elapsed,
-                         f"DAQP exit flag {int(flag)}")
+        message = f"DAQP exit flag {int(flag)}"
+        if status == "solved" and not kkt <= KKT_TOLERANCE:
+            status, message = "error", f"{message}, but KKT violated by {kkt:.3g}"
+        return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
+
+    @staticmethod
+    def _kkt(flag, H, g, M, lower, upper, sense, x, info) -> float:
+        """KKT violation of a DAQP answer that says optimal (inf otherwise)."""
+        if int(flag) != 1:
+            return float("inf")
+        return kkt_violation(H, g, M, lower, upper, sense == 5, np.asarray(x), info["lam"])
 
 
 class QuadprogSolver:
@@ -127,8 +205,12 @@ def single_threaded_math() -> None:
     threadpool_limits(1)
 
 
-def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None):
+def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None,
+                warm_start: bool = False):
     """A tau-QP solver by backend name (one of :data:`BACKENDS`).
+
+    ``warm_start`` applies to DAQP only (ProxSuite's own warm start gave
+    unsolved or off-optimum answers on slowly moving Allegro sequences).
 
     Raises:
         ValueError: an unknown backend, naming the known ones.
@@ -136,7 +218,7 @@ def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None =
     if backend == "proxsuite":
         return TauQPSolver(settings)
     if backend == "daqp":
-        return DaqpSolver(settings)
+        return DaqpSolver(settings, warm_start)
     if backend == "quadprog":
         return QuadprogSolver(settings)
     raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")

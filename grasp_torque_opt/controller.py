@@ -213,14 +213,16 @@ class TorqueController:
         config: timing and safety settings.
         solver_settings: solver tolerance and iteration caps.
         backend: QP backend, one of :data:`grasp_torque_opt.backends.BACKENDS`.
+        warm_start: start each solve from the previous one (DAQP only; verified,
+            with a cold fallback in the same cycle).
     """
 
     def __init__(self, setup: GraspSetup, config: CycleConfig | None = None,
                  solver_settings: ProxSuiteSettings | None = None,
-                 backend: str = "proxsuite") -> None:
+                 backend: str = "proxsuite", warm_start: bool = False) -> None:
         self.setup = setup
         self.config = config or CycleConfig()
-        self.solver = make_solver(backend, solver_settings)
+        self.solver = make_solver(backend, solver_settings, warm_start)
         self.inputs = Inputs()
         self.counters = Counters()
         self.last_command: np.ndarray | None = None

@@ -79,6 +79,10 @@ def report(controller: TorqueController, now: float) -> Report:
                ("recoveries", str(n.recoveries)), ("solver_failures", str(n.solver_failures)),
                ("overruns", str(n.overruns)), ("max_cycle_time_s", f"{n.max_cycle_time:.6f}"),
                ("cycle_budget_s", f"{cfg.cycle_budget:.6f}")]
+    solver = c.solver
+    values += [("solver.backend", getattr(solver, "name", type(solver).__name__)),
+               ("solver.warm_solves", str(getattr(solver, "warm_solves", 0))),
+               ("solver.warm_start_fallbacks", str(getattr(solver, "fallbacks", 0)))]
     values += [(f"rejected.{k}", str(v)) for k, v in n.rejected.items()]
     values.append(("last_rejection", c.last_rejection or "none"))
     values += [("age.joint_states_s", _ago(now, c.inputs.q_time)),

@@ -113,6 +113,10 @@ PARAMETERS: dict[str, Spec] = {
     "solver.backend": Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
                            "without internal-force variables only); every result is "
                            "certified whichever solves it."),
+    "solver.warm_start": Spec("Start each DAQP solve from the previous cycle's active set; an "
+                              "answer that is not optimal (flag, KKT check) is redone cold in "
+                              "the same cycle and counted (diagnostics "
+                              "solver.warm_start_fallbacks). No effect on other backends."),
     "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
                            "[-].", 1e-12, 1e-4),
     "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 100000),
@@ -196,6 +200,7 @@ class GraspTorqueNode(Node):
             "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
             "cycle_budget": CycleConfig.cycle_budget,
             "solver.backend": BACKENDS[0],
+            "solver.warm_start": False,
             "solver.eps_abs": ProxSuiteSettings.eps_abs,
             "solver.max_iter": ProxSuiteSettings.max_iter,
             "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
@@ -213,7 +218,10 @@ class GraspTorqueNode(Node):
                 raise InputError(name, reason.split(": ", 1)[1])
         self._base_setup = setup
         backend = self.get_parameter("solver.backend").value
-        self.controller = TorqueController(*self._configure(setup, self._params()), backend)
+        warm = self.get_parameter("solver.warm_start").value
+        self.controller = TorqueController(*self._configure(setup, self._params()), backend,
+                                           warm)
+        # The service solves snapshots out of sequence: always cold.
         self._service_controller = TorqueController(*self._configure(
             dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
             backend)
@@ -305,12 +313,14 @@ class GraspTorqueNode(Node):
     def _apply_parameters(self, params: list[Parameter]) -> None:
         p = self._params()
         with self._lock:
-            for ctrl in (self.controller, self._service_controller):
+            warm_loop = p["solver.warm_start"] and p["solver.backend"] == "daqp"
+            for ctrl, warm in ((self.controller, warm_loop), (self._service_controller, False)):
                 setup, config, solver = self._configure(ctrl.setup, p)
                 ctrl.setup, ctrl.config = setup, config
                 if solver != ctrl.solver.settings or \
-                        p["solver.backend"] != getattr(ctrl.solver, "name", None):
-                    ctrl.solver = make_solver(p["solver.backend"], solver)
+                        p["solver.backend"] != getattr(ctrl.solver, "name", None) or \
+                        warm != getattr(ctrl.solver, "warm_start", False):
+                    ctrl.solver = make_solver(p["solver.backend"], solver, warm)
 
     # -- inputs and cycle -----------------------------------------------------------------
 

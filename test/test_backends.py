@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from independent import assert_holds
 
-from grasp_torque_opt.backends import BACKENDS, make_solver
+from grasp_torque_opt.backends import BACKENDS, kkt_violation, make_solver
 from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.solve import solve
 from grasp_torque_opt.tau_qp import build_tau_qp
@@ -88,3 +88,63 @@ def test_bad_qp_data_never_reaches_the_solver(backend, defect, allegro):
 def test_unknown_backend_is_named():
     with pytest.raises(ValueError, match="proxsuite, daqp, quadprog.*'osqp'"):
         make_solver("osqp")
+
+
+def moving_sequence(setup, steps):
+    """A slowly rotating load with the fingers drifting: what the node sees cycle to cycle."""
+    scale = np.linalg.norm(setup.external_wrench[:3])
+    for k in range(steps):
+        th = 2 * np.pi * k / steps
+        w = setup.external_wrench.copy()
+        w[:3] = scale * np.array([np.cos(th), 0.2 * np.sin(3 * th), -abs(np.sin(th)) - 0.3])
+        q = setup.q.copy()
+        q[setup.hand.idx_q] += 0.03 * np.sin(th)
+        yield dataclasses.replace(setup, external_wrench=w, q=q)
+
+
+@pytest.mark.parametrize("name", ["planar", "allegro"])
+def test_daqp_warm_start_gives_the_cold_optimum(name, request):
+    setup = request.getfixturevalue(name)
+    cold, warm = make_solver("daqp"), make_solver("daqp", warm_start=True)
+    for s in moving_sequence(setup, 40):
+        maps = s.maps()
+        a, b = solve(s, maps=maps, solver=cold), solve(s, maps=maps, solver=warm)
+        assert a.status == b.status
+        if a.optimal:
+            np.testing.assert_allclose(b.tau, a.tau, atol=1e-8)
+    assert warm.warm_solves == 39 and cold.warm_solves == 0
+
+
+def test_daqp_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro):
+    """From a feasible grasp's active set to an infeasible load and back: each result is the
+    cold one, and every warm answer that was not optimal was redone cold (and counted)."""
+    warm = make_solver("daqp", warm_start=True)
+    heavy = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * 1e3)
+    assert solve(allegro, solver=warm).optimal
+    assert solve(heavy, solver=warm).status == "infeasible"
+    assert warm.fallbacks == 1  # the warm answer on the heavy load was not optimal
+    back = solve(allegro, solver=warm)
+    assert back.optimal
+    np.testing.assert_allclose(back.tau, solve(allegro, backend="daqp").tau, atol=1e-8)
+
+
+def test_kkt_violation_sees_a_suboptimal_point(allegro):
+    """The optimality check itself: the solver's point passes, a feasible detour does not."""
+    maps = allegro.maps()
+    qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
+                      allegro.weights)
+    n = qp.H.shape[0]
+    M = np.vstack((np.eye(n), qp.A, qp.C))
+    lower = np.concatenate((qp.l_box, qp.b, np.full(qp.C.shape[0], -1e30)))
+    upper = np.concatenate((qp.u_box, qp.b, qp.u))
+    eq = np.zeros(M.shape[0], bool)
+    eq[n:n + qp.A.shape[0]] = True
+    import daqp
+    x, _, flag, info = daqp.solve(qp.H.copy(), qp.g, M[n:], upper, lower,
+                                  np.where(eq, 5, 0).astype(np.int32), primal_tol=1e-9)
+    assert flag == 1
+    assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x, info["lam"]) < 1e-9
+    # The same multipliers at a point moved along the equality-feasible directions.
+    lam = info["lam"]
+    assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x * 1.01, lam) > 1e-4
+    assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x, -lam) > 1e-4

@@ -1,9 +1,12 @@
 """The diagnostic report is a pure function of the controller's state."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from test_controller import fresh, joint_state
 
+from grasp_torque_opt.controller import CycleConfig, TorqueController
 from grasp_torque_opt.diagnostics import ERROR, OK, STALE, WARN, report
 from grasp_torque_opt.exceptions import InputError
 
@@ -54,3 +57,20 @@ def test_friction_usage_matches_the_wrenches(allegro):
         expected = np.hypot(w[0], w[1]) / (mu1 * w[2])
         assert float(v[f"contact{i}.{c.link}.tangential_usage"]) == \
             float(f"{expected:.4f}")
+
+
+def test_warm_starts_and_their_fallbacks_are_reported(allegro):
+    ctrl = TorqueController(dataclasses.replace(allegro, hand=dataclasses.replace(allegro.hand)),
+                            CycleConfig(cycle_budget=10.0), backend="daqp", warm_start=True)
+    names, positions = joint_state(allegro)
+    ctrl.update_joint_state(names, positions, 0.0)
+    assert ctrl.cycle(0.0).kind == "solution"
+    ctrl.update_joint_state(names, positions, 0.01)
+    assert ctrl.cycle(0.01).kind == "solution"
+    # A load no grasp holds: the warm answer is not optimal, so it is redone cold.
+    ctrl.update_wrench("", allegro.external_wrench[:3] * 100, np.zeros(3), 0.02)
+    ctrl.update_joint_state(names, positions, 0.02)
+    assert ctrl.cycle(0.02).kind == "none"
+    v = values(report(ctrl, 0.02))
+    assert v["solver.backend"] == "daqp"
+    assert v["solver.warm_solves"] == "2" and v["solver.warm_start_fallbacks"] == "1"
