@@ -1,13 +1,13 @@
 """Time the full control cycle on the bundled scenarios, per QP backend.
 
-Usage: .venv/bin/python bench/cycle.py [--repeats 3000] [--backends proxsuite,daqp,quadprog]
-       [--out FILE]
+Usage: .venv/bin/python bench/cycle.py [--repeats 3000]
+       [--backends proxsuite,daqp,quadprog,daqp+warm] [--out FILE]
 
 Two paths, median and p99 over the repeats, with the machine it ran on:
 
 - ``core``: kinematics and maps, build, solve, certificate (``solve.solve`` with
-  the maps computed in the loop and a solver reused across cycles), with each
-  stage's share of the total;
+  a solver reused across cycles, the fingers moving by 1 mrad between cycles),
+  with each stage's share of the total;
 - ``controller``: what the node runs on each joint state, without ROS: the joint
   state checked and taken, then ``TorqueController.cycle`` (kinematics, gravity
   torques when compensated, maps, build, solve, certificate, gate).
@@ -18,6 +18,7 @@ Speed is measured here, never asserted in a test.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import platform
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from grasp_torque_opt.backends import BACKENDS, make_solver
+from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.controller import CycleConfig, TorqueController
 from grasp_torque_opt.grasp_setup import GraspSetup
 from grasp_torque_opt.solve import solve
@@ -71,16 +72,33 @@ def summary(samples: list[float]) -> dict:
     return {"median_s": float(np.median(samples)), "p99_s": float(np.percentile(samples, 99))}
 
 
-def bench_core(setup: GraspSetup, backend: str, repeats: int) -> dict:
-    """The core cycle: maps, build, solve, certify; per stage and in total."""
-    solver = make_solver(backend)
+def solver_of(variant: str):
+    """A solver from a variant name: a backend, ``+warm`` for DAQP's verified warm start."""
+    backend, _, warm = variant.partition("+")
+    return make_solver(backend, warm_start=warm == "warm")
+
+
+def moving(setup: GraspSetup, count: int) -> list[GraspSetup]:
+    """The grasp with the fingers moving by 1 mrad (seeded) from cycle to cycle."""
+    rng = np.random.default_rng(0)
+    out = []
+    for _ in range(count):
+        q = setup.q.copy()
+        q[setup.hand.idx_q] += rng.normal(scale=1e-3, size=setup.hand.m)
+        out.append(dataclasses.replace(setup, q=q))
+    return out
+
+
+def bench_core(setup: GraspSetup, variant: str, repeats: int) -> dict:
+    """The core cycle on a moving grasp: maps, build, solve, certify; per stage and in total."""
+    solver = solver_of(variant)
     sol = solve(setup, solver=solver)
     if not sol.optimal:
         return {"skipped": sol.message}
     samples = {k: [] for k in STAGES + ["total"]}
-    for i in range(repeats + 50):
+    for i, grasp in enumerate(moving(setup, repeats + 50)):
         t0 = time.perf_counter()
-        sol = solve(setup, solver=solver)
+        sol = solve(grasp, solver=solver)
         total = time.perf_counter() - t0
         if not sol.optimal:
             raise RuntimeError(f"{backend}: {sol.message}")
@@ -95,10 +113,10 @@ def bench_core(setup: GraspSetup, backend: str, repeats: int) -> dict:
     return out
 
 
-def bench_controller(setup: GraspSetup, backend: str, repeats: int) -> dict:
+def bench_controller(setup: GraspSetup, variant: str, repeats: int) -> dict:
     """The node's cycle without ROS: take a joint state, then run the cycle."""
     ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True))
-    ctrl.solver = make_solver(backend)
+    ctrl.solver = solver_of(variant)
     names = list(setup.hand.joints)
     q0 = setup.q[setup.hand.idx_q]
     rng = np.random.default_rng(0)
@@ -116,7 +134,11 @@ def bench_controller(setup: GraspSetup, backend: str, repeats: int) -> dict:
     return {"total": summary(samples), "certified_commands": published, "cycles": repeats}
 
 
-def run(repeats: int = 3000, backends: tuple[str, ...] = BACKENDS) -> dict:
+#: What is timed: each backend, and DAQP with its verified warm start.
+VARIANTS = (*BACKENDS, "daqp+warm")
+
+
+def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS) -> dict:
     """Every scenario and backend, both paths."""
     out = {"machine": machine(), "repeats": repeats, "scenarios": {}}
     for name in SCENARIOS:
@@ -154,9 +176,10 @@ def table(results: dict) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3000)
-    parser.add_argument("--backends", default=",".join(BACKENDS))
+    parser.add_argument("--backends", default=",".join(VARIANTS))
     parser.add_argument("--out", type=Path, help="also write the results here (JSON)")
     args = parser.parse_args()
+    single_threaded_math()
     results = run(args.repeats, tuple(args.backends.split(",")))
     print(machine_line(results["machine"]))
     print(table(results))

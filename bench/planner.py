@@ -115,7 +115,8 @@ def pooled(backend: str, work: list, workers: int, worker_threads: str = "1") ->
             else:
                 os.environ[k] = v
     with pool:
-        pids = set(pool.map(_warm_up, work[:workers], chunksize=1))
+        warm_up = [work[i % len(work)] for i in range(workers)]  # one each, even if few
+        pids = set(pool.map(_warm_up, warm_up, chunksize=1))
         t1 = time.perf_counter()
         res = pool.map(_score, work, chunksize=1)
         t2 = time.perf_counter()
