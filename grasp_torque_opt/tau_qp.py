@@ -159,7 +159,7 @@ def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarra
     C = S @ np.hstack((M2, N)) if k else S @ M2
     A = np.zeros((n_eq, m + k))
     A[:, :m] = U_perp[6:].T
-    H = _hessian(tuple(float(x) for x in weights), k)
+    H = _hessian(tuple(np.asarray(weights, dtype=float).tolist()), k)
     l_box = np.full(m + k, -np.inf)
     u_box = np.full(m + k, np.inf)
     l_box[:m] = tau_min + BOX_MARGIN
