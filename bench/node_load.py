@@ -53,7 +53,7 @@ WARMUP_S = 1.0
 #: After the last joint state, how long commands in flight are still awaited [s].
 DRAIN_S = 0.5
 #: Longest wait for the answering node to be discovered, then to answer once [s].
-READY_TIMEOUT_S = 20.0
+READY_TIMEOUT_S = 10.0
 #: Executors of the answering node. ``events-once`` is the echo node only (the node's
 #: main offers single and events): EventsExecutor served by a spin_once loop rather
 #: than spin(), to show what that executor gives when its spin() does not deliver.
@@ -280,9 +280,9 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
     if code == 0 and result_file.exists():
         out.update(json.loads(result_file.read_text()))
     else:
-        out["error"] = (f"load process exit {code}: "
-                        + (tmp / f"{tag}.load.log").read_text()[-500:]
-                        + " | target: " + (tmp / f"{tag}.target.log").read_text()[-500:])
+        tail = " / ".join(line.strip() for line in
+                          (tmp / f"{tag}.load.log").read_text().splitlines()[-3:] if line.strip())
+        out["error"] = f"load process exit {code}: {tail} (logs in {tmp})"
     return out
 
 
@@ -299,7 +299,7 @@ def table(cases: list[dict]) -> str:
     for c in cases:
         if "error" in c:
             lines.append(f"| {c['hand']} | {c['rate_hz']:g} | {c['executor']} | {c['target']} "
-                         f"| failed: {c['error'][:80]} ||||||||")
+                         f"| failed: {c['error'][:60]} ||||||||")
             continue
         lat = c["latency"]
         lines.append(

@@ -1,0 +1,605 @@
+"""The soak run: grasp_torque_node at 1 kHz for minutes under valid, invalid and infeasible inputs.
+
+Usage: .venv/bin/python bench/soak.py [--duration 600] [--rate 1000] [--seed 0] [--out FILE]
+
+The node runs as a child process on the Allegro hand (``config/allegro_right_node.yaml``,
+``publish_stamped_command:=true``) on a private ROS domain, localhost only. This
+process drives it, with a seeded mix (printed at the start):
+
+- joint states at ``--rate``: mostly valid (in order; shuffled with NaN efforts
+  and an extra joint, as joint_state_broadcaster sends them), some invalid (NaN or
+  out-of-range position of a commanded joint, names and positions of different
+  lengths, a duplicate or empty name, a commanded joint missing, an empty message,
+  100000 positions, a stamp far in the future or going backwards);
+- contacts (PoseArray in the base frame) and loads (WrenchStamped) at 50 Hz,
+  mostly valid, some invalid (non-unit or zero quaternion, NaN, wrong count,
+  unknown frame; NaN or Inf load, unknown frame, force over ``max_wrench_force``);
+- in some 2 s blocks, either a silence (no joint states for 0.3 s) or an
+  infeasible load (200 N, accepted but beyond the hand) for 0.3 s, then back to
+  a holdable load: faults and recoveries.
+
+Checked from outside, on every command (invariants, must stay 0): exactly
+len(joints) finite values within the torque limits; the stamped copy names a
+valid joint state this process published (or is a zero-policy command); no
+command later than joint_state_timeout + hold_time + DELIVERY_MARGIN_S into a
+silence (zero commands only under the zero policy); no command stamped more than
+DELIVERY_MARGIN_S into an infeasible-load phase and received before a holdable
+load was published again. Also reported: the node's own
+counters from /diagnostics (commands, faults, recoveries, rejected.*) and its
+resident memory (VmRSS) at start, end and in between. Not in CI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import random
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  # noqa: E402
+                     Pacer, UniqueClock, isolated_env, node_command, percentiles_ms,
+                     private_domains, raise_on_sigterm, set_stamp, stamp_ns, vm_rss_kib)
+
+PARAMS = CONFIG / "allegro_right_node.yaml"
+#: Time for a joint state to reach the node and for a command computed from a queued
+#: one to come back: the node may hold a backlog of joint states (depth 5) behind a
+#: slow cycle (an infeasible load, up to cycle_budget) [s].
+DELIVERY_MARGIN_S = 0.1
+WARMUP_S = 2.0
+DRAIN_S = 1.0
+BLOCK_S = 2.0
+PHASE_S = 0.3
+SLOW_RATE_HZ = 50.0
+INFEASIBLE_FORCE_N = 200.0
+MEMORY_SAMPLES = 10
+
+JS_INVALID = {  # kind: relative weight
+    "nan_position": 3, "out_of_range_position": 2, "length_mismatch": 3, "duplicate_name": 2,
+    "empty_name": 2, "missing_joint": 2, "empty_message": 1, "huge_arrays": 1,
+    "future_stamp": 2, "backwards_stamp": 2}
+CONTACT_INVALID = {"non_unit_quaternion": 1, "zero_quaternion": 1, "nan_position": 1,
+                   "wrong_count": 1, "unknown_frame": 1}
+WRENCH_INVALID = {"nan_force": 1, "inf_torque": 1, "unknown_frame": 1, "over_max_force": 1}
+P_JS_INVALID = 0.05
+P_SLOW_INVALID = 0.2
+P_SILENCE = 0.25
+P_INFEASIBLE = 0.25
+
+
+def _node_params() -> dict:
+    doc = yaml.safe_load(PARAMS.read_text())
+    return next(iter(doc.values()))["ros__parameters"]
+
+
+def _pick(rng: random.Random, weights: dict[str, int]) -> str:
+    return rng.choices(list(weights), weights=list(weights.values()))[0]
+
+
+def schedule(rng: random.Random, duration: float) -> list[tuple[str, float, float]]:
+    """Silences and infeasible-load phases: (kind, start, end) [s from the start of the mix]."""
+    phases = []
+    for b in range(int(duration // BLOCK_S)):
+        u = rng.random()
+        start = b * BLOCK_S + rng.uniform(0.2, BLOCK_S - PHASE_S - 0.2)
+        if u < P_SILENCE:
+            phases.append(("silence", start, start + PHASE_S))
+        elif u < P_SILENCE + P_INFEASIBLE:
+            phases.append(("infeasible_load", start, start + PHASE_S))
+    return phases
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=600.0, help="seconds of the mix [s]")
+    parser.add_argument("--rate", type=float, default=1000.0, help="joint-state rate [Hz]")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--out", type=Path,
+                        default=Path(__file__).resolve().parent / "results" / "soak.json")
+    args = parser.parse_args()
+    raise_on_sigterm()
+    logs = Path(tempfile.mkdtemp(prefix="soak_"))
+    domain = private_domains(1)[0]
+    env = isolated_env(domain)
+    os.environ.update(env)  # this process drives the node: the same private domain
+    os.environ.pop("ROS_STATIC_PEERS", None)
+    node = None
+    result = None
+    with open(logs / "node.log", "w") as log:
+        try:
+            node = Child(node_command(PARAMS, "single"), env, log)
+            result = drive(args, node, domain, logs)
+        finally:
+            if node is not None:
+                node.stop()
+    return 0 if result is not None and result["invariants_broken"] == 0 else 1
+
+
+def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dict | None:
+    """Publish the mix at the node, check every command, report."""
+    import pinocchio as pin
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+    from rclpy.experimental import EventsExecutor
+    from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from cycle import machine
+    from grasp_torque_opt.grasp_setup import GraspSetup
+
+    p = _node_params()
+    setup = GraspSetup.from_file(CONFIG / p["scenario"])
+    hand = setup.hand
+    names = list(hand.joints)
+    m = len(names)
+    limits = np.array(p.get("torque_limits", hand.torque_limits), dtype=float)
+    q0 = setup.q[hand.idx_q].astype(float)
+    base = hand.base_frame
+    timeout = float(p.get("joint_state_timeout", 0.1))
+    hold = float(p.get("hold_time", 0.1))
+    policy = p.get("fault_policy", "hold")
+    stop_bound_s = timeout + hold + DELIVERY_MARGIN_S
+    w0 = np.asarray(setup.external_wrench, dtype=float)
+    frames = setup.maps().contacts
+    contact_poses = [(np.asarray(f.position, dtype=float),
+                      np.asarray(pin.Quaternion(f.rotation).coeffs(), dtype=float))  # x y z w
+                     for f in frames]
+
+    rng = random.Random(args.seed)
+    phases = schedule(rng, args.duration)
+    # The warm-up lasts until the node answers: its draws come from a generator of their
+    # own, so that the mix depends on the seed only.
+    state = {"last_valid_stamp": 0, "since_silence": 0, "mixing": False, "phase": None,
+             "rng": random.Random(args.seed + 1)}
+    mix = {"joint_states_invalid_fraction": P_JS_INVALID, "joint_states_invalid_kinds": JS_INVALID,
+           "contacts_and_load_rate_hz": SLOW_RATE_HZ, "slow_invalid_fraction": P_SLOW_INVALID,
+           "contacts_invalid_kinds": CONTACT_INVALID, "external_wrench_invalid_kinds":
+           WRENCH_INVALID, "silences": sum(k == "silence" for k, _, _ in phases),
+           "infeasible_load_phases": sum(k == "infeasible_load" for k, _, _ in phases),
+           "phase_s": PHASE_S, "infeasible_force_N": INFEASIBLE_FORCE_N,
+           "holdable_load": "scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis"}
+    mach = machine()
+    print(f"machine: {mach['cpu']}, {mach['cores']} cores, Python {mach['python']}; "
+          f"{mach['date']}")
+    print(f"soak: {args.duration:g} s at {args.rate:g} Hz, seed {args.seed}, node pid "
+          f"{node.pid}, ROS_DOMAIN_ID {domain}, logs {logs}")
+    print(f"mix: joint states {100 * (1 - P_JS_INVALID):.0f}% valid, "
+          f"{100 * P_JS_INVALID:.0f}% invalid ({', '.join(JS_INVALID)}); contacts and load at "
+          f"{SLOW_RATE_HZ:g} Hz, {100 * P_SLOW_INVALID:.0f}% invalid (contacts: "
+          f"{', '.join(CONTACT_INVALID)}; load: {', '.join(WRENCH_INVALID)}); "
+          f"{mix['silences']} silences and {mix['infeasible_load_phases']} infeasible loads "
+          f"({INFEASIBLE_FORCE_N:g} N) of {PHASE_S:g} s; fault_policy {policy}, stop bound "
+          f"{timeout:g} + {hold:g} + {DELIVERY_MARGIN_S:g} s", flush=True)
+
+    rclpy.init()
+    ros = rclpy.create_node("grasp_soak_driver")
+    js_pub = ros.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    contacts_pub = ros.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
+    wrench_pub = ros.create_publisher(WrenchStamped, "external_wrench", qos_profile_sensor_data)
+    receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+
+    valid_stamps: set[int] = set()
+    invalid_stamps: set[int] = set()
+    commands: list[tuple[int, bool]] = []  # (receipt [ns], all zero)
+    violations: dict[str, int] = {}
+    examples: list[str] = []
+    stamped_ok = 0
+    zero_policy_commands = 0
+    stamped_times: list[tuple[int, int]] = []  # (stamp, receipt) of valid-stamp commands
+    diag: dict[str, str] = {}
+
+    def broken(kind: str, detail: str) -> None:
+        violations[kind] = violations.get(kind, 0) + 1
+        if len(examples) < 10:
+            examples.append(f"{kind}: {detail}")
+
+    def check_values(values, where: str) -> None:
+        v = np.asarray(values, dtype=float)
+        if v.shape != (m,):
+            broken("wrong_length", f"{where} has {v.size} values for {m} joints")
+        elif not np.all(np.isfinite(v)):
+            broken("not_finite", f"{where} {v.tolist()}")
+        elif np.any(np.abs(v) > limits):
+            broken("over_limit", f"{where} max |value| {np.abs(v).max():.6g}")
+
+    def on_command(msg: Float64MultiArray) -> None:
+        commands.append((time.time_ns(), not any(msg.data)))
+        check_values(msg.data, "effort_commands")
+
+    def on_stamped(msg: JointState) -> None:
+        nonlocal stamped_ok, zero_policy_commands
+        now = time.time_ns()
+        s = stamp_ns(msg.header.stamp)
+        check_values(msg.effort, "effort_commands_stamped")
+        if list(msg.name) != names:
+            broken("wrong_names", f"stamped command names {list(msg.name)[:3]}...")
+        if s in valid_stamps:
+            stamped_ok += 1
+            stamped_times.append((s, now))
+        elif s in invalid_stamps:
+            broken("from_invalid_joint_state", f"command stamped {s} answers a rejected state")
+        elif policy == "zero" and not any(msg.effort):
+            zero_policy_commands += 1
+        else:
+            broken("unknown_stamp", f"command stamped {s} answers no published joint state")
+
+    def on_diag(msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            if status.name.startswith("grasp_torque_node"):
+                diag.clear()
+                diag.update({kv.key: kv.value for kv in status.values})
+                diag["_level"] = str(status.level[0] if isinstance(status.level, bytes)
+                                     else status.level)
+
+    ros.create_subscription(Float64MultiArray, "effort_commands", on_command, receiver_qos)
+    ros.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
+    ros.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 10)
+    # Served by spin_once in the pacer (its spin() does not deliver here; see node_load.py).
+    executor = EventsExecutor()
+    executor.add_node(ros)
+    pacer = Pacer(executor, args.rate)
+    clock = UniqueClock()
+
+    # -- messages ------------------------------------------------------------------------
+    sent = {"joint_states": {"valid": 0}, "contacts": {"valid": 0},
+            "external_wrench": {"valid": 0, "infeasible": 0}}
+    for kind in JS_INVALID:
+        sent["joint_states"][kind] = 0
+    for kind in CONTACT_INVALID:
+        sent["contacts"][kind] = 0
+    for kind in WRENCH_INVALID:
+        sent["external_wrench"][kind] = 0
+    huge = JointState(name=names, position=[0.0] * 100000)
+
+    def joint_state(k: int, invalid: str | None) -> None:
+        q = (q0 + 1e-3 * np.sin(np.pi * k / args.rate + 0.4 * np.arange(m))).tolist()
+        n = list(names)
+        msg = JointState()
+        s = clock()
+        if invalid is None:
+            variant = k % 3
+            if variant == 1:  # as joint_state_broadcaster: any order, NaN efforts
+                order = list(range(m))
+                state["rng"].shuffle(order)
+                n, q = [n[i] for i in order], [q[i] for i in order]
+                msg.effort = [math.nan] * m
+            elif variant == 2:  # a joint the model does not know: ignored
+                n, q = n + ["wrist_camera_joint"], q + [0.0]
+            msg.name, msg.position = n, q
+        elif invalid == "huge_arrays":
+            msg = huge
+        else:
+            i = state["rng"].randrange(m)
+            if invalid == "nan_position":
+                q[i] = math.nan
+            elif invalid == "out_of_range_position":
+                q[i] = 1e4
+            elif invalid == "length_mismatch":
+                q = q[:-1]
+            elif invalid == "duplicate_name":
+                n[(i + 1) % m] = n[i]
+            elif invalid == "empty_name":
+                n[i] = ""
+            elif invalid == "missing_joint":
+                del n[i], q[i]
+            elif invalid == "empty_message":
+                n, q = [], []
+            elif invalid == "future_stamp":
+                s += 10_000_000_000
+            elif invalid == "backwards_stamp":
+                s = state["last_valid_stamp"] - 200_000_000
+                while s in valid_stamps:
+                    s -= 1
+            msg.name, msg.position = n, q
+        set_stamp(msg.header, s)
+        if invalid is None:
+            valid_stamps.add(s)
+            state["last_valid_stamp"] = s
+        else:
+            invalid_stamps.add(s)
+        if state["mixing"]:
+            sent["joint_states"]["valid" if invalid is None else invalid] += 1
+        js_pub.publish(msg)
+
+    def contacts(invalid: str | None) -> None:
+        msg = PoseArray()
+        msg.header.frame_id = base if state["rng"].random() < 0.5 else ""
+        for i, (pos, quat) in enumerate(contact_poses):
+            pos, quat = pos.copy(), quat.copy()
+            if invalid == "non_unit_quaternion" and i == 0:
+                quat *= 1.1
+            elif invalid == "zero_quaternion" and i == 0:
+                quat[:] = 0.0
+            elif invalid == "nan_position" and i == 0:
+                pos[1] = math.nan
+            elif invalid == "wrong_count" and i == len(contact_poses) - 1:
+                continue
+            pose = Pose()
+            pose.position.x, pose.position.y, pose.position.z = map(float, pos)
+            (pose.orientation.x, pose.orientation.y, pose.orientation.z,
+             pose.orientation.w) = map(float, quat)
+            msg.poses.append(pose)
+        if invalid == "unknown_frame":
+            msg.header.frame_id = "no_such_frame"
+        set_stamp(msg.header, clock())
+        if state["mixing"]:
+            sent["contacts"]["valid" if invalid is None else invalid] += 1
+        contacts_pub.publish(msg)
+
+    def wrench(kind: str) -> None:
+        r = state["rng"]
+        msg = WrenchStamped()
+        msg.header.frame_id = base if r.random() < 0.5 else ""
+        w = w0 * r.uniform(0.7, 1.3)
+        w[:3] += [r.uniform(-0.2, 0.2) for _ in range(3)]
+        if kind == "infeasible":
+            w = np.array([INFEASIBLE_FORCE_N, 0.0, 0.0, 0.0, 0.0, 0.0])
+        elif kind == "nan_force":
+            w[1] = math.nan
+        elif kind == "inf_torque":
+            w[4] = math.inf
+        elif kind == "over_max_force":
+            w[0] = 10.0 * float(p.get("max_wrench_force", 1000.0))
+        elif kind == "unknown_frame":
+            msg.header.frame_id = "no_such_frame"
+        f, t = msg.wrench.force, msg.wrench.torque
+        f.x, f.y, f.z, t.x, t.y, t.z = map(float, w)
+        s = clock()
+        set_stamp(msg.header, s)
+        if state["mixing"]:
+            sent["external_wrench"][kind] += 1
+        if kind == "infeasible" and state["phase"] is not None:
+            state["phase"].setdefault("first_infeasible_ns", s)
+            state["infeasible_span"] = state["phase"]
+        elif kind == "valid" and state.get("infeasible_span") is not None:
+            state["infeasible_span"]["holdable_again_ns"] = s
+            state["infeasible_span"] = None
+        wrench_pub.publish(msg)
+
+    # -- discovery and warm-up -------------------------------------------------------------
+    deadline = time.monotonic() + 60.0
+    while time.monotonic() < deadline and not (
+            ros.count_subscribers("joint_states") and ros.count_publishers(STAMPED_TOPIC)):
+        pacer.spin_for(0.05)
+        if not node.alive():
+            break
+    if not (ros.count_subscribers("joint_states") and ros.count_publishers(STAMPED_TOPIC)):
+        print(f"soak: the node did not come up (log: {logs / 'node.log'})", file=sys.stderr)
+        return None
+    slow_every = max(1, round(args.rate / SLOW_RATE_HZ))
+    warm: dict[str, float] = {}
+
+    def warm_tick(k: int, now: float) -> bool:
+        if k % slow_every == 0:
+            contacts(None)
+            wrench("valid")
+        joint_state(k, None)
+        if stamped_ok and "t" not in warm:
+            warm["t"] = now
+        return not ("t" in warm and now - warm["t"] >= WARMUP_S) and k < 60 * args.rate
+
+    pacer.run(warm_tick)
+    if "t" not in warm:
+        print(f"soak: no command came back (log: {logs / 'node.log'})", file=sys.stderr)
+        return None
+    pacer.spin_for(0.3)  # a fresh /diagnostics
+    diag_start = dict(diag)
+    commands_before, stamped_before = len(commands), stamped_ok
+    memory = [(0.0, vm_rss_kib(node.pid))]
+    share = CpuShare()
+
+    # -- the mix -----------------------------------------------------------------------------
+    state["mixing"] = True
+    state["rng"] = rng
+    start_ns = time.time_ns()
+    # Phases by tick (deterministic), with the wall-clock times they really had.
+    spans = [{"kind": kind, "k0": round(a * args.rate), "k1": round(b * args.rate)}
+             for kind, a, b in phases]
+    memory_every = max(1, int(args.duration * args.rate / MEMORY_SAMPLES))
+    n_ticks = int(args.duration * args.rate)
+    period_ns = int(1e9 / args.rate)
+    pi = {"i": 0}
+
+    def current_phase(k: int) -> str:
+        while pi["i"] < len(spans) and spans[pi["i"]]["k1"] <= k:
+            pi["i"] += 1
+        if pi["i"] < len(spans) and spans[pi["i"]]["k0"] <= k:
+            span = spans[pi["i"]]
+            t = time.time_ns()
+            span.setdefault("start_ns", t)
+            span["end_ns"] = t + period_ns
+            state["phase"] = span
+            return span["kind"]
+        state["phase"] = None
+        return ""
+
+    def mix_tick(k: int, now: float) -> bool:
+        if k >= n_ticks:
+            return False
+        phase = current_phase(k)
+        if k % slow_every == 0:
+            contacts(_pick(rng, CONTACT_INVALID) if rng.random() < P_SLOW_INVALID else None)
+            if phase == "infeasible_load":
+                wrench("infeasible")
+            else:
+                wrench(_pick(rng, WRENCH_INVALID) if rng.random() < P_SLOW_INVALID else "valid")
+        if phase != "silence":
+            invalid = _pick(rng, JS_INVALID) if rng.random() < P_JS_INVALID else None
+            if invalid == "backwards_stamp" and state["since_silence"] < 100:
+                invalid = None  # right after a silence the node's last stamp may be stale
+            state["since_silence"] += 1
+            joint_state(k, invalid)
+        else:
+            state["since_silence"] = 0
+        if k and k % memory_every == 0:
+            memory.append((k / args.rate, vm_rss_kib(node.pid)))
+        return True
+
+    t_mix = time.perf_counter()
+    pacer.run(mix_tick)
+    mix_s = time.perf_counter() - t_mix
+    published_rate = n_ticks / mix_s
+    end_ns = time.time_ns()
+    pacer.spin_for(DRAIN_S)
+    pacer.spin_for(0.3)
+    diag_end = dict(diag)
+    memory.append((args.duration, vm_rss_kib(node.pid)))
+    others = share.others_cores()
+    alive = node.alive()
+    ros.destroy_node()
+    rclpy.try_shutdown()
+
+    # -- after the run: silences and infeasible phases -----------------------------------------
+    for span in spans:
+        if "start_ns" not in span:
+            continue
+        kind, a, b = span["kind"], span["start_ns"], span["end_ns"]
+        if kind == "silence":
+            bound = a + int(1e9 * stop_bound_s)
+            late = [t for t, zero in commands if bound < t <= b and not (zero and policy == "zero")]
+            if late:
+                broken("command_during_silence",
+                       f"{len(late)} command(s) {1e-9 * (late[0] - a):.3f} s into a silence")
+        else:
+            # A state of the phase may be answered late, once a holdable load is back.
+            bound = span.get("first_infeasible_ns", a) + int(1e9 * DELIVERY_MARGIN_S)
+            back = span.get("holdable_again_ns", end_ns)
+            under = [s for s, r in stamped_times if bound < s <= b and r < back]
+            if under:
+                broken("command_under_infeasible_load",
+                       f"{len(under)} command(s) stamped {1e-9 * (under[0] - a):.3f} s into "
+                       "an infeasible load")
+    mixed_commands = [t for t, _ in commands if start_ns <= t <= end_ns + int(1e9 * DRAIN_S)]
+    latencies = [(s, r) for s, r in stamped_times if s >= start_ns]
+
+    def counter(d: dict, key: str) -> int | None:
+        try:
+            return int(d[key])
+        except (KeyError, ValueError):
+            return None
+
+    keys = sorted({k for k in diag_end if k in ("cycles", "commands", "zero_commands", "faults",
+                                                "recoveries", "overruns", "solver_failures")
+                   or k.startswith("rejected.")})
+    node_counters = {k: {"start": counter(diag_start, k), "end": counter(diag_end, k)}
+                     for k in keys}
+    for v in node_counters.values():
+        v["during"] = (v["end"] - v["start"]) if None not in (v["start"], v["end"]) else None
+    result = {
+        "machine": mach, "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "duration_s": args.duration, "rate_hz": args.rate, "seed": args.seed,
+        "params_file": PARAMS.name, "fault_policy": policy, "stop_bound_s": stop_bound_s,
+        "delivery_margin_s": DELIVERY_MARGIN_S, "mix": mix, "sent": sent,
+        "published_joint_state_rate_hz": published_rate,
+        "publish_lateness": percentiles_ms(pacer.lateness[-n_ticks:]),
+        "commands_received": len(commands) - commands_before,
+        "commands_received_in_mix": len(mixed_commands),
+        "stamped_commands_matched": stamped_ok - stamped_before,
+        "zero_policy_commands": zero_policy_commands,
+        "latency_ms": percentiles_ms([1e-9 * (r - s) for s, r in latencies]),
+        "latency_ms_per_window": _windows(latencies, start_ns, args.duration),
+        "node_counters": node_counters,
+        "node_fault_at_end": diag_end.get("fault"),
+        "memory_kib": [{"t_s": t, "vm_rss_kib": r} for t, r in memory],
+        "memory_growth_kib": (memory[-1][1] - memory[0][1])
+        if memory[0][1] is not None and memory[-1][1] is not None else None,
+        "other_processes_cores": others, "node_alive_at_end": alive,
+        "invariants_broken": sum(violations.values()) + (0 if alive else 1),
+        "violations": violations if alive else {**violations, "node_died": 1},
+        "examples": examples,
+    }
+    print()
+    print(report(result))
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(result, indent=2))
+    print(f"\nwritten: {args.out}")
+    return result
+
+
+def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -> list[dict]:
+    """Latency per tenth of the run: does it drift?"""
+    out = []
+    width = duration / MEMORY_SAMPLES
+    for i in range(MEMORY_SAMPLES):
+        a, b = start_ns + int(1e9 * i * width), start_ns + int(1e9 * (i + 1) * width)
+        v = [1e-9 * (r - s) for s, r in latencies if a <= s < b]
+        out.append({"t_s": i * width, "n": len(v), **percentiles_ms(v)})
+    return out
+
+
+def report(r: dict) -> str:
+    """The soak run as a markdown block."""
+    c = r["node_counters"]
+
+    def during(key: str) -> str:
+        v = c.get(key, {}).get("during")
+        return "-" if v is None else str(v)
+
+    js = r["sent"]["joint_states"]
+    ct = r["sent"]["contacts"]
+    wr = r["sent"]["external_wrench"]
+    mem = r["memory_kib"]
+    lines = [
+        f"### Soak: {r['duration_s']:g} s at {r['rate_hz']:g} Hz, seed {r['seed']} "
+        f"({r['machine']['cpu']}, {r['machine']['cores']} cores; {r['date_utc']})",
+        "",
+        "| figure | value |", "|---|---:|",
+        f"| joint states published (valid / invalid) | {js['valid']} / "
+        f"{sum(v for k, v in js.items() if k != 'valid')} |",
+        f"| joint-state rate achieved [Hz] | {r['published_joint_state_rate_hz']:.1f} |",
+        f"| contacts published (valid / invalid) | {ct['valid']} / "
+        f"{sum(v for k, v in ct.items() if k != 'valid')} |",
+        f"| loads published (valid / infeasible / invalid) | {wr['valid']} / {wr['infeasible']} / "
+        f"{sum(v for k, v in wr.items() if k not in ('valid', 'infeasible'))} |",
+        f"| silences / infeasible-load phases | {r['mix']['silences']} / "
+        f"{r['mix']['infeasible_load_phases']} |",
+        f"| commands received | {r['commands_received']} |",
+        f"| commands counted by the node | {during('commands')} |",
+        f"| node cycles | {during('cycles')} |",
+        f"| rejected by the node: joint_states / contacts / external_wrench | "
+        f"{during('rejected.joint_states')} / {during('rejected.contacts')} / "
+        f"{during('rejected.external_wrench')} |",
+        f"| faults / recoveries | {during('faults')} / {during('recoveries')} |",
+        f"| overruns / solver failures | {during('overruns')} / {during('solver_failures')} |",
+        f"| latency p50 / p99 / max [ms] | {_f(r['latency_ms']['p50_ms'])} / "
+        f"{_f(r['latency_ms']['p99_ms'])} / {_f(r['latency_ms']['max_ms'])} |",
+        f"| node VmRSS start / end [MiB] | {_mib(mem[0]['vm_rss_kib'])} / "
+        f"{_mib(mem[-1]['vm_rss_kib'])} |",
+        f"| node VmRSS samples [MiB] | "
+        f"{', '.join(_mib(x['vm_rss_kib']) for x in mem)} |",
+        f"| other work on the machine [cores] | {_f(r['other_processes_cores'], '.2f')} |",
+        f"| **invariants broken** | **{r['invariants_broken']}** |",
+    ]
+    if r["violations"]:
+        lines += ["", "violations: " + ", ".join(f"{k} {v}" for k, v in r["violations"].items())]
+        lines += [f"- {e}" for e in r["examples"]]
+    sent = ", ".join(f"{k} {v}" for k, v in js.items() if k != "valid")
+    lines += ["", f"invalid joint states sent: {sent}",
+              "invalid contacts sent: " + ", ".join(f"{k} {v}" for k, v in ct.items()
+                                                     if k != "valid"),
+              "invalid loads sent: " + ", ".join(f"{k} {v}" for k, v in wr.items()
+                                                 if k not in ("valid", "infeasible"))]
+    return "\n".join(lines)
+
+
+def _f(x: float | None, spec: str = ".3f") -> str:
+    return "-" if x is None else format(x, spec)
+
+
+def _mib(kib: int | None) -> str:
+    return "-" if kib is None else f"{kib / 1024:.1f}"
+
+
+if __name__ == "__main__":
+    sys.exit(main())
