@@ -44,7 +44,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  # noqa: E402
                       Pacer, UniqueClock, isolated_env, node_command, percentiles_ms,
-                      private_domains, raise_on_sigterm, set_stamp, stamp_ns)
+                      private_domains, interrupt_on_signals, set_stamp, stamp_ns)
 
 HANDS = {"allegro": ("allegro_right.yaml", "allegro_right_node.yaml"),
          "planar": ("planar_two_finger.yaml", "planar_two_finger_node.yaml")}
@@ -340,7 +340,7 @@ def ratios(cases: list[dict]) -> list[dict]:
 def main_run(args: argparse.Namespace) -> int:
     from cycle import machine
 
-    raise_on_sigterm()
+    interrupt_on_signals()
     keys = [k for k in itertools.product(args.hands, args.rates, args.executors, TARGETS)
             if not (k[2] == "events-once" and k[3] == "grasp_torque_node")]
     domains = private_domains(len(keys))
@@ -404,7 +404,11 @@ def main() -> int:
         return echo_main(args)
     if args.role == "load":
         return load_main(args)
-    return main_run(args)
+    try:
+        return main_run(args)
+    except KeyboardInterrupt:
+        print("node_load: interrupted, child processes stopped", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -100,11 +100,16 @@ class Child:
             pass
 
 
-def raise_on_sigterm() -> None:
-    """Turn SIGTERM into KeyboardInterrupt so that ``finally`` blocks stop the children."""
+def interrupt_on_signals() -> None:
+    """SIGINT and SIGTERM raise KeyboardInterrupt, so that ``finally`` blocks stop the children.
+
+    SIGINT too: a process started in the background by a non-interactive shell
+    inherits it ignored.
+    """
     def handler(signum, frame):  # noqa: ARG001 -- signal handler signature
         raise KeyboardInterrupt
     signal.signal(signal.SIGTERM, handler)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def stamp_ns(stamp) -> int:

@@ -48,7 +48,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  # noqa: E402
                      Pacer, UniqueClock, isolated_env, node_command, percentiles_ms,
-                     private_domains, raise_on_sigterm, set_stamp, stamp_ns, vm_rss_kib)
+                     private_domains, interrupt_on_signals, set_stamp, stamp_ns, vm_rss_kib)
 
 PARAMS = CONFIG / "allegro_right_node.yaml"
 #: Time for a joint state to reach the node and for a command computed from a queued
@@ -106,7 +106,7 @@ def main() -> int:
     parser.add_argument("--out", type=Path,
                         default=Path(__file__).resolve().parent / "results" / "soak.json")
     args = parser.parse_args()
-    raise_on_sigterm()
+    interrupt_on_signals()
     logs = Path(tempfile.mkdtemp(prefix="soak_"))
     domain = private_domains(1)[0]
     env = isolated_env(domain)
@@ -118,6 +118,9 @@ def main() -> int:
         try:
             node = Child(node_command(PARAMS, "single"), env, log)
             result = drive(args, node, domain, logs)
+        except KeyboardInterrupt:
+            print("soak: interrupted, node stopped", file=sys.stderr)
+            return 130
         finally:
             if node is not None:
                 node.stop()
