@@ -517,7 +517,13 @@ def main(args: list[str] | None = None) -> int:
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()
         executor.add_node(node)
-        executor.spin()
+        if opts.executor == "events":
+            # EventsExecutor.spin() delivered no subscription callback with these wheels
+            # (rclpy 7.1.6, Fast DDS) while keeping a core busy; spin_once serves it.
+            while rclpy.ok():
+                executor.spin_once(timeout_sec=1.0)
+        else:
+            executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except GraspTorqueError as e:

@@ -391,12 +391,14 @@ def test_stopping_applies_the_policy_in_process(planar):
             h.close()
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
-def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig):
-    """grasp_torque_node as users run it: a signal stops it, and with fault_policy zero
-    the effort controller is left with zero torques, not the last command."""
+@pytest.mark.parametrize("sig,executor", [(signal.SIGINT, "single"), (signal.SIGTERM, "single"),
+                                          (signal.SIGINT, "events")])
+def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig, executor):
+    """grasp_torque_node as users run it (either executor): it answers joint states, a signal
+    stops it, and with fault_policy zero the effort controller is left with zero torques."""
     env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
-    child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.node", "--ros-args",
+    child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.node", "--executor",
+                              executor, "--ros-args",
                               "-p", f"scenario:={PLANAR}", "-p", "fault_policy:=zero",
                               "-p", "joint_state_timeout:=5.0", "-p", "hold_time:=5.0"],
                              env=env, stderr=subprocess.PIPE, text=True)
