@@ -157,8 +157,10 @@ class Counters:
     """Running totals, for diagnostics.
 
     ``solver_failures`` counts solves that raised or gave nothing certifiable
-    (not the confirmed infeasible ones); ``overruns`` cycles over
-    ``cycle_budget``; ``max_cycle_time`` is the longest cycle [s].
+    (not the confirmed infeasible ones); ``fallback_solves`` certified
+    solutions that came from the fallback backend after the first one failed;
+    ``overruns`` cycles over ``cycle_budget``; ``max_cycle_time`` is the longest
+    cycle [s].
     """
 
     cycles: int = 0
@@ -168,6 +170,7 @@ class Counters:
     recoveries: int = 0
     overruns: int = 0
     solver_failures: int = 0
+    fallback_solves: int = 0
     max_cycle_time: float = 0.0
     rejected: dict[str, int] = field(default_factory=lambda: dict.fromkeys(SOURCES, 0))
 
@@ -215,14 +218,18 @@ class TorqueController:
         backend: QP backend, one of :data:`grasp_torque_opt.backends.BACKENDS`.
         warm_start: start each solve from the previous one (DAQP only; verified,
             with a cold fallback in the same cycle).
+        fallback: a second backend, asked in the same cycle when the first gives
+            nothing certifiable; None for none.
     """
 
     def __init__(self, setup: GraspSetup, config: CycleConfig | None = None,
                  solver_settings: ProxSuiteSettings | None = None,
-                 backend: str = "proxsuite", warm_start: bool = False) -> None:
+                 backend: str = "proxsuite", warm_start: bool = False,
+                 fallback: str | None = None) -> None:
         self.setup = setup
         self.config = config or CycleConfig()
         self.solver = make_solver(backend, solver_settings, warm_start)
+        self.fallback = make_solver(fallback, solver_settings) if fallback else None
         self.inputs = Inputs()
         self.counters = Counters()
         self.last_command: np.ndarray | None = None
@@ -504,7 +511,7 @@ class TorqueController:
         """
         setup, g = self.grasp_at(inputs)
         maps = setup.maps()
-        sol = solve(setup, maps=maps, solver=self.solver,
+        sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback,
                     tolerance=self.config.certificate_tolerance)
         return sol, maps, g
 
@@ -547,6 +554,8 @@ class TorqueController:
             self.fault = ""
             self.last_command, self.last_command_time = result.command, now
             self.counters.commands += 1
+            if self.fallback is not None and result.solution.backend == self.fallback.name:
+                self.counters.fallback_solves += 1
             self.last = result
         result.cycle_time = elapsed
         return result

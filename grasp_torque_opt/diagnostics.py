@@ -82,7 +82,8 @@ def report(controller: TorqueController, now: float) -> Report:
     solver = c.solver
     values += [("solver.backend", getattr(solver, "name", type(solver).__name__)),
                ("solver.warm_solves", str(getattr(solver, "warm_solves", 0))),
-               ("solver.warm_start_fallbacks", str(getattr(solver, "fallbacks", 0)))]
+               ("solver.warm_start_fallbacks", str(getattr(solver, "fallbacks", 0))),
+               ("solver.fallback_solves", str(n.fallback_solves))]
     values += [(f"rejected.{k}", str(v)) for k, v in n.rejected.items()]
     values.append(("last_rejection", c.last_rejection or "none"))
     values += [("age.joint_states_s", _ago(now, c.inputs.q_time)),

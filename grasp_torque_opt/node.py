@@ -113,6 +113,9 @@ PARAMETERS: dict[str, Spec] = {
     "solver.backend": Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
                            "without internal-force variables only); every result is "
                            "certified whichever solves it."),
+    "solver.fallback": Spec("Backend asked in the same cycle when solver.backend gives nothing "
+                            "certifiable ('none': no second try); its answer is certified "
+                            "the same way and counted (diagnostics solver.fallback_solves)."),
     "solver.warm_start": Spec("Start each DAQP solve from the previous cycle's active set; an "
                               "answer that is not optimal (flag, KKT check) is redone cold in "
                               "the same cycle and counted (diagnostics "
@@ -146,6 +149,15 @@ def descriptor(name: str) -> ParameterDescriptor:
     return d
 
 
+#: Values of ``solver.fallback``.
+FALLBACKS = (*BACKENDS, "none")
+
+
+def _fallback(backend: str, fallback: str) -> str | None:
+    """The fallback backend to build: None for 'none' or the backend itself."""
+    return None if fallback in ("none", backend) else fallback
+
+
 def check(name: str, value: Any, m: int) -> str:
     """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too."""
     spec = PARAMETERS[name]
@@ -153,6 +165,8 @@ def check(name: str, value: Any, m: int) -> str:
         return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
     if name == "solver.backend":
         return "" if value in BACKENDS else f"{name}: must be one of {', '.join(BACKENDS)}"
+    if name == "solver.fallback":
+        return "" if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
     if spec.length is not None:
         n = m if spec.length == "joints" else int(spec.length)
         values = list(value)
@@ -200,6 +214,7 @@ class GraspTorqueNode(Node):
             "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
             "cycle_budget": CycleConfig.cycle_budget,
             "solver.backend": BACKENDS[0],
+            "solver.fallback": "daqp",
             "solver.warm_start": False,
             "solver.eps_abs": ProxSuiteSettings.eps_abs,
             "solver.max_iter": ProxSuiteSettings.max_iter,
@@ -219,12 +234,13 @@ class GraspTorqueNode(Node):
         self._base_setup = setup
         backend = self.get_parameter("solver.backend").value
         warm = self.get_parameter("solver.warm_start").value
+        fallback = _fallback(backend, self.get_parameter("solver.fallback").value)
         self.controller = TorqueController(*self._configure(setup, self._params()), backend,
-                                           warm)
+                                           warm, fallback)
         # The service solves snapshots out of sequence: always cold.
         self._service_controller = TorqueController(*self._configure(
             dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
-            backend)
+            backend, False, fallback)
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
@@ -321,6 +337,10 @@ class GraspTorqueNode(Node):
                         p["solver.backend"] != getattr(ctrl.solver, "name", None) or \
                         warm != getattr(ctrl.solver, "warm_start", False):
                     ctrl.solver = make_solver(p["solver.backend"], solver, warm)
+                fallback = _fallback(p["solver.backend"], p["solver.fallback"])
+                if fallback != getattr(ctrl.fallback, "name", None) or \
+                        (ctrl.fallback is not None and ctrl.fallback.settings != solver):
+                    ctrl.fallback = make_solver(fallback, solver) if fallback else None
 
     # -- inputs and cycle -----------------------------------------------------------------
 

@@ -33,6 +33,8 @@ class Solution:
         certificate: residuals of the candidate (None if the solver gave none).
         message: what happened, in words.
         timings: seconds per stage (``maps``, ``build``, ``solve``, ``certify``).
+        backend: who solved: the QP backend for ``tau-qp`` (the fallback's name
+            when the first backend failed), else the method.
     """
 
     status: str
@@ -45,6 +47,7 @@ class Solution:
     certificate: Certificate | None = None
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)
+    backend: str = ""
 
     @property
     def optimal(self) -> bool:

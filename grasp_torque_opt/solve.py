@@ -7,17 +7,19 @@ the independent LP of :mod:`grasp_torque_opt.feasibility` to agree.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.certificate import DEFAULT_TOLERANCE, certify
 from grasp_torque_opt.exact_nlp import solve_exact_nlp
 from grasp_torque_opt.exact_socp import solve_exact_socp
+from grasp_torque_opt.exceptions import SolverError
 from grasp_torque_opt.feasibility import linearized_feasible
 from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.grasp_setup import GraspSetup
-from grasp_torque_opt.solution import FAILED, INFEASIBLE, OPTIMAL, Solution
+from grasp_torque_opt.solution import FAILED, INFEASIBLE, OPTIMAL, RawResult, Solution
 from grasp_torque_opt.tau_qp import TauQPSolver, build_tau_qp
 
 #: Methods: the product's (``tau-qp``) and the references.
@@ -28,6 +30,7 @@ LINEARIZED = ("tau-qp", "force-qp")
 
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
           solver: TauQPSolver | None = None, backend: str = "proxsuite",
+          fallback: TauQPSolver | None = None,
           tolerance: float = DEFAULT_TOLERANCE) -> Solution:
     """Solve one grasp with one method and certify the result.
 
@@ -38,6 +41,10 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         solver: a tau-QP solver to reuse across calls (tau-qp only), any backend
             of :mod:`grasp_torque_opt.backends`.
         backend: the backend to use when no solver is given (tau-qp only).
+        fallback: a second tau-QP solver, asked only when the first gives nothing
+            certifiable (ProxSuite called some holdable Allegro loads
+            PRIMAL_INFEASIBLE or hit its cap; DAQP solved them). Its answer is
+            certified the same way; ``Solution.backend`` says who solved.
         tolerance: certificate tolerance, SI units.
 
     Returns:
@@ -54,10 +61,18 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     tau_min, tau_max = setup.tau_bounds
     args = (maps, setup.friction, setup.external_wrench, tau_min, tau_max, setup.weights)
     J = maps.J
+    used = method
     if method == "tau-qp":
         qp = build_tau_qp(*args)
         t2 = time.perf_counter()
-        raw = (solver or make_solver(backend)).solve(qp)
+        solver = solver or make_solver(backend)
+        used = getattr(solver, "name", backend)
+        try:
+            raw = solver.solve(qp)
+        except SolverError as e:
+            if fallback is None:
+                raise
+            raw = RawResult("error", None, 0, 0.0, str(e))
         tau, f = (None, None) if raw.x is None else (qp.split(raw.x)[0], qp.wrenches(raw.x))
     else:
         t2 = time.perf_counter()
@@ -78,10 +93,24 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         cert = certify(maps.G, J, setup.external_wrench, setup.friction,
                        tau_min, tau_max, tau, f, tolerance)
     timings["certify"] = time.perf_counter() - t3
+    if method == "tau-qp" and fallback is not None and \
+            not (raw.status == "solved" and cert is not None and cert.ok):
+        t4 = time.perf_counter()
+        raw2 = fallback.solve(qp)
+        if raw2.status == "solved" and raw2.x is not None:
+            tau2, f2 = qp.split(raw2.x)[0], qp.wrenches(raw2.x)
+            cert2 = certify(maps.G, J, setup.external_wrench, setup.friction,
+                            tau_min, tau_max, tau2, f2, tolerance)
+            if cert2.ok:
+                used = getattr(fallback, "name", "fallback")
+                raw = dataclasses.replace(raw2, message=f"{raw2.message}; fallback after "
+                                          f"{raw.message}")
+                tau, f, cert = tau2, f2, cert2
+        timings["fallback"] = time.perf_counter() - t4
 
     out = Solution(status=FAILED, method=method, joints=list(setup.hand.joints),
                    iterations=raw.iterations, solve_time_s=raw.solve_time_s,
-                   certificate=cert, timings=timings)
+                   certificate=cert, timings=timings, backend=used)
     if raw.status == "solved" and cert is not None and cert.ok:
         out.status, out.tau, out.wrenches = OPTIMAL, tau, f.reshape(-1, 4)
         out.message = f"certified (solver: {raw.message})"

@@ -7,6 +7,7 @@ import pytest
 from independent import assert_holds
 
 from grasp_torque_opt.backends import BACKENDS, kkt_violation, make_solver
+from grasp_torque_opt.exceptions import SolverError
 from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.solve import solve
 from grasp_torque_opt.tau_qp import build_tau_qp
@@ -148,3 +149,44 @@ def test_kkt_violation_sees_a_suboptimal_point(allegro):
     lam = info["lam"]
     assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x * 1.01, lam) > 1e-4
     assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x, -lam) > 1e-4
+
+
+class WrongAnswer:
+    """A first backend that claims SOLVED with a finite, wrong x (fault injection)."""
+
+    name = "wrong"
+
+    def __init__(self, raises: bool = False):
+        self.inner, self.raises = make_solver("proxsuite"), raises
+        self.settings = self.inner.settings
+
+    def solve(self, qp):
+        if self.raises:
+            raise SolverError("injected")
+        good = self.inner.solve(qp)
+        return dataclasses.replace(good, x=good.x + 0.05)
+
+
+@pytest.mark.parametrize("raises", [False, True])
+def test_fallback_backend_answers_when_the_first_fails(allegro, raises):
+    maps = allegro.maps()
+    alone = solve(allegro, maps=maps, solver=WrongAnswer()) if not raises else None
+    if alone is not None:
+        assert alone.status == "failed" and alone.tau is None
+    sol = solve(allegro, maps=maps, solver=WrongAnswer(raises), fallback=make_solver("daqp"))
+    assert sol.status == "optimal" and sol.backend == "daqp"
+    assert "fallback after" in sol.message
+    np.testing.assert_allclose(sol.tau, force_space_optimum(allegro, maps), atol=1e-5)
+    assert_holds(allegro, maps, sol.tau, sol.wrenches)
+
+
+def test_fallback_is_not_asked_when_the_first_backend_certifies(allegro):
+    class Counting:
+        name, calls = "counting", 0
+
+        def solve(self, qp):
+            Counting.calls += 1
+            return make_solver("daqp").solve(qp)
+
+    sol = solve(allegro, fallback=Counting())
+    assert sol.optimal and sol.backend == "proxsuite" and Counting.calls == 0

@@ -74,3 +74,24 @@ def test_warm_starts_and_their_fallbacks_are_reported(allegro):
     v = values(report(ctrl, 0.02))
     assert v["solver.backend"] == "daqp"
     assert v["solver.warm_solves"] == "2" and v["solver.warm_start_fallbacks"] == "1"
+
+
+def test_fallback_solves_are_reported(allegro):
+    """A first backend whose answers fail the certificate: DAQP's are published, and counted."""
+    ctrl = TorqueController(dataclasses.replace(allegro, hand=dataclasses.replace(allegro.hand)),
+                            CycleConfig(cycle_budget=10.0), fallback="daqp")
+    good = ctrl.solver
+
+    class Wrong:
+        name, settings = "wrong", good.settings
+
+        def solve(self, qp):
+            r = good.solve(qp)
+            return dataclasses.replace(r, x=r.x + 0.05)
+
+    ctrl.solver = Wrong()
+    names, positions = joint_state(allegro)
+    ctrl.update_joint_state(names, positions, 0.0)
+    result = ctrl.cycle(0.0)
+    assert result.kind == "solution" and result.solution.backend == "daqp"
+    assert values(report(ctrl, 0.0))["solver.fallback_solves"] == "1"
