@@ -10,7 +10,7 @@ import argparse
 import json
 import sys
 
-from grasp_torque_opt.backends import BACKENDS, single_threaded_math
+from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.compare import compare, format_table
 from grasp_torque_opt.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.grasp_setup import GraspSetup
@@ -32,6 +32,9 @@ def _parser() -> argparse.ArgumentParser:
     p_solve.add_argument("--method", choices=METHODS, default="tau-qp")
     p_solve.add_argument("--backend", choices=BACKENDS, default="proxsuite",
                          help="QP solver of the tau-qp method (default: proxsuite)")
+    p_solve.add_argument("--fallback", choices=(*BACKENDS, "none"), default="daqp",
+                         help="backend asked when the first gives nothing certifiable "
+                              "(default: daqp)")
     p_solve.add_argument("--json", action="store_true", help="print one JSON object")
     p_cmp = sub.add_parser("compare", help="every method side by side (the paper's Table 2)")
     p_cmp.add_argument("scenario", help="scenario YAML file")
@@ -65,7 +68,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         setup = GraspSetup.from_file(args.scenario)
         if args.command == "solve":
-            sol = solve(setup, args.method, backend=args.backend)
+            fallback = None if args.fallback in ("none", args.backend) else \
+                make_solver(args.fallback)
+            sol = solve(setup, args.method, backend=args.backend, fallback=fallback)
             d = solution_dict(sol, setup.maps())
             if args.json:
                 print(json.dumps(d))

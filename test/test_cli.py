@@ -119,3 +119,13 @@ def test_backend_option_gives_the_same_certified_torques(allegro, capsys, backen
     d = json.loads(out)
     assert d["certificate"]["ok"] is True and backend.upper()[:4] in d["message"].upper()
     np.testing.assert_allclose(d["tau"], default["tau"], atol=1e-6)
+
+
+def test_fallback_answers_for_a_backend_that_cannot(planar, capsys):
+    """quadprog cannot take the planar grasp's internal force: DAQP answers, unless told not to."""
+    code, out, _ = run(["solve", str(PLANAR), "--backend", "quadprog", "--json"], capsys)
+    d = json.loads(out)
+    assert code == 0 and d["certificate"]["ok"] is True and "fallback after quadprog" in d["message"]
+    code, out, _ = run(["solve", str(PLANAR), "--backend", "quadprog", "--fallback", "none",
+                        "--json"], capsys)
+    assert code == 4 and json.loads(out)["tau"] is None
