@@ -1,18 +1,18 @@
 """The node under load: latency and dropped cycles of grasp_torque_node beside a trivial echo node.
 
 Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
-       [--hands allegro planar] [--executors single events events-once] [--out FILE]
+       [--hands allegro planar] [--executors single events] [--out FILE]
 
-For each hand, joint-state rate and rclpy executor, two answering processes
+For each hand, joint-state rate and rclpy executor, three answering processes
 are measured in turn with the same load process:
 
 - ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
-  ``publish_stamped_command:=true``);
+  ``publish_stamped_command:=true``), as configured (ProxSuite) and with
+  ``solver.backend:=daqp`` (target ``grasp_torque_node/daqp``);
 - an echo node written here, named ``grasp_torque_node`` too, that answers each
   joint state with zero torques on ``effort_commands`` and the stamped copy on
   ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
-  its executor as the node's main does (``spin()``); ``events-once`` (echo
-  only) serves the EventsExecutor with a ``spin_once`` loop instead.
+  its executor as the node's main does (``events``: a ``spin_once`` loop).
 
 The load process (a separate process, the same for every case) publishes joint
 states with sensor-data QoS on absolute deadlines (the scenario's grasp with a
@@ -48,16 +48,16 @@ from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  #
 
 HANDS = {"allegro": ("allegro_right.yaml", "allegro_right_node.yaml"),
          "planar": ("planar_two_finger.yaml", "planar_two_finger_node.yaml")}
-TARGETS = ("echo", "grasp_torque_node")
+#: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
+TARGETS = ("echo", "grasp_torque_node", "grasp_torque_node/daqp")
 WARMUP_S = 1.0
 #: After the last joint state, how long commands in flight are still awaited [s].
 DRAIN_S = 0.5
 #: Longest wait for the answering node to be discovered, then to answer once [s].
 READY_TIMEOUT_S = 10.0
-#: Executors of the answering node. ``events-once`` is the echo node only (the node's
-#: main offers single and events): EventsExecutor served by a spin_once loop rather
-#: than spin(), to show what that executor gives when its spin() does not deliver.
-EXECUTORS = ("single", "events", "events-once")
+#: Executors of the answering node. ``events`` is rclpy's EventsExecutor served by a
+#: spin_once loop, as the node's main does (its spin() delivered no callback here).
+EXECUTORS = ("single", "events")
 #: Amplitude of the joint motion around the scenario's grasp [rad].
 AMPLITUDE = 1e-3
 
@@ -65,8 +65,7 @@ AMPLITUDE = 1e-3
 def _executor(name: str):
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.experimental import EventsExecutor
-    return {"single": SingleThreadedExecutor, "events": EventsExecutor,
-            "events-once": EventsExecutor}[name]()
+    return {"single": SingleThreadedExecutor, "events": EventsExecutor}[name]()
 
 
 # -- the echo node ---------------------------------------------------------------------------
@@ -102,11 +101,11 @@ def echo_main(args: argparse.Namespace) -> int:
                                  qos_profile_sensor_data)
         executor = _executor(args.executor)
         executor.add_node(node)
-        if args.executor == "events-once":
+        if args.executor == "events":  # as grasp_torque_node's main does
             while rclpy.ok():
                 executor.spin_once(timeout_sec=1.0)
         else:
-            executor.spin()  # as grasp_torque_node's main does
+            executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -245,13 +244,16 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
     from grasp_torque_opt.grasp_setup import GraspSetup
 
     env = isolated_env(domain)
-    tag = f"{hand}-{target}-{int(rate)}-{executor}"
+    tag = f"{hand}-{target.replace('/', '-')}-{int(rate)}-{executor}"
     me = [sys.executable, str(Path(__file__).resolve())]
     if target == "echo":
         joints = GraspSetup.from_file(CONFIG / HANDS[hand][0]).hand.joints
         cmd = me + ["--role", "echo", "--executor", executor, "--joints", ",".join(joints)]
     else:
-        cmd = node_command(CONFIG / HANDS[hand][1], executor, ["--log-level", "error"])
+        extra = ["--log-level", "error"]
+        if "/" in target:
+            extra += ["-p", f"solver.backend:={target.split('/', 1)[1]}"]
+        cmd = node_command(CONFIG / HANDS[hand][1], executor, extra)
     result_file = tmp / f"{tag}.json"
     load_cmd = me + ["--role", "load", "--hand", hand, "--rate", str(rate),
                      "--duration", str(duration), "--load-executor", load_executor,
@@ -308,10 +310,10 @@ def table(cases: list[dict]) -> str:
             f"{c['dropped']} | {_fmt(c['dropped_pct'], '.2f')} | "
             f"{_fmt(lat['p50_ms'], '.3f')} | {_fmt(lat['p99_ms'], '.3f')} | "
             f"{_fmt(lat['max_ms'], '.3f')} | {_fmt(c['other_processes_cores'], '.2f')} |")
-    lines += ["", "| hand | rate [Hz] | executor | p99 node / echo | "
-              "dropped node - echo [pp] | p50 node / echo |", "|---|---:|---|---:|---:|---:|"]
+    lines += ["", "| hand | rate [Hz] | executor | node | p99 node / echo | "
+              "dropped node - echo [pp] | p50 node / echo |", "|---|---:|---|---|---:|---:|---:|"]
     for r in ratios(cases):
-        lines.append(f"| {r['hand']} | {r['rate_hz']:g} | {r['executor']} | "
+        lines.append(f"| {r['hand']} | {r['rate_hz']:g} | {r['executor']} | {r['target']} | "
                      f"{_fmt(r['p99_ratio'], '.2f')} | {_fmt(r['dropped_diff_pp'], '+.2f')} | "
                      f"{_fmt(r['p50_ratio'], '.2f')} |")
     return "\n".join(lines)
@@ -325,7 +327,8 @@ def ratios(cases: list[dict]) -> list[dict]:
         echo = by_key.get((hand, rate, executor, "echo"))
         if target == "echo" or echo is None:
             continue
-        r = {"hand": hand, "rate_hz": rate, "executor": executor, "p99_ratio": None,
+        r = {"hand": hand, "rate_hz": rate, "executor": executor, "target": target,
+             "p99_ratio": None,
              "p50_ratio": None, "dropped_diff_pp": None}
         if "error" not in node and "error" not in echo:
             for q in ("p50", "p99"):
@@ -341,8 +344,7 @@ def main_run(args: argparse.Namespace) -> int:
     from cycle import machine
 
     interrupt_on_signals()
-    keys = [k for k in itertools.product(args.hands, args.rates, args.executors, TARGETS)
-            if not (k[2] == "events-once" and k[3] == "grasp_torque_node")]
+    keys = list(itertools.product(args.hands, args.rates, args.executors, TARGETS))
     domains = private_domains(len(keys))
     m = machine()
     print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}")
@@ -385,7 +387,7 @@ def main() -> int:
                         help="joint-state rates [Hz]")
     parser.add_argument("--hands", nargs="+", choices=sorted(HANDS), default=list(HANDS))
     parser.add_argument("--executors", nargs="+", choices=EXECUTORS, default=list(EXECUTORS),
-                        help="executors of the answering nodes (events-once: echo only)")
+                        help="executors of the answering nodes")
     parser.add_argument("--load-executor", choices=["single", "events"], default="events",
                         help="executor of the load process itself (the same in every case)")
     parser.add_argument("--out", type=Path,
