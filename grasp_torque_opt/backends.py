@@ -33,29 +33,29 @@ DAQP_INF = 1e30
 KKT_TOLERANCE = 1e-6
 
 
-def kkt_violation(H: np.ndarray, g: np.ndarray, M: np.ndarray, lower: np.ndarray,
-                  upper: np.ndarray, equality: np.ndarray, x: np.ndarray,
-                  lam: np.ndarray) -> float:
-    """How far (x, lam) is from a KKT point of min 1/2 x'Hx + g'x, lower <= M x <= upper.
+def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray,
+                  upper: np.ndarray, x: np.ndarray, lam: np.ndarray) -> float:
+    """How far (x, lam) is from a KKT point of min 1/2 x'Hx + g'x, lower <= [x; A x] <= upper.
 
-    Sign convention (DAQP's): H x + g + M' lam = 0, lam > 0 on an active upper
-    bound, lam < 0 on an active lower one; equality rows take any sign.
+    Sign convention (DAQP's, bounds on x first): H x + g + [I A'] lam = 0,
+    lam > 0 on an active upper bound, lam < 0 on an active lower one. An
+    equality row has lower = upper, so its slack is zero whatever its sign.
 
     Returns:
         The largest of: the stationarity residual relative to the size of its
-        terms, the primal infeasibility, and each inequality's multiplier
-        times its slack (complementarity, which also catches a wrong sign).
+        terms, the primal infeasibility, and each row's multiplier times its
+        slack (complementarity, which also catches a wrong sign).
     """
-    Mx = M @ x
+    n = x.size
+    Mx = np.concatenate((x, A @ x))
     grad = H @ x + g
-    dual = M.T @ lam
+    dual = A.T @ lam[n:]
+    dual[:n] += lam[:n]
     scale = max(1.0, float(np.abs(grad).max()), float(np.abs(dual).max()))
-    stationarity = float(np.abs(grad + dual).max()) / scale
-    primal = max(0.0, float((Mx - upper).max()), float((lower - Mx).max()))
-    ineq = ~equality
-    comp = max(float((np.maximum(lam, 0.0) * (upper - Mx))[ineq].max(initial=0.0)),
-               float((np.maximum(-lam, 0.0) * (Mx - lower))[ineq].max(initial=0.0)))
-    return max(stationarity, primal, comp)
+    to_upper, to_lower = upper - Mx, Mx - lower
+    return max(float(np.abs(grad + dual).max()) / scale,
+               -float(to_upper.min()), -float(to_lower.min()),
+               float((lam * np.where(lam > 0.0, to_upper, -to_lower)).max()))
 
 
 class DaqpSolver:
@@ -120,10 +120,9 @@ class DaqpSolver:
             self._model.update(H=H, f=qp.g, A=A, bupper=upper, blower=lower,
                                sense=None if warm else sense)
         self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
-        M = np.vstack((np.eye(n), A))
         x, _, flag, info = self._model.solve()
         iterations = int(info["iterations"])
-        kkt = self._kkt(flag, H, qp.g, M, lower, upper, sense, x, info)
+        kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
         if warm:
             self.warm_solves += 1
             if not kkt <= KKT_TOLERANCE:
@@ -131,7 +130,7 @@ class DaqpSolver:
                 self._model.update(sense=sense)  # the same data, cold
                 x, _, flag, info = self._model.solve()
                 iterations += int(info["iterations"])
-                kkt = self._kkt(flag, H, qp.g, M, lower, upper, sense, x, info)
+                kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
         elapsed = time.perf_counter() - t0
         status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
         message = f"DAQP exit flag {int(flag)}"
@@ -140,11 +139,11 @@ class DaqpSolver:
         return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
 
     @staticmethod
-    def _kkt(flag, H, g, M, lower, upper, sense, x, info) -> float:
+    def _kkt(flag, H, g, A, lower, upper, x, info) -> float:
         """KKT violation of a DAQP answer that says optimal (inf otherwise)."""
         if int(flag) != 1:
             return float("inf")
-        return kkt_violation(H, g, M, lower, upper, sense == 5, np.asarray(x), info["lam"])
+        return kkt_violation(H, g, A, lower, upper, np.asarray(x), info["lam"])
 
 
 class QuadprogSolver:

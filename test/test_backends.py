@@ -131,24 +131,27 @@ def test_daqp_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro)
 
 def test_kkt_violation_sees_a_suboptimal_point(allegro):
     """The optimality check itself: the solver's point passes, a feasible detour does not."""
+    import daqp
+
     maps = allegro.maps()
     qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
                       allegro.weights)
-    n = qp.H.shape[0]
-    M = np.vstack((np.eye(n), qp.A, qp.C))
+    n, n_eq = qp.H.shape[0], qp.A.shape[0]
+    A = np.vstack((qp.A, qp.C))
     lower = np.concatenate((qp.l_box, qp.b, np.full(qp.C.shape[0], -1e30)))
     upper = np.concatenate((qp.u_box, qp.b, qp.u))
-    eq = np.zeros(M.shape[0], bool)
-    eq[n:n + qp.A.shape[0]] = True
-    import daqp
-    x, _, flag, info = daqp.solve(qp.H.copy(), qp.g, M[n:], upper, lower,
-                                  np.where(eq, 5, 0).astype(np.int32), primal_tol=1e-9)
+    sense = np.zeros(n + A.shape[0], dtype=np.int32)
+    sense[n:n + n_eq] = 5
+    x, _, flag, info = daqp.solve(qp.H.copy(), qp.g, A, upper, lower, sense, primal_tol=1e-9)
     assert flag == 1
-    assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x, info["lam"]) < 1e-9
-    # The same multipliers at a point moved along the equality-feasible directions.
     lam = info["lam"]
-    assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x * 1.01, lam) > 1e-4
-    assert kkt_violation(qp.H, qp.g, M, lower, upper, eq, x, -lam) > 1e-4
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x, lam) < 1e-9
+    # Written out independently: stationarity with the full constraint matrix.
+    M = np.vstack((np.eye(n), A))
+    assert np.abs(qp.H @ x + qp.g + M.T @ lam).max() < 1e-9
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x * 1.01, lam) > 1e-4  # moved
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x, -lam) > 1e-4  # wrong signs
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x, np.zeros_like(lam)) > 1e-4
 
 
 class WrongAnswer:
