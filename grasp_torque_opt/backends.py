@@ -22,6 +22,7 @@ import time
 
 import numpy as np
 
+from grasp_torque_opt.exceptions import SolverError
 from grasp_torque_opt.solution import RawResult
 from grasp_torque_opt.tau_qp import ProxSuiteSettings, TauQP, TauQPSolver, check_data
 
@@ -105,20 +106,49 @@ class DaqpSolver:
         sense[n:n + n_eq] = 5  # equality
         H = qp.H.copy()  # DAQP wants writable buffers; H is shared read-only
         t0 = time.perf_counter()
-        if self._dims != (n, n_eq, n_in):
+        try:
+            x, flag, info, iterations = self._run(qp, n, (n, n_eq, n_in), H, A, upper, lower,
+                                                  sense)
+        except RuntimeError as e:  # e.g. a failed setup: the next call starts anew
+            self._dims = None
+            raise SolverError(f"DAQP failed: {e}") from e
+        if x is None:
+            self._dims = None
+            return RawResult("error", None, 0, time.perf_counter() - t0,
+                             f"DAQP setup or update failed (exit flag {flag})")
+        kkt = info["kkt"]
+        elapsed = time.perf_counter() - t0
+        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
+        message = f"DAQP exit flag {int(flag)}"
+        if status == "solved" and not kkt <= KKT_TOLERANCE:
+            status, message = "error", f"{message}, but KKT violated by {kkt:.3g}"
+        return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
+
+    def _run(self, qp: TauQP, n: int, dims: tuple[int, int, int], H: np.ndarray,
+             A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray):
+        """Set up or update the workspace and solve (warm if enabled, verified).
+
+        Returns:
+            (x, flag, info with "kkt", iterations); x None if the setup failed.
+        """
+        if self._dims != dims:
             self._model = self._daqp.Model()
-            self._model.setup(H, qp.g, A, upper, lower, sense)
+            flag, _ = self._model.setup(H, qp.g, A, upper, lower, sense)
+            if flag < 0:
+                return None, flag, {}, 0
             s = self._model.settings
             s.update(primal_tol=self.settings.eps_abs, iter_limit=self.settings.max_iter,
                      eps_prox=0.0 if n == qp.m else -1e-6)
             self._model.settings = s
-            self._dims = (n, n_eq, n_in)
+            self._dims = dims
             warm = False
         else:
             warm = self.warm_start
             # Without sense, DAQP keeps the previous active set: a warm start.
-            self._model.update(H=H, f=qp.g, A=A, bupper=upper, blower=lower,
-                               sense=None if warm else sense)
+            flag = self._model.update(H=H, f=qp.g, A=A, bupper=upper, blower=lower,
+                                      sense=None if warm else sense)
+            if flag is not None and flag < 0:
+                return None, flag, {}, 0
         self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
         x, _, flag, info = self._model.solve()
         iterations = int(info["iterations"])
@@ -131,12 +161,7 @@ class DaqpSolver:
                 x, _, flag, info = self._model.solve()
                 iterations += int(info["iterations"])
                 kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
-        elapsed = time.perf_counter() - t0
-        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
-        message = f"DAQP exit flag {int(flag)}"
-        if status == "solved" and not kkt <= KKT_TOLERANCE:
-            status, message = "error", f"{message}, but KKT violated by {kkt:.3g}"
-        return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
+        return x, flag, {**info, "kkt": kkt}, iterations
 
     @staticmethod
     def _kkt(flag, H, g, A, lower, upper, x, info) -> float:
