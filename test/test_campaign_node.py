@@ -116,7 +116,8 @@ def test_input_publisher_dies_and_comes_back(planar, policy):
         died = time.monotonic()
         n_before = len(h.commands)
         h.spin_for(0.4)
-        after = h.commands[n_before:]
+        # Commands already in flight when it died may still arrive (30 ms for delivery).
+        after = [c for c in h.commands[n_before:] if c[0] > died + 0.03]
         if policy == "zero":
             assert after and all(np.all(c == 0.0) for _, c in after)
             # Zero once hold_time has passed since the last certified command (seen here
