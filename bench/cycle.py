@@ -67,6 +67,15 @@ def machine_line(m: dict) -> str:
             f"Pinocchio {m['versions']['pin']}; {m['date']}")
 
 
+def report(results: dict, table_text: str, out: Path | None, detail: str = "") -> None:
+    """Print the machine line (with ``detail``) and the table; write the JSON to ``out``."""
+    print(machine_line(results["machine"]) + (f"; {detail}" if detail else ""))
+    print(table_text)
+    if out:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(results, indent=2))
+
+
 def summary(samples: list[float]) -> dict:
     """Median and p99 [s]."""
     return {"median_s": float(np.median(samples)), "p99_s": float(np.percentile(samples, 99))}
@@ -194,11 +203,7 @@ def main() -> None:
     args = parser.parse_args()
     single_threaded_math()
     results = run(args.repeats, tuple(args.backends.split(",")))
-    print(machine_line(results["machine"]))
-    print(table(results))
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(results, indent=2))
+    report(results, table(results), args.out)
 
 
 if __name__ == "__main__":

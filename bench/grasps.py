@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import os
 import sys
 from pathlib import Path
@@ -35,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import ROOT, machine  # noqa: E402
+from cycle import ROOT, machine, report  # noqa: E402
 
 from grasp_torque_opt.exceptions import GraspTorqueError  # noqa: E402
 from grasp_torque_opt.feasibility import linearized_feasible  # noqa: E402
@@ -160,13 +159,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="write the results as JSON here")
     args = parser.parse_args()
     res = run(args.grasps, args.seed)
-    m = res["machine"]
-    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}; "
-          f"threads: {res['blas_threads']}")
-    print(table(res))
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(res, indent=2))
+    report(res, table(res), args.out,
+           f"threads: {res['blas_threads']}")
 
 
 if __name__ == "__main__":

@@ -20,14 +20,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine  # noqa: E402
+from cycle import machine, report  # noqa: E402
 from grasps import allegro_grasps, blas_threads  # noqa: E402
 
 from grasp_torque_opt.backends import make_solver  # noqa: E402
@@ -95,13 +94,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="write the results as JSON here")
     args = parser.parse_args()
     res = run(args.grasps, args.seed, tuple(args.sides), args.backend)
-    m = res["machine"]
-    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}; "
-          f"{args.grasps} grasps, seed {args.seed}; threads: {res['blas_threads']}")
-    print(table(res))
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(res, indent=2))
+    report(res, table(res), args.out,
+           f"{args.grasps} grasps, seed {args.seed}; threads: {res['blas_threads']}")
 
 
 if __name__ == "__main__":

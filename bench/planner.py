@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import multiprocessing as mp
 import os
 import sys
@@ -42,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine  # noqa: E402
+from cycle import machine, report  # noqa: E402
 from grasps import SCENARIO, THREAD_VARS, allegro_grasps, blas_threads  # noqa: E402
 
 from grasp_torque_opt.backends import make_solver  # noqa: E402
@@ -176,14 +175,8 @@ def main() -> None:
     args = parser.parse_args()
     res = run(args.grasps, args.seed, args.rounds, args.workers, tuple(args.backends),
               args.worker_threads)
-    m = res["machine"]
-    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}; "
-          f"{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; "
-          f"threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
-    print(table(res))
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(res, indent=2))
+    report(res, table(res), args.out,
+           f"{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
 
 
 if __name__ == "__main__":

@@ -60,7 +60,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import sys
 import time
 from collections.abc import Callable
@@ -73,7 +72,7 @@ import proxsuite
 import scipy.sparse as sp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import ROOT, SCENARIOS, machine  # noqa: E402
+from cycle import ROOT, SCENARIOS, machine, report  # noqa: E402
 from grasps import SCENARIO, allegro_grasps, blas_threads  # noqa: E402
 
 from grasp_torque_opt.backends import make_solver  # noqa: E402
@@ -599,14 +598,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="write the results as JSON here")
     args = parser.parse_args()
     res = run(args.grasps, args.seed, args.repeats, args.scenario_repeats, args.steps)
-    m = res["machine"]
-    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}, "
-          f"ProxSuite {m['versions']['proxsuite']}; {m['date']}; {args.grasps} grasps, "
-          f"seed {args.seed}, {args.repeats} calls per grasp; threads: {res['blas_threads']}")
-    print(table(res))
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps(res, indent=2))
+    report(res, table(res), args.out,
+           f"{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp; threads: {res['blas_threads']}")
 
 
 if __name__ == "__main__":
