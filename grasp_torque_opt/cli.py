@@ -61,6 +61,17 @@ def _print_solution(d: dict) -> None:
                                         "torque_limit")) + f" (tolerance {c['tolerance']:.0e})")
 
 
+def _one_line(text: str) -> str:
+    """Escape every character that is not printable, line breaks included.
+
+    A message quotes the user's input (a path, a name), and str.splitlines()
+    breaks a line at \\x85 or \\u2028 as well as at \\n: the error stays one
+    line whatever the input holds.
+    """
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
+                   for c in text)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
     args = _parser().parse_args(argv)
@@ -86,10 +97,10 @@ def main(argv: list[str] | None = None) -> int:
             print(format_table(comparison))
         return _exit_code(comparison.solutions["tau-qp"].status)
     except InputError as e:
-        print(f"{PROG}: error: {args.scenario}: {e}", file=sys.stderr)
+        print(_one_line(f"{PROG}: error: {args.scenario}: {e}"), file=sys.stderr)
         return EXIT_BAD_INPUT
     except GraspTorqueError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
+        print(_one_line(f"{PROG}: error: {e}"), file=sys.stderr)
         return EXIT_FAILED
 
 

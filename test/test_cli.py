@@ -129,3 +129,17 @@ def test_fallback_answers_for_a_backend_that_cannot(planar, capsys):
     code, out, _ = run(["solve", str(PLANAR), "--backend", "quadprog", "--fallback", "none",
                         "--json"], capsys)
     assert code == 4 and json.loads(out)["tau"] is None
+
+
+@pytest.mark.parametrize("urdf", ["a\nb.urdf", "\x85", "x\u2028y.urdf", "tab\there.urdf"])
+def test_line_breaks_in_the_input_stay_escaped_in_the_one_line(tmp_path, capsys, planar_doc,
+                                                                urdf):
+    """str.splitlines() breaks at \\x85 and \\u2028 too: the quoted input must not."""
+    doc = mutated(planar_doc, ("hand", "urdf"), urdf)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(doc))
+    code, out, err = run(["solve", str(bad), "--json"], capsys)
+    assert code == 2 and out == ""
+    assert len(err.splitlines()) == 1 and err.endswith("\n")
+    assert err.startswith(f"grasp-torque-opt: error: {bad}: hand.urdf: file not found: ")
+    assert urdf.encode("unicode_escape").decode("ascii") in err
