@@ -14,6 +14,7 @@ functions here only stack them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import pinocchio as pin
@@ -58,27 +59,42 @@ class GraspMaps:
     Attributes:
         G: grasp matrix, shape (6, 4p), about the object origin, base axes.
         J: hand Jacobian, shape (4p, m), contact frames x actuated joints.
-        contacts: the contact frames.
+        links: per contact, the model frame that touches.
+        frame_ids: per contact, its Pinocchio frame index.
+        positions: contact points p_i, base frame, shape (p, 3) [m].
+        rotations: R_i, columns x_i, y_i, z_i in base axes, shape (p, 3, 3).
         object_origin: c, base frame, shape (3,) [m].
     """
 
     G: np.ndarray
     J: np.ndarray
-    contacts: list[ContactFrame]
+    links: tuple[str, ...]
+    frame_ids: tuple[int, ...]
+    positions: np.ndarray
+    rotations: np.ndarray
     object_origin: np.ndarray
 
     @property
     def p(self) -> int:
         """Number of contacts."""
-        return len(self.contacts)
+        return len(self.links)
+
+    @cached_property
+    def contacts(self) -> list[ContactFrame]:
+        """The contact frames, one object each (built when first asked: the cycle never is)."""
+        return [ContactFrame(link=link, frame_id=fid, position=pos, rotation=R)
+                for link, fid, pos, R in zip(self.links, self.frame_ids, self.positions,
+                                             self.rotations)]
+
+
+#: skew(v) = [[0, -v2, v1], [v2, 0, -v0], [-v1, v0, 0]], row-major, as v[_SKEW_INDEX] * _SKEW_SIGN.
+_SKEW_INDEX = np.array([0, 2, 1, 2, 0, 0, 1, 0, 0])
+_SKEW_SIGN = np.array([0.0, -1.0, 1.0, 1.0, 0.0, -1.0, -1.0, 1.0, 0.0])
 
 
 def _skews(v: np.ndarray) -> np.ndarray:
     """skew(v_i) for rows v_i of v, shape (n, 3, 3)."""
-    out = np.zeros((len(v), 3, 3))
-    out[:, 0, 1], out[:, 0, 2], out[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
-    out[:, 1, 0], out[:, 2, 0], out[:, 2, 1] = v[:, 2], -v[:, 1], v[:, 0]
-    return out
+    return (v[:, _SKEW_INDEX] * _SKEW_SIGN).reshape(-1, 3, 3)
 
 
 def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
@@ -108,41 +124,43 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
     pin.updateFramePlacements(model, data)
     c = np.asarray(object_origin, dtype=float)
     p = len(contacts)
-    fields = [f"grasp.contacts[{i}]" for i in range(p)]
-    fids = [hand.frame_index(spec.link, f"{field}.link")
-            for spec, field in zip(contacts, fields)]
-    origins, points, normals = [], [], []
-    for spec, fid, field in zip(contacts, fids, fields):
+    fids = tuple(hand.frame_index(spec.link, f"grasp.contacts[{i}].link")
+                 for i, spec in enumerate(contacts))
+    po = np.empty((2 * p, 3))  # contact points p_i, then link origins o_i
+    for i, (spec, fid) in enumerate(zip(contacts, fids)):
         oMf = data.oMf[fid]
-        o = oMf.translation
-        pt = oMf.act(np.asarray(spec.position, dtype=float))
-        normal = spec.normal
-        if normal is None:
-            normal = c - pt
-            if normal @ normal < 1e-18:
-                raise InputError(f"{field}.normal", "cannot default: the contact point "
-                                 "coincides with grasp.object_origin")
-        origins.append(o)
-        points.append(pt)
-        normals.append(normal)
-    points = np.array(points)
-    R = contact_rotations(np.array(normals), [spec.tangent for spec in contacts], fields)
+        po[i] = oMf.act(spec.position)
+        po[p + i] = oMf.translation
+    points = po[:p]
+    normals = [spec.normal for spec in contacts]
+    for i, n in enumerate(normals):
+        if n is None:
+            towards = c - points[i]
+            if towards @ towards < 1e-18:
+                raise InputError(f"grasp.contacts[{i}].normal", "cannot default: the "
+                                 "contact point coincides with grasp.object_origin")
+            normals[i] = towards
+    R = contact_rotations(normals, [spec.tangent for spec in contacts],
+                          [f"grasp.contacts[{i}]" for i in range(p)])
     # skew(v) rows for r_i = p_i - c (moments) and d_i = p_i - o_i (point velocity).
-    sk = _skews(np.concatenate((points - c, points - np.array(origins))))
-    Gb = np.zeros((p, 6, 4))
-    Gb[:, :3, :3] = R
-    Gb[:, 3:, :3] = sk[:p] @ R
-    Gb[:, 3:, 3] = R[:, :, 2]
+    arms = np.empty((2 * p, 3))
+    np.subtract(points, c, out=arms[:p])
+    np.subtract(points, po[p:], out=arms[p:])
+    sk = _skews(arms)
+    Rt = R.transpose(0, 2, 1)
+    Gb = np.empty((6, p, 4))  # G[:, 4i + j] = Gb[:, i, j]
+    Gb[:3, :, :3] = R.transpose(1, 0, 2)
+    Gb[3:, :, :3] = (sk[:p] @ R).transpose(1, 0, 2)
+    Gb[:3, :, 3] = 0.0
+    Gb[3:, :, 3] = R[:, :, 2].T
 
     J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
                    for fid in fids])[:, :, hand.idx_v]
     ang = J6[:, 3:]
     Jb = np.empty((p, 4, hand.m))
     # Velocity of the contact point: v_o + w x (p - o) = J_v - skew(p - o) J_w.
-    Jb[:, :3] = R.transpose(0, 2, 1) @ (J6[:, :3] - sk[p:] @ ang)
-    Jb[:, 3] = (R[:, :, 2:].transpose(0, 2, 1) @ ang)[:, 0]
-
-    frames = [ContactFrame(link=spec.link, frame_id=fid, position=points[i], rotation=R[i])
-              for i, (spec, fid) in enumerate(zip(contacts, fids))]
-    return GraspMaps(G=Gb.transpose(1, 0, 2).reshape(6, 4 * p), J=Jb.reshape(4 * p, hand.m),
-                     contacts=frames, object_origin=c)
+    Jb[:, :3] = Rt @ (J6[:, :3] - sk[p:] @ ang)
+    Jb[:, 3] = (Rt[:, 2:] @ ang)[:, 0]
+    return GraspMaps(G=Gb.reshape(6, 4 * p), J=Jb.reshape(4 * p, hand.m),
+                     links=tuple(spec.link for spec in contacts), frame_ids=fids,
+                     positions=points, rotations=R, object_origin=c)
