@@ -43,20 +43,25 @@ def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray
     equality row has lower = upper, so its slack is zero whatever its sign.
 
     Returns:
-        The largest of: the stationarity residual relative to the size of its
-        terms, the primal infeasibility, and each row's multiplier times its
-        slack (complementarity, which also catches a wrong sign).
+        The largest of: the stationarity residual relative to the size of the
+        gradient (at least 1), the primal infeasibility, and each row's
+        multiplier times its slack (complementarity, which also catches a wrong
+        sign).
     """
     n = x.size
-    Mx = np.concatenate((x, A @ x))
     grad = H @ x + g
-    dual = A.T @ lam[n:]
-    dual[:n] += lam[:n]
-    scale = max(1.0, float(np.abs(grad).max()), float(np.abs(dual).max()))
+    residual = A.T @ lam[n:]
+    residual[:n] += lam[:n]
+    residual += grad
+    Mx = np.empty(lower.size)
+    Mx[:n] = x
+    np.dot(A, x, out=Mx[n:])
     to_upper, to_lower = upper - Mx, Mx - lower
-    return max(float(np.abs(grad + dual).max()) / scale,
-               -float(to_upper.min()), -float(to_lower.min()),
-               float((lam * np.where(lam > 0.0, to_upper, -to_lower)).max()))
+    # lam_i to_upper_i on a row held at its upper bound (lam_i > 0), -lam_i to_lower_i at
+    # its lower one; the other product is <= 0 on a feasible point, so the larger is it.
+    complementarity = np.maximum(lam * to_upper, -lam * to_lower)
+    return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
+               -float(np.minimum(to_upper, to_lower).min()), float(complementarity.max()))
 
 
 class DaqpSolver:

@@ -7,6 +7,7 @@ solver's view of it: equilibrium G f + w_ext = 0, tau = J^T f, the exact
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -73,18 +74,19 @@ def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction:
     """
     tau = np.asarray(tau, dtype=float)
     f = np.asarray(f, dtype=float)
-    if not (np.isfinite(tau).all() and np.isfinite(f).all()):
+    # One sum per array: NaN or Inf anywhere makes it non-finite.
+    if not math.isfinite(tau.sum() + f.sum()):
         inf = float("inf")
         return Certificate(inf, inf, inf, inf, inf, False, tolerance)
     w = f.reshape(-1, 4)
-    fz = w[:, 2]
     margin = cone_margin(w, friction.mu1, friction.mu2)
+    over = np.concatenate((tau_min - tau, tau - tau_max))
     return Certificate(
         equilibrium=float(np.abs(G @ f + external_wrench).max()),
         torque=float(np.abs(J.T @ f - tau).max()),
         cone=max(0.0, -float(margin.min())),
-        normal_force=max(0.0, friction.min_normal_force - float(fz.min())),
-        torque_limit=max(0.0, float((tau_min - tau).max()), float((tau - tau_max).max())),
+        normal_force=max(0.0, friction.min_normal_force - float(w[:, 2].min())),
+        torque_limit=max(0.0, float(over.max())),
         finite=True,
         tolerance=tolerance,
     )

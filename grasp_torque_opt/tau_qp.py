@@ -23,6 +23,7 @@ solve in 10 to 70 iterations.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from functools import lru_cache
@@ -206,7 +207,7 @@ def check_data(qp: TauQP) -> str:
     # One sum per array: NaN or Inf anywhere makes it non-finite (so does an
     # overflow of huge finite entries, which is refused as well).
     total = qp.H.sum() + qp.g.sum() + qp.A.sum() + qp.b.sum() + qp.C.sum() + qp.u.sum()
-    if not np.isfinite(total):
+    if not math.isfinite(total):
         return "QP data not finite"
     if not (qp.l_box <= qp.u_box).all():  # False for NaN as well
         return "QP bounds NaN or inverted (lower > upper)"
