@@ -111,8 +111,8 @@ class ProxVariant:
     are the project's configuration.
     """
 
-    hessian: str = "Dense"
-    backend: str = "Automatic"
+    hessian: str = ProxSuiteSettings.hessian_type
+    backend: str = ProxSuiteSettings.dense_backend
     eps_abs: float = 1e-9
     preconditioner: str = "first"
 
