@@ -75,7 +75,9 @@ class DaqpSolver:
     With ``warm_start``, a cycle starts from the previous cycle's active set
     (DAQP keeps it across updates); an answer that is not optimal by DAQP's
     flag and the KKT check is dropped and the QP solved again from a cold
-    start within the same call. ``warm_solves`` and ``fallbacks`` count them.
+    start within the same call; so is one that fails the caller's certificate
+    (:func:`grasp_torque_opt.solve.solve` asks again with ``cold=True``).
+    ``warm_solves`` and ``fallbacks`` count them.
 
     Args:
         settings: ``eps_abs`` is DAQP's primal tolerance, ``max_iter`` its
@@ -94,12 +96,24 @@ class DaqpSolver:
         self.warm_start = warm_start
         self.warm_solves = 0
         self.fallbacks = 0
+        #: Whether the last answer came from a warm start (not redone cold).
+        self.last_warm = False
         self._model = None
         self._dims: tuple[int, int, int] | None = None
         self._keep: tuple = ()
 
-    def solve(self, qp: TauQP) -> RawResult:
-        """Solve a built tau-QP (warm if enabled and verified, else cold)."""
+    def solve(self, qp: TauQP, cold: bool = False) -> RawResult:
+        """Solve a built tau-QP (warm if enabled and verified, else cold).
+
+        Args:
+            qp: the QP.
+            cold: start cold even with ``warm_start`` (the caller's redo of a warm
+                answer that failed its certificate; counted in ``fallbacks``).
+        """
+        if cold and self.last_warm:
+            self.fallbacks += 1
+            self._dims = None  # a new workspace: nothing of the previous active set
+        self.last_warm = False
         why = check_data(qp)
         if why:
             return RawResult("error", None, 0, 0.0, why)
@@ -160,7 +174,8 @@ class DaqpSolver:
         kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
         if warm:
             self.warm_solves += 1
-            if not kkt <= KKT_TOLERANCE:
+            self.last_warm = kkt <= KKT_TOLERANCE
+            if not self.last_warm:
                 self.fallbacks += 1
                 self._model.update(sense=sense)  # the same data, cold
                 x, _, flag, info = self._model.solve()

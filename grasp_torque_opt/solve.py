@@ -10,8 +10,10 @@ from __future__ import annotations
 import dataclasses
 import time
 
+import numpy as np
+
 from grasp_torque_opt.backends import make_solver
-from grasp_torque_opt.certificate import DEFAULT_TOLERANCE, certify
+from grasp_torque_opt.certificate import DEFAULT_TOLERANCE, Certificate, certify
 from grasp_torque_opt.exact_nlp import solve_exact_nlp
 from grasp_torque_opt.exact_socp import solve_exact_socp
 from grasp_torque_opt.exceptions import SolverError
@@ -20,12 +22,19 @@ from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.grasp_maps import GraspMaps
 from grasp_torque_opt.grasp_setup import GraspSetup
 from grasp_torque_opt.solution import FAILED, INFEASIBLE, OPTIMAL, RawResult, Solution
-from grasp_torque_opt.tau_qp import TauQPSolver, build_tau_qp
+from grasp_torque_opt.tau_qp import TauQP, TauQPSolver, build_tau_qp
 
 #: Methods: the product's (``tau-qp``) and the references.
 METHODS = ("tau-qp", "force-qp", "socp", "nlp")
 #: Methods whose feasible set is the linearized (polygon) one.
 LINEARIZED = ("tau-qp", "force-qp")
+
+
+def qp_answer(qp: TauQP, raw: RawResult) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """(tau, f) of a tau-QP solver's answer, (None, None) without one."""
+    if raw.x is None:
+        return None, None
+    return qp.split(raw.x)[0], qp.wrenches(raw.x)
 
 
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
@@ -73,7 +82,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
             if fallback is None:
                 raise
             raw = RawResult("error", None, 0, 0.0, str(e))
-        tau, f = (None, None) if raw.x is None else (qp.split(raw.x)[0], qp.wrenches(raw.x))
+        tau, f = qp_answer(qp, raw)
     else:
         t2 = time.perf_counter()
         if method == "force-qp":
@@ -88,19 +97,26 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     timings["build"] = t2 - t1
     timings["solve"] = t3 - t2
 
-    cert = None
-    if f is not None:
-        cert = certify(maps.G, J, setup.external_wrench, setup.friction,
-                       tau_min, tau_max, tau, f, tolerance)
+    def certified(tau, f) -> Certificate | None:
+        return None if f is None else certify(maps.G, J, setup.external_wrench,
+                                               setup.friction, tau_min, tau_max, tau, f,
+                                               tolerance)
+
+    cert = certified(tau, f)
+    if method == "tau-qp" and getattr(solver, "last_warm", False) and \
+            raw.status == "solved" and cert is not None and not cert.ok:
+        # A warm start that lands off the certificate is redone cold in the same call.
+        raw = solver.solve(qp, cold=True)
+        tau, f = qp_answer(qp, raw)
+        cert = certified(tau, f)
     timings["certify"] = time.perf_counter() - t3
     if method == "tau-qp" and fallback is not None and \
             not (raw.status == "solved" and cert is not None and cert.ok):
         t4 = time.perf_counter()
         raw2 = fallback.solve(qp)
         if raw2.status == "solved" and raw2.x is not None:
-            tau2, f2 = qp.split(raw2.x)[0], qp.wrenches(raw2.x)
-            cert2 = certify(maps.G, J, setup.external_wrench, setup.friction,
-                            tau_min, tau_max, tau2, f2, tolerance)
+            tau2, f2 = qp_answer(qp, raw2)
+            cert2 = certified(tau2, f2)
             if cert2.ok:
                 used = getattr(fallback, "name", "fallback")
                 raw = dataclasses.replace(raw2, message=f"{raw2.message}; fallback after "

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from independent import assert_holds
 
-from grasp_torque_opt.backends import BACKENDS, kkt_violation, make_solver
+from grasp_torque_opt.backends import BACKENDS, DaqpSolver, kkt_violation, make_solver
 from grasp_torque_opt.exceptions import SolverError
 from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.solve import solve
@@ -193,3 +193,22 @@ def test_fallback_is_not_asked_when_the_first_backend_certifies(allegro):
 
     sol = solve(allegro, fallback=Counting())
     assert sol.optimal and sol.backend == "proxsuite" and Counting.calls == 0
+
+
+def test_daqp_warm_answer_off_the_certificate_is_redone_cold(allegro):
+    """A warm answer that DAQP and the KKT check accept but the certificate refuses (injected:
+    the warm x moved by 5%) is solved again cold in the same call, and counted."""
+
+    class WrongWhenWarm(DaqpSolver):
+        def solve(self, qp, cold=False):
+            raw = super().solve(qp, cold)
+            return dataclasses.replace(raw, x=raw.x * 1.05) if self.last_warm else raw
+
+    warm = WrongWhenWarm(warm_start=True)
+    first = moving_sequence(allegro, 40)
+    assert solve(next(first), solver=warm).optimal  # cold: a new workspace
+    moved = next(first)
+    sol = solve(moved, solver=warm)
+    assert warm.warm_solves == 1 and warm.fallbacks == 1
+    assert sol.optimal and sol.backend == "daqp"
+    np.testing.assert_allclose(sol.tau, solve(moved, backend="daqp").tau, atol=1e-8)
