@@ -117,7 +117,8 @@ PARAMETERS: dict[str, Spec] = {
                             "certifiable ('none': no second try); its answer is certified "
                             "the same way and counted (diagnostics solver.fallback_solves)."),
     "solver.warm_start": Spec("Start each DAQP solve from the previous cycle's active set; an "
-                              "answer that is not optimal (flag, KKT check) is redone cold in "
+                              "answer that is not optimal (flag, KKT check) or not certified is "
+                              "redone cold in "
                               "the same cycle and counted (diagnostics "
                               "solver.warm_start_fallbacks). No effect on other backends."),
     "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
