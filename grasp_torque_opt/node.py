@@ -507,8 +507,23 @@ class GraspTorqueNode(Node):
         super().destroy_node()
 
 
+#: Signal that asked ``main`` to stop (None: none yet).
+_stop_signal: int | None = None
+
+
 def _interrupt(signum: int, frame: Any) -> None:
-    raise KeyboardInterrupt
+    """SIGINT/SIGTERM: ask ``main``'s spin loop to end; the node then stops cleanly.
+
+    Only a flag: an exception raised here would surface at whatever bytecode the main
+    thread runs next -- inside rclpy's executor (between a handle's ``__enter__`` and its
+    exit), inside the events executor's C++ callback loop, or inside a ``__del__``, where
+    Python drops it and the node spins on. A second signal raises KeyboardInterrupt (a way
+    out should the stop itself hang).
+    """
+    global _stop_signal
+    if _stop_signal is not None:
+        raise KeyboardInterrupt
+    _stop_signal = signum
 
 
 #: Executors ``main`` can spin: rclpy's default and its experimental events executor.
@@ -520,6 +535,7 @@ def main(args: list[str] | None = None) -> int:
 
     Besides the ROS arguments, ``--executor single|events`` picks the executor.
     """
+    global _stop_signal
     argv = sys.argv if args is None else args
     parser = argparse.ArgumentParser(prog=NODE_NAME)
     parser.add_argument("--executor", choices=sorted(EXECUTORS), default="single",
@@ -527,10 +543,13 @@ def main(args: list[str] | None = None) -> int:
     opts = parser.parse_args(remove_ros_args(argv)[1:])
     single_threaded_math()
     # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the safe
-    # action could publish; here both interrupt the spin and the context stays valid.
+    # action could publish; here both end the spin loop and the context stays valid.
+    # SIGINT explicitly too: a process started from a background job inherits it ignored.
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    signal.signal(signal.SIGTERM, _interrupt)
+    _stop_signal = None
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     node = None
+    executor = None
     code = 0
     try:
         node = GraspTorqueNode()
@@ -538,22 +557,25 @@ def main(args: list[str] | None = None) -> int:
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()
         executor.add_node(node)
-        if opts.executor == "events":
-            # EventsExecutor.spin() delivered no subscription callback with these wheels
-            # (rclpy 7.1.6, Fast DDS) while keeping a core busy; spin_once serves it.
-            while rclpy.ok():
-                executor.spin_once(timeout_sec=1.0)
-        else:
-            executor.spin()
+        # A spin_once loop, so that the stop flag is seen: each wait ends by the next
+        # watchdog tick at the latest. (EventsExecutor.spin() also delivered no subscription
+        # callback with these wheels, rclpy 7.1.6 and Fast DDS, while keeping a core busy.)
+        timeout = 1.0 if opts.executor == "events" else None
+        while _stop_signal is None and rclpy.ok():
+            executor.spin_once(timeout_sec=timeout)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except GraspTorqueError as e:
         print(f"{NODE_NAME}: error: {e}", file=sys.stderr)
         code = 2
     finally:
+        if executor is not None:
+            executor.shutdown(timeout_sec=1.0)  # its callbacks are off the entities first
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return code
 
 
