@@ -194,7 +194,7 @@ class ProxSuiteSettings:
         dense_backend: ProxSuite's ``DenseBackend``: ``PrimalDualLDLT``,
             ``PrimalLDLT`` or ``Automatic``. Diagonal with PrimalDualLDLT was
             the fastest of 54 variants tuned by bench/solvers.py on a separate
-            grasp set (about 0.6 times the time of Dense/Automatic, the same
+            grasp set (about 0.7 times the time of Dense/Automatic, the same
             optimum to 1e-7 N m on the 200 bench grasps).
 
     The duality gap is checked as well, to ``eps_abs``: without that check
