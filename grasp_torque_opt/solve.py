@@ -30,11 +30,20 @@ METHODS = ("tau-qp", "force-qp", "socp", "nlp")
 LINEARIZED = ("tau-qp", "force-qp")
 
 
-def qp_answer(qp: TauQP, raw: RawResult) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """(tau, f) of a tau-QP solver's answer, (None, None) without one."""
+def qp_answer(qp: TauQP, raw: RawResult
+              ) -> tuple[RawResult, np.ndarray | None, np.ndarray | None]:
+    """(raw, tau, f) of a tau-QP solver's answer; (raw, None, None) without one.
+
+    An x of the wrong shape is no answer: ``raw`` comes back as an error saying so
+    (the next backend may still answer), never as an exception in the cycle.
+    """
+    n = qp.H.shape[0]
+    if raw.x is not None and np.shape(raw.x) != (n,):
+        raw = dataclasses.replace(raw, status="error", x=None, message=(
+            f"{raw.message}, but x has shape {np.shape(raw.x)} for {n} variables"))
     if raw.x is None:
-        return None, None
-    return qp.split(raw.x)[0], qp.wrenches(raw.x)
+        return raw, None, None
+    return raw, qp.split(raw.x)[0], qp.wrenches(raw.x)
 
 
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
@@ -82,7 +91,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
             if fallback is None:
                 raise
             raw = RawResult("error", None, 0, 0.0, str(e))
-        tau, f = qp_answer(qp, raw)
+        raw, tau, f = qp_answer(qp, raw)
     else:
         t2 = time.perf_counter()
         if method == "force-qp":
@@ -106,16 +115,14 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     if method == "tau-qp" and getattr(solver, "last_warm", False) and \
             raw.status == "solved" and cert is not None and not cert.ok:
         # A warm start that lands off the certificate is redone cold in the same call.
-        raw = solver.solve(qp, cold=True)
-        tau, f = qp_answer(qp, raw)
+        raw, tau, f = qp_answer(qp, solver.solve(qp, cold=True))
         cert = certified(tau, f)
     timings["certify"] = time.perf_counter() - t3
     if method == "tau-qp" and fallback is not None and \
             not (raw.status == "solved" and cert is not None and cert.ok):
         t4 = time.perf_counter()
-        raw2 = fallback.solve(qp)
-        if raw2.status == "solved" and raw2.x is not None:
-            tau2, f2 = qp_answer(qp, raw2)
+        raw2, tau2, f2 = qp_answer(qp, fallback.solve(qp))
+        if raw2.status == "solved" and f2 is not None:
             cert2 = certified(tau2, f2)
             if cert2.ok:
                 used = getattr(fallback, "name", "fallback")

@@ -48,7 +48,9 @@ class Recorder:
     def publish(self, msg) -> None:
         self.real.publish(msg)
         ctrl = self.node.controller  # publish follows the cycle at once: same inputs
-        self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs))
+        # The controller as it is now (a shallow copy keeps this setup and config): a
+        # parameter change after the command must not be held against it.
+        self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs, copy.copy(ctrl)))
 
     def __getattr__(self, name: str):
         return getattr(self.real, name)  # e.g. wait_for_all_acked in the safe stop
@@ -156,9 +158,8 @@ def run(rig: Rig, ops) -> None:
         if kind != "sleep" and time.perf_counter() - t0 > STALL:
             broken(f"{kind} took {time.perf_counter() - t0:.2f} s")
     ctrl = node.controller
-    limits = ctrl.setup.hand.torque_limits
-    for cmd, decision, inputs in rig.recorder.seen:
-        check_command(cmd, rig.setup.hand.m, limits)
+    for cmd, decision, inputs, then in rig.recorder.seen:
+        check_command(cmd, rig.setup.hand.m, then.setup.hand.torque_limits)
         if decision is None or decision.command is None or \
                 not np.array_equal(decision.command, cmd):
             broken("a command that is not the controller's decision")
@@ -169,11 +170,11 @@ def run(rig: Rig, ops) -> None:
         sol = decision.solution
         if decision.kind != "solution" or not sol.optimal or not sol.certificate.ok:
             broken(f"a command from an uncertified solution ({decision.kind})")
-        if decision.cycle_time > ctrl.config.cycle_budget:
+        if decision.cycle_time > then.config.cycle_budget:
             broken(f"a command from a cycle over budget ({decision.cycle_time:.4f} s)")
-        # Independently of the package's certificate, at the inputs it was computed from
-        # (the limits in force now: a parameter change may have come after it).
-        setup, _ = ctrl.grasp_at(inputs)
+        # Independently of the package's certificate, at the inputs and parameters it was
+        # computed from (its limits are checked on the command above).
+        setup, _ = then.grasp_at(inputs)
         try:
             assert_holds(dataclasses.replace(setup, hand=dataclasses.replace(
                 setup.hand, torque_limits=np.full(rig.setup.hand.m, np.inf))),
@@ -186,7 +187,7 @@ def run(rig: Rig, ops) -> None:
     success, message = done.result()
     if success:
         d = json.loads(message)
-        check_command(d["command"], rig.setup.hand.m, limits)
+        check_command(d["command"], rig.setup.hand.m, ctrl.setup.hand.torque_limits)
     elif not message.startswith("cannot solve: ") and \
             json.loads(message).get("command", "missing") is not None:
         broken(f"service failed without a reason: {message[:200]}")

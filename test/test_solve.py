@@ -1,11 +1,13 @@
 """Every method, certified; infeasible verdicts confirmed by an independent LP."""
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 from independent import assert_holds, lp_feasible
 
+from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.solve import METHODS, solve
 
 CASES = ["planar", "hyperstatic", "allegro"]
@@ -123,3 +125,27 @@ def test_torque_offset_shifts_the_limits(planar):
     assert sol.status == "optimal"
     assert_holds(shifted, shifted.maps(), sol.tau, sol.wrenches)
     np.testing.assert_allclose(sol.tau, free.tau, atol=1e-7)
+
+
+class ShortAnswer:
+    """A solver that claims success with one variable too few (a broken backend)."""
+
+    name = "short"
+
+    def solve(self, qp):
+        raw = make_solver("daqp").solve(qp)
+        return dataclasses.replace(raw, x=raw.x[:-1])
+
+
+@pytest.mark.parametrize("name", ["planar", "allegro"])
+def test_an_answer_of_the_wrong_size_is_an_error_and_the_fallback_answers(name, request):
+    setup = request.getfixturevalue(name)
+    alone = solve(setup, solver=ShortAnswer())
+    assert alone.status == "failed" and alone.tau is None
+    got, n = map(int, re.search(r"x has shape \((\d+),\) for (\d+) variables",
+                                alone.message).groups())
+    assert got == n - 1 and n >= setup.hand.m
+    rescued = solve(setup, solver=ShortAnswer(), fallback=make_solver("daqp"))
+    assert rescued.optimal and rescued.backend == "daqp"
+    assert "fallback after" in rescued.message and "x has shape" in rescued.message
+    assert_holds(setup, setup.maps(), rescued.tau, rescued.wrenches)
