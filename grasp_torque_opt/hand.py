@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from functools import cached_property
 from importlib import metadata
 from pathlib import Path
 
@@ -107,9 +108,10 @@ class Hand:
         """Number of actuated joints."""
         return len(self.joints)
 
-    @property
+    @cached_property
     def base_frame(self) -> str:
-        """Name of the root link: the base frame."""
+        """Name of the root link: the base frame (looked up once: the node stamps every
+        command with it)."""
         return next(f.name for f in self.model.frames
                     if f.type == pin.FrameType.BODY and f.parentJoint == 0)
 
