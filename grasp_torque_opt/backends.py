@@ -112,7 +112,6 @@ class DaqpSolver:
         """
         if cold and self.last_warm:
             self.fallbacks += 1
-            self._dims = None  # a new workspace: nothing of the previous active set
         self.last_warm = False
         why = check_data(qp)
         if why:
@@ -127,7 +126,7 @@ class DaqpSolver:
         t0 = time.perf_counter()
         try:
             x, flag, info, iterations = self._run(qp, n, (n, n_eq, n_in), H, A, upper, lower,
-                                                  sense)
+                                                  sense, cold)
         except RuntimeError as e:  # e.g. a failed setup: the next call starts anew
             self._dims = None
             raise SolverError(f"DAQP failed: {e}") from e
@@ -144,8 +143,9 @@ class DaqpSolver:
         return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
 
     def _run(self, qp: TauQP, n: int, dims: tuple[int, int, int], H: np.ndarray,
-             A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray):
-        """Set up or update the workspace and solve (warm if enabled, verified).
+             A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray,
+             cold: bool):
+        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified).
 
         Returns:
             (x, flag, info with "kkt", iterations); x None if the setup failed.
@@ -162,7 +162,7 @@ class DaqpSolver:
             self._dims = dims
             warm = False
         else:
-            warm = self.warm_start
+            warm = self.warm_start and not cold
             # Without sense, DAQP keeps the previous active set: a warm start.
             flag = self._model.update(H=H, f=qp.g, A=A, bupper=upper, blower=lower,
                                       sense=None if warm else sense)

@@ -234,19 +234,13 @@ class TauQPSolver:
         self.settings = settings or ProxSuiteSettings()
         self._qp = None
         self._dims: tuple | None = None
-        self._diagonal_H: np.ndarray | None = None  # the last H seen diagonal (read-only)
 
     def _hessian_type(self, H: np.ndarray) -> str:
         """The settings' Hessian type, unless H is not diagonal (then ``Dense``)."""
-        if self.settings.hessian_type != "Diagonal":
-            return self.settings.hessian_type
-        if H is self._diagonal_H:  # the cached read-only H of build_tau_qp: checked once
-            return "Diagonal"
-        if np.count_nonzero(H - np.diag(np.diagonal(H))):
+        if self.settings.hessian_type == "Diagonal" and \
+                np.count_nonzero(H) != np.count_nonzero(np.diagonal(H)):
             return "Dense"
-        if not H.flags.writeable:
-            self._diagonal_H = H
-        return "Diagonal"
+        return self.settings.hessian_type
 
     def solve(self, qp: TauQP) -> RawResult:
         """Solve a built tau-QP from a cold start.

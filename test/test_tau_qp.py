@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from independent import assert_holds, lp_feasible
 
+from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.exact_socp import solve_exact_socp
 from grasp_torque_opt.force_qp import solve_force_qp
 from grasp_torque_opt.solve import solve
@@ -147,3 +148,18 @@ def test_feasible_load_is_not_declared_infeasible(allegro):
     sol = solve(setup, maps=maps)
     assert sol.status == "optimal", sol.message
     assert_holds(setup, maps, sol.tau, sol.wrenches)
+
+
+def test_a_hessian_that_is_not_diagonal_is_solved_as_dense(allegro):
+    """The default Hessian type is Diagonal (build_tau_qp's H is); a coupled H must still
+    give its own optimum, the one DAQP finds for it, not the diagonal one."""
+    maps = allegro.maps()
+    qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
+                      allegro.weights)
+    v = np.linspace(1.0, 2.0, qp.m)
+    coupled = dataclasses.replace(qp, H=qp.H + 4.0 * np.outer(v, v))
+    x = TauQPSolver().solve(coupled).x
+    ref = make_solver("daqp").solve(coupled).x
+    diagonal_only = TauQPSolver().solve(qp).x
+    np.testing.assert_allclose(x, ref, atol=1e-6)
+    assert np.abs(x - diagonal_only).max() > 1e-3
