@@ -57,10 +57,10 @@ setup(
     entry_points={
         "console_scripts": [
             "grasp-torque-opt = grasp_torque_opt.cli:main",
-            "grasp-torque-demo = grasp_torque_opt.demo_driver:main",
+            "grasp-torque-demo = grasp_torque_opt.ros.demo_driver:main",
             # ROS executables (ros2 run grasp_torque_opt ...), installed into lib/<pkg>.
-            "grasp_torque_node = grasp_torque_opt.node:main",
-            "grasp_demo_driver = grasp_torque_opt.demo_driver:main",
+            "grasp_torque_node = grasp_torque_opt.ros.node:main",
+            "grasp_demo_driver = grasp_torque_opt.ros.demo_driver:main",
         ],
     },
 )

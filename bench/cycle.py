@@ -30,9 +30,9 @@ from pathlib import Path
 import numpy as np
 
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
-from grasp_torque_opt.controller import CycleConfig, TorqueController
-from grasp_torque_opt.grasp_setup import GraspSetup
-from grasp_torque_opt.solve import solve
+from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.methods.dispatch import solve
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ["planar_two_finger.yaml", "allegro_right.yaml"]

@@ -16,7 +16,7 @@ order from one ``numpy.random.default_rng(seed)``:
   weight), plus a random moment (normal, sigma 0.05 * 0.05 * magnitude N m).
 
 A candidate is kept only if G and J are computable and the HiGHS LP
-(:func:`grasp_torque_opt.feasibility.linearized_feasible`) proves the
+(:func:`grasp_torque_opt.reference.feasibility.linearized_feasible`) proves the
 linearized problem (N = 8 polygon, torque limits) feasible; rejected
 candidates still consume their draws, so the set depends only on (count, seed)
 and the first k grasps of a larger set are the set of k. Run as a script, it
@@ -36,9 +36,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import ROOT, machine, report  # noqa: E402
 
-from grasp_torque_opt.exceptions import GraspTorqueError  # noqa: E402
-from grasp_torque_opt.feasibility import linearized_feasible  # noqa: E402
-from grasp_torque_opt.grasp_setup import GraspSetup  # noqa: E402
+from grasp_torque_opt.core.exceptions import GraspTorqueError  # noqa: E402
+from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
+from grasp_torque_opt.reference.feasibility import linearized_feasible  # noqa: E402
 
 SCENARIO = ROOT / "config" / "allegro_right.yaml"
 #: Half-width of the uniform joint-position noise [rad].

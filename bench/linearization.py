@@ -30,7 +30,7 @@ from cycle import machine, report  # noqa: E402
 from grasps import allegro_grasps, blas_threads  # noqa: E402
 
 from grasp_torque_opt.backends import make_solver  # noqa: E402
-from grasp_torque_opt.solve import solve  # noqa: E402
+from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
 
 SIDES = (3, 4, 6, 8, 12, 16, 32)
 

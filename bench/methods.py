@@ -23,9 +23,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import ROOT, SCENARIOS, machine  # noqa: E402
 
-from grasp_torque_opt.grasp_setup import GraspSetup  # noqa: E402
-from grasp_torque_opt.solve import METHODS, solve  # noqa: E402
-from grasp_torque_opt.tau_qp import TauQPSolver  # noqa: E402
+from grasp_torque_opt.backends.proxsuite import TauQPSolver  # noqa: E402
+from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
+from grasp_torque_opt.methods.dispatch import METHODS, solve  # noqa: E402
 
 
 def random_loads(setup: GraspSetup, count: int, rng: np.random.Generator) -> np.ndarray:

@@ -42,9 +42,22 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  # noqa: E402
-                      Pacer, UniqueClock, isolated_env, node_command, percentiles_ms,
-                      private_domains, interrupt_on_signals, set_stamp, stamp_ns)
+from ros_load import (  # noqa: E402
+    CONFIG,
+    RECEIVER_DEPTH,
+    STAMPED_TOPIC,
+    Child,
+    CpuShare,
+    Pacer,
+    UniqueClock,
+    interrupt_on_signals,
+    isolated_env,
+    node_command,
+    percentiles_ms,
+    private_domains,
+    set_stamp,
+    stamp_ns,
+)
 
 HANDS = {"allegro": ("allegro_right.yaml", "allegro_right_node.yaml"),
          "planar": ("planar_two_finger.yaml", "planar_two_finger_node.yaml")}
@@ -79,7 +92,7 @@ def echo_main(args: argparse.Namespace) -> int:
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from grasp_torque_opt.node import COMMAND_QOS, NODE_NAME
+    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME
 
     joints = args.joints.split(",")
     zeros = [0.0] * len(joints)
@@ -125,7 +138,7 @@ def load_main(args: argparse.Namespace) -> int:
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from grasp_torque_opt.grasp_setup import GraspSetup
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
 
     setup = GraspSetup.from_file(CONFIG / HANDS[args.hand][0])
     names = list(setup.hand.joints)
@@ -241,7 +254,7 @@ def load_main(args: argparse.Namespace) -> int:
 def run_case(hand: str, target: str, rate: float, executor: str, duration: float,
              load_executor: str, domain: int, tmp: Path) -> dict:
     """One case: start the answering node, run the load process against it, stop both."""
-    from grasp_torque_opt.grasp_setup import GraspSetup
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
 
     env = isolated_env(domain)
     tag = f"{hand}-{target.replace('/', '-')}-{int(rate)}-{executor}"

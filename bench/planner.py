@@ -45,8 +45,8 @@ from cycle import machine, report  # noqa: E402
 from grasps import SCENARIO, THREAD_VARS, allegro_grasps, blas_threads  # noqa: E402
 
 from grasp_torque_opt.backends import make_solver  # noqa: E402
-from grasp_torque_opt.grasp_setup import GraspSetup  # noqa: E402
-from grasp_torque_opt.solve import solve  # noqa: E402
+from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
+from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
 
 CHUNK = 25
 TARGET = 5000.0
@@ -148,8 +148,8 @@ def run(grasps: int = 200, seed: int = 0, rounds: int = 5, workers: int = 2,
 
 def table(results: dict) -> str:
     """Markdown table: one row per backend and mode."""
-    lines = [f"| backend | mode | scored | certified | grasps/s | "
-             f"grasps/s with start-up (start-up s) |", "|---|---|---:|---:|---:|---|"]
+    lines = ["| backend | mode | scored | certified | grasps/s | "
+             "grasps/s with start-up (start-up s) |", "|---|---|---:|---:|---:|---|"]
     for b, r in results["backends"].items():
         s, p = r["sequential"], r["pool"]
         lines.append(f"| {b} | sequential | {s['scored']} | {s['certified']} | "

@@ -53,7 +53,7 @@ def isolated_env(domain: int) -> dict[str, str]:
 def node_command(params: Path, executor: str, extra: list[str] | None = None) -> list[str]:
     """Command line of ``grasp_torque_node`` on a params file, stamped commands on."""
     exe = Path(sys.executable).parent / "grasp_torque_node"
-    head = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasp_torque_opt.node"]
+    head = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasp_torque_opt.ros.node"]
     return head + ["--executor", executor, "--ros-args", "--params-file", str(params),
                    "-p", "publish_stamped_command:=true"] + (extra or [])
 

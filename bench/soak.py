@@ -46,9 +46,23 @@ import numpy as np
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ros_load import (CONFIG, RECEIVER_DEPTH, STAMPED_TOPIC, Child, CpuShare,  # noqa: E402
-                     Pacer, UniqueClock, isolated_env, node_command, percentiles_ms,
-                     private_domains, interrupt_on_signals, set_stamp, stamp_ns, vm_rss_kib)
+from ros_load import (  # noqa: E402
+    CONFIG,
+    RECEIVER_DEPTH,
+    STAMPED_TOPIC,
+    Child,
+    CpuShare,
+    Pacer,
+    UniqueClock,
+    interrupt_on_signals,
+    isolated_env,
+    node_command,
+    percentiles_ms,
+    private_domains,
+    set_stamp,
+    stamp_ns,
+    vm_rss_kib,
+)
 
 PARAMS = CONFIG / "allegro_right_node.yaml"
 #: Time for a joint state to reach the node and for a command computed from a queued
@@ -131,6 +145,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     """Publish the mix at the node, check every command, report."""
     import pinocchio as pin
     import rclpy
+    from cycle import machine
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
     from rclpy.experimental import EventsExecutor
@@ -138,8 +153,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from cycle import machine
-    from grasp_torque_opt.grasp_setup import GraspSetup
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
 
     p = _node_params()
     setup = GraspSetup.from_file(CONFIG / p["scenario"])

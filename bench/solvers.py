@@ -76,14 +76,15 @@ from cycle import ROOT, SCENARIOS, machine, report  # noqa: E402
 from grasps import SCENARIO, allegro_grasps, blas_threads  # noqa: E402
 
 from grasp_torque_opt.backends import make_solver  # noqa: E402
-from grasp_torque_opt.certificate import certify  # noqa: E402
-from grasp_torque_opt.conic import solve_conic  # noqa: E402
-from grasp_torque_opt.exact_nlp import solve_exact_nlp  # noqa: E402
-from grasp_torque_opt.exact_socp import solve_exact_socp  # noqa: E402
-from grasp_torque_opt.force_qp import solve_force_qp  # noqa: E402
-from grasp_torque_opt.grasp_setup import GraspSetup  # noqa: E402
-from grasp_torque_opt.solution import RawResult  # noqa: E402
-from grasp_torque_opt.tau_qp import ProxSuiteSettings, TauQP, build_tau_qp, check_data  # noqa: E402
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings  # noqa: E402
+from grasp_torque_opt.core.certificate import certify  # noqa: E402
+from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
+from grasp_torque_opt.core.solution import RawResult  # noqa: E402
+from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp, check_data  # noqa: E402
+from grasp_torque_opt.reference.conic import solve_conic  # noqa: E402
+from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp  # noqa: E402
+from grasp_torque_opt.reference.exact_socp import solve_exact_socp  # noqa: E402
+from grasp_torque_opt.reference.force_qp import solve_force_qp  # noqa: E402
 
 #: Two optima agree when their torques differ by at most this [N m].
 AGREE_TOL = 1e-6

@@ -11,12 +11,12 @@ import json
 import sys
 
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
-from grasp_torque_opt.compare import compare, format_table
-from grasp_torque_opt.exceptions import GraspTorqueError, InputError
-from grasp_torque_opt.grasp_setup import GraspSetup
-from grasp_torque_opt.report import solution_dict
-from grasp_torque_opt.solution import INFEASIBLE, OPTIMAL
-from grasp_torque_opt.solve import METHODS, solve
+from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.report import solution_dict
+from grasp_torque_opt.core.solution import INFEASIBLE, OPTIMAL
+from grasp_torque_opt.methods.compare import compare, format_table
+from grasp_torque_opt.methods.dispatch import METHODS, solve
 
 EXIT_OPTIMAL, EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_FAILED = 0, 2, 3, 4
 PROG = "grasp-torque-opt"

@@ -8,13 +8,15 @@ from pathlib import Path
 import pytest
 import yaml
 
-from grasp_torque_opt.grasp_setup import GraspSetup
-from grasp_torque_opt.scenario import parse_scenario
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import parse_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 CONFIG = ROOT / "config"
 PLANAR = CONFIG / "planar_two_finger.yaml"
 ALLEGRO = CONFIG / "allegro_right.yaml"
+#: The Allegro right hand that example-robot-data ships.
+ALLEGRO_URDF = "example-robot-data:allegro_hand_description/urdf/allegro_right_hand.urdf"
 
 
 def scenario_doc(path: Path) -> dict:

@@ -1,4 +1,4 @@
-"""Checks written from the paper and DESIGN.md, without the package's own builders."""
+"""Checks written from the paper and docs/design.md, without the package's own builders."""
 
 import numpy as np
 from scipy.optimize import linprog

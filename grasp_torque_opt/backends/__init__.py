@@ -1,0 +1,59 @@
+"""QP backends for the tau-QP: ProxSuite (the default), DAQP and quadprog.
+
+Every backend takes a built :class:`~grasp_torque_opt.core.tau_qp.TauQP` and returns
+a :class:`~grasp_torque_opt.core.solution.RawResult`; none is trusted: the caller
+certifies whatever comes back (:func:`grasp_torque_opt.methods.dispatch.solve`). Each
+refuses non-finite data and inverted bounds before calling its solver, and each
+has its iterations capped, so one cycle can never stall.
+
+- ``proxsuite``: :class:`~grasp_torque_opt.core.tau_qp.TauQPSolver`, dense ProxQP,
+  the design's choice.
+- ``daqp``: DAQP, a dual active-set method, exact to its tolerances on small
+  dense QPs. A positive semidefinite Hessian (the internal-force variables z
+  carry no cost) is handled by DAQP's proximal-point iterations.
+- ``quadprog``: Goldfarb-Idnani; needs a positive definite Hessian, so only
+  grasps without internal-force variables (k = 0, e.g. the Allegro's four
+  fingertips); otherwise it returns an error, never a regularized answer.
+"""
+
+from __future__ import annotations
+
+from grasp_torque_opt.backends.daqp import DaqpSolver
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings, TauQPSolver
+from grasp_torque_opt.backends.quadprog import QuadprogSolver
+
+#: Selectable backends; the first is the default.
+BACKENDS = ("proxsuite", "daqp", "quadprog")
+
+
+def single_threaded_math() -> None:
+    """Limit BLAS and OpenMP to one thread in this process (the node's and CLI's mains call it).
+
+    The matrices of one grasp are tiny; with OpenBLAS's default threads, a
+    triangular solve in the QP build took 8 to 16 ms instead of tens of
+    microseconds whenever the other core was busy, and SLSQP 387 ms instead of
+    8 ms. A library user running the cycle in a loop should do the same
+    (``threadpoolctl.threadpool_limits(1)`` or ``OPENBLAS_NUM_THREADS=1``).
+    """
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(1)
+
+
+def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None,
+                warm_start: bool = False):
+    """A tau-QP solver by backend name (one of :data:`BACKENDS`).
+
+    ``warm_start`` applies to DAQP only (ProxSuite's own warm start gave
+    unsolved or off-optimum answers on slowly moving Allegro sequences).
+
+    Raises:
+        ValueError: an unknown backend, naming the known ones.
+    """
+    if backend == "proxsuite":
+        return TauQPSolver(settings)
+    if backend == "daqp":
+        return DaqpSolver(settings, warm_start)
+    if backend == "quadprog":
+        return QuadprogSolver(settings)
+    raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")

@@ -1,0 +1,179 @@
+"""DAQP (a dual active-set method) on the tau-QP, every answer KKT-checked.
+
+DAQP is exact to its tolerances on small dense QPs. A positive semidefinite
+Hessian (the internal-force variables z carry no cost) is handled by DAQP's
+proximal-point iterations.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.core.exceptions import SolverError
+from grasp_torque_opt.core.solution import RawResult
+from grasp_torque_opt.core.tau_qp import TauQP, check_data
+
+#: DAQP's "infinite" bound.
+DAQP_INF = 1e30
+#: Largest KKT violation (:func:`kkt_violation`) of an answer taken as optimal.
+KKT_TOLERANCE = 1e-6
+
+
+def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray,
+                  upper: np.ndarray, x: np.ndarray, lam: np.ndarray) -> float:
+    """How far (x, lam) is from a KKT point of min 1/2 x'Hx + g'x, lower <= [x; A x] <= upper.
+
+    Sign convention (DAQP's, bounds on x first): H x + g + [I A'] lam = 0,
+    lam > 0 on an active upper bound, lam < 0 on an active lower one. An
+    equality row has lower = upper, so its slack is zero whatever its sign.
+
+    Returns:
+        The largest of: the stationarity residual relative to the size of the
+        gradient (at least 1), the primal infeasibility, and each row's
+        multiplier times its slack (complementarity, which also catches a wrong
+        sign).
+    """
+    n = x.size
+    grad = H @ x + g
+    residual = A.T @ lam[n:]
+    residual[:n] += lam[:n]
+    residual += grad
+    Mx = np.empty(lower.size)
+    Mx[:n] = x
+    np.dot(A, x, out=Mx[n:])
+    to_upper, to_lower = upper - Mx, Mx - lower
+    # lam_i to_upper_i on a row held at its upper bound (lam_i > 0), -lam_i to_lower_i at
+    # its lower one; the other product is <= 0 on a feasible point, so the larger is it.
+    complementarity = np.maximum(lam * to_upper, -lam * to_lower)
+    return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
+               -float(np.minimum(to_upper, to_lower).min()), float(complementarity.max()))
+
+
+class DaqpSolver:
+    """DAQP on the tau-QP: bounds on x, then the equalities, then the cone rows.
+
+    One DAQP workspace is kept per problem size. Every answer is checked for
+    optimality (:func:`kkt_violation` with DAQP's multipliers, to
+    :data:`KKT_TOLERANCE`) before it is returned as solved, on top of the
+    caller's certificate.
+
+    With ``warm_start``, a cycle starts from the previous cycle's active set
+    (DAQP keeps it across updates); an answer that is not optimal by DAQP's
+    flag and the KKT check is dropped and the QP solved again from a cold
+    start within the same call; so is one that fails the caller's certificate
+    (:func:`grasp_torque_opt.methods.dispatch.solve` asks again with ``cold=True``).
+    ``warm_solves`` and ``fallbacks`` count them.
+
+    Args:
+        settings: ``eps_abs`` is DAQP's primal tolerance, ``max_iter`` its
+            iteration cap; the rest does not apply.
+        warm_start: start from the previous active set.
+    """
+
+    name = "daqp"
+
+    def __init__(self, settings: ProxSuiteSettings | None = None,
+                 warm_start: bool = False) -> None:
+        import daqp  # imported here: the core runs without the optional backends
+
+        self._daqp = daqp
+        self.settings = settings or ProxSuiteSettings()
+        self.warm_start = warm_start
+        self.warm_solves = 0
+        self.fallbacks = 0
+        #: Whether the last answer came from a warm start (not redone cold).
+        self.last_warm = False
+        self._model = None
+        self._dims: tuple[int, int, int] | None = None
+        self._keep: tuple = ()
+
+    def solve(self, qp: TauQP, cold: bool = False) -> RawResult:
+        """Solve a built tau-QP (warm if enabled and verified, else cold).
+
+        Args:
+            qp: the QP.
+            cold: start cold even with ``warm_start`` (the caller's redo of a warm
+                answer that failed its certificate; counted in ``fallbacks``).
+        """
+        if cold and self.last_warm:
+            self.fallbacks += 1
+        self.last_warm = False
+        why = check_data(qp)
+        if why:
+            return RawResult("error", None, 0, 0.0, why)
+        n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
+        A = np.vstack((qp.A, qp.C))
+        upper = np.concatenate((np.minimum(qp.u_box, DAQP_INF), qp.b, qp.u))
+        lower = np.concatenate((np.maximum(qp.l_box, -DAQP_INF), qp.b, np.full(n_in, -DAQP_INF)))
+        sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
+        sense[n:n + n_eq] = 5  # equality
+        H = qp.H.copy()  # DAQP wants writable buffers; H is shared read-only
+        t0 = time.perf_counter()
+        try:
+            x, flag, info, iterations = self._run(qp, n, (n, n_eq, n_in), H, A, upper, lower,
+                                                  sense, cold)
+        except RuntimeError as e:  # e.g. a failed setup: the next call starts anew
+            self._dims = None
+            raise SolverError(f"DAQP failed: {e}") from e
+        if x is None:
+            self._dims = None
+            return RawResult("error", None, 0, time.perf_counter() - t0,
+                             f"DAQP setup or update failed (exit flag {flag})")
+        kkt = info["kkt"]
+        elapsed = time.perf_counter() - t0
+        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
+        message = f"DAQP exit flag {int(flag)}"
+        if status == "solved" and not kkt <= KKT_TOLERANCE:
+            status, message = "error", f"{message}, but KKT violated by {kkt:.3g}"
+        return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
+
+    def _run(self, qp: TauQP, n: int, dims: tuple[int, int, int], H: np.ndarray,
+             A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray,
+             cold: bool):
+        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified).
+
+        Returns:
+            (x, flag, info with "kkt", iterations); x None if the setup failed.
+        """
+        if self._dims != dims:
+            self._model = self._daqp.Model()
+            flag, _ = self._model.setup(H, qp.g, A, upper, lower, sense)
+            if flag < 0:
+                return None, flag, {}, 0
+            s = self._model.settings
+            s.update(primal_tol=self.settings.eps_abs, iter_limit=self.settings.max_iter,
+                     eps_prox=0.0 if n == qp.m else -1e-6)
+            self._model.settings = s
+            self._dims = dims
+            warm = False
+        else:
+            warm = self.warm_start and not cold
+            # Without sense, DAQP keeps the previous active set: a warm start.
+            flag = self._model.update(H=H, f=qp.g, A=A, bupper=upper, blower=lower,
+                                      sense=None if warm else sense)
+            if flag is not None and flag < 0:
+                return None, flag, {}, 0
+        self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
+        x, _, flag, info = self._model.solve()
+        iterations = int(info["iterations"])
+        kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
+        if warm:
+            self.warm_solves += 1
+            self.last_warm = kkt <= KKT_TOLERANCE
+            if not self.last_warm:
+                self.fallbacks += 1
+                self._model.update(sense=sense)  # the same data, cold
+                x, _, flag, info = self._model.solve()
+                iterations += int(info["iterations"])
+                kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
+        return x, flag, {**info, "kkt": kkt}, iterations
+
+    @staticmethod
+    def _kkt(flag, H, g, A, lower, upper, x, info) -> float:
+        """KKT violation of a DAQP answer that says optimal (inf otherwise)."""
+        if int(flag) != 1:
+            return float("inf")
+        return kkt_violation(H, g, A, lower, upper, np.asarray(x), info["lam"])

@@ -1,0 +1,60 @@
+"""quadprog (Goldfarb-Idnani) on the tau-QP.
+
+It needs a positive definite Hessian, so only grasps without internal-force
+variables (k = 0, e.g. the Allegro's four fingertips); otherwise it returns an
+error, never a regularized answer.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.core.solution import RawResult
+from grasp_torque_opt.core.tau_qp import TauQP, check_data
+
+
+class QuadprogSolver:
+    """quadprog (Goldfarb-Idnani) on the tau-QP; grasps with k = 0 only.
+
+    Args:
+        settings: unused (quadprog has no tolerances; its active-set method
+            ends after finitely many steps).
+    """
+
+    name = "quadprog"
+
+    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+        import quadprog
+
+        self._quadprog = quadprog
+        self.settings = settings or ProxSuiteSettings()
+
+    def solve(self, qp: TauQP) -> RawResult:
+        """Solve a built tau-QP."""
+        why = check_data(qp)
+        if why:
+            return RawResult("error", None, 0, 0.0, why)
+        if qp.H.shape[0] != qp.m:
+            return RawResult("error", None, 0, 0.0, "quadprog needs a positive definite "
+                             f"Hessian; this grasp has {qp.H.shape[0] - qp.m} internal-force "
+                             "variables")
+        n = qp.m
+        lo, hi = np.isfinite(qp.l_box), np.isfinite(qp.u_box)
+        eye = np.eye(n)
+        # quadprog: C^T x >= b, the first meq rows equalities.
+        C = np.vstack((qp.A, -qp.C, eye[lo], -eye[hi])).T
+        b = np.concatenate((qp.b, -qp.u, qp.l_box[lo], -qp.u_box[hi]))
+        t0 = time.perf_counter()
+        try:
+            x, _, _, _, iterations, _ = self._quadprog.solve_qp(qp.H.copy(), -qp.g, C, b,
+                                                                meq=qp.A.shape[0])
+        except ValueError as e:
+            elapsed = time.perf_counter() - t0
+            status = "infeasible" if "inconsistent" in str(e) else "error"
+            return RawResult(status, None, 0, elapsed, f"quadprog: {e}")
+        elapsed = time.perf_counter() - t0
+        return RawResult("solved", np.asarray(x, dtype=float), int(iterations[0]), elapsed,
+                         "quadprog solved")

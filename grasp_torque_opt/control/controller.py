@@ -1,0 +1,611 @@
+"""The control cycle, free of ROS: inputs checked and timed, solve, certify, gate, fault policy.
+
+The node (:mod:`grasp_torque_opt.ros.node`) only converts messages to the plain
+arrays taken here and publishes what :meth:`TorqueController.cycle` and
+:meth:`TorqueController.watchdog` return.
+
+Fault policy (README, "Faults"): a command is published only from a certified
+solution that passes the gate (finite, one value per joint, within the torque
+limits). When a cycle cannot produce one (stale or invalid input, failed solve
+or certificate), nothing new is published: the effort controller keeps the
+last certified command. Once ``hold_time`` has passed since that command, the
+policy applies: ``hold`` keeps publishing nothing (the hand keeps its last
+certified torques), ``zero`` publishes zero torques. The first certified
+solution after a fault is published at once (recovery).
+
+A cycle that fails in any way (a solver that raises, a status other than
+solved, a certificate that fails, an unexpected exception) is such a fault; so
+is a cycle that overruns ``cycle_budget``: its command is late and is dropped.
+
+Input rules (README, "Faults" and "Input checks"): every message is checked
+whole before it is kept (sizes, names, finite values, unit quaternions, known
+frames, magnitudes, header stamps); a rejected message changes nothing.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+
+from grasp_torque_opt.backends import make_solver
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
+from grasp_torque_opt.core.exceptions import FrameNotFound, GraspTorqueError, InputError
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import ContactSpec
+from grasp_torque_opt.core.solution import Solution
+from grasp_torque_opt.methods.dispatch import solve
+
+POLICIES = ("hold", "zero")
+#: A quaternion is accepted when | ||q|| - 1 | is at most this, then normalized.
+QUATERNION_TOLERANCE = 1e-3
+#: |joint position| above this [rad or m] is a corrupted message, not a hand.
+MAX_ABS_JOINT_POSITION = 1e3
+#: Names and frames in error messages are cut to this many characters.
+SHOWN_NAME_LENGTH = 64
+#: The input topics, as named in counters, stamps and messages.
+SOURCES = ("joint_states", "contacts", "external_wrench")
+
+
+@dataclass(frozen=True)
+class CycleConfig:
+    """Timing and safety settings of the cycle.
+
+    Attributes:
+        joint_state_timeout: joint states older than this stop commands [s] (> 0).
+        contacts_timeout: once contacts have arrived on the topic, older than this
+            stop commands [s]; 0 disables the check.
+        wrench_timeout: the same for the external wrench [s]; 0 disables it.
+        hold_time: how long after the last certified command a fault may last
+            before the policy applies [s].
+        fault_policy: ``hold`` or ``zero``.
+        gravity_compensation: add the fingers' own gravity torques g(q).
+        gravity: gravity in the base frame [m/s^2], shape (3,).
+        certificate_tolerance: tolerance of the certificate (SI units).
+        max_joint_state_entries: a joint state with more names or positions than
+            this is rejected unread [-].
+        max_wrench_force: a load whose force norm exceeds this is rejected [N].
+        max_wrench_torque: a load whose moment norm exceeds this is rejected [N m].
+        max_contact_distance: a contact point farther than this from the base
+            origin (at the cycle's configuration) stops commands [m].
+        stamp_future_tolerance: a header stamp more than this ahead of the clock
+            is rejected [s].
+        cycle_budget: a cycle that takes longer publishes nothing (overrun) [s].
+    """
+
+    joint_state_timeout: float = 0.1
+    contacts_timeout: float = 0.5
+    wrench_timeout: float = 0.5
+    hold_time: float = 0.1
+    fault_policy: str = "hold"
+    gravity_compensation: bool = False
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    certificate_tolerance: float = DEFAULT_TOLERANCE
+    max_joint_state_entries: int = 256
+    max_wrench_force: float = 1000.0
+    max_wrench_torque: float = 100.0
+    max_contact_distance: float = 1.0
+    stamp_future_tolerance: float = 0.5
+    cycle_budget: float = 0.05
+
+
+@dataclass(frozen=True)
+class ContactPoses:
+    """Contact frames as estimated: pose i is contact i's frame in frame ``frame``.
+
+    Attributes:
+        frame: model frame the poses are expressed in ('' = the base frame).
+        positions: contact points, shape (p, 3) [m].
+        rotations: contact frame axes (columns x, y, z = inward normal), shape (p, 3, 3).
+    """
+
+    frame: str
+    positions: np.ndarray
+    rotations: np.ndarray
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """A snapshot of the latest valid inputs and their monotonic receipt times [s].
+
+    ``contacts`` and ``wrench`` are None until one arrives (then the scenario's
+    defaults are used); ``q`` is None until the first joint state. ``wrench`` is
+    (frame, [F, M]) in that frame's axes.
+    """
+
+    q: np.ndarray | None = None
+    q_time: float | None = None
+    contacts: ContactPoses | None = None
+    contacts_time: float | None = None
+    wrench: tuple[str, np.ndarray] | None = None
+    wrench_time: float | None = None
+
+
+@dataclass
+class CycleResult:
+    """What one cycle decided.
+
+    Attributes:
+        command: effort command to publish now, in ``joints`` order [N m], or None.
+        kind: ``solution`` (a certified command), ``zero`` (the zero policy) or
+            ``none`` (nothing published).
+        solution: the solve, if one ran.
+        maps: its kinematic maps.
+        gravity_torque: g(q) added to the solution, or None.
+        fault: why no certified command was published ('' when healthy).
+        cycle_time: wall time of the cycle [s] (0 for the watchdog's results).
+    """
+
+    command: np.ndarray | None
+    kind: str
+    solution: Solution | None = None
+    maps: GraspMaps | None = None
+    gravity_torque: np.ndarray | None = None
+    fault: str = ""
+    cycle_time: float = 0.0
+
+
+@dataclass
+class Counters:
+    """Running totals, for diagnostics.
+
+    ``solver_failures`` counts solves that raised or gave nothing certifiable
+    (not the confirmed infeasible ones); ``fallback_solves`` certified
+    solutions that came from the fallback backend after the first one failed;
+    ``overruns`` cycles over ``cycle_budget``; ``max_cycle_time`` is the longest
+    cycle [s].
+    """
+
+    cycles: int = 0
+    commands: int = 0
+    zero_commands: int = 0
+    faults: int = 0
+    recoveries: int = 0
+    overruns: int = 0
+    solver_failures: int = 0
+    fallback_solves: int = 0
+    max_cycle_time: float = 0.0
+    rejected: dict[str, int] = field(default_factory=lambda: dict.fromkeys(SOURCES, 0))
+
+
+def show(name: str) -> str:
+    """A name as quoted in messages, cut to :data:`SHOWN_NAME_LENGTH` characters."""
+    return name if len(name) <= SHOWN_NAME_LENGTH else name[:SHOWN_NAME_LENGTH] + "..."
+
+
+def stamp_seconds(sec: int, nanosec: int) -> float:
+    """A builtin_interfaces/Time as seconds (0.0 for an unstamped message)."""
+    return sec + 1e-9 * nanosec
+
+
+def _finite(a: np.ndarray, name: str) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if not np.all(np.isfinite(a)):
+        raise InputError(name, "must be finite (NaN or Inf found)")
+    return a
+
+
+def quaternion_matrix(xyzw: np.ndarray, name: str) -> np.ndarray:
+    """Rotation matrix of a unit quaternion (x, y, z, w).
+
+    Raises:
+        InputError: not finite, or its norm is off 1 by more than
+            :data:`QUATERNION_TOLERANCE`.
+    """
+    q = _finite(xyzw, name)
+    norm = float(np.linalg.norm(q))
+    if abs(norm - 1.0) > QUATERNION_TOLERANCE:
+        raise InputError(name, f"is not a unit quaternion (norm {norm:.6g})")
+    x, y, z, w = q / norm
+    return pin.Quaternion(w, x, y, z).toRotationMatrix()
+
+
+class TorqueController:
+    """The cycle of the node, on plain arrays.
+
+    Args:
+        setup: the grasp of the scenario: hand, default contacts and load,
+            friction, limits, weights. Its hand is owned by this controller.
+        config: timing and safety settings.
+        solver_settings: solver tolerance and iteration caps.
+        backend: QP backend, one of :data:`grasp_torque_opt.backends.BACKENDS`.
+        warm_start: start each solve from the previous one (DAQP only; verified,
+            with a cold fallback in the same cycle).
+        fallback: a second backend, asked in the same cycle when the first gives
+            nothing certifiable; None for none.
+    """
+
+    def __init__(self, setup: GraspSetup, config: CycleConfig | None = None,
+                 solver_settings: ProxSuiteSettings | None = None,
+                 backend: str = "proxsuite", warm_start: bool = False,
+                 fallback: str | None = None) -> None:
+        self.setup = setup
+        self.config = config or CycleConfig()
+        self.solver = make_solver(backend, solver_settings, warm_start)
+        self.fallback = make_solver(fallback, solver_settings) if fallback else None
+        self.inputs = Inputs()
+        self.counters = Counters()
+        self.last_command: np.ndarray | None = None
+        self.last_command_time: float | None = None
+        self.last: CycleResult | None = None
+        self.fault = ""
+        self.last_rejection = ""
+        self._stamps: dict[str, tuple[float, float]] = {}  # source -> (stamp, receipt time)
+        model = self.setup.hand.model
+        self._model_joints = {model.names[j]: model.joints[j].idx_q
+                              for j in range(1, model.njoints) if model.joints[j].nq == 1}
+
+    # -- inputs ---------------------------------------------------------------------------
+
+    def check_size(self, source: str, n: int) -> None:
+        """Reject a message by its size alone, before it is read.
+
+        Args:
+            source: ``joint_states`` (``n`` names or positions, at most
+                ``max_joint_state_entries``) or ``contacts`` (``n`` poses, exactly
+                one per scenario contact).
+
+        Raises:
+            InputError: the size is out of bounds (counted as a rejection).
+        """
+        try:
+            if source == "joint_states" and n > self.config.max_joint_state_entries:
+                raise InputError("joint_states", f"{n} entries, more than "
+                                 f"max_joint_state_entries ({self.config.max_joint_state_entries})")
+            p = len(self.setup.contacts)
+            if source == "contacts" and n != p:
+                raise InputError("contacts", f"{n} poses for {p} contacts")
+        except InputError as e:
+            self._reject(source, e)
+            raise
+
+    def _check_stamp(self, source: str, stamp: float, clock: float | None, now: float) -> None:
+        """The header stamp rule (README, "Input checks").
+
+        0 is an unstamped message: accepted, not compared. A stamp more than
+        ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)
+        is rejected. A stamp before the last accepted one of the same topic is
+        rejected (out of order), unless that one is itself stale by receipt
+        time: a restarted publisher or a rewound clock recovers after the
+        topic's timeout.
+        """
+        if stamp == 0.0:
+            return
+        if not math.isfinite(stamp) or stamp < 0.0:
+            raise InputError(f"{source}.header.stamp", f"is negative ({stamp:.9g} s)")
+        tol = self.config.stamp_future_tolerance
+        if clock is not None and clock > 0.0 and stamp > clock + tol:
+            raise InputError(f"{source}.header.stamp", f"is {stamp - clock:.3f} s ahead of the "
+                             f"clock (stamp_future_tolerance {tol} s)")
+        last = self._stamps.get(source)
+        if last is not None and stamp < last[0] and now - last[1] <= self._timeout(source):
+            raise InputError(f"{source}.header.stamp", f"goes backwards by "
+                             f"{last[0] - stamp:.6f} s (out of order)")
+
+    def _timeout(self, source: str) -> float:
+        c = self.config
+        t = {"joint_states": c.joint_state_timeout, "contacts": c.contacts_timeout,
+             "external_wrench": c.wrench_timeout}[source]
+        return t if t > 0 else c.joint_state_timeout
+
+    def _keep_stamp(self, source: str, stamp: float, now: float) -> None:
+        if stamp != 0.0:
+            self._stamps[source] = (stamp, now)
+
+    def update_joint_state(self, names: list[str], positions: list[float], now: float,
+                           stamp: float = 0.0, clock: float | None = None) -> None:
+        """Take a joint state: names and positions, any order, extra joints ignored.
+
+        Only the positions of model joints are used, so NaN elsewhere (velocity,
+        effort, unknown joints) is accepted. Names that are not model joints are
+        ignored (a robot's joint_states lists every joint), but must be unique.
+
+        Args:
+            names: joint names.
+            positions: their positions [rad or m].
+            now: monotonic receipt time [s].
+            stamp: header stamp [s] (0: unstamped).
+            clock: the clock the stamps are on, now [s] (None: not checked ahead).
+
+        Raises:
+            InputError: more than ``max_joint_state_entries`` entries, length
+                mismatch, empty or duplicate name, a commanded joint missing, a
+                used position not finite or beyond :data:`MAX_ABS_JOINT_POSITION`,
+                a bad stamp. The state is not kept.
+        """
+        self.check_size("joint_states", max(len(names), len(positions)))
+        try:
+            if len(names) != len(positions):
+                raise InputError("joint_states", f"{len(names)} names but "
+                                 f"{len(positions)} positions")
+            if len(set(names)) != len(names):
+                dup = next(n for n, k in Counter(names).items() if k > 1)
+                raise InputError("joint_states", f"duplicate joint name '{show(dup)}'")
+            if any(not n for n in names):
+                raise InputError("joint_states", "empty joint name")
+            given = set(names)
+            missing = [n for n in self.setup.hand.joints if n not in given]
+            if missing:
+                raise InputError("joint_states", f"missing commanded joint(s) "
+                                 f"{', '.join(missing[:4])}")
+            q = (self.setup.q if self.inputs.q is None else self.inputs.q).copy()
+            for name, value in zip(names, positions):
+                iq = self._model_joints.get(name)
+                if iq is None:
+                    continue
+                if not math.isfinite(value):
+                    raise InputError("joint_states", f"position of '{name}' is not finite")
+                if abs(value) > MAX_ABS_JOINT_POSITION:
+                    raise InputError("joint_states", f"position of '{name}' is {value:.6g}, "
+                                     f"beyond +-{MAX_ABS_JOINT_POSITION:g}")
+                q[iq] = value
+            self._check_stamp("joint_states", stamp, clock, now)
+        except InputError as e:
+            self._reject("joint_states", e)
+            raise
+        self._keep_stamp("joint_states", stamp, now)
+        self.inputs = dataclasses.replace(self.inputs, q=q, q_time=now)
+
+    def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
+                        now: float, stamp: float = 0.0, clock: float | None = None) -> None:
+        """Take contact frames: one pose per scenario contact, in model frame ``frame``.
+
+        Args:
+            frame: model frame of the poses ('' = the base frame).
+            positions: contact points, shape (p, 3) [m].
+            quaternions: contact frame orientations (x, y, z, w), shape (p, 4).
+            now: monotonic receipt time [s].
+            stamp: header stamp [s] (0: unstamped).
+            clock: the clock the stamps are on, now [s] (None: not checked ahead).
+
+        Raises:
+            InputError: wrong count or shape, unknown frame, non-finite values, a
+                non-unit quaternion, a bad stamp. The contacts are not kept. (The
+                distance from the base is checked in the cycle, where the frame
+                is placed.)
+        """
+        positions = np.asarray(positions, dtype=float)
+        quaternions = np.asarray(quaternions, dtype=float)
+        self.check_size("contacts", len(positions))
+        try:
+            p = len(self.setup.contacts)
+            if positions.shape != (p, 3) or quaternions.shape != (p, 4):
+                raise InputError("contacts", f"positions of shape {positions.shape} and "
+                                 f"quaternions of shape {quaternions.shape}, expected "
+                                 f"({p}, 3) and ({p}, 4)")
+            model = self.setup.hand.model
+            if frame and not model.existFrame(frame):
+                raise FrameNotFound("contacts.header.frame_id", show(frame),
+                                    {f.name for f in model.frames})
+            _finite(positions, "contacts.poses.position")
+            rotations = np.array([quaternion_matrix(quaternions[i],
+                                                    f"contacts.poses[{i}].orientation")
+                                  for i in range(p)])
+            self._check_stamp("contacts", stamp, clock, now)
+        except InputError as e:
+            self._reject("contacts", e)
+            raise
+        self._keep_stamp("contacts", stamp, now)
+        self.inputs = dataclasses.replace(
+            self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
+
+    def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
+                      now: float, stamp: float = 0.0, clock: float | None = None) -> None:
+        """Take the load on the object (about its origin), axes of model frame ``frame``.
+
+        Args:
+            frame: model frame of the axes ('' = the base frame).
+            force: force [N], shape (3,).
+            torque: moment about the object origin [N m], shape (3,).
+            now: monotonic receipt time [s].
+            stamp: header stamp [s] (0: unstamped).
+            clock: the clock the stamps are on, now [s] (None: not checked ahead).
+
+        Raises:
+            InputError: unknown frame, non-finite values, a force or moment norm
+                above ``max_wrench_force`` / ``max_wrench_torque``, a bad stamp.
+                The load is not kept.
+        """
+        try:
+            model = self.setup.hand.model
+            if frame and not model.existFrame(frame):
+                raise FrameNotFound("external_wrench.header.frame_id", show(frame),
+                                    {f.name for f in model.frames})
+            w = np.concatenate((_finite(force, "external_wrench.wrench.force"),
+                                _finite(torque, "external_wrench.wrench.torque")))
+            if w.shape != (6,):
+                raise InputError("external_wrench.wrench", f"{w.size} values, expected 6")
+            c = self.config
+            for part, v, bound, key, unit in ((
+                    "force", w[:3], c.max_wrench_force, "max_wrench_force", "N"), (
+                    "torque", w[3:], c.max_wrench_torque, "max_wrench_torque", "N m")):
+                with np.errstate(over="ignore"):  # 1e308 entries: an infinite norm
+                    norm = float(np.linalg.norm(v))
+                if norm > bound:
+                    raise InputError(f"external_wrench.wrench.{part}",
+                                     f"norm {norm:.6g} {unit} exceeds {key} "
+                                     f"({bound} {unit})")
+            self._check_stamp("external_wrench", stamp, clock, now)
+        except InputError as e:
+            self._reject("external_wrench", e)
+            raise
+        self._keep_stamp("external_wrench", stamp, now)
+        # Kept in the given axes; turned into base axes at the cycle's configuration.
+        self.inputs = dataclasses.replace(self.inputs, wrench=(frame, w), wrench_time=now)
+
+    def _reject(self, source: str, error: InputError) -> None:
+        self.counters.rejected[source] += 1
+        self.last_rejection = str(error)  # names the field, e.g. contacts.poses[0]...
+
+    # -- the cycle ------------------------------------------------------------------------
+
+    def stale(self, now: float, inputs: Inputs | None = None) -> str:
+        """Why the inputs cannot be used at time ``now`` ('' if they can)."""
+        i = inputs or self.inputs
+        c = self.config
+        if i.q is None:
+            return "no joint state yet"
+        if now - i.q_time > c.joint_state_timeout:
+            return f"joint_states stale ({now - i.q_time:.3f} s > {c.joint_state_timeout} s)"
+        if i.contacts_time is not None and c.contacts_timeout > 0 and \
+                now - i.contacts_time > c.contacts_timeout:
+            return f"contacts stale ({now - i.contacts_time:.3f} s > {c.contacts_timeout} s)"
+        if i.wrench_time is not None and c.wrench_timeout > 0 and \
+                now - i.wrench_time > c.wrench_timeout:
+            return f"external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)"
+        return ""
+
+    def grasp_at(self, inputs: Inputs) -> tuple[GraspSetup, np.ndarray | None]:
+        """The grasp of a snapshot of inputs, and g(q) if compensated.
+
+        Raises:
+            InputError: a contact point beyond ``max_contact_distance``, or the
+                contacts cannot be placed on their links.
+        """
+        setup = self.setup
+        hand = setup.hand
+        q = inputs.q
+        model, data = hand.model, hand.data
+        pin.framesForwardKinematics(model, data, q)
+        contacts = setup.contacts
+        if inputs.contacts is not None:
+            cp = inputs.contacts
+            oMF = data.oMf[model.getFrameId(cp.frame)] if cp.frame else pin.SE3.Identity()
+            contacts = []
+            limit = self.config.max_contact_distance
+            for i, (spec, p, R) in enumerate(zip(setup.contacts, cp.positions, cp.rotations)):
+                distance = float(np.linalg.norm(oMF.act(p)))
+                if distance > limit:
+                    raise InputError(f"contacts.poses[{i}].position",
+                                     f"is {distance:.6g} m from the base origin, beyond "
+                                     f"max_contact_distance ({limit} m)")
+                R_base = oMF.rotation @ R
+                oMl = data.oMf[model.getFrameId(spec.link)]
+                contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(oMF.act(p)),
+                                            normal=R_base[:, 2], tangent=R_base[:, 0]))
+        wrench = setup.external_wrench
+        if inputs.wrench is not None:
+            frame, w = inputs.wrench
+            R = data.oMf[model.getFrameId(frame)].rotation if frame else np.eye(3)
+            wrench = np.concatenate((R @ w[:3], R @ w[3:]))
+        g = None
+        if self.config.gravity_compensation:
+            model.gravity.linear = np.asarray(self.config.gravity, dtype=float)
+            g = pin.computeGeneralizedGravity(model, data, q)[hand.idx_v].copy()
+        return dataclasses.replace(setup, q=q, contacts=contacts, external_wrench=wrench,
+                                   torque_offset=g), g
+
+    def solve_inputs(self, inputs: Inputs) -> tuple[Solution, GraspMaps, np.ndarray | None]:
+        """Solve the grasp of a snapshot of inputs with the tau-QP (certified).
+
+        Raises:
+            InputError: the inputs do not make a grasp (e.g. a tangent parallel to
+                its normal).
+        """
+        setup, g = self.grasp_at(inputs)
+        maps = setup.maps()
+        sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback,
+                    tolerance=self.config.certificate_tolerance)
+        return sol, maps, g
+
+    def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
+        """The last check before a command leaves: certified, finite, sized, within limits."""
+        if not solution.optimal:
+            return None, f"no certified solution ({solution.status}: {solution.message})"
+        cmd = solution.tau + (0.0 if g is None else g)
+        lim = self.setup.hand.torque_limits
+        if cmd.shape != lim.shape:
+            return None, f"command has {cmd.size} values for {lim.size} joints"
+        if not np.all(np.isfinite(cmd)):
+            return None, "command not finite"
+        if np.any(np.abs(cmd) > lim):
+            k = int(np.argmax(np.abs(cmd) - lim))
+            return None, f"command over the limit at {self.setup.hand.joints[k]}"
+        return cmd, ""
+
+    def cycle(self, now: float) -> CycleResult:
+        """One cycle on the latest inputs (run it on each new joint state).
+
+        Never raises: every failure is a fault, handled by the policy. A
+        certified command from a cycle that took longer than ``cycle_budget``
+        is not published (it answers a joint state older than the budget).
+        """
+        t0 = time.perf_counter()
+        self.counters.cycles += 1
+        result = self._attempt(now)
+        elapsed = time.perf_counter() - t0
+        self.counters.max_cycle_time = max(self.counters.max_cycle_time, elapsed)
+        if elapsed > self.config.cycle_budget:
+            self.counters.overruns += 1
+            if result.kind == "solution":
+                result = self._faulted(now, f"cycle overrun ({1e3 * elapsed:.1f} ms > "
+                                       f"cycle_budget {1e3 * self.config.cycle_budget:.1f} ms)",
+                                       result.solution, result.maps, result.gravity_torque)
+        if result.kind == "solution":
+            if self.fault:
+                self.counters.recoveries += 1
+            self.fault = ""
+            self.last_command, self.last_command_time = result.command, now
+            self.counters.commands += 1
+            if self.fallback is not None and result.solution.backend == self.fallback.name:
+                self.counters.fallback_solves += 1
+            self.last = result
+        result.cycle_time = elapsed
+        return result
+
+    def _attempt(self, now: float) -> CycleResult:
+        """Solve and gate; a certified command is returned, not yet committed."""
+        reason = self.stale(now)
+        if reason:
+            return self._faulted(now, reason)
+        try:
+            sol, maps, g = self.solve_inputs(self.inputs)
+        except InputError as e:
+            return self._faulted(now, f"inputs do not make a grasp: {e}")
+        except GraspTorqueError as e:
+            self.counters.solver_failures += 1
+            return self._faulted(now, f"solver failed: {e}")
+        except Exception as e:  # noqa: BLE001 -- a control loop fails safe, it does not die
+            self.counters.solver_failures += 1
+            return self._faulted(now, f"cycle failed: {type(e).__name__}: {e}")
+        if sol.status == "failed":
+            self.counters.solver_failures += 1
+        cmd, why = self.gate(sol, g)
+        if cmd is None:
+            return self._faulted(now, why, sol, maps, g)
+        return CycleResult(cmd, "solution", sol, maps, g)
+
+    def watchdog(self, now: float) -> CycleResult | None:
+        """Between cycles: notice stale joint states and apply the policy.
+
+        Returns:
+            A result when there is a fault (its command may be the zero policy's),
+            None when the inputs are fresh or no joint state has arrived yet.
+        """
+        if self.inputs.q is None:
+            return None  # not started: nothing was ever commanded
+        reason = self.stale(now)
+        return self._faulted(now, reason) if reason else None
+
+    def _faulted(self, now: float, reason: str, sol: Solution | None = None,
+                 maps: GraspMaps | None = None, g: np.ndarray | None = None) -> CycleResult:
+        if not self.fault:
+            self.counters.faults += 1
+        self.fault = reason
+        held = (self.last_command_time is not None
+                and now - self.last_command_time <= self.config.hold_time)
+        if not held and self.config.fault_policy == "zero":
+            cmd = np.zeros(self.setup.hand.m)
+            self.counters.zero_commands += 1
+            result = CycleResult(cmd, "zero", sol, maps, g, reason)
+        else:
+            result = CycleResult(None, "none", sol, maps, g, reason)
+        self.last = result
+        return result

@@ -1,0 +1,92 @@
+"""What the node says on /diagnostics: a pure function of the controller's state."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.core.friction import friction_usage
+
+# diagnostic_msgs/DiagnosticStatus levels, without importing ROS.
+OK, WARN, ERROR, STALE = 0, 1, 2, 3
+
+
+@dataclass(frozen=True)
+class Report:
+    """One diagnostic status: level, message and key-value pairs (strings)."""
+
+    level: int
+    message: str
+    values: list[tuple[str, str]]
+
+
+def _ago(now: float, t: float | None) -> str:
+    return "never" if t is None else f"{now - t:.4f}"
+
+
+def report(controller: TorqueController, now: float) -> Report:
+    """The controller's state as a diagnostic status.
+
+    Level: STALE before the first joint state, OK while certified commands flow,
+    WARN during a fault while the last certified command is held (within
+    ``hold_time``), ERROR once the fault policy applies.
+    """
+    c = controller
+    cfg = c.config
+    values: list[tuple[str, str]] = []
+    last = c.last
+    sol = last.solution if last is not None else None
+    if c.inputs.q is None:
+        level, message = STALE, "waiting for joint_states"
+    elif not c.fault:
+        level, message = OK, "certified torques published"
+    else:
+        held = (c.last_command_time is not None
+                and now - c.last_command_time <= cfg.hold_time)
+        if held:
+            level, message = WARN, f"holding last certified command: {c.fault}"
+        elif cfg.fault_policy == "zero":
+            level, message = ERROR, f"zero torques published: {c.fault}"
+        else:
+            level, message = ERROR, f"hold policy, last certified command kept: {c.fault}"
+    values.append(("fault", c.fault or "none"))
+    values.append(("fault_policy", cfg.fault_policy))
+    if sol is not None:
+        values += [("status", sol.status), ("solver_message", sol.message),
+                   ("solve_time_s", f"{sol.solve_time_s:.6f}"),
+                   ("cycle_time_s", f"{last.cycle_time or sum(sol.timings.values()):.6f}"),
+                   ("iterations", str(sol.iterations))]
+        if sol.certificate is not None:
+            cert = sol.certificate.as_dict()
+            values += [(f"certificate.{k}", f"{cert[k]:.3e}")
+                       for k in ("equilibrium", "torque", "cone", "normal_force",
+                                 "torque_limit")]
+            values.append(("certificate.ok", str(sol.certificate.ok).lower()))
+        if sol.optimal and last.maps is not None:
+            values.append(("torque_norm", f"{sol.torque_norm:.6f}"))
+            usage = friction_usage(sol.wrenches, c.setup.friction.mu1, c.setup.friction.mu2)
+            for i, (frame, (ut, ur)) in enumerate(zip(last.maps.contacts, usage)):
+                key = f"contact{i}.{frame.link}"
+                values += [(f"{key}.normal_force_N", f"{sol.wrenches[i, 2]:.4f}"),
+                           (f"{key}.tangential_usage", f"{ut:.4f}"),
+                           (f"{key}.torsional_usage", f"{ur:.4f}")]
+    if last is not None and last.gravity_torque is not None:
+        values.append(("gravity_torque_norm",
+                       f"{float((last.gravity_torque ** 2).sum() ** 0.5):.6f}"))
+    n = c.counters
+    values += [("cycles", str(n.cycles)), ("commands", str(n.commands)),
+               ("zero_commands", str(n.zero_commands)), ("faults", str(n.faults)),
+               ("recoveries", str(n.recoveries)), ("solver_failures", str(n.solver_failures)),
+               ("overruns", str(n.overruns)), ("max_cycle_time_s", f"{n.max_cycle_time:.6f}"),
+               ("cycle_budget_s", f"{cfg.cycle_budget:.6f}")]
+    solver = c.solver
+    values += [("solver.backend", getattr(solver, "name", type(solver).__name__)),
+               ("solver.warm_solves", str(getattr(solver, "warm_solves", 0))),
+               ("solver.warm_start_fallbacks", str(getattr(solver, "fallbacks", 0))),
+               ("solver.fallback_solves", str(n.fallback_solves))]
+    values += [(f"rejected.{k}", str(v)) for k, v in n.rejected.items()]
+    values.append(("last_rejection", c.last_rejection or "none"))
+    values += [("age.joint_states_s", _ago(now, c.inputs.q_time)),
+               ("age.contacts_s", _ago(now, c.inputs.contacts_time)),
+               ("age.external_wrench_s", _ago(now, c.inputs.wrench_time))]
+    return Report(level, message, values)

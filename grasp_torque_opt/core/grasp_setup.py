@@ -1,0 +1,89 @@
+"""A grasp problem bound to its hand: what every method solves."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.grasp_maps import GraspMaps, compute_grasp_maps
+from grasp_torque_opt.core.hand import Hand, resolve_urdf
+from grasp_torque_opt.core.scenario import (
+    ContactSpec,
+    Friction,
+    Scenario,
+    load_scenario,
+)
+
+
+@dataclass(frozen=True)
+class GraspSetup:
+    """Everything one solve needs.
+
+    Attributes:
+        hand: the hand (model, actuated joints, torque limits).
+        q: full configuration, shape (nq,).
+        contacts: contact specifications.
+        object_origin: c, base frame [m].
+        friction: friction model and linearization.
+        external_wrench: w_ext, load on the object about c, base axes [N, N m].
+        weights: W's diagonal, shape (m,), > 0.
+        torque_offset: torque added to the solution before it is commanded, e.g.
+            the fingers' own gravity torques g(q), shape (m,) [N m], or None.
+            The torque limits then bound the sum: -limit <= tau + offset <= limit.
+    """
+
+    hand: Hand
+    q: np.ndarray
+    contacts: list[ContactSpec]
+    object_origin: np.ndarray
+    friction: Friction
+    external_wrench: np.ndarray
+    weights: np.ndarray
+    torque_offset: np.ndarray | None = None
+
+    @property
+    def tau_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(tau_min, tau_max) on the optimized torque [N m], after the offset."""
+        lim = self.hand.torque_limits
+        off = 0.0 if self.torque_offset is None else self.torque_offset
+        return -lim - off, lim - off
+
+    @classmethod
+    def from_scenario(cls, scenario: Scenario, urdf_xml: str | None = None) -> GraspSetup:
+        """Load the hand of a scenario and bind the scenario to it.
+
+        Args:
+            scenario: the validated scenario.
+            urdf_xml: a URDF document to use instead of the scenario's
+                ``hand.urdf`` (e.g. the node's ``robot_description``).
+
+        Raises:
+            InputError: naming the field (file, joint or frame not found, ...).
+        """
+        if urdf_xml:
+            hand = Hand.from_urdf_string(urdf_xml, scenario.joints, scenario.torque_limits)
+        else:
+            hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
+                                  scenario.joints, scenario.torque_limits)
+        weights = np.ones(hand.m) if scenario.weights is None else np.asarray(scenario.weights)
+        if weights.shape != (hand.m,):
+            raise InputError("objective.weights",
+                             f"must have {hand.m} entries (one per joint), got {weights.size}")
+        setup = cls(hand=hand, q=hand.configuration(scenario.joint_positions),
+                    contacts=scenario.contacts, object_origin=scenario.object_origin,
+                    friction=scenario.friction, external_wrench=scenario.external_wrench,
+                    weights=weights)
+        setup.maps()  # names unknown frames and bad normals now, not at solve time
+        return setup
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> GraspSetup:
+        """Read, validate and bind a scenario file."""
+        return cls.from_scenario(load_scenario(path))
+
+    def maps(self) -> GraspMaps:
+        """Contact frames, G and J at this configuration."""
+        return compute_grasp_maps(self.hand, self.q, self.contacts, self.object_origin)

@@ -1,0 +1,200 @@
+"""The hand: a Pinocchio model loaded from URDF, its actuated joints and torque limits."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from functools import cached_property
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
+
+ERD_PREFIX = "example-robot-data:"
+
+
+def example_robot_data_dir() -> Path:
+    """Folder ``robots/`` of example-robot-data.
+
+    Looked up in this order: the pip distribution ``example-robot-data`` (its
+    cmeel prefix), then ``share/example-robot-data/robots`` under each entry
+    of ``AMENT_PREFIX_PATH`` (a ROS installation).
+
+    Raises:
+        InputError: example-robot-data is not installed.
+    """
+    candidates = []
+    try:
+        dist = metadata.distribution("example-robot-data")
+        candidates.append(Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
+    except metadata.PackageNotFoundError:
+        pass
+    for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+        if prefix:
+            candidates.append(Path(prefix) / "share" / "example-robot-data" / "robots")
+    for c in candidates:
+        if c.is_dir():
+            return c
+    raise InputError("hand.urdf", "example-robot-data is not installed "
+                     "(pip install example-robot-data, or source a ROS installation that has it)")
+
+
+def resolve_urdf(spec: str, base_dir: Path) -> Path:
+    """Resolve a URDF reference of a scenario to a file.
+
+    Args:
+        spec: ``example-robot-data:<path under robots/>``, an absolute path, or a
+            path relative to ``base_dir``.
+        base_dir: folder of the scenario file.
+
+    Raises:
+        InputError: the file does not exist (field ``hand.urdf``).
+    """
+    if spec.startswith(ERD_PREFIX):
+        path = example_robot_data_dir() / spec[len(ERD_PREFIX):]
+    else:
+        path = Path(spec).expanduser()
+        if not path.is_absolute():
+            path = base_dir / path
+    if not path.is_file():
+        raise InputError("hand.urdf", f"file not found: {path}")
+    return path
+
+
+@dataclass(frozen=True)
+class Hand:
+    """A hand model with its actuated joints in command order.
+
+    Attributes:
+        model: Pinocchio model; its world frame is the base frame.
+        joints: actuated joint names in command order (m of them).
+        data: Pinocchio workspace of ``model``.
+        idx_q: index of each actuated joint in q, shape (m,).
+        idx_v: index of each actuated joint in v (columns of the Jacobians), shape (m,).
+        torque_limits: |tau_i| <= torque_limits[i] [N m], shape (m,).
+    """
+
+    model: pin.Model
+    joints: list[str]
+    idx_q: np.ndarray
+    idx_v: np.ndarray
+    torque_limits: np.ndarray
+    data: pin.Data = field(init=False, repr=False, compare=False)
+    _frame_ids: dict[str, int] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        # Kinematics workspace, allocated once; a Hand is not shared across threads.
+        object.__setattr__(self, "data", self.model.createData())
+        object.__setattr__(self, "_frame_ids", {})
+
+    def frame_index(self, name: str, field_name: str) -> int:
+        """Index of a model frame by name, looked up once per name.
+
+        Raises:
+            FrameNotFound: naming ``field_name`` and listing close matches.
+        """
+        fid = self._frame_ids.get(name)
+        if fid is None:
+            if not self.model.existFrame(name):
+                raise FrameNotFound(field_name, name, {f.name for f in self.model.frames})
+            fid = self._frame_ids[name] = self.model.getFrameId(name)
+        return fid
+
+    @property
+    def m(self) -> int:
+        """Number of actuated joints."""
+        return len(self.joints)
+
+    @cached_property
+    def base_frame(self) -> str:
+        """Name of the root link: the base frame (looked up once: the node stamps every
+        command with it)."""
+        return next(f.name for f in self.model.frames
+                    if f.type == pin.FrameType.BODY and f.parentJoint == 0)
+
+    @staticmethod
+    def one_dof_joints(model: pin.Model) -> list[str]:
+        """Names of the model's one-degree-of-freedom joints, in model order."""
+        return [model.names[j] for j in range(1, model.njoints)
+                if model.joints[j].nq == 1 and model.joints[j].nv == 1]
+
+    @classmethod
+    def from_model(cls, model: pin.Model, joints: list[str] | None = None,
+                   torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+        """Bind actuated joints and limits to a model.
+
+        Args:
+            model: the Pinocchio model.
+            joints: actuated joints in command order; None for every 1-DoF joint.
+            torque_limits: scalar or per-joint bound [N m]; None for the URDF
+                effort limits.
+
+        Raises:
+            JointNotFound: a joint is not a 1-DoF joint of the model (``hand.joints[i]``).
+            InputError: a limit is missing or not positive (``hand.torque_limits``).
+        """
+        available = cls.one_dof_joints(model)
+        if joints is None:
+            joints = available
+        for i, name in enumerate(joints):
+            if name not in available:
+                raise JointNotFound(f"hand.joints[{i}]", name, available)
+        ids = [model.getJointId(n) for n in joints]
+        idx_q = np.array([model.joints[j].idx_q for j in ids], dtype=int)
+        idx_v = np.array([model.joints[j].idx_v for j in ids], dtype=int)
+        if torque_limits is None:
+            limits = np.asarray(model.effortLimit, dtype=float)[idx_v]
+            for name, lim in zip(joints, limits):
+                if not (np.isfinite(lim) and lim > 0.0):
+                    raise InputError("hand.torque_limits",
+                                     f"the URDF gives no effort limit for joint '{name}'; "
+                                     "set hand.torque_limits")
+        else:
+            limits = np.asarray(torque_limits, dtype=float)
+            if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):
+                raise InputError("hand.torque_limits",
+                                 f"must have {len(joints)} entries (one per joint), "
+                                 f"got {limits.size}")
+            limits = np.broadcast_to(limits, (len(joints),))
+            if not np.all(np.isfinite(limits) & (limits > 0.0)):
+                raise InputError("hand.torque_limits", "must be finite and > 0")
+        return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
+                   torque_limits=np.array(limits, dtype=float))
+
+    @classmethod
+    def from_urdf(cls, path: str | Path, joints: list[str] | None = None,
+                  torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+        """Load a hand from a URDF file (fixed base; meshes are not needed)."""
+        try:
+            model = pin.buildModelFromUrdf(str(path))
+        except (RuntimeError, ValueError) as e:
+            raise InputError("hand.urdf", f"cannot parse {path}: {e}") from e
+        return cls.from_model(model, joints, torque_limits)
+
+    @classmethod
+    def from_urdf_string(cls, xml: str, joints: list[str] | None = None,
+                         torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+        """Load a hand from a URDF document (e.g. the ``robot_description`` parameter)."""
+        try:
+            model = pin.buildModelFromXML(xml)
+        except (RuntimeError, ValueError) as e:
+            raise InputError("robot_description", f"cannot parse the URDF: {e}") from e
+        return cls.from_model(model, joints, torque_limits)
+
+    def configuration(self, positions: dict[str, float],
+                      field: str = "grasp.joint_positions") -> np.ndarray:
+        """Full configuration q from joint positions by name; others stay at 0.
+
+        Raises:
+            JointNotFound: a name is not a 1-DoF joint of the model.
+        """
+        q = pin.neutral(self.model)
+        available = self.one_dof_joints(self.model)
+        for name, value in positions.items():
+            if name not in available:
+                raise JointNotFound(f"{field}.{name}", name, available)
+            q[self.model.joints[self.model.getJointId(name)].idx_q] = value
+        return q

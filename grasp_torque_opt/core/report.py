@@ -1,0 +1,46 @@
+"""The CLI's JSON form of a solution (docs/design.md section 4), shared with the node's service."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.solution import Solution
+
+
+def _floats(a) -> list[float] | None:
+    return None if a is None else [float(x) for x in a]
+
+
+def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
+    """Plain data for JSON.
+
+    Pinned keys: ``status``, ``method``, ``joints``, ``tau`` [N m],
+    ``torque_norm`` [N m], ``solve_time_s``, ``certificate``, ``contacts`` (per
+    contact ``link``, ``position``, ``normal``, ``tangent`` in the base frame and
+    ``wrench`` [fx, fy, fz, mz] in the contact frame). Added: ``message``,
+    ``iterations``, ``timings_s``. ``tau``, ``torque_norm`` and every ``wrench``
+    are null unless the status is ``optimal``.
+    """
+    contacts = []
+    for i, frame in enumerate(maps.contacts):
+        contacts.append({
+            "link": frame.link,
+            "position": _floats(frame.position),
+            "normal": _floats(frame.normal),
+            "tangent": _floats(frame.tangent),
+            "wrench": None if solution.wrenches is None else _floats(solution.wrenches[i]),
+        })
+    return {
+        "status": solution.status,
+        "method": solution.method,
+        "joints": list(solution.joints),
+        "tau": _floats(solution.tau),
+        "torque_norm": solution.torque_norm,
+        "solve_time_s": solution.solve_time_s,
+        "certificate": None if solution.certificate is None else solution.certificate.as_dict(),
+        "contacts": contacts,
+        "message": solution.message,
+        "iterations": solution.iterations,
+        "timings_s": dict(solution.timings),
+    }

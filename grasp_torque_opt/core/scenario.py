@@ -1,0 +1,275 @@
+"""Scenario files (YAML, schema in docs/design.md section 4): load and validate.
+
+Validation here is structural (types, lengths, finiteness, ranges); what needs
+the model (joint and frame names, URDF limits) is checked when the scenario is
+bound to a hand in :mod:`grasp_torque_opt.core.grasp_setup`. Every error names the
+field, e.g. ``grasp.contacts[1].normal: must not be zero``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from grasp_torque_opt.core.exceptions import InputError
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """One contact as the scenario states it.
+
+    Attributes:
+        link: model frame that touches the object.
+        position: contact point in that frame [m], shape (3,).
+        normal: inward unit normal in base axes, shape (3,), or None for
+            "from the contact point towards the object origin".
+        tangent: x axis of the contact frame in base axes, shape (3,), or None
+            for the pinned tangent rule.
+    """
+
+    link: str
+    position: np.ndarray
+    normal: np.ndarray | None = None
+    tangent: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Soft-finger friction and its linearization.
+
+    Attributes:
+        mu1: tangential friction coefficient [-].
+        mu2: torsional friction coefficient [m].
+        sides: number of sides N of the inscribed polygon (N >= 3).
+        min_normal_force: lower bound on every normal force [N].
+    """
+
+    mu1: float
+    mu2: float
+    sides: int
+    min_normal_force: float = 0.0
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario.
+
+    Attributes:
+        urdf: the hand's URDF path as written (see :func:`resolve_urdf`).
+        base_dir: folder of the scenario file, for relative URDF paths.
+        joints: actuated joints in command order, or None for all 1-DoF joints.
+        torque_limits: |tau_i| bound [N m], a scalar, a list, or None (URDF effort).
+        joint_positions: joint name -> position [rad or m].
+        object_origin: object origin c in the base frame [m], shape (3,).
+        contacts: the contacts.
+        friction: friction model.
+        external_wrench: load on the object about c, base axes, shape (6,) [N, N m].
+        weights: objective weights per joint, or None for ones.
+    """
+
+    urdf: str
+    base_dir: Path
+    joints: list[str] | None
+    torque_limits: float | list[float] | None
+    joint_positions: dict[str, float]
+    object_origin: np.ndarray
+    contacts: list[ContactSpec]
+    friction: Friction
+    external_wrench: np.ndarray
+    weights: list[float] | None = None
+    source: str = field(default="<memory>")
+
+
+_SECTIONS = {
+    "hand": {"urdf", "joints", "torque_limits"},
+    "grasp": {"joint_positions", "object_origin", "contacts"},
+    "friction": {"mu_tangential", "mu_torsional", "polygon_sides", "min_normal_force"},
+    "load": {"external_wrench"},
+    "objective": {"weights"},
+}
+_CONTACT_KEYS = {"link", "position", "normal", "tangent"}
+
+
+def _mapping(value: Any, name: str, allowed: set[str]) -> dict:
+    if not isinstance(value, dict):
+        raise InputError(name, f"must be a mapping, got {type(value).__name__}")
+    for key in value:
+        if key not in allowed:
+            raise InputError(f"{name}.{key}" if name else str(key),
+                             f"unknown field (allowed: {', '.join(sorted(allowed))})")
+    return value
+
+
+def _require(section: dict, key: str, name: str) -> Any:
+    if key not in section or section[key] is None:
+        raise InputError(f"{name}.{key}" if name else key, "missing required field")
+    return section[key]
+
+
+def _number(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(name, f"must be a number, got {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise InputError(name, f"must be finite, got {value!r}")
+    return x
+
+
+def _vector(value: Any, name: str, length: int | None = None) -> np.ndarray:
+    if not isinstance(value, (list, tuple)):
+        raise InputError(name, f"must be a list of numbers, got {value!r}")
+    if length is not None and len(value) != length:
+        raise InputError(name, f"must have {length} entries, got {len(value)}")
+    return np.array([_number(v, f"{name}[{i}]") for i, v in enumerate(value)], dtype=float)
+
+
+def _positive(value: Any, name: str) -> float:
+    x = _number(value, name)
+    if x <= 0.0:
+        raise InputError(name, f"must be > 0, got {value!r}")
+    return x
+
+
+def _names(value: Any, name: str) -> list[str]:
+    if not isinstance(value, list) or not value:
+        raise InputError(name, "must be a non-empty list of names")
+    out = []
+    for i, v in enumerate(value):
+        if not isinstance(v, str) or not v:
+            raise InputError(f"{name}[{i}]", f"must be a name, got {v!r}")
+        if v in out:
+            raise InputError(f"{name}[{i}]", f"duplicate name '{v}'")
+        out.append(v)
+    return out
+
+
+def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scenario:
+    """Validate a scenario given as plain data (as parsed from YAML).
+
+    Args:
+        data: the parsed document.
+        base_dir: folder that relative URDF paths are relative to.
+        source: where the data came from, for messages.
+
+    Returns:
+        The validated scenario.
+
+    Raises:
+        InputError: naming the first invalid field.
+    """
+    top = _mapping(data, "", set(_SECTIONS))
+    hand = _mapping(_require(top, "hand", ""), "hand", _SECTIONS["hand"])
+    grasp = _mapping(_require(top, "grasp", ""), "grasp",
+                     _SECTIONS["grasp"])
+    friction = _mapping(_require(top, "friction", ""), "friction",
+                        _SECTIONS["friction"])
+    load = _mapping(_require(top, "load", ""), "load", _SECTIONS["load"])
+    objective = _mapping(top.get("objective") or {}, "objective", _SECTIONS["objective"])
+
+    urdf = _require(hand, "urdf", "hand")
+    if not isinstance(urdf, str) or not urdf:
+        raise InputError("hand.urdf", f"must be a path, got {urdf!r}")
+    joints = _names(hand["joints"], "hand.joints") if hand.get("joints") is not None else None
+
+    limits = hand.get("torque_limits")
+    if limits is not None:
+        if isinstance(limits, (list, tuple)):
+            limits = [_positive(v, f"hand.torque_limits[{i}]") for i, v in enumerate(limits)]
+            if joints is not None and len(limits) != len(joints):
+                raise InputError("hand.torque_limits",
+                                 f"must have {len(joints)} entries (one per joint), "
+                                 f"got {len(limits)}")
+        else:
+            limits = _positive(limits, "hand.torque_limits")
+
+    positions_raw = grasp.get("joint_positions") or {}
+    if not isinstance(positions_raw, dict):
+        raise InputError("grasp.joint_positions", "must be a mapping joint name -> position")
+    positions = {str(k): _number(v, f"grasp.joint_positions.{k}")
+                 for k, v in positions_raw.items()}
+
+    origin = _vector(_require(grasp, "object_origin", "grasp"), "grasp.object_origin", 3)
+
+    contacts_raw = _require(grasp, "contacts", "grasp")
+    if not isinstance(contacts_raw, list) or not contacts_raw:
+        raise InputError("grasp.contacts", "must be a non-empty list of contacts")
+    contacts = []
+    for i, c in enumerate(contacts_raw):
+        name = f"grasp.contacts[{i}]"
+        c = _mapping(c, name, _CONTACT_KEYS)
+        link = _require(c, "link", name)
+        if not isinstance(link, str) or not link:
+            raise InputError(f"{name}.link", f"must be a frame name, got {link!r}")
+        position = (_vector(c["position"], f"{name}.position", 3)
+                    if c.get("position") is not None else np.zeros(3))
+        normal = None
+        if c.get("normal") is not None:
+            normal = _vector(c["normal"], f"{name}.normal", 3)
+            norm = np.linalg.norm(normal)
+            if norm < 1e-9:
+                raise InputError(f"{name}.normal", "must not be zero")
+            normal = normal / norm
+        tangent = None
+        if c.get("tangent") is not None:
+            tangent = _vector(c["tangent"], f"{name}.tangent", 3)
+            if np.linalg.norm(tangent) < 1e-9:
+                raise InputError(f"{name}.tangent", "must not be zero")
+            if normal is not None:
+                t = tangent / np.linalg.norm(tangent)
+                if np.linalg.norm(t - (t @ normal) * normal) < 1e-6:
+                    raise InputError(f"{name}.tangent", "is parallel to the normal")
+        contacts.append(ContactSpec(link=link, position=position, normal=normal, tangent=tangent))
+
+    sides = _require(friction, "polygon_sides", "friction")
+    if isinstance(sides, bool) or not isinstance(sides, int):
+        raise InputError("friction.polygon_sides", f"must be an integer, got {sides!r}")
+    if sides < 3:
+        raise InputError("friction.polygon_sides", f"must be >= 3, got {sides}")
+    fmin = _number(friction.get("min_normal_force", 0.0), "friction.min_normal_force")
+    if fmin < 0.0:
+        raise InputError("friction.min_normal_force", f"must be >= 0, got {fmin}")
+    fric = Friction(
+        mu1=_positive(_require(friction, "mu_tangential", "friction"), "friction.mu_tangential"),
+        mu2=_positive(_require(friction, "mu_torsional", "friction"), "friction.mu_torsional"),
+        sides=sides,
+        min_normal_force=fmin,
+    )
+
+    wrench = _vector(_require(load, "external_wrench", "load"), "load.external_wrench", 6)
+
+    weights = None
+    if objective.get("weights") is not None:
+        weights = [_positive(v, f"objective.weights[{i}]")
+                   for i, v in enumerate(_vector(objective["weights"], "objective.weights"))]
+        if joints is not None and len(weights) != len(joints):
+            raise InputError("objective.weights",
+                             f"must have {len(joints)} entries (one per joint), "
+                             f"got {len(weights)}")
+
+    return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
+                    joint_positions=positions, object_origin=origin, contacts=contacts,
+                    friction=fric, external_wrench=wrench, weights=weights, source=source)
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario file.
+
+    Raises:
+        InputError: the file cannot be read or parsed (field ``scenario``), or a
+            field is invalid (named).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise InputError("scenario", f"cannot read {path}: {e.strerror}") from e
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        raise InputError("scenario", f"{path} is not valid YAML: {e}".splitlines()[0]) from e
+    return parse_scenario(data, path.resolve().parent, source=str(path))

@@ -1,0 +1,227 @@
+"""A demo driver that needs no robot: it plays a scenario as a hand would.
+
+It publishes joint states (the scenario's grasp with a small sinusoidal motion,
+NaN efforts as joint_state_broadcaster sends them), the contact frames at the
+current configuration and the scenario's load; it listens to
+``effort_commands`` and ``/diagnostics`` and prints a live line a second (command
+rate, solve time, torque norm, status), then a summary.
+
+``--with-node`` starts ``grasp_torque_node`` in a child process first, on a
+private ROS domain with localhost-only discovery, and stops it at the end.
+``--watch`` publishes nothing and prints the live line of a node already
+running: a way to see what it does without RViz.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def _isolate() -> None:
+    """A private ROS domain (unless one is set) and localhost-only discovery."""
+    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
+    os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="grasp-torque-demo", description=__doc__.splitlines()[0])
+    p.add_argument("--params", default="allegro_right_node.yaml",
+                   help="node params file (bundled name or path); its scenario is played")
+    p.add_argument("--duration", type=float, default=5.0, help="seconds to play [s]")
+    p.add_argument("--rate", type=float, default=200.0, help="joint state rate [Hz]")
+    p.add_argument("--amplitude", type=float, default=0.01, help="joint motion [rad]")
+    p.add_argument("--with-node", action="store_true",
+                   help="start grasp_torque_node in a child process")
+    p.add_argument("--watch", action="store_true",
+                   help="publish nothing: only print what a running node does "
+                        "(on the current ROS_DOMAIN_ID)")
+    return p
+
+
+def _scenario_of(params: Path) -> str:
+    import yaml
+
+    doc = yaml.safe_load(params.read_text())
+    return next(iter(doc.values()))["ros__parameters"]["scenario"]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the demo; exit code 0 when certified commands flowed and all were well-formed."""
+    args = _parser().parse_args(argv)
+    if args.with_node and args.watch:
+        print("grasp-torque-demo: error: --watch and --with-node exclude each other",
+              file=sys.stderr)
+        return 2
+    if not args.watch:
+        _isolate()
+    from grasp_torque_opt.core.exceptions import InputError
+    from grasp_torque_opt.core.resources import find_config
+
+    try:
+        params = find_config(args.params, "--params")
+        scenario = find_config(_scenario_of(params))
+    except InputError as e:
+        print(f"grasp-torque-demo: error: {e}", file=sys.stderr)
+        return 2
+    child = None
+    if args.with_node:
+        child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--ros-args",
+                                  "--params-file", str(params), "--log-level", "error"])
+    try:
+        return _play(args, scenario)
+    finally:
+        if child is not None:
+            child.send_signal(signal.SIGINT)
+            try:
+                child.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                child.kill()
+
+
+def _play(args: argparse.Namespace, scenario: Path) -> int:
+    import pinocchio as pin
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
+    from grasp_torque_opt.ros.node import COMMAND_QOS
+
+    setup = GraspSetup.from_file(scenario)
+    hand = setup.hand
+    names = hand.one_dof_joints(hand.model)
+    idx_q = [hand.model.joints[hand.model.getJointId(n)].idx_q for n in names]
+    base = hand.base_frame
+    limits = hand.torque_limits
+
+    rclpy.init()
+    node = rclpy.create_node("grasp_demo_driver")
+    js_pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    contacts_pub = node.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
+    wrench_pub = node.create_publisher(WrenchStamped, "external_wrench",
+                                       qos_profile_sensor_data)
+    received: list[tuple[float, np.ndarray]] = []
+    diag: dict[str, str] = {}
+    solve_times: list[float] = []
+    bad = 0
+
+    def on_command(msg: Float64MultiArray) -> None:
+        nonlocal bad
+        cmd = np.array(msg.data)
+        if cmd.shape != limits.shape or not np.all(np.isfinite(cmd)) or \
+                np.any(np.abs(cmd) > limits):
+            bad += 1
+        received.append((time.monotonic(), cmd))
+
+    def on_diagnostics(msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            if status.name.startswith("grasp_torque_node"):
+                diag.clear()
+                diag.update({kv.key: kv.value for kv in status.values})
+                diag["message"] = status.message
+                if "solve_time_s" in diag:
+                    solve_times.append(float(diag["solve_time_s"]))
+
+    node.create_subscription(Float64MultiArray, "effort_commands", on_command, COMMAND_QOS)
+    node.create_subscription(DiagnosticArray, "/diagnostics", on_diagnostics, 10)
+
+    domain = os.environ.get("ROS_DOMAIN_ID", "0")
+    if args.watch:
+        print(f"grasp-torque-demo: watching effort_commands and /diagnostics for "
+              f"{args.duration:g} s (ROS_DOMAIN_ID {domain})")
+    else:
+        print(f"grasp-torque-demo: {scenario.name}, {hand.m} joints, joint states at "
+              f"{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID {domain})")
+    deadline = time.monotonic() + 30.0
+    while node.count_subscribers("joint_states") == 0 and time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    if node.count_subscribers("joint_states") == 0 and not args.watch:
+        print("grasp-torque-demo: no grasp_torque_node is listening on joint_states",
+              file=sys.stderr)
+        node.destroy_node()
+        rclpy.try_shutdown()
+        return 1
+
+    period = 1.0 / args.rate
+    t0 = time.monotonic()
+    next_tick, next_print, next_slow = t0, t0 + 1.0, t0
+    last_count = 0
+    q = setup.q.copy()
+    while (now := time.monotonic()) < t0 + args.duration:
+        if now >= next_tick and not args.watch:
+            next_tick += period
+            t = now - t0
+            for k, iq in enumerate(idx_q):
+                q[iq] = setup.q[iq] + args.amplitude * np.sin(2 * np.pi * 0.5 * t + 0.4 * k)
+            js = JointState(name=list(names), position=[float(q[i]) for i in idx_q],
+                            effort=[float("nan")] * len(names))
+            js.header.stamp = node.get_clock().now().to_msg()
+            js_pub.publish(js)
+            if now >= next_slow:  # contacts and load at 50 Hz
+                next_slow += 0.02
+                maps = compute_grasp_maps(hand, q, setup.contacts, setup.object_origin)
+                poses = PoseArray()
+                poses.header.frame_id, poses.header.stamp = base, js.header.stamp
+                for frame in maps.contacts:
+                    x, y, z, w = pin.Quaternion(frame.rotation).coeffs()
+                    pose = Pose()
+                    pose.position.x, pose.position.y, pose.position.z = map(float,
+                                                                            frame.position)
+                    pose.orientation.x, pose.orientation.y = float(x), float(y)
+                    pose.orientation.z, pose.orientation.w = float(z), float(w)
+                    poses.poses.append(pose)
+                contacts_pub.publish(poses)
+                ws = WrenchStamped()
+                ws.header.frame_id, ws.header.stamp = base, js.header.stamp
+                F, M = setup.external_wrench[:3], setup.external_wrench[3:]
+                ws.wrench.force.x, ws.wrench.force.y, ws.wrench.force.z = map(float, F)
+                ws.wrench.torque.x, ws.wrench.torque.y, ws.wrench.torque.z = map(float, M)
+                wrench_pub.publish(ws)
+        if now >= next_print:
+            next_print += 1.0
+            n = len(received) - last_count
+            last_count = len(received)
+            norm = np.linalg.norm(received[-1][1]) if received else float("nan")
+            solve_ms = 1e3 * float(diag.get("solve_time_s", "nan"))
+            if args.watch:
+                next_tick = next_print
+            print(f"t={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  "
+                  f"|command| {norm:.4f} N m  status {diag.get('status', '-')}  "
+                  f"fault {diag.get('fault', '-')}")
+        rclpy.spin_once(node, timeout_sec=max(0.0, min(next_tick, next_print)
+                                                   - time.monotonic()))
+    played = dict(diag)  # the node's state while joint states flowed
+    end = time.monotonic() + 0.2  # the last commands in flight
+    while time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.02)
+
+    sent = "" if args.watch else f" for about {int(args.duration * args.rate)} joint states"
+    norms = [np.linalg.norm(c) for _, c in received]
+    print(f"summary: {len(received)} commands{sent} "
+          f"({len(received) / args.duration:.1f}/s); malformed {bad}; "
+          + (f"|command| {min(norms):.4f} to {max(norms):.4f} N m; " if norms else "")
+          + (f"solve time median {1e3 * np.median(solve_times):.3f} ms (diagnostics); "
+             if solve_times else "")
+          + f"node cycles {played.get('cycles', '-')}, faults {played.get('faults', '-')}, "
+          f"rejected joint states {played.get('rejected.joint_states', '-')}, "
+          f"last status {played.get('status', '-')}")
+    node.destroy_node()
+    rclpy.try_shutdown()
+    return 0 if (received or args.watch) and bad == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

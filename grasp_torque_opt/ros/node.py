@@ -1,0 +1,592 @@
+"""ROS 2 node ``grasp_torque_node``: certified grasp torques every cycle, and a solve service.
+
+A thin adapter over :class:`grasp_torque_opt.control.controller.TorqueController`:
+messages in, plain arrays to the controller, its decisions out. Interface
+pinned in docs/design.md section 4; parameters, units and defaults in docs/node.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import signal
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import Point, PoseArray, WrenchStamped
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    SetParametersResult,
+)
+from rclpy.duration import Duration
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
+from rclpy.utilities import remove_ros_args
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+from visualization_msgs.msg import Marker, MarkerArray
+
+from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.control import diagnostics
+from grasp_torque_opt.control.controller import (
+    POLICIES,
+    CycleConfig,
+    CycleResult,
+    TorqueController,
+    stamp_seconds,
+)
+from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.report import solution_dict
+from grasp_torque_opt.core.resources import find_config
+from grasp_torque_opt.core.scenario import load_scenario
+
+NODE_NAME = "grasp_torque_node"
+#: Commands: reliable, only the newest matters.
+COMMAND_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
+#: ~/solve: reliable, up to 100 queued requests (the default 10 dropped a planner's burst).
+SERVICE_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One parameter: description (with unit), range, and whether it can change at run time."""
+
+    description: str
+    low: float | None = None
+    high: float | None = None
+    read_only: bool = False
+    length: str | None = None  # "joints" or a number, for arrays
+
+
+#: Every parameter, declared in this order. Defaults come from the scenario.
+PARAMETERS: dict[str, Spec] = {
+    "scenario": Spec("Scenario file (docs/design.md section 4): hand, default contacts and load. "
+                     "A path, or the name of a bundled file in the package's config/.",
+                     read_only=True),
+    "robot_description": Spec("URDF document of the hand (the ROS convention) or a path to "
+                              "one; empty: the scenario's hand.urdf.", read_only=True),
+    "joints": Spec("Actuated joints in command order (default: the scenario's).",
+                   read_only=True),
+    "object_origin": Spec("Object origin c in the base frame [m].", length="3"),
+    "mu_tangential": Spec("Tangential friction coefficient mu1 [-].", 1e-6, 10.0),
+    "mu_torsional": Spec("Torsional friction coefficient mu2 [m].", 1e-9, 1.0),
+    "polygon_sides": Spec("Sides N of the inscribed friction polygon [-].", 3, 64),
+    "min_normal_force": Spec("Minimum normal force per contact [N].", 0.0, 1000.0),
+    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint.",
+                          length="joints"),
+    "weights": Spec("Objective weights W (diagonal), per joint [-].", length="joints"),
+    "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
+                                 "limits then bound the sum."),
+    "gravity": Spec("Gravity in the base frame [m/s^2].", length="3"),
+    "joint_state_timeout": Spec("Joint states older than this stop commands [s].", 1e-4, 10.0),
+    "contacts_timeout": Spec("Once contacts arrived, older than this stop commands [s]; "
+                             "0: never stale.", 0.0, 60.0),
+    "wrench_timeout": Spec("Once a load arrived, older than this stops commands [s]; "
+                           "0: never stale.", 0.0, 60.0),
+    "hold_time": Spec("How long a fault may hold the last certified command before the "
+                      "fault policy applies [s].", 0.0, 60.0),
+    "fault_policy": Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
+                         "controller keeps the last certified command) or 'zero' (publish "
+                         "zero torques)."),
+    "max_joint_state_entries": Spec("A joint state with more names or positions than this is "
+                                    "rejected unread [-].", 1, 100000),
+    "max_wrench_force": Spec("A load whose force norm exceeds this is rejected [N].",
+                             1e-6, 1e6),
+    "max_wrench_torque": Spec("A load whose moment norm exceeds this is rejected [N m].",
+                              1e-6, 1e6),
+    "max_contact_distance": Spec("A contact point farther than this from the base origin "
+                                 "stops commands [m].", 1e-3, 100.0),
+    "stamp_future_tolerance": Spec("A header stamp more than this ahead of the node's clock "
+                                   "is rejected [s].", 0.0, 3600.0),
+    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun) [s].",
+                         1e-4, 10.0),
+    "solver.backend": Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
+                           "without internal-force variables only); every result is "
+                           "certified whichever solves it."),
+    "solver.fallback": Spec("Backend asked in the same cycle when solver.backend gives nothing "
+                            "certifiable ('none': no second try); its answer is certified "
+                            "the same way and counted (diagnostics solver.fallback_solves)."),
+    "solver.warm_start": Spec("Start each DAQP solve from the previous cycle's active set; an "
+                              "answer that is not optimal (flag, KKT check) or not certified is "
+                              "redone cold in "
+                              "the same cycle and counted (diagnostics "
+                              "solver.warm_start_fallbacks). No effect on other backends."),
+    "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
+                           "[-].", 1e-12, 1e-4),
+    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 100000),
+    "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
+    "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
+                                  1e-12, 1e-2),
+    "diagnostics_period": Spec("Period of /diagnostics and ~/contact_wrenches [s].",
+                               1e-3, 60.0, read_only=True),
+    "watchdog_period": Spec("Period of the staleness check between joint states [s].",
+                            1e-4, 1.0, read_only=True),
+    "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
+    "publish_stamped_command": Spec("Also publish each command on ~/effort_commands_stamped "
+                                    "(sensor_msgs/JointState: joints, effort, and the stamp of "
+                                    "the joint state it was computed from).", read_only=True),
+}
+
+
+def descriptor(name: str) -> ParameterDescriptor:
+    """The ParameterDescriptor of a parameter of :data:`PARAMETERS`."""
+    spec = PARAMETERS[name]
+    d = ParameterDescriptor(name=name, description=spec.description, read_only=spec.read_only)
+    if spec.low is not None and isinstance(spec.low, int) and isinstance(spec.high, int):
+        d.integer_range = [IntegerRange(from_value=spec.low, to_value=spec.high, step=1)]
+    elif spec.low is not None:
+        d.floating_point_range = [FloatingPointRange(from_value=float(spec.low),
+                                                     to_value=float(spec.high), step=0.0)]
+    return d
+
+
+#: Values of ``solver.fallback``.
+FALLBACKS = (*BACKENDS, "none")
+
+
+def _fallback(backend: str, fallback: str) -> str | None:
+    """The fallback backend to build: None for 'none' or the backend itself."""
+    return None if fallback in ("none", backend) else fallback
+
+
+def check(name: str, value: Any, m: int) -> str:
+    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too."""
+    spec = PARAMETERS[name]
+    if name == "fault_policy":
+        return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
+    if name == "solver.backend":
+        return "" if value in BACKENDS else f"{name}: must be one of {', '.join(BACKENDS)}"
+    if name == "solver.fallback":
+        return "" if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
+    if spec.length is not None:
+        n = m if spec.length == "joints" else int(spec.length)
+        values = list(value)
+        if len(values) != n:
+            return f"{name}: must have {n} entries, got {len(values)}"
+        if not all(math.isfinite(v) for v in values):
+            return f"{name}: must be finite"
+        if name in ("torque_limits", "weights") and not all(v > 0 for v in values):
+            return f"{name}: every entry must be > 0"
+        return ""
+    if isinstance(value, float) and not math.isfinite(value):
+        return f"{name}: must be finite"
+    if spec.low is not None and not (spec.low <= value <= spec.high):
+        return f"{name}: must be in [{spec.low}, {spec.high}], got {value}"
+    return ""
+
+
+class GraspTorqueNode(Node):
+    """Publishes certified effort commands on each joint state; answers ``~/solve``."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self._lock = threading.Lock()
+        setup = self._load_setup()
+        self._m = setup.hand.m
+        defaults = {
+            "object_origin": [float(x) for x in setup.object_origin],
+            "mu_tangential": setup.friction.mu1,
+            "mu_torsional": setup.friction.mu2,
+            "polygon_sides": setup.friction.sides,
+            "min_normal_force": setup.friction.min_normal_force,
+            "torque_limits": [float(x) for x in setup.hand.torque_limits],
+            "weights": [float(x) for x in setup.weights],
+            "gravity_compensation": False,
+            "gravity": [0.0, 0.0, -9.81],
+            "joint_state_timeout": 0.1,
+            "contacts_timeout": 0.5,
+            "wrench_timeout": 0.5,
+            "hold_time": 0.1,
+            "fault_policy": "hold",
+            "max_joint_state_entries": CycleConfig.max_joint_state_entries,
+            "max_wrench_force": CycleConfig.max_wrench_force,
+            "max_wrench_torque": CycleConfig.max_wrench_torque,
+            "max_contact_distance": CycleConfig.max_contact_distance,
+            "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
+            "cycle_budget": CycleConfig.cycle_budget,
+            "solver.backend": BACKENDS[0],
+            "solver.fallback": "daqp",
+            "solver.warm_start": False,
+            "solver.eps_abs": ProxSuiteSettings.eps_abs,
+            "solver.max_iter": ProxSuiteSettings.max_iter,
+            "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
+            "certificate_tolerance": CycleConfig.certificate_tolerance,
+            "diagnostics_period": 0.1,
+            "watchdog_period": 0.01,
+            "marker_scale": 0.02,
+            "publish_stamped_command": False,
+        }
+        for name, value in defaults.items():
+            self.declare_parameter(name, value, descriptor(name))
+        for name in defaults:
+            reason = check(name, self.get_parameter(name).value, self._m)
+            if reason:
+                raise InputError(name, reason.split(": ", 1)[1])
+        self._base_setup = setup
+        backend = self.get_parameter("solver.backend").value
+        warm = self.get_parameter("solver.warm_start").value
+        fallback = _fallback(backend, self.get_parameter("solver.fallback").value)
+        self.controller = TorqueController(*self._configure(setup, self._params()), backend,
+                                           warm, fallback)
+        # The service solves snapshots out of sequence: always cold.
+        self._service_controller = TorqueController(*self._configure(
+            dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
+            backend, False, fallback)
+        self.add_on_set_parameters_callback(self._validate_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+
+        self.create_subscription(JointState, "joint_states", self._on_joint_state,
+                                 qos_profile_sensor_data)
+        self.create_subscription(PoseArray, "contacts", self._on_contacts,
+                                 qos_profile_sensor_data)
+        self.create_subscription(WrenchStamped, "external_wrench", self._on_wrench,
+                                 qos_profile_sensor_data)
+        self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
+                                                  COMMAND_QOS)
+        self._stamped_pub = None
+        if self.get_parameter("publish_stamped_command").value:
+            self._stamped_pub = self.create_publisher(JointState, "~/effort_commands_stamped",
+                                                      COMMAND_QOS)
+        self._marker_pub = self.create_publisher(MarkerArray, "~/contact_wrenches", 1)
+        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        # The service solves in a worker thread while the executor goes on with the loop.
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
+        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS)
+        self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
+        self.create_timer(self.get_parameter("diagnostics_period").value,
+                          self._on_diagnostics)
+        self.get_logger().info(
+            f"{self._m} joints, {len(setup.contacts)} default contacts; "
+            f"commands on {self._command_pub.topic_name}")
+
+    # -- configuration --------------------------------------------------------------------
+
+    def _load_setup(self) -> GraspSetup:
+        name = self.declare_parameter("scenario", "", descriptor("scenario")).value
+        urdf = self.declare_parameter("robot_description", "",
+                                      descriptor("robot_description")).value
+        if not name:
+            raise InputError("scenario", "parameter not set (a scenario file gives the "
+                             "default contacts and load)")
+        scenario = load_scenario(find_config(name))
+        if urdf and not urdf.lstrip().startswith("<"):
+            urdf = find_config(urdf, "robot_description").read_text()
+        setup = GraspSetup.from_scenario(scenario, urdf or None)
+        joints = self.declare_parameter("joints", list(setup.hand.joints),
+                                        descriptor("joints")).value
+        if list(joints) != list(setup.hand.joints):
+            setup = GraspSetup.from_scenario(dataclasses.replace(scenario, joints=list(joints)),
+                                             urdf or None)
+        return setup
+
+    def _params(self) -> dict[str, Any]:
+        return {name: self.get_parameter(name).value for name in PARAMETERS}
+
+    def _configure(self, setup: GraspSetup, p: dict[str, Any]
+                   ) -> tuple[GraspSetup, CycleConfig, ProxSuiteSettings]:
+        """The controller's setup, cycle settings and solver settings from parameter values."""
+        hand = setup.hand
+        if not np.array_equal(hand.torque_limits, p["torque_limits"]):
+            hand = dataclasses.replace(hand, torque_limits=np.array(p["torque_limits"]))
+        setup = dataclasses.replace(
+            setup, hand=hand, object_origin=np.array(p["object_origin"]),
+            weights=np.array(p["weights"]),
+            friction=dataclasses.replace(setup.friction, mu1=p["mu_tangential"],
+                                         mu2=p["mu_torsional"], sides=p["polygon_sides"],
+                                         min_normal_force=p["min_normal_force"]))
+        config = CycleConfig(
+            joint_state_timeout=p["joint_state_timeout"],
+            contacts_timeout=p["contacts_timeout"], wrench_timeout=p["wrench_timeout"],
+            hold_time=p["hold_time"], fault_policy=p["fault_policy"],
+            gravity_compensation=p["gravity_compensation"], gravity=tuple(p["gravity"]),
+            certificate_tolerance=p["certificate_tolerance"],
+            max_joint_state_entries=p["max_joint_state_entries"],
+            max_wrench_force=p["max_wrench_force"], max_wrench_torque=p["max_wrench_torque"],
+            max_contact_distance=p["max_contact_distance"],
+            stamp_future_tolerance=p["stamp_future_tolerance"],
+            cycle_budget=p["cycle_budget"])
+        solver = ProxSuiteSettings(eps_abs=p["solver.eps_abs"], max_iter=p["solver.max_iter"],
+                                   max_iter_in=p["solver.max_iter_in"])
+        return setup, config, solver
+
+    def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        for param in params:
+            if param.name in PARAMETERS:
+                reason = check(param.name, param.value, self._m)
+                if reason:
+                    return SetParametersResult(successful=False, reason=reason)
+        return SetParametersResult(successful=True)
+
+    def _apply_parameters(self, params: list[Parameter]) -> None:
+        p = self._params()
+        with self._lock:
+            warm_loop = p["solver.warm_start"] and p["solver.backend"] == "daqp"
+            for ctrl, warm in ((self.controller, warm_loop), (self._service_controller, False)):
+                setup, config, solver = self._configure(ctrl.setup, p)
+                ctrl.setup, ctrl.config = setup, config
+                if solver != ctrl.solver.settings or \
+                        p["solver.backend"] != getattr(ctrl.solver, "name", None) or \
+                        warm != getattr(ctrl.solver, "warm_start", False):
+                    ctrl.solver = make_solver(p["solver.backend"], solver, warm)
+                fallback = _fallback(p["solver.backend"], p["solver.fallback"])
+                if fallback != getattr(ctrl.fallback, "name", None) or \
+                        (ctrl.fallback is not None and ctrl.fallback.settings != solver):
+                    ctrl.fallback = make_solver(fallback, solver) if fallback else None
+
+    # -- inputs and cycle -----------------------------------------------------------------
+
+    def _clock_now(self) -> float:
+        """Now on the node's clock (ROS time), the clock of header stamps [s]."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _on_joint_state(self, msg: JointState) -> None:
+        now = time.monotonic()
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        with self._lock:
+            try:
+                # Sizes first: an oversized message is not even copied.
+                self.controller.check_size("joint_states",
+                                           max(len(msg.name), len(msg.position)))
+                self.controller.update_joint_state(list(msg.name), list(msg.position), now,
+                                                   stamp, self._clock_now())
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                return
+            self._publish(self.controller.cycle(now), msg.header.stamp)
+
+    def _on_contacts(self, msg: PoseArray) -> None:
+        now = time.monotonic()
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        with self._lock:
+            try:
+                self.controller.check_size("contacts", len(msg.poses))
+                positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
+                quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
+                         for p in msg.poses]
+                self.controller.update_contacts(msg.header.frame_id, np.array(positions),
+                                                np.array(quats), now, stamp, self._clock_now())
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+
+    def _on_wrench(self, msg: WrenchStamped) -> None:
+        now = time.monotonic()
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        f, t = msg.wrench.force, msg.wrench.torque
+        with self._lock:
+            try:
+                self.controller.update_wrench(msg.header.frame_id, [f.x, f.y, f.z],
+                                              [t.x, t.y, t.z], now, stamp, self._clock_now())
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+
+    def _on_watchdog(self) -> None:
+        with self._lock:
+            result = self.controller.watchdog(time.monotonic())
+            if result is not None:
+                self._publish(result)
+
+    def _publish(self, result: CycleResult, stamp: Any = None) -> None:
+        if result.fault:
+            self.get_logger().warn(f"no command: {result.fault}", throttle_duration_sec=1.0)
+        if result.command is None:
+            return
+        cmd = result.command
+        # The node's own promise, whatever the controller decided.
+        if cmd.shape != (self._m,) or not np.all(np.isfinite(cmd)) or \
+                np.any(np.abs(cmd) > self.controller.setup.hand.torque_limits):
+            self.get_logger().error("refused to publish a malformed command")
+            return
+        data = [float(x) for x in cmd]
+        self._command_pub.publish(Float64MultiArray(data=data))
+        if self._stamped_pub is not None:
+            msg = JointState(name=list(self.controller.setup.hand.joints), effort=data)
+            msg.header.stamp = stamp if stamp is not None else self.get_clock().now().to_msg()
+            msg.header.frame_id = self.controller.setup.hand.base_frame
+            self._stamped_pub.publish(msg)
+
+    # -- outputs between cycles -----------------------------------------------------------
+
+    def _on_diagnostics(self) -> None:
+        with self._lock:
+            rep = diagnostics.report(self.controller, time.monotonic())
+            last = self.controller.last
+            base = self.controller.setup.hand.base_frame
+        stamp = self.get_clock().now().to_msg()
+        status = DiagnosticStatus(level=bytes([rep.level]), name=f"{self.get_name()}: grasp "
+                                  "torques", message=rep.message, hardware_id=base,
+                                  values=[KeyValue(key=k, value=v) for k, v in rep.values])
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = stamp
+        self._diag_pub.publish(msg)
+        self._marker_pub.publish(self._markers(last, base, stamp))
+
+    def _markers(self, last: CycleResult | None, base: str, stamp) -> MarkerArray:
+        clear = Marker(action=Marker.DELETEALL)
+        if last is None or last.kind != "solution":
+            return MarkerArray(markers=[clear])
+        scale = self.get_parameter("marker_scale").value
+        markers = [clear]
+        for i, (frame, w) in enumerate(zip(last.maps.contacts, last.solution.wrenches)):
+            force = frame.rotation @ w[:3]
+            start, end = frame.position, frame.position + scale * force
+            m = Marker(type=Marker.ARROW, action=Marker.ADD, ns="contact_force", id=i)
+            m.header.frame_id, m.header.stamp = base, stamp
+            m.points = [Point(x=float(start[0]), y=float(start[1]), z=float(start[2])),
+                        Point(x=float(end[0]), y=float(end[1]), z=float(end[2]))]
+            m.pose.orientation.w = 1.0
+            m.scale.x, m.scale.y, m.scale.z = 0.002, 0.004, 0.004
+            m.color.g, m.color.a = 0.8, 1.0
+            markers.append(m)
+        return MarkerArray(markers=markers)
+
+    # -- the service ----------------------------------------------------------------------
+
+    async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
+                        ) -> Trigger.Response:
+        with self._lock:
+            inputs = self.controller.inputs
+        done = Future(executor=self.executor)
+        done.add_done_callback(lambda _: None)  # completion wakes the executor
+        self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
+        await done
+        response.success, response.message = done.result()
+        return response
+
+    def _solve_for_service(self, inputs: Any, now: float, done: Future) -> None:
+        """One solve on a snapshot of the inputs, with the service's own controller
+        (own Pinocchio data and ProxSuite workspace): (success, CLI JSON or reason)."""
+        ctrl = self._service_controller
+        try:
+            stale = ctrl.stale(now, inputs)
+            if stale:
+                done.set_result((False, f"cannot solve: {stale}"))
+                return
+            sol, maps, g = ctrl.solve_inputs(inputs)
+            cmd, _ = ctrl.gate(sol, g)
+            d = solution_dict(sol, maps)
+            d["command"] = None if cmd is None else [float(x) for x in cmd]
+            d["gravity_torque"] = None if g is None else [float(x) for x in g]
+            done.set_result((cmd is not None, json.dumps(d)))
+        except Exception as e:  # noqa: BLE001 -- the caller gets the reason, the node lives on
+            done.set_result((False, f"cannot solve: {type(e).__name__}: {e}"))
+
+    def safe_stop(self) -> bool:
+        """The safe action when the node stops, per ``fault_policy``.
+
+        ``zero``: publish zero torques once and wait (up to 0.5 s) for the
+        subscribers to acknowledge them, since the effort controller would keep
+        the last command forever. ``hold``: nothing (the last certified command
+        stays, as during a fault). Nothing either before the first command.
+
+        Returns:
+            True if zero torques were published.
+        """
+        with self._lock:
+            if self.controller.config.fault_policy != "zero" or \
+                    self.controller.counters.commands == 0 or not self.context.ok():
+                return False
+            self._command_pub.publish(Float64MultiArray(data=[0.0] * self._m))
+        self._command_pub.wait_for_all_acked(Duration(seconds=0.5))
+        self.get_logger().info("stopped: zero torques published (fault_policy zero)")
+        return True
+
+    def destroy_node(self) -> None:
+        """The safe action, then stop the service worker and the node."""
+        self.safe_stop()
+        self._worker.shutdown(wait=True, cancel_futures=True)
+        super().destroy_node()
+
+
+#: Signal that asked ``main`` to stop (None: none yet).
+_stop_signal: int | None = None
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    """SIGINT/SIGTERM: ask ``main``'s spin loop to end; the node then stops cleanly.
+
+    Only a flag: an exception raised here would surface at whatever bytecode the main
+    thread runs next -- inside rclpy's executor (between a handle's ``__enter__`` and its
+    exit), inside the events executor's C++ callback loop, or inside a ``__del__``, where
+    Python drops it and the node spins on. A second signal raises KeyboardInterrupt (a way
+    out should the stop itself hang).
+    """
+    global _stop_signal
+    if _stop_signal is not None:
+        raise KeyboardInterrupt
+    _stop_signal = signum
+
+
+#: Executors ``main`` can spin: rclpy's default and its experimental events executor.
+EXECUTORS = {"single": SingleThreadedExecutor, "events": EventsExecutor}
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the node (Jazzy pattern): spin, then destroy and shut down.
+
+    Besides the ROS arguments, ``--executor single|events`` picks the executor.
+    """
+    global _stop_signal
+    argv = sys.argv if args is None else args
+    parser = argparse.ArgumentParser(prog=NODE_NAME)
+    parser.add_argument("--executor", choices=sorted(EXECUTORS), default="single",
+                        help="rclpy executor to spin (default: single)")
+    opts = parser.parse_args(remove_ros_args(argv)[1:])
+    single_threaded_math()
+    # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the safe
+    # action could publish; here both end the spin loop and the context stays valid.
+    # SIGINT explicitly too: a process started from a background job inherits it ignored.
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    _stop_signal = None
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    node = None
+    executor = None
+    code = 0
+    try:
+        node = GraspTorqueNode()
+        # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
+        # the single-threaded one keeps up (the service runs in its own worker).
+        executor = EXECUTORS[opts.executor]()
+        executor.add_node(node)
+        # A spin_once loop, so that the stop flag is seen: each wait ends by the next
+        # watchdog tick at the latest. (EventsExecutor.spin() also delivered no subscription
+        # callback with these wheels, rclpy 7.1.6 and Fast DDS, while keeping a core busy.)
+        timeout = 1.0 if opts.executor == "events" else None
+        while _stop_signal is None and rclpy.ok():
+            executor.spin_once(timeout_sec=timeout)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except GraspTorqueError as e:
+        print(f"{NODE_NAME}: error: {e}", file=sys.stderr)
+        code = 2
+    finally:
+        if executor is not None:
+            executor.shutdown(timeout_sec=1.0)  # its callbacks are off the entities first
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return code
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,215 @@
+"""Every QP backend: the same certified optimum as an independent solver, and no stall on bad data."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from independent import assert_holds
+
+from grasp_torque_opt.backends import BACKENDS, DaqpSolver, make_solver
+from grasp_torque_opt.backends.daqp import kkt_violation
+from grasp_torque_opt.core.exceptions import SolverError
+from grasp_torque_opt.core.tau_qp import build_tau_qp
+from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.reference.force_qp import solve_force_qp
+
+
+def force_space_optimum(setup, maps):
+    """tau of the force-space QP with the torque objective (Clarabel), or None if infeasible."""
+    raw = solve_force_qp(maps, setup.friction, setup.external_wrench, *setup.tau_bounds,
+                         setup.weights, objective="torque")
+    return None if raw.status != "solved" else maps.J.T @ raw.x
+
+
+@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+def test_allegro_backends_match_clarabel_on_seeded_loads(backend, allegro):
+    rng = np.random.default_rng(7)
+    solver = make_solver(backend)
+    maps = allegro.maps()
+    checked = 0
+    for _ in range(20):
+        w = allegro.external_wrench * rng.uniform(0.3, 1.5) + np.concatenate(
+            (rng.normal(scale=0.3, size=3), rng.normal(scale=0.01, size=3)))
+        setup = dataclasses.replace(allegro, external_wrench=w)
+        ours = solve(setup, maps=maps, solver=solver)
+        ref = force_space_optimum(setup, maps)
+        if ref is None:
+            assert ours.status == "infeasible"
+            continue
+        assert ours.status == "optimal", ours.message
+        assert_holds(setup, maps, ours.tau, ours.wrenches)
+        np.testing.assert_allclose(ours.tau, ref, atol=1e-5)
+        checked += 1
+    assert checked >= 15
+
+
+@pytest.mark.parametrize("name", ["planar", "hyperstatic"])
+def test_daqp_handles_internal_force_variables(name, request):
+    """z has no cost there (semidefinite Hessian): DAQP's proximal iterations still find tau*."""
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    ours = solve(setup, maps=maps, backend="daqp")
+    assert ours.status == "optimal", ours.message
+    np.testing.assert_allclose(ours.tau, force_space_optimum(setup, maps), atol=1e-5)
+
+
+def test_quadprog_refuses_a_semidefinite_qp(planar):
+    sol = solve(planar, backend="quadprog")
+    assert sol.status == "failed" and sol.tau is None
+    assert "positive definite" in sol.message
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_infeasible_load_is_not_passed_through(backend, allegro):
+    heavy = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * 1e4)
+    sol = solve(heavy, backend=backend)
+    assert sol.status == "infeasible" and sol.tau is None
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("defect", ["nan_in_C", "inf_in_u", "inverted_box", "nan_box"])
+def test_bad_qp_data_never_reaches_the_solver(backend, defect, allegro):
+    maps = allegro.maps()
+    qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
+                      allegro.weights)
+    if defect == "nan_in_C":
+        C = qp.C.copy()
+        C[3, 2] = np.nan
+        qp = dataclasses.replace(qp, C=C)
+    elif defect == "inf_in_u":
+        qp = dataclasses.replace(qp, u=np.where(np.arange(qp.u.size) == 0, np.inf, qp.u))
+    elif defect == "inverted_box":
+        qp = dataclasses.replace(qp, l_box=qp.u_box + 0.1)
+    else:
+        qp = dataclasses.replace(qp, u_box=np.full_like(qp.u_box, np.nan))
+    raw = make_solver(backend).solve(qp)
+    assert raw.status == "error" and raw.x is None
+    assert "QP" in raw.message
+
+
+def test_unknown_backend_is_named():
+    with pytest.raises(ValueError, match="proxsuite, daqp, quadprog.*'osqp'"):
+        make_solver("osqp")
+
+
+def moving_sequence(setup, steps):
+    """A slowly rotating load with the fingers drifting: what the node sees cycle to cycle."""
+    scale = np.linalg.norm(setup.external_wrench[:3])
+    for k in range(steps):
+        th = 2 * np.pi * k / steps
+        w = setup.external_wrench.copy()
+        w[:3] = scale * np.array([np.cos(th), 0.2 * np.sin(3 * th), -abs(np.sin(th)) - 0.3])
+        q = setup.q.copy()
+        q[setup.hand.idx_q] += 0.03 * np.sin(th)
+        yield dataclasses.replace(setup, external_wrench=w, q=q)
+
+
+@pytest.mark.parametrize("name", ["planar", "allegro"])
+def test_daqp_warm_start_gives_the_cold_optimum(name, request):
+    setup = request.getfixturevalue(name)
+    cold, warm = make_solver("daqp"), make_solver("daqp", warm_start=True)
+    for s in moving_sequence(setup, 40):
+        maps = s.maps()
+        a, b = solve(s, maps=maps, solver=cold), solve(s, maps=maps, solver=warm)
+        assert a.status == b.status
+        if a.optimal:
+            np.testing.assert_allclose(b.tau, a.tau, atol=1e-8)
+    assert warm.warm_solves == 39 and cold.warm_solves == 0
+
+
+def test_daqp_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro):
+    """From a feasible grasp's active set to an infeasible load and back: each result is the
+    cold one, and every warm answer that was not optimal was redone cold (and counted)."""
+    warm = make_solver("daqp", warm_start=True)
+    heavy = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * 1e3)
+    assert solve(allegro, solver=warm).optimal
+    assert solve(heavy, solver=warm).status == "infeasible"
+    assert warm.fallbacks == 1  # the warm answer on the heavy load was not optimal
+    back = solve(allegro, solver=warm)
+    assert back.optimal
+    np.testing.assert_allclose(back.tau, solve(allegro, backend="daqp").tau, atol=1e-8)
+
+
+def test_kkt_violation_sees_a_suboptimal_point(allegro):
+    """The optimality check itself: the solver's point passes, a feasible detour does not."""
+    import daqp
+
+    maps = allegro.maps()
+    qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
+                      allegro.weights)
+    n, n_eq = qp.H.shape[0], qp.A.shape[0]
+    A = np.vstack((qp.A, qp.C))
+    lower = np.concatenate((qp.l_box, qp.b, np.full(qp.C.shape[0], -1e30)))
+    upper = np.concatenate((qp.u_box, qp.b, qp.u))
+    sense = np.zeros(n + A.shape[0], dtype=np.int32)
+    sense[n:n + n_eq] = 5
+    x, _, flag, info = daqp.solve(qp.H.copy(), qp.g, A, upper, lower, sense, primal_tol=1e-9)
+    assert flag == 1
+    lam = info["lam"]
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x, lam) < 1e-9
+    # Written out independently: stationarity with the full constraint matrix.
+    M = np.vstack((np.eye(n), A))
+    assert np.abs(qp.H @ x + qp.g + M.T @ lam).max() < 1e-9
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x * 1.01, lam) > 1e-4  # moved
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x, -lam) > 1e-4  # wrong signs
+    assert kkt_violation(qp.H, qp.g, A, lower, upper, x, np.zeros_like(lam)) > 1e-4
+
+
+class WrongAnswer:
+    """A first backend that claims SOLVED with a finite, wrong x (fault injection)."""
+
+    name = "wrong"
+
+    def __init__(self, raises: bool = False):
+        self.inner, self.raises = make_solver("proxsuite"), raises
+        self.settings = self.inner.settings
+
+    def solve(self, qp):
+        if self.raises:
+            raise SolverError("injected")
+        good = self.inner.solve(qp)
+        return dataclasses.replace(good, x=good.x + 0.05)
+
+
+@pytest.mark.parametrize("raises", [False, True])
+def test_fallback_backend_answers_when_the_first_fails(allegro, raises):
+    maps = allegro.maps()
+    alone = solve(allegro, maps=maps, solver=WrongAnswer()) if not raises else None
+    if alone is not None:
+        assert alone.status == "failed" and alone.tau is None
+    sol = solve(allegro, maps=maps, solver=WrongAnswer(raises), fallback=make_solver("daqp"))
+    assert sol.status == "optimal" and sol.backend == "daqp"
+    assert "fallback after" in sol.message
+    np.testing.assert_allclose(sol.tau, force_space_optimum(allegro, maps), atol=1e-5)
+    assert_holds(allegro, maps, sol.tau, sol.wrenches)
+
+
+def test_fallback_is_not_asked_when_the_first_backend_certifies(allegro):
+    class Counting:
+        name, calls = "counting", 0
+
+        def solve(self, qp):
+            Counting.calls += 1
+            return make_solver("daqp").solve(qp)
+
+    sol = solve(allegro, fallback=Counting())
+    assert sol.optimal and sol.backend == "proxsuite" and Counting.calls == 0
+
+
+def test_daqp_warm_answer_off_the_certificate_is_redone_cold(allegro):
+    """A warm answer that DAQP and the KKT check accept but the certificate refuses (injected:
+    the warm x moved by 5%) is solved again cold in the same call, and counted."""
+
+    class WrongWhenWarm(DaqpSolver):
+        def solve(self, qp, cold=False):
+            raw = super().solve(qp, cold)
+            return dataclasses.replace(raw, x=raw.x * 1.05) if self.last_warm else raw
+
+    warm = WrongWhenWarm(warm_start=True)
+    first = moving_sequence(allegro, 40)
+    assert solve(next(first), solver=warm).optimal  # cold: a new workspace
+    moved = next(first)
+    sol = solve(moved, solver=warm)
+    assert warm.warm_solves == 1 and warm.fallbacks == 1
+    assert sol.optimal and sol.backend == "daqp"
+    np.testing.assert_allclose(sol.tau, solve(moved, backend="daqp").tau, atol=1e-8)

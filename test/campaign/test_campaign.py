@@ -1,0 +1,314 @@
+"""The adversarial campaign, part 1: generated messages, parameter changes and failing
+solvers through a real node's own callbacks (no executor: every publish is seen), and
+generated scenario files through the CLI. Counts are printed at the end of the run."""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import dataclasses
+import io
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+import rclpy
+import yaml
+from campaign import CAMPAIGN, COUNTS, FLOATS, broken, check_command, mutated
+from conftest import ALLEGRO, PLANAR
+from cycle_inputs import FAULT_MODES, Injected, base_poses, joint_state
+from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from independent import assert_holds
+from rclpy.parameter import Parameter
+from rclpy.task import Future
+from ros_harness import DOMAIN
+from sensor_msgs.msg import JointState
+
+from grasp_torque_opt.cli import main as cli_main
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.core import scenario as schema
+from grasp_torque_opt.ros.node import GraspTorqueNode
+
+#: No cycle may take longer than this, whatever the input (the solver is capped).
+STALL = 1.0
+
+
+class Recorder:
+    """Stands in front of the node's command publisher: publishes for real, and keeps
+    each command with the controller's decision it came from."""
+
+    def __init__(self, node: GraspTorqueNode):
+        self.node, self.real, self.seen = node, node._command_pub, []
+        node._command_pub = self
+
+    def publish(self, msg) -> None:
+        self.real.publish(msg)
+        ctrl = self.node.controller  # publish follows the cycle at once: same inputs
+        # The controller as it is now (a shallow copy keeps this setup and config): a
+        # parameter change after the command must not be held against it.
+        self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs, copy.copy(ctrl)))
+
+    def __getattr__(self, name: str):
+        return getattr(self.real, name)  # e.g. wait_for_all_acked in the safe stop
+
+
+class Rig:
+    """A real node on a private domain; the campaign calls its callbacks directly."""
+
+    def __init__(self, scenario, setup, **params):
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=DOMAIN)
+        overrides = [Parameter("scenario", value=str(scenario))]
+        overrides += [Parameter(k, value=v) for k, v in params.items()]
+        self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
+        self.defaults = [Parameter(n, value=v) for n, v in self.node._params().items()
+                         if n not in ("scenario", "robot_description", "joints",
+                                      "diagnostics_period", "watchdog_period",
+                                      "publish_stamped_command")]
+        self.recorder = Recorder(self.node)
+        self.setup = setup
+        names, pos = joint_state(setup)
+        self.valid_js = JointState(name=names, position=pos, effort=[math.nan] * len(names))
+        self.valid_contacts = PoseArray()
+        for p, q in zip(*base_poses(setup)):
+            pose = Pose()
+            pose.position.x, pose.position.y, pose.position.z = (float(v) for v in p)
+            (pose.orientation.x, pose.orientation.y, pose.orientation.z,
+             pose.orientation.w) = (float(v) for v in q)
+            self.valid_contacts.poses.append(pose)
+        self.valid_wrench = WrenchStamped()
+        w = setup.external_wrench
+        f, t = self.valid_wrench.wrench.force, self.valid_wrench.wrench.torque
+        f.x, f.y, f.z, t.x, t.y, t.z = (float(v) for v in w)
+        model = setup.hand.model
+        self.names = names + [model.frames[i].name for i in range(0, len(model.frames), 3)]
+
+    def reset(self) -> None:
+        assert all(r.successful for r in self.node.set_parameters(self.defaults))
+        n = self.node
+        with n._lock:
+            n.controller = TorqueController(*n._configure(n._base_setup, n._params()))
+        self.recorder.seen.clear()
+
+    def close(self) -> None:
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
+
+
+def operations(rig: Rig, size: int) -> st.SearchStrategy:
+    """What can happen to a running node: messages, time, parameter changes, solvers."""
+    js = mutated(rig.valid_js, rig.names)
+    param = st.one_of(
+        st.tuples(st.sampled_from(["mu_tangential", "mu_torsional", "min_normal_force",
+                                   "hold_time", "joint_state_timeout", "max_wrench_force",
+                                   "max_contact_distance", "stamp_future_tolerance",
+                                   "cycle_budget", "certificate_tolerance"]), FLOATS),
+        st.tuples(st.sampled_from(["torque_limits", "weights", "object_origin", "gravity"]),
+                  st.lists(FLOATS, max_size=20)),
+        st.tuples(st.sampled_from(["polygon_sides", "solver.max_iter", "solver.max_iter_in",
+                                   "max_joint_state_entries"]), st.integers(-5, 300)),
+        st.tuples(st.just("fault_policy"), st.sampled_from(["hold", "zero", "", "explode"])),
+        st.tuples(st.just("gravity_compensation"), st.booleans()))
+    op = st.one_of(
+        st.tuples(st.just("joint_states"), js), st.tuples(st.just("joint_states"), js),
+        st.tuples(st.just("joint_states"), st.just(rig.valid_js)),
+        st.tuples(st.just("contacts"), mutated(rig.valid_contacts, rig.names)),
+        st.tuples(st.just("external_wrench"), mutated(rig.valid_wrench, rig.names)),
+        st.tuples(st.just("sleep"), st.sampled_from([0.005, 0.02, 0.05])),
+        st.tuples(st.just("watchdog"), st.none()),
+        st.tuples(st.just("solver"), st.sampled_from(FAULT_MODES + ["healthy"] * 4)),
+        st.tuples(st.just("param"), param))
+    return st.lists(op, min_size=1, max_size=size)
+
+
+def run(rig: Rig, ops) -> None:
+    """Apply the operations, then check every published command and the service."""
+    rig.reset()
+    node = rig.node
+    for kind, arg in ops:
+        COUNTS["inputs"] += 1
+        t0 = time.perf_counter()
+        if kind == "joint_states":
+            node._on_joint_state(arg)
+        elif kind == "contacts":
+            node._on_contacts(arg)
+        elif kind == "external_wrench":
+            node._on_wrench(arg)
+        elif kind == "sleep":
+            time.sleep(arg)
+        elif kind == "watchdog":
+            node._on_watchdog()
+        elif kind == "solver":
+            solver = Injected(arg if arg != "healthy" else FAULT_MODES[0])
+            solver.healthy = arg == "healthy"
+            node.controller.solver = solver
+        else:
+            name, value = arg
+            if isinstance(value, list) and name in ("torque_limits", "weights"):
+                value = [float(v) for v in value]
+            try:
+                node.set_parameters([Parameter(name, value=value)])
+            except Exception as e:  # noqa: BLE001 -- a refused type is fine; anything else not
+                assert type(e).__name__ in ("InvalidParameterTypeException",
+                                            "InvalidParameterValueException"), e
+        if kind != "sleep" and time.perf_counter() - t0 > STALL:
+            broken(f"{kind} took {time.perf_counter() - t0:.2f} s")
+    ctrl = node.controller
+    for cmd, decision, inputs, then in rig.recorder.seen:
+        check_command(cmd, rig.setup.hand.m, then.setup.hand.torque_limits)
+        if decision is None or decision.command is None or \
+                not np.array_equal(decision.command, cmd):
+            broken("a command that is not the controller's decision")
+        if decision.kind == "zero":
+            if np.any(cmd != 0.0):
+                broken("a zero-policy command that is not zero")
+            continue
+        sol = decision.solution
+        if decision.kind != "solution" or not sol.optimal or not sol.certificate.ok:
+            broken(f"a command from an uncertified solution ({decision.kind})")
+        if decision.cycle_time > then.config.cycle_budget:
+            broken(f"a command from a cycle over budget ({decision.cycle_time:.4f} s)")
+        # Independently of the package's certificate, at the inputs and parameters it was
+        # computed from (its limits are checked on the command above).
+        setup, _ = then.grasp_at(inputs)
+        try:
+            assert_holds(dataclasses.replace(setup, hand=dataclasses.replace(
+                setup.hand, torque_limits=np.full(rig.setup.hand.m, np.inf))),
+                decision.maps, sol.tau, sol.wrenches)
+        except AssertionError as e:
+            broken(f"a command fails the independent check: {e}")
+    # The service still answers, with a certified command or a reason.
+    done = Future()
+    node._solve_for_service(ctrl.inputs, time.monotonic(), done)
+    success, message = done.result()
+    if success:
+        d = json.loads(message)
+        check_command(d["command"], rig.setup.hand.m, ctrl.setup.hand.torque_limits)
+    elif not message.startswith("cannot solve: ") and \
+            json.loads(message).get("command", "missing") is not None:
+        broken(f"service failed without a reason: {message[:200]}")
+
+
+@pytest.fixture(scope="module")
+def planar_rig(planar):
+    rig = Rig(PLANAR, planar, joint_state_timeout=0.03, contacts_timeout=0.06,
+              wrench_timeout=0.06, hold_time=0.02, fault_policy="zero")
+    yield rig
+    rig.close()
+
+
+@pytest.fixture(scope="module")
+def allegro_rig(allegro):
+    rig = Rig(ALLEGRO, allegro, joint_state_timeout=0.03, hold_time=0.02,
+              gravity_compensation=True, gravity=[9.81, 0.0, 0.0])
+    yield rig
+    rig.close()
+
+
+def test_campaign_planar_node(planar_rig):
+    @settings(CAMPAIGN, max_examples=150)
+    @given(ops=operations(planar_rig, 14))
+    def campaign(ops):
+        run(planar_rig, ops)
+
+    before = COUNTS["commands"]
+    campaign()
+    assert COUNTS["commands"] > before  # the campaign reached the solver, not only checks
+
+
+def test_campaign_allegro_node(allegro_rig):
+    @settings(CAMPAIGN, max_examples=50)
+    @given(ops=operations(allegro_rig, 10))
+    def campaign(ops):
+        run(allegro_rig, ops)
+
+    before = COUNTS["commands"]
+    campaign()
+    assert COUNTS["commands"] > before
+
+
+# -- the CLI on generated scenario files ----------------------------------------------------
+
+
+def scenario_fields(doc: dict) -> list[tuple]:
+    """Paths of every field the schema allows, in a scenario document."""
+    out = [(section, key) for section, keys in schema._SECTIONS.items() for key in keys]
+    for i in range(len(doc["grasp"]["contacts"])):
+        out += [("grasp", "contacts", i, key) for key in schema._CONTACT_KEYS]
+    return out
+
+
+JUNK = st.one_of(FLOATS, st.none(), st.booleans(), st.integers(-10, 10), st.text(max_size=8),
+                 st.lists(FLOATS, max_size=8), st.lists(st.text(max_size=6), max_size=4),
+                 st.dictionaries(st.text(max_size=6), FLOATS, max_size=3), st.just([]))
+
+
+@st.composite
+def scenario_docs(draw, doc: dict):
+    fields = scenario_fields(doc)
+    doc = copy.deepcopy(doc)
+    for _ in range(draw(st.integers(1, 3))):
+        path = draw(st.sampled_from(fields))
+        target = doc
+        for k in path[:-1]:
+            if isinstance(k, str) and isinstance(target, dict):
+                target = target.setdefault(k, {})
+            elif isinstance(k, int) and isinstance(target, list) and k < len(target):
+                target = target[k]
+            else:
+                target = None  # an earlier mutation replaced the parent: skip
+                break
+        if not isinstance(target, dict):
+            continue
+        old = target.get(path[-1])
+        if isinstance(old, list) and old and all(isinstance(v, (int, float)) for v in old) \
+                and draw(st.booleans()):
+            value = list(old)
+            value[draw(st.integers(0, len(value) - 1))] = draw(FLOATS)
+        else:
+            value = draw(JUNK)
+        target[path[-1]] = value
+    return doc
+
+
+def test_campaign_cli(tmp_path, planar_doc):
+    doc = copy.deepcopy(planar_doc)
+    doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
+    path = tmp_path / "generated.yaml"
+
+    codes = []
+
+    @settings(CAMPAIGN, max_examples=120)
+    @given(scenario_docs(doc))
+    def campaign(d):
+        COUNTS["inputs"] += 1
+        path.write_text(yaml.safe_dump(d))
+        out, err = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = cli_main(["solve", str(path), "--json"])
+        codes.append(code)
+        if code == 2:
+            lines = err.getvalue().splitlines()
+            if len(lines) != 1 or not lines[0].startswith(f"grasp-torque-opt: error: {path}: "):
+                broken(f"bad input without one line naming the field: {err.getvalue()!r}")
+            return
+        if code not in (0, 3, 4):
+            broken(f"exit code {code}")
+        r = json.loads(out.getvalue())
+        if code == 0:
+            check_command(r["tau"], len(r["joints"]), np.full(len(r["joints"]), np.inf))
+            if not r["certificate"]["ok"] or r["status"] != "optimal":
+                broken("exit 0 without a certified optimum")
+            limits = d["hand"].get("torque_limits")
+            if isinstance(limits, list) and len(limits) == len(r["tau"]) and \
+                    np.any(np.abs(r["tau"]) > np.array(limits, dtype=float)):
+                broken("a torque over its limit")
+        elif r["tau"] is not None:
+            broken(f"exit {code} with torques")
+
+    campaign()
+    assert {0, 2} <= set(codes)  # both solved and refused files were generated

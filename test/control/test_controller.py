@@ -1,0 +1,304 @@
+"""The control cycle on plain arrays: inputs, gate, staleness, fault policy, gravity."""
+
+import dataclasses
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import ALLEGRO_URDF
+from cycle_inputs import FAULT_MODES, Injected, base_poses, fresh, joint_state
+from independent import assert_holds
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.methods.dispatch import solve
+
+
+@pytest.mark.parametrize("name", ["planar", "allegro"])
+def test_command_is_the_cores_solution(name, request):
+    setup = request.getfixturevalue(name)
+    ctrl = fresh(setup)
+    ctrl.update_joint_state(*joint_state(setup), now=0.0)
+    r = ctrl.cycle(0.0)
+    assert r.kind == "solution" and r.fault == ""
+    ref = solve(setup)
+    np.testing.assert_allclose(r.command, ref.tau, atol=1e-9)
+
+
+def test_joint_order_and_extra_joints_do_not_matter(allegro):
+    names, pos = joint_state(allegro)
+    order = np.random.default_rng(3).permutation(len(names))
+    a, b = fresh(allegro), fresh(allegro)
+    a.update_joint_state(names, pos, 0.0)
+    b.update_joint_state([names[i] for i in order] + ["conveyor"],
+                         [pos[i] for i in order] + [float("nan")], 0.0)
+    np.testing.assert_allclose(a.cycle(0.0).command, b.cycle(0.0).command, atol=1e-12)
+
+
+@pytest.mark.parametrize("names,positions,match", [
+    (["joint1", "joint2", "joint3"], [0.1, 0.2], "3 names but 2 positions"),
+    (["joint1", "joint1", "joint2", "joint3", "joint4"], [0.0] * 5, "duplicate joint name"),
+    (["joint1", "joint2", "joint3"], [0.0] * 3, "missing commanded joint.* joint4"),
+    (["joint1", "joint2", "joint3", "joint4"], [0.0, float("nan"), 0.0, 0.0],
+     "position of 'joint2' is not finite"),
+    (["joint1", "", "joint3", "joint4"], [0.0] * 4, "empty joint name"),
+])
+def test_malformed_joint_states_are_rejected(planar, names, positions, match):
+    ctrl = fresh(planar)
+    with pytest.raises(InputError, match=match):
+        ctrl.update_joint_state(names, positions, 0.0)
+    assert ctrl.inputs.q is None and ctrl.counters.rejected["joint_states"] == 1
+    assert ctrl.last_rejection.startswith("joint_states: ") and match.split(".")[0][:8] in \
+        ctrl.last_rejection
+
+
+def test_contacts_in_any_model_frame_give_the_same_grasp(allegro):
+    q = allegro.q.copy()
+    q[allegro.hand.idx_q[1]] += 0.02
+    ref = fresh(allegro)
+    ref.update_joint_state(*joint_state(allegro, q), 0.0)
+    expected = ref.cycle(0.0).command
+    pos, quat = base_poses(allegro, q)
+    in_base = fresh(allegro)
+    in_base.update_joint_state(*joint_state(allegro, q), 0.0)
+    in_base.update_contacts("", pos, quat, 0.0)
+    np.testing.assert_allclose(in_base.cycle(0.0).command, expected, atol=1e-9)
+    # The same frames expressed in the thumb's distal link.
+    model = allegro.hand.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    oMl = data.oMf[model.getFrameId("link_15.0")]
+    local_pos = [oMl.actInv(p) for p in pos]
+    local_quat = [pin.Quaternion(oMl.rotation.T @ pin.Quaternion(*np.roll(qt, 1)).matrix()
+                                 ).coeffs() for qt in quat]
+    in_link = fresh(allegro)
+    in_link.update_joint_state(*joint_state(allegro, q), 0.0)
+    in_link.update_contacts("link_15.0", np.array(local_pos), np.array(local_quat), 0.0)
+    np.testing.assert_allclose(in_link.cycle(0.0).command, expected, atol=1e-9)
+
+
+@pytest.mark.parametrize("frame,change,match", [
+    ("palm_link", lambda p, q: (p[:3], q[:3]), "3 poses for 4 contacts"),
+    ("no_such_link", lambda p, q: (p, q), "unknown frame 'no_such_link'"),
+    ("", lambda p, q: (p, q * 1.01), r"poses\[0\].orientation: is not a unit quaternion"),
+    ("", lambda p, q: (p, np.zeros_like(q)), "is not a unit quaternion"),
+    ("", lambda p, q: (p + np.array([0, np.nan, 0]), q), "must be finite"),
+])
+def test_malformed_contacts_are_rejected(allegro, frame, change, match):
+    ctrl = fresh(allegro)
+    pos, quat = change(*base_poses(allegro))
+    with pytest.raises(InputError, match=match):
+        ctrl.update_contacts(frame, pos, quat, 0.0)
+    assert ctrl.inputs.contacts is None and ctrl.counters.rejected["contacts"] == 1
+
+
+def test_wrench_axes_follow_its_frame(allegro):
+    model = allegro.hand.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, allegro.q)
+    R = data.oMf[model.getFrameId("link_13.0")].rotation
+    w = allegro.external_wrench * 1.3
+    a, b = fresh(allegro), fresh(allegro)
+    for c in (a, b):
+        c.update_joint_state(*joint_state(allegro), 0.0)
+    a.update_wrench("", w[:3], w[3:], 0.0)
+    b.update_wrench("link_13.0", R.T @ w[:3], R.T @ w[3:], 0.0)
+    np.testing.assert_allclose(a.cycle(0.0).command, b.cycle(0.0).command, atol=1e-9)
+    with pytest.raises(InputError, match="external_wrench.wrench.force: must be finite"):
+        a.update_wrench("", [0, np.inf, 0], [0, 0, 0], 0.0)
+
+
+@pytest.mark.parametrize("policy", ["hold", "zero"])
+def test_stale_contacts_stop_commands_then_policy(planar, policy):
+    ctrl = fresh(planar, contacts_timeout=0.2, joint_state_timeout=0.1, hold_time=0.3,
+                 fault_policy=policy)
+    pos, quat = base_poses(planar)
+    ctrl.update_contacts("", pos, quat, 0.0)
+    js = joint_state(planar)
+    t, kinds = 0.0, []
+    while t < 1.0:
+        ctrl.update_joint_state(*js, t)
+        kinds.append((t, ctrl.cycle(t).kind))
+        t += 0.01
+    last_solution = max(tt for tt, k in kinds if k == "solution")
+    assert last_solution <= 0.2 + 1e-9
+    assert all(k != "solution" for tt, k in kinds if tt > 0.2 + 1e-9)
+    # Held (nothing published) until hold_time after the last command, then the policy.
+    after = [k for tt, k in kinds if tt > last_solution + 0.3 + 1e-9]
+    assert after and set(after) == ({"zero"} if policy == "zero" else {"none"})
+    assert all(k == "none" for tt, k in kinds if last_solution < tt < last_solution + 0.3 - 1e-9)
+    # Fresh contacts: the next joint state recovers at once.
+    ctrl.update_contacts("", pos, quat, t)
+    ctrl.update_joint_state(*js, t)
+    assert ctrl.cycle(t).kind == "solution"
+    assert ctrl.counters.recoveries == 1 and ctrl.fault == ""
+
+
+def test_watchdog_sees_stale_joint_states(planar):
+    ctrl = fresh(planar, joint_state_timeout=0.05, hold_time=0.0, fault_policy="zero")
+    assert ctrl.watchdog(0.0) is None  # not started
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    assert ctrl.cycle(0.0).kind == "solution"
+    assert ctrl.watchdog(0.04) is None
+    r = ctrl.watchdog(0.06)
+    assert r.kind == "zero" and "joint_states stale" in r.fault
+    np.testing.assert_array_equal(r.command, np.zeros(4))
+
+
+def test_infeasible_load_gives_no_command(planar):
+    ctrl = fresh(planar)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.update_wrench("", [0.0, -500.0, 0.0], [0.0, 0.0, 0.0], 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None and r.solution.status == "infeasible"
+    assert "no certified solution (infeasible" in r.fault
+
+
+def test_gravity_compensation_adds_g(allegro):
+    gravity = np.array([9.81, 0.0, 0.0])
+    ctrl = fresh(allegro, gravity_compensation=True, gravity=tuple(gravity))
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.kind == "solution"
+    model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path("."))))
+    model.gravity.linear = gravity
+    g = pin.computeGeneralizedGravity(model, model.createData(), allegro.q)[allegro.hand.idx_v]
+    np.testing.assert_allclose(r.gravity_torque, g, atol=1e-12)
+    assert np.linalg.norm(g) > 1e-3
+    np.testing.assert_allclose(r.command, r.solution.tau + g, atol=1e-12)
+    shifted = dataclasses.replace(allegro, torque_offset=g)
+    assert_holds(shifted, r.maps, r.solution.tau, r.solution.wrenches)
+    assert np.all(np.abs(r.command) <= allegro.hand.torque_limits)
+
+
+# -- bounds, stamps, budget -----------------------------------------------------------------
+
+
+def test_oversized_joint_state_is_rejected_unread(planar):
+    ctrl = fresh(planar, max_joint_state_entries=8)
+    names, pos = joint_state(planar)
+    extra = [f"j{i}" for i in range(5)]
+    with pytest.raises(InputError, match=r"^joint_states: 9 entries, more than "
+                       r"max_joint_state_entries \(8\)$"):
+        ctrl.update_joint_state(names + extra, pos + [0.0] * 5, 0.0)
+    ctrl.update_joint_state(names + extra[:4], pos + [0.0] * 4, 0.0)  # 8 is within
+    assert ctrl.counters.rejected["joint_states"] == 1
+
+
+def test_absurd_joint_position_is_rejected(planar):
+    names, pos = joint_state(planar)
+    pos[2] = 1e6
+    with pytest.raises(InputError, match="position of 'joint3' is 1e\\+06, beyond"):
+        fresh(planar).update_joint_state(names, pos, 0.0)
+
+
+@pytest.mark.parametrize("force,torque,match", [
+    ([0.0, 0.0, 2000.0], [0.0] * 3, r"wrench.force: norm 2000 N exceeds max_wrench_force"),
+    ([0.0] * 3, [0.0, 300.0, 400.0], r"wrench.torque: norm 500 N m exceeds max_wrench_torque"),
+    ([0.0, 0.0], [0.0] * 3, "5 values, expected 6"),
+])
+def test_wrench_magnitude_is_bounded(planar, force, torque, match):
+    ctrl = fresh(planar)
+    with pytest.raises(InputError, match=match):
+        ctrl.update_wrench("", force, torque, 0.0)
+    assert ctrl.inputs.wrench is None and ctrl.counters.rejected["external_wrench"] == 1
+
+
+def test_far_contact_stops_commands_until_good_contacts_return(planar):
+    ctrl = fresh(planar, max_contact_distance=0.5)
+    pos, quat = base_poses(planar)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    far = pos.copy()
+    far[1] = [0.0, 0.6, 0.0]
+    ctrl.update_contacts("", far, quat, 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None
+    assert "contacts.poses[1].position: is 0.6 m from the base origin, beyond " \
+           "max_contact_distance (0.5 m)" in r.fault
+    ctrl.update_contacts("", pos, quat, 0.01)
+    assert ctrl.cycle(0.01).kind == "solution"
+
+
+def test_contacts_of_the_wrong_shape_are_rejected(planar):
+    pos, quat = base_poses(planar)
+    with pytest.raises(InputError, match=r"quaternions of shape \(2, 3\), expected"):
+        fresh(planar).update_contacts("", pos, quat[:, :3], 0.0)
+
+
+def test_long_names_are_cut_in_messages(planar):
+    names, pos = joint_state(planar)
+    pos, quat = base_poses(planar)
+    with pytest.raises(InputError) as e:
+        fresh(planar).update_contacts("x" * 100000, pos, quat, 0.0)
+    assert "'" + "x" * 64 + "...'" in str(e.value) and len(str(e.value)) < 1000
+
+
+def test_stamp_rule(planar):
+    """Zero: unstamped, accepted. Ahead of the clock beyond the tolerance: rejected.
+    Backwards: rejected while the last accepted one is fresh, accepted once it is stale."""
+    ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
+    js = joint_state(planar)
+    ctrl.update_joint_state(*js, now=0.0, stamp=0.0, clock=100.0)
+    ctrl.update_joint_state(*js, now=0.01, stamp=100.4, clock=100.0)  # within tolerance
+    with pytest.raises(InputError, match=r"^joint_states.header.stamp: is 0.600 s ahead of "
+                       r"the clock \(stamp_future_tolerance 0.5 s\)$"):
+        ctrl.update_joint_state(*js, now=0.02, stamp=100.6, clock=100.0)
+    with pytest.raises(InputError, match="header.stamp: goes backwards by 0.100000 s"):
+        ctrl.update_joint_state(*js, now=0.05, stamp=100.3, clock=100.05)
+    assert ctrl.inputs.q_time == 0.01  # the rejected states were not kept
+    ctrl.update_joint_state(*js, now=0.05, stamp=0.0, clock=100.05)  # unstamped: not compared
+    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the last stamp is stale
+    ctrl.update_joint_state(*js, now=0.21, stamp=50.01, clock=100.21)
+    with pytest.raises(InputError, match="is negative"):
+        ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=-1.0)
+    ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=5.0, clock=0.0)  # clock not running
+    assert ctrl.counters.rejected == {"joint_states": 2, "contacts": 0, "external_wrench": 1}
+
+
+def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar):
+    ctrl = fresh(planar, cycle_budget=1e-4, hold_time=1.0)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None and r.fault.startswith("cycle overrun (") and r.cycle_time > 1e-4
+    assert ctrl.counters.overruns == 1 and ctrl.counters.commands == 0
+    assert ctrl.last_command is None and ctrl.counters.max_cycle_time == r.cycle_time
+    ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=10.0)
+    ctrl.update_joint_state(*joint_state(planar), 0.01)
+    r = ctrl.cycle(0.01)
+    assert r.kind == "solution" and ctrl.counters.recoveries == 1 and ctrl.fault == ""
+
+
+# -- fault injection: solvers that fail in every way ----------------------------------------
+
+
+@pytest.mark.parametrize("mode", FAULT_MODES)
+@pytest.mark.parametrize("policy", ["hold", "zero"])
+def test_a_failing_solver_never_passes_through(planar, mode, policy):
+    ctrl = fresh(planar, hold_time=0.05, fault_policy=policy)
+    js = joint_state(planar)
+    ctrl.update_joint_state(*js, 0.0)
+    good = ctrl.cycle(0.0)
+    assert good.kind == "solution"
+    ctrl.solver = Injected(mode)
+    kinds = []
+    for k in range(1, 11):
+        t = 0.01 * k
+        ctrl.update_joint_state(*js, t)
+        t0 = time.perf_counter()
+        r = ctrl.cycle(t)
+        assert time.perf_counter() - t0 < 1.0  # refused or capped, never a stall
+        assert r.kind != "solution" and r.fault
+        if mode in ("nan-data", "inverted-bounds"):  # refused before ProxSuite ran
+            assert r.solution.iterations == 0 and "solver: QP " in r.solution.message
+        kinds.append((t, r.kind))
+        if r.command is not None:
+            np.testing.assert_array_equal(r.command, np.zeros(4))
+    assert all(k == "none" for t, k in kinds if t <= 0.05 + 1e-9)
+    assert all(k == ("zero" if policy == "zero" else "none") for t, k in kinds if t > 0.05 + 1e-9)
+    assert ctrl.counters.solver_failures == 10
+    assert ctrl.last_command is good.command  # the last certified command is what is held
+    ctrl.solver.healthy = True
+    ctrl.update_joint_state(*js, 0.2)
+    assert ctrl.cycle(0.2).kind == "solution" and ctrl.counters.recoveries == 1

@@ -1,0 +1,44 @@
+"""Loading hands: paths, example-robot-data, joints and limits."""
+
+import numpy as np
+import pytest
+from conftest import ALLEGRO_URDF, ROOT
+
+from grasp_torque_opt.core.exceptions import InputError, JointNotFound
+from grasp_torque_opt.core.hand import Hand, example_robot_data_dir, resolve_urdf
+
+
+def test_example_robot_data_allegro():
+    path = resolve_urdf(ALLEGRO_URDF, ROOT)
+    assert path.is_file() and path.is_relative_to(example_robot_data_dir())
+    hand = Hand.from_urdf(path)
+    assert hand.m == 16 and hand.joints[0] == "joint_0.0"
+    np.testing.assert_allclose(hand.torque_limits, hand.model.effortLimit[hand.idx_v])
+
+
+def test_relative_and_missing_paths():
+    assert resolve_urdf("urdf/planar_two_finger.urdf", ROOT).is_file()
+    with pytest.raises(InputError, match="hand.urdf: file not found"):
+        resolve_urdf("example-robot-data:nope/none.urdf", ROOT)
+
+
+def test_joint_order_is_command_order():
+    hand = Hand.from_urdf(ROOT / "urdf/planar_two_finger.urdf", ["joint3", "joint1"], 2.0)
+    assert hand.joints == ["joint3", "joint1"]
+    assert list(hand.idx_v) == [hand.model.joints[hand.model.getJointId(n)].idx_v
+                                for n in ("joint3", "joint1")]
+    np.testing.assert_array_equal(hand.torque_limits, [2.0, 2.0])
+
+
+def test_fixed_joint_is_not_actuated():
+    with pytest.raises(JointNotFound, match=r"hand.joints\[0\]: unknown joint "
+                                            r"'finger1_tip_joint' \(1-DoF joints: joint1"):
+        Hand.from_urdf(ROOT / "urdf/planar_two_finger.urdf", ["finger1_tip_joint"])
+
+
+def test_urdf_string_is_parsed():
+    hand = Hand.from_urdf_string((ROOT / "urdf/planar_two_finger.urdf").read_text())
+    assert hand.joints == ["joint1", "joint2", "joint3", "joint4"]
+    np.testing.assert_array_equal(hand.torque_limits, [10, 5, 10, 5])
+    with pytest.raises(InputError, match="robot_description: cannot parse"):
+        Hand.from_urdf_string("<robot name='x'><link name='a'/><joint/></robot>")

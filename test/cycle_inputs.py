@@ -1,0 +1,77 @@
+"""Inputs for the control cycle shared by the controller, node and campaign tests.
+
+Joint states and contact poses of a scenario's grasp, a controller on fresh
+inputs, and :class:`Injected`, a solver that fails on purpose in every way a
+real one can (for the fault paths; the healthy path is the real ProxSuite).
+"""
+
+import dataclasses
+
+import numpy as np
+import pinocchio as pin
+
+from grasp_torque_opt.backends.proxsuite import TauQPSolver
+from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.core.exceptions import SolverError
+from grasp_torque_opt.core.solution import RawResult
+
+
+def joint_state(setup, q=None, names=None):
+    q = setup.q if q is None else q
+    hand = setup.hand
+    names = names or hand.one_dof_joints(hand.model)
+    return names, [float(q[hand.model.joints[hand.model.getJointId(n)].idx_q]) for n in names]
+
+
+def fresh(setup, **config):
+    """A controller of its own; the cycle budget is generous unless a test is about it
+    (other processes may load this machine)."""
+    config.setdefault("cycle_budget", 10.0)
+    return TorqueController(dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)),
+                            CycleConfig(**config))
+
+
+def base_poses(setup, q=None):
+    """The default contact frames at q, as (positions, xyzw quaternions) in the base frame."""
+    maps = dataclasses.replace(setup, q=setup.q if q is None else q).maps()
+    pos = np.array([f.position for f in maps.contacts])
+    quat = np.array([pin.Quaternion(f.rotation).coeffs() for f in maps.contacts])
+    return pos, quat
+
+
+class Injected:
+    """A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose:
+    ``mode`` says how; ``healthy`` makes it the real one again."""
+
+    def __init__(self, mode: str):
+        self.inner = TauQPSolver()
+        self.settings = self.inner.settings
+        self.mode = mode
+        self.healthy = False
+
+    def solve(self, qp):
+        if self.healthy:
+            return self.inner.solve(qp)
+        if self.mode == "raise-solver":
+            raise SolverError("injected: ProxSuite failed")
+        if self.mode == "raise-other":
+            raise ZeroDivisionError("injected")
+        if self.mode == "nan-data":  # the real solver must refuse it at once
+            return self.inner.solve(dataclasses.replace(qp, H=qp.H * np.nan))
+        if self.mode == "inverted-bounds":
+            return self.inner.solve(dataclasses.replace(qp, l_box=qp.u_box + 1.0))
+        good = self.inner.solve(qp)
+        if self.mode == "max-iter":
+            return RawResult("error", good.x, 1000, 0.01, "PROXQP_MAX_ITER_REACHED")
+        if self.mode == "wrong-x":  # finite, claimed solved, but not a solution
+            return RawResult("solved", good.x + 0.05, good.iterations, good.solve_time_s,
+                             "PROXQP_SOLVED")
+        if self.mode == "nan-x":
+            return RawResult("solved", good.x * np.nan, 1, 0.0, "PROXQP_SOLVED")
+        if self.mode == "wrong-size-x":
+            return RawResult("solved", good.x[:-1], 1, 0.0, "PROXQP_SOLVED")
+        raise AssertionError(self.mode)
+
+
+FAULT_MODES = ["raise-solver", "raise-other", "nan-data", "inverted-bounds", "max-iter",
+               "wrong-x", "nan-x", "wrong-size-x"]

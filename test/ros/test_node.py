@@ -1,0 +1,385 @@
+"""grasp_torque_node with real rclpy in-process: real topics, a real service call."""
+
+import dataclasses
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import rclpy
+from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
+from cycle_inputs import base_poses, joint_state
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.qos import ReliabilityPolicy, qos_profile_sensor_data
+from ros_harness import DOMAIN, Harness
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+from visualization_msgs.msg import Marker
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
+
+# Each run on its own domain, heard only on this machine.
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+
+
+@pytest.fixture
+def planar_node():
+    h = Harness(PLANAR)
+    yield h
+    h.close()
+
+
+def test_published_torques_are_the_cores_solution(planar_node, planar):
+    q = planar.q.copy()
+    q[planar.hand.idx_q[1]] += 0.01
+    planar_node.send_joint_state(*joint_state(planar, q))
+    cmd = planar_node.next_command()
+    assert cmd is not None and cmd.shape == (4,)
+    ref = solve(dataclasses.replace(planar, q=q))
+    assert ref.optimal
+    np.testing.assert_allclose(cmd, ref.tau, atol=1e-9)
+    # The same state, joints shuffled and an extra joint with NaN: the same torques.
+    names, pos = joint_state(planar, q)
+    order = [2, 0, 3, 1]
+    planar_node.send_joint_state([names[i] for i in order] + ["wrist"],
+                                 [pos[i] for i in order] + [float("nan")])
+    np.testing.assert_allclose(planar_node.next_command(), cmd, atol=1e-12)
+    # Arrows for RViz: one per contact, from the contact point.
+    assert planar_node.spin_until(lambda: any(len(m.markers) == 3
+                                              for m in planar_node.markers), 2.0)
+    arrows = [m for m in planar_node.markers[-1].markers if m.action == Marker.ADD]
+    assert len(arrows) == 2 and arrows[0].header.frame_id == "palm"
+    maps = dataclasses.replace(planar, q=q).maps()
+    start = arrows[0].points[0]
+    np.testing.assert_allclose([start.x, start.y, start.z], maps.contacts[0].position,
+                               atol=1e-9)
+
+
+def test_service_returns_the_cli_json(planar_node, planar):
+    planar_node.send_joint_state(*joint_state(planar))
+    cmd = planar_node.next_command()
+    future = planar_node.solve_client.call_async(Trigger.Request())
+    assert planar_node.spin_until(future.done, 5.0)
+    res = future.result()
+    assert res.success, res.message
+    d = json.loads(res.message)
+    assert {"status", "method", "joints", "tau", "torque_norm", "solve_time_s", "certificate",
+            "contacts"} <= set(d)
+    assert d["status"] == "optimal" and d["joints"] == planar.hand.joints
+    np.testing.assert_allclose(d["command"], cmd, atol=1e-12)
+    # Many calls while the loop runs: each answered, the loop keeps publishing.
+    futures = [planar_node.solve_client.call_async(Trigger.Request()) for _ in range(20)]
+    n = len(planar_node.commands)
+    for _ in range(20):
+        planar_node.send_joint_state(*joint_state(planar))
+        planar_node.spin_for(0.01)
+    assert planar_node.spin_until(lambda: all(f.done() for f in futures), 10.0)
+    assert all(f.result().success for f in futures)
+    assert len(planar_node.commands) - n >= 10
+
+
+def test_service_says_why_without_inputs(planar_node):
+    future = planar_node.solve_client.call_async(Trigger.Request())
+    assert planar_node.spin_until(future.done, 5.0)
+    assert not future.result().success
+    assert future.result().message == "cannot solve: no joint state yet"
+
+
+@pytest.mark.parametrize("name,value,reason", [
+    ("torque_limits", [1.0, 2.0], "torque_limits: must have 4 entries, got 2"),
+    ("torque_limits", [1.0, -2.0, 1.0, 1.0], "torque_limits: every entry must be > 0"),
+    ("polygon_sides", 2, "polygon_sides"),
+    ("fault_policy", "explode", "fault_policy: must be one of hold, zero"),
+    ("mu_tangential", 0.0, "mu_tangential"),
+    ("joints", ["joint1"], "read-only parameter: joints"),
+])
+def test_bad_parameter_is_refused_with_its_reason(planar_node, name, value, reason):
+    before = planar_node.node.get_parameter(name).value
+    result = planar_node.node.set_parameters([Parameter(name, value=value)])[0]
+    assert not result.successful
+    assert reason in result.reason
+    assert planar_node.node.get_parameter(name).value == before
+
+
+def test_good_parameter_change_takes_effect(planar_node, planar):
+    planar_node.send_joint_state(*joint_state(planar))
+    free = planar_node.next_command()
+    fmin = 1.5 * float(np.max(solve(planar).wrenches[:, 2]))
+    assert planar_node.node.set_parameters(
+        [Parameter("min_normal_force", value=fmin)])[0].successful
+    planar_node.send_joint_state(*joint_state(planar))
+    squeezed = planar_node.next_command()
+    ref = solve(dataclasses.replace(planar, friction=dataclasses.replace(
+        planar.friction, min_normal_force=fmin)))
+    np.testing.assert_allclose(squeezed, ref.tau, atol=1e-9)
+    assert np.linalg.norm(squeezed) > np.linalg.norm(free)
+
+
+def malformed_joint_states(setup):
+    names, pos = joint_state(setup)
+    yield "length", names, pos[:-1], "4 names but 3 positions"
+    yield "duplicate", names[:3] + names[:1], pos, "duplicate joint name 'joint1'"
+    yield "missing", names[:3] + ["other"], pos, "missing commanded joint(s) joint4"
+    yield "nan", names, [pos[0], float("nan")] + pos[2:], "position of 'joint2' is not finite"
+
+
+def test_malformed_inputs_give_no_command_and_a_diagnostic(planar_node, planar):
+    for _, names, pos, reason in malformed_joint_states(planar):
+        n = len(planar_node.commands)
+        planar_node.send_joint_state(names, pos)
+        assert planar_node.spin_until(
+            lambda: planar_node.diagnostics and
+            planar_node.diagnostics[-1]["last_rejection"] == f"joint_states: {reason}", 2.0), \
+            reason
+        assert len(planar_node.commands) == n
+    assert planar_node.diagnostics[-1]["rejected.joint_states"] == "4"
+    pos, quat = base_poses(planar)
+    bad_contacts = [("palm", pos, quat * 1.1, "contacts.poses[0].orientation: is not a unit "
+                     "quaternion"),
+                    ("finger9", pos, quat, "contacts.header.frame_id: unknown frame "
+                     "'finger9'"),
+                    ("palm", pos[:1], quat[:1], "contacts: 1 poses for 2 contacts")]
+    for frame, p, q, reason in bad_contacts:
+        planar_node.send_contacts(frame, p, q)
+        assert planar_node.spin_until(
+            lambda: planar_node.diagnostics and
+            planar_node.diagnostics[-1]["last_rejection"].startswith(reason), 2.0), reason
+    assert planar_node.commands == []  # rejected inputs never triggered a command
+    # The bad contacts were not used: a good joint state gives the default grasp's torques.
+    planar_node.send_joint_state(*joint_state(planar))
+    np.testing.assert_allclose(planar_node.next_command(), solve(planar).tau, atol=1e-9)
+    assert planar_node.diagnostics[-1]["rejected.contacts"] == "3"
+
+
+def test_stale_contacts_stop_commands_within_timeout_plus_one_cycle(planar):
+    timeout, period = 0.2, 0.02
+    h = Harness(PLANAR, contacts_timeout=timeout, joint_state_timeout=1.0)
+    try:
+        pos, quat = base_poses(planar)
+        h.send_contacts("palm", pos, quat)
+        h.spin_for(0.05)
+        t_contacts = time.monotonic()
+        end = t_contacts + 0.6
+        while time.monotonic() < end:
+            h.send_joint_state(*joint_state(planar))
+            h.spin_for(period)
+        times = [t for t, _ in h.commands]
+        assert len([t for t in times if t <= t_contacts + timeout]) >= 3
+        # 30 ms for delivery and scheduling on a loaded 2-core machine.
+        assert max(times) <= t_contacts + timeout + period + 0.03
+        assert "contacts stale" in h.diagnostics[-1]["fault"]
+    finally:
+        h.close()
+
+
+def test_stale_joint_states_apply_the_zero_policy(planar):
+    h = Harness(PLANAR, joint_state_timeout=0.05, hold_time=0.05, fault_policy="zero")
+    try:
+        h.send_joint_state(*joint_state(planar))
+        first = h.next_command()
+        assert first is not None and np.linalg.norm(first) > 0
+        zero = h.next_command(1.0)
+        assert zero is not None and np.all(zero == 0.0)
+        assert h.spin_until(lambda: h.diagnostics and
+                            h.diagnostics[-1]["_message"].startswith("zero torques"), 2.0)
+    finally:
+        h.close()
+
+
+def test_gravity_compensation_adds_g_of_q(allegro):
+    gravity = [9.81, 0.0, 0.0]
+    h = Harness(ALLEGRO, gravity_compensation=True, gravity=gravity)
+    try:
+        q = allegro.q.copy()
+        q[allegro.hand.idx_q[5]] += 0.05
+        h.send_joint_state(*joint_state(allegro, q))
+        cmd = h.next_command()
+        model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path("."))))
+        model.gravity.linear = np.array(gravity)
+        g = pin.computeGeneralizedGravity(model, model.createData(), q)[allegro.hand.idx_v]
+        ref = solve(dataclasses.replace(GraspSetup.from_file(ALLEGRO), q=q, torque_offset=g))
+        assert ref.optimal and np.linalg.norm(g) > 1e-3
+        np.testing.assert_allclose(cmd, ref.tau + g, atol=1e-9)
+        assert np.all(np.abs(cmd) <= allegro.hand.torque_limits)
+    finally:
+        h.close()
+
+
+def test_qos_of_every_endpoint(planar_node):
+    t = planar_node.tester
+
+    def mine(infos):
+        return [i for i in infos if i.node_name == "grasp_torque_node"]
+
+    for topic in ("/joint_states", "/contacts", "/external_wrench"):
+        (sub,) = mine(t.get_subscriptions_info_by_topic(topic))
+        assert sub.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT, topic
+        assert str(sub.topic_type).startswith(("sensor_msgs", "geometry_msgs"))
+    (cmd,) = mine(t.get_publishers_info_by_topic("/effort_commands"))
+    assert cmd.qos_profile.reliability == ReliabilityPolicy.RELIABLE
+    assert cmd.topic_type == "std_msgs/msg/Float64MultiArray"
+    (diag,) = mine(t.get_publishers_info_by_topic("/diagnostics"))
+    assert diag.qos_profile.reliability == ReliabilityPolicy.RELIABLE
+    (mk,) = mine(t.get_publishers_info_by_topic("/grasp_torque_node/contact_wrenches"))
+    assert mk.topic_type == "visualization_msgs/msg/MarkerArray"
+    services = dict(t.get_service_names_and_types())
+    assert services["/grasp_torque_node/solve"] == ["std_srvs/srv/Trigger"]
+
+
+def test_the_docs_document_every_parameter():
+    from grasp_torque_opt.ros.node import PARAMETERS
+
+    readme = "".join(p.read_text() for p in [ROOT / "README.md", *sorted(ROOT.glob("docs/*.md"))])
+    for name in PARAMETERS:
+        assert f"| `{name}` |" in readme, name
+
+
+@pytest.mark.parametrize("as_path", [False, True])
+def test_robot_description_gives_the_hand(planar, as_path):
+    urdf = PLANAR.parent.parent / "urdf" / "planar_two_finger.urdf"
+    h = Harness(PLANAR, robot_description=str(urdf) if as_path else urdf.read_text())
+    try:
+        h.send_joint_state(*joint_state(planar))
+        np.testing.assert_allclose(h.next_command(), solve(planar).tau, atol=1e-9)
+    finally:
+        h.close()
+
+
+def test_startup_errors_name_the_parameter():
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=DOMAIN)
+    try:
+        with pytest.raises(InputError, match="^scenario: parameter not set"):
+            GraspTorqueNode(context=ctx)
+        with pytest.raises(InputError, match="^torque_limits: must have 4 entries, got 1"):
+            GraspTorqueNode(context=ctx, parameter_overrides=[
+                Parameter("scenario", value=str(PLANAR)),
+                Parameter("torque_limits", value=[1.0])])
+    finally:
+        rclpy.try_shutdown(context=ctx)
+
+
+def test_stamped_command_carries_the_joint_states_stamp(planar):
+    h = Harness(PLANAR, publish_stamped_command=True)
+    try:
+        stamped = []
+        h.tester.create_subscription(JointState, "grasp_torque_node/effort_commands_stamped",
+                                     stamped.append, COMMAND_QOS)
+        h.spin_until(lambda: h.node.count_subscribers(
+            "grasp_torque_node/effort_commands_stamped") > 0, 5.0)
+        msg = JointState(name=list(planar.hand.joints),
+                         position=[float(planar.q[i]) for i in planar.hand.idx_q])
+        msg.header.stamp.sec, msg.header.stamp.nanosec = 1234, 5678
+        h.js_pub.publish(msg)
+        assert h.spin_until(lambda: stamped and h.commands, 5.0)
+        out = stamped[-1]
+        assert (out.header.stamp.sec, out.header.stamp.nanosec) == (1234, 5678)
+        assert list(out.name) == list(planar.hand.joints)
+        np.testing.assert_array_equal(out.effort, h.commands[-1][1])
+    finally:
+        h.close()
+
+
+def test_stopping_applies_the_policy_in_process(planar):
+    for policy, expect_zero in (("zero", True), ("hold", False)):
+        # Long timeouts: the only zero command can come from the stop.
+        h = Harness(PLANAR, fault_policy=policy, joint_state_timeout=5.0, hold_time=5.0)
+        try:
+            assert h.node.safe_stop() is False  # never commanded: nothing to undo
+            h.send_joint_state(*joint_state(planar))
+            assert h.next_command() is not None
+            n = len(h.commands)
+            assert h.node.safe_stop() is expect_zero
+            h.spin_for(0.2)
+            received = [c for _, c in h.commands[n:]]
+            assert len(received) == (1 if expect_zero else 0)
+            assert all(np.all(c == 0.0) for c in received)
+        finally:
+            h.close()
+
+
+@pytest.mark.parametrize("sig,executor", [(signal.SIGINT, "single"), (signal.SIGTERM, "single"),
+                                          (signal.SIGINT, "events")])
+def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig, executor):
+    """grasp_torque_node as users run it (either executor): it answers joint states, a signal
+    stops it, and with fault_policy zero the effort controller is left with zero torques."""
+    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--executor",
+                              executor, "--ros-args",
+                              "-p", f"scenario:={PLANAR}", "-p", "fault_policy:=zero",
+                              "-p", "joint_state_timeout:=5.0", "-p", "hold_time:=5.0"],
+                             env=env, stderr=subprocess.PIPE, text=True)
+    ctx = rclpy.Context()
+    rclpy.init(context=ctx, domain_id=DOMAIN)
+    tester = rclpy.create_node("stop_tester", context=ctx)
+    executor = SingleThreadedExecutor(context=ctx)
+    executor.add_node(tester)
+    commands = []
+    tester.create_subscription(Float64MultiArray, "effort_commands",
+                               lambda m: commands.append(np.array(m.data)), COMMAND_QOS)
+    pub = tester.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+
+    def spin_until(pred, timeout):
+        end = time.monotonic() + timeout
+        while not pred() and time.monotonic() < end:
+            executor.spin_once(timeout_sec=0.01)
+        return pred()
+
+    try:
+        names, pos = joint_state(planar)
+        assert spin_until(lambda: pub.get_subscription_count() > 0, 20.0)
+        end = time.monotonic() + 10.0
+        while not commands and time.monotonic() < end:
+            pub.publish(JointState(name=names, position=pos))
+            spin_until(lambda: bool(commands), 0.1)
+        assert commands and np.linalg.norm(commands[-1]) > 0
+        child.send_signal(sig)
+        # Within 4 s: 5 s after the last joint state the stale policy would publish zeros
+        # itself, and they would pass for the stop's (as they did while a SIGINT inherited
+        # ignored, from a background job, left the node spinning).
+        assert spin_until(lambda: np.all(commands[-1] == 0.0), 4.0), commands[-3:]
+        # The zeros arrived (the safety promise); the process then ends cleanly. Read
+        # stderr while waiting, so a chatty child cannot block on a full pipe.
+        _, err = child.communicate(timeout=10)
+        assert child.returncode == 0, err
+        assert "Traceback" not in err, err
+        assert "stopped: zero torques published" in err, err
+    finally:
+        if child.poll() is None:
+            child.kill()
+        tester.destroy_node()
+        executor.shutdown()
+        rclpy.try_shutdown(context=ctx)
+
+
+@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, backend):
+    h = Harness(ALLEGRO)
+    try:
+        names = list(allegro.hand.joints)
+        positions = allegro.q[allegro.hand.idx_q]
+        h.send_joint_state(names, positions)
+        before = h.next_command(5.0)
+        assert before is not None
+        assert h.node.set_parameters([Parameter("solver.backend", value=backend)])[0].successful
+        assert h.node.controller.solver.name == backend
+        h.send_joint_state(names, positions)
+        after = h.next_command(5.0)
+        assert after is not None
+        np.testing.assert_allclose(after, before, atol=1e-6)
+        refused = h.node.set_parameters([Parameter("solver.backend", value="osqp")])[0]
+        assert not refused.successful and "solver.backend" in refused.reason
+    finally:
+        h.close()
