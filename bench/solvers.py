@@ -46,14 +46,16 @@ rows, "excess" is the torque-norm excess of the polygon optimum (the force-QP
 reference) over that row's exact optimum, next to the time ratio.
 
 Warm starts: 500 steps on the Allegro grasp of the scenario file, the load's
-force rotating once around base y at constant magnitude (sequence "load"), and
-the same with every joint also drifting sinusoidally by up to 0.05 rad
-(sequence "drift"). Per step the cold solve (a persistent solver without
-initial guess) is compared with ProxSuite's WARM_START_WITH_PREVIOUS_RESULT on
-a persistent QP (update, then solve), and DAQP's make_solver (cold) with a
-persistent daqp.Model (setup once, update, solve: it starts from the previous
-working set). A warm result is bad if it is not solved, fails the certificate,
-or lands more than 1e-6 (in tau, infinity norm) off the cold optimum.
+force rotating once around base y at constant magnitude (sequence "load"), the
+same with every joint also drifting sinusoidally by up to 0.05 rad (sequence
+"drift"), and the rotating load made 1000 times heavier (infeasible) for 10
+steps in every 50 (sequence "step"). Per step the cold solve (make_solver) is
+compared with the product's verified warm start (make_solver(...,
+warm_start=True): ProxSuite's WARM_START_WITH_PREVIOUS_RESULT with the
+preconditioner kept, DAQP's previous working set), including its cold redo of
+a warm answer that is not solved or fails the certificate (both counted). A warm
+result is bad if, after that, its verdict (certified or not) differs from the
+cold one, or it lands more than 1e-6 (in tau, infinity norm) off the cold optimum.
 """
 
 from __future__ import annotations
@@ -80,7 +82,7 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings  # noqa: E402
 from grasp_torque_opt.core.certificate import certify  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.core.solution import RawResult  # noqa: E402
-from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp, check_data  # noqa: E402
+from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp  # noqa: E402
 from grasp_torque_opt.reference.conic import solve_conic  # noqa: E402
 from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp  # noqa: E402
 from grasp_torque_opt.reference.exact_socp import solve_exact_socp  # noqa: E402
@@ -102,123 +104,17 @@ EXACT_ROWS = ["clarabel-socp", "slsqp"]
 # ---------------------------------------------------------------- solvers
 
 
-@dataclasses.dataclass(frozen=True)
-class ProxVariant:
-    """A ProxSuite dense configuration for the tau-QP (the rest as ProxSuiteSettings).
-
-    ``preconditioner``: "first" computes it in ``init`` on the first problem and
-    keeps it (ProxSuite's ``update`` default, what TauQPSolver does); "every"
-    recomputes it in every ``update``; "off" never computes it. The defaults
-    are the project's configuration.
-    """
-
-    hessian: str = ProxSuiteSettings.hessian_type
-    backend: str = ProxSuiteSettings.dense_backend
-    eps_abs: float = 1e-9
-    preconditioner: str = "first"
-
-    @property
-    def label(self) -> str:
-        return (f"HessianType.{self.hessian}, DenseBackend.{self.backend}, eps_abs {self.eps_abs:g}"
-                f", preconditioner {self.preconditioner}")
+def variant_label(v: ProxSuiteSettings) -> str:
+    return (f"HessianType.{v.hessian_type}, DenseBackend.{v.dense_backend}, eps_abs "
+            f"{v.eps_abs:g}, preconditioner {v.preconditioner}")
 
 
-def variant_grid() -> list[ProxVariant]:
-    return [ProxVariant(h, b, e, pc) for h in ("Dense", "Diagonal")
+def variant_grid() -> list[ProxSuiteSettings]:
+    """ProxSuite dense variants: Hessian type, dense backend, tolerance, preconditioner."""
+    return [ProxSuiteSettings(eps_abs=e, hessian_type=h, dense_backend=b, preconditioner=pc)
+            for h in ("Dense", "Diagonal")
             for b in ("Automatic", "PrimalDualLDLT", "PrimalLDLT")
             for e in (1e-9, 1e-8, 1e-7) for pc in ("first", "every", "off")]
-
-
-class ProxSuiteQP:
-    """ProxSuite dense on the tau-QP, one persistent QP per problem size (update, then solve).
-
-    With ``warm`` the QP starts from its previous result
-    (WARM_START_WITH_PREVIOUS_RESULT); otherwise every solve is cold, as in
-    the project's TauQPSolver, whose settings it copies apart from the variant's.
-    """
-
-    def __init__(self, variant: ProxVariant = ProxVariant(), warm: bool = False) -> None:
-        self.variant, self.warm = variant, warm
-        self.base = ProxSuiteSettings()
-        self._qp, self._dims = None, None
-
-    def solve(self, qp: TauQP) -> RawResult:
-        why = check_data(qp)
-        if why:
-            return RawResult("error", None, 0, 0.0, why)
-        n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
-        A, b = (qp.A, qp.b) if n_eq else (None, None)
-        lower = np.full(n_in, -np.inf)
-        v = self.variant
-        t0 = time.perf_counter()
-        if self._dims != (n, n_eq, n_in):
-            self._qp = DENSE.QP(n, n_eq, n_in, True,
-                                hessian_type=getattr(DENSE.HessianType, v.hessian),
-                                dense_backend=getattr(DENSE.DenseBackend, v.backend))
-            s = self._qp.settings
-            s.eps_abs, s.eps_rel = v.eps_abs, self.base.eps_rel
-            s.max_iter, s.max_iter_in = self.base.max_iter, self.base.max_iter_in
-            s.eps_primal_inf = self.base.eps_primal_inf
-            s.check_duality_gap = True
-            s.eps_duality_gap_abs, s.eps_duality_gap_rel = v.eps_abs, 0.0
-            s.initial_guess = (proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
-                               if self.warm else proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS)
-            self._qp.init(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=lower, u=qp.u,
-                          l_box=qp.l_box, u_box=qp.u_box,
-                          compute_preconditioner=v.preconditioner != "off")
-            self._dims = (n, n_eq, n_in)
-        else:
-            self._qp.update(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=lower, u=qp.u,
-                            l_box=qp.l_box, u_box=qp.u_box,
-                            update_preconditioner=v.preconditioner == "every")
-        self._qp.solve()
-        elapsed = time.perf_counter() - t0
-        info = self._qp.results.info
-        out = proxsuite.proxqp.QPSolverOutput
-        status = {out.PROXQP_SOLVED: "solved",
-                  out.PROXQP_PRIMAL_INFEASIBLE: "infeasible"}.get(info.status, "error")
-        return RawResult(status, np.array(self._qp.results.x), int(info.iter), elapsed,
-                         str(info.status).rsplit(".", 1)[-1])
-
-
-class DaqpModel:
-    """A persistent daqp.Model on the tau-QP: set up once, then update and solve (warm).
-
-    Same data layout and settings as backends.DaqpSolver.
-    """
-
-    def __init__(self) -> None:
-        import daqp
-
-        self._daqp, self._model, self._dims = daqp, None, None
-        self.settings = ProxSuiteSettings()
-
-    def solve(self, qp: TauQP) -> RawResult:
-        why = check_data(qp)
-        if why:
-            return RawResult("error", None, 0, 0.0, why)
-        n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
-        A = np.vstack((qp.A, qp.C))
-        big = 1e30
-        upper = np.concatenate((np.minimum(qp.u_box, big), qp.b, qp.u))
-        lower = np.concatenate((np.maximum(qp.l_box, -big), qp.b, np.full(n_in, -big)))
-        t0 = time.perf_counter()
-        if self._dims != (n, n_eq, n_in):
-            sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
-            sense[n:n + n_eq] = 5
-            self._model = self._daqp.Model()
-            self._model.settings = {"primal_tol": self.settings.eps_abs,
-                                    "iter_limit": self.settings.max_iter,
-                                    "eps_prox": 0.0 if n == qp.m else -1e-6}
-            self._model.setup(qp.H.copy(), qp.g, A, upper, lower, sense)  # H may be read-only
-            self._dims = (n, n_eq, n_in)
-        else:
-            self._model.update(H=qp.H.copy(), f=qp.g, A=A, bupper=upper, blower=lower)
-        x, _, flag, info = self._model.solve()
-        elapsed = time.perf_counter() - t0
-        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
-        return RawResult(status, np.asarray(x, dtype=float), int(info["iterations"]), elapsed,
-                         f"DAQP exit flag {int(flag)}")
 
 
 def _finite_box(qp: TauQP) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -305,9 +201,9 @@ def outcome(grasp: Grasp, raw: RawResult, kind: str) -> tuple[bool, np.ndarray |
     return True, tau, ""
 
 
-def make_rows(variant: ProxVariant) -> dict[str, tuple[str, Callable[[Grasp], RawResult]]]:
+def make_rows(variant: ProxSuiteSettings) -> dict[str, tuple[str, Callable[[Grasp], RawResult]]]:
     """Row name -> (kind, call); each call sees only the grasp."""
-    prox, tuned = make_solver("proxsuite"), ProxSuiteQP(variant)
+    prox, tuned = make_solver("proxsuite"), make_solver("proxsuite", variant)
     daqp_, quadprog_ = make_solver("daqp"), make_solver("quadprog")
     return {
         "proxsuite": ("qp", lambda g: prox.solve(g.qp)),
@@ -328,7 +224,7 @@ def pct(a: list[float], q: float) -> float | None:
     return float(np.percentile(a, q)) if len(a) else None
 
 
-def compare(setups: list[GraspSetup], repeats: int, variant: ProxVariant,
+def compare(setups: list[GraspSetup], repeats: int, variant: ProxSuiteSettings,
             rows: list[str] | None = None) -> dict:
     """Every row on every grasp: failures, agreement, times, ratios (see the module docstring)."""
     table_rows = make_rows(variant)
@@ -407,7 +303,7 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
         refs.append(tau if ok else None)
     tried = []
     for v in variant_grid():
-        solver = ProxSuiteQP(v)
+        solver = make_solver("proxsuite", v)
         times, failed, dev = [], 0, 0.0
         for g, ref in zip(grasps, refs):
             ts, good = [], True
@@ -421,7 +317,7 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
                     dev = max(dev, float(np.max(np.abs(tau - ref))))
             times.append(float(np.median(ts)))
             failed += not good
-        tried.append({"variant": dataclasses.asdict(v), "label": v.label, "failed": failed,
+        tried.append({"variant": dataclasses.asdict(v), "label": variant_label(v), "failed": failed,
                       "max_abs_tau_dev": dev, "median_s": float(np.median(times))})
     good = [t for t in tried if t["failed"] == 0 and t["max_abs_tau_dev"] <= AGREE_TOL]
     best = None
@@ -437,34 +333,58 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
 # ---------------------------------------------------------------- warm starts
 
 
-def sequence(base: GraspSetup, steps: int, drift: bool, seed: int = 0) -> list[GraspSetup]:
-    """A slowly moving sequence: the load's force rotating once around base y, q drifting."""
+def sequence(base: GraspSetup, steps: int, kind: str, seed: int = 0) -> list[GraspSetup]:
+    """A slowly moving sequence: the load's force rotating once around base y.
+
+    ``kind``: ``load`` only that; ``drift`` every joint also drifting sinusoidally by up
+    to 0.05 rad; ``step`` the rotating load 1000 times heavier (infeasible) for 10
+    steps out of every 50, then back.
+    """
     scale = np.linalg.norm(base.external_wrench[:3])
     phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, base.hand.m)
     out = []
     for k in range(steps):
         th = 2 * np.pi * k / steps
         w = np.array([scale * np.cos(th), 0.0, scale * np.sin(th), 0.0, 0.0, 0.0])
+        if kind == "step" and k % 50 >= 40:
+            w *= 1e3
         q = base.q.copy()
-        if drift:
+        if kind == "drift":
             q[base.hand.idx_q] += 0.05 * np.sin(th + phase)
         out.append(dataclasses.replace(base, q=q, external_wrench=w))
     return out
 
 
 def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) -> dict:
-    """Cold and warm solvers on the same steps, in step order; refs: the force-QP taus."""
+    """Cold and warm solvers on the same steps, in step order; refs: the force-QP taus.
+
+    ``warm`` is the product's verified warm start (make_solver(..., warm_start=True)):
+    a warm answer that is not solved is redone cold inside its call (counted by
+    the solver, reported here as not solved), one that fails the certificate is
+    redone cold here as :func:`grasp_torque_opt.methods.dispatch.solve` does, and
+    its time counted in the warm column.
+    """
     t_cold, t_warm, it_cold, it_warm = [], [], [], []
-    cold_bad, not_solved, cert_failed, off = 0, 0, 0, 0
+    cold_bad, not_solved, cert_failed, off, verdict = 0, 0, 0, 0, 0
     off_ref = {"cold": 0, "warm": 0}
     worst = 0.0
     for g, ref in zip(grasps, refs):
         t0 = time.perf_counter()
         rc = cold.solve(g.qp)
         t_cold.append(time.perf_counter() - t0)
+        redone = warm.fallbacks
         t0 = time.perf_counter()
         rw = warm.solve(g.qp)
-        t_warm.append(time.perf_counter() - t0)
+        elapsed = time.perf_counter() - t0
+        not_solved += warm.fallbacks > redone
+        tau_w, f_w = g.from_qp(rw)
+        if warm.last_warm and (tau_w is None or not g.certify_tau_f(tau_w, f_w).ok):
+            cert_failed += 1
+            t0 = time.perf_counter()
+            rw = warm.solve(g.qp, cold=True)
+            elapsed += time.perf_counter() - t0
+            tau_w, f_w = g.from_qp(rw)
+        t_warm.append(elapsed)
         it_cold.append(rc.iterations)
         it_warm.append(rw.iterations)
         ok_c, tau_c, _ = outcome(g, rc, "qp")
@@ -472,12 +392,9 @@ def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) ->
             cold_bad += 1
         elif ref is not None:
             off_ref["cold"] += float(np.max(np.abs(tau_c - ref))) > AGREE_TOL
-        tau_w, f_w = g.from_qp(rw)
-        if rw.status != "solved" or tau_w is None:
-            not_solved += 1
-            continue
-        if not g.certify_tau_f(tau_w, f_w).ok:
-            cert_failed += 1
+        ok_w = rw.status == "solved" and tau_w is not None and g.certify_tau_f(tau_w, f_w).ok
+        verdict += ok_w != ok_c
+        if not ok_w:
             continue
         if ref is not None:
             off_ref["warm"] += float(np.max(np.abs(tau_w - ref))) > AGREE_TOL
@@ -487,7 +404,8 @@ def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) ->
             off += d > AGREE_TOL
     return {"steps": len(grasps), "cold_not_certified": cold_bad,
             "warm_not_solved": not_solved, "warm_certificate_failed": cert_failed,
-            "warm_off_cold_optimum": off, "warm_max_abs_tau_dev_from_cold": worst,
+            "warm_off_cold_optimum": off, "warm_verdict_differs": verdict,
+            "warm_max_abs_tau_dev_from_cold": worst,
             "cold_off_reference": off_ref["cold"], "warm_off_reference": off_ref["warm"],
             "cold_median_s": pct(t_cold, 50), "cold_p99_s": pct(t_cold, 99),
             "warm_median_s": pct(t_warm, 50), "warm_p99_s": pct(t_warm, 99),
@@ -495,11 +413,11 @@ def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) ->
             "warm_iterations_median": float(np.median(it_warm))}
 
 
-def warm_starts(steps: int, variant: ProxVariant) -> dict:
+def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
     base = GraspSetup.from_file(SCENARIO)
     out = {}
-    for name, drift in (("load", False), ("drift", True)):
-        grasps = [Grasp.of(s) for s in sequence(base, steps, drift)]
+    for name in ("load", "drift", "step"):
+        grasps = [Grasp.of(s) for s in sequence(base, steps, name)]
         refs = []
         for g in grasps:
             ok, tau, _ = outcome(g, solve_force_qp(*g.args, objective="torque"), "exact")
@@ -507,10 +425,11 @@ def warm_starts(steps: int, variant: ProxVariant) -> dict:
         out[name] = {
             "reference_not_certified": sum(r is None for r in refs),
             "proxsuite": warm_pair(grasps, refs, make_solver("proxsuite"),
-                                   ProxSuiteQP(ProxVariant(), warm=True)),
-            "proxsuite-tuned": warm_pair(grasps, refs, ProxSuiteQP(variant),
-                                         ProxSuiteQP(variant, warm=True)),
-            "daqp": warm_pair(grasps, refs, make_solver("daqp"), DaqpModel()),
+                                   make_solver("proxsuite", warm_start=True)),
+            "proxsuite-tuned": warm_pair(grasps, refs, make_solver("proxsuite", variant),
+                                         make_solver("proxsuite", variant, warm_start=True)),
+            "daqp": warm_pair(grasps, refs, make_solver("daqp"),
+                              make_solver("daqp", warm_start=True)),
         }
     return out
 
@@ -523,7 +442,8 @@ def run(grasps: int = 200, seed: int = 0, repeats: int = 5, scenario_repeats: in
     """The whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
     tuning = tune_proxsuite(allegro_grasps(TUNING_GRASPS, seed + TUNING_SEED_OFFSET),
                             max(1, min(repeats, 3)))
-    variant = ProxVariant(**tuning["best"]["variant"]) if tuning["best"] else ProxVariant()
+    variant = ProxSuiteSettings(**tuning["best"]["variant"]) if tuning["best"] else \
+        ProxSuiteSettings()
     sets = {}
     for name in SCENARIOS:
         sets[name] = compare([GraspSetup.from_file(ROOT / "config" / name)], scenario_repeats,
@@ -532,7 +452,7 @@ def run(grasps: int = 200, seed: int = 0, repeats: int = 5, scenario_repeats: in
         allegro_grasps(grasps, seed), repeats, variant)
     return {"machine": machine(), "osqp": osqp.__version__, "blas_threads": blas_threads(),
             "grasps": grasps, "seed": seed, "repeats": repeats,
-            "tuning": tuning, "tuned_variant": variant.label, "sets": sets,
+            "tuning": tuning, "tuned_variant": variant_label(variant), "sets": sets,
             "warm_starts": warm_starts(steps, variant)}
 
 
@@ -568,12 +488,13 @@ def table(results: dict) -> str:
                       f"exact one: median {100 * ex['median']:.2f}%, p90 {100 * ex['p90']:.2f}%,"
                       f" max {100 * ex['max']:.2f}%."]
         lines.append("")
-    lines += ["**warm starts** (cold bad: not certified; warm bad: not solved / certificate "
-              "failed / off the cold optimum by > 1e-6; off ref: > 1e-6 from the force QP)",
+    lines += ["**warm starts** (cold bad: not certified; warm redone cold: not solved / "
+              "certificate failed; warm bad: verdict differs from the cold one / off the cold "
+              "optimum by > 1e-6; off ref: > 1e-6 from the force QP)",
               "", "| sequence | solver | cold median / p99 [us] | warm median / p99 [us] | "
-              "iterations cold / warm | cold bad | warm bad | max abs warm - cold [N m] | "
-              "off ref cold / warm |",
-              "|---|---|---|---|---|---:|---|---:|---|"]
+              "iterations cold / warm | cold bad | warm redone cold | warm bad | "
+              "max abs warm - cold [N m] | off ref cold / warm |",
+              "|---|---|---|---|---|---:|---|---|---:|---|"]
     for seq, res in results["warm_starts"].items():
         for solver, w in res.items():
             if not isinstance(w, dict):
@@ -583,7 +504,8 @@ def table(results: dict) -> str:
                 f"{_us(w['cold_p99_s'])} | {_us(w['warm_median_s'])} / {_us(w['warm_p99_s'])} | "
                 f"{w['cold_iterations_median']:.0f} / {w['warm_iterations_median']:.0f} | "
                 f"{w['cold_not_certified']} | {w['warm_not_solved']} / "
-                f"{w['warm_certificate_failed']} / {w['warm_off_cold_optimum']} | "
+                f"{w['warm_certificate_failed']} | {w['warm_verdict_differs']} / "
+                f"{w['warm_off_cold_optimum']} | "
                 f"{w['warm_max_abs_tau_dev_from_cold']:.1e} | {w['cold_off_reference']} / "
                 f"{w['warm_off_reference']} |")
     return "\n".join(lines)

@@ -44,14 +44,14 @@ def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None =
                 warm_start: bool = False):
     """A tau-QP solver by backend name (one of :data:`BACKENDS`).
 
-    ``warm_start`` applies to DAQP only (ProxSuite's own warm start gave
-    unsolved or off-optimum answers on slowly moving Allegro sequences).
+    ``warm_start`` applies to ProxSuite and DAQP (each verifies its warm answers
+    and redoes a bad one cold); quadprog has none.
 
     Raises:
         ValueError: an unknown backend, naming the known ones.
     """
     if backend == "proxsuite":
-        return TauQPSolver(settings)
+        return TauQPSolver(settings, warm_start)
     if backend == "daqp":
         return DaqpSolver(settings, warm_start)
     if backend == "quadprog":

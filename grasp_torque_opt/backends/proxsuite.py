@@ -41,6 +41,12 @@ class ProxSuiteSettings:
             grasp set (about 0.7 times the time of Dense/Automatic, the same
             optimum to 1e-7 N m on the 200 bench grasps).
 
+        preconditioner: ``first`` computes ProxSuite's preconditioner on the
+            first problem of a size and keeps it through every ``update``
+            (ProxSuite's default for ``update``; it also keeps a warm start's
+            scaling consistent), ``every`` recomputes it in each ``update``,
+            ``off`` never computes it.
+
     The duality gap is checked as well, to ``eps_abs``: without that check
     ProxSuite stopped up to 2e-6 (relative) above Clarabel's optimum.
     """
@@ -52,16 +58,36 @@ class ProxSuiteSettings:
     eps_primal_inf: float = 1e-12
     hessian_type: str = "Diagonal"
     dense_backend: str = "PrimalDualLDLT"
+    preconditioner: str = "first"
 
 
 
 class TauQPSolver:
-    """ProxSuite dense solver for tau-QPs, allocated once per problem size."""
+    """ProxSuite dense solver for tau-QPs, allocated once per problem size.
+
+    With ``warm_start``, each solve on a QP of the same size starts from the
+    previous result (``WARM_START_WITH_PREVIOUS_RESULT``; data replaced with
+    ``update``, preconditioner kept). A warm answer that ProxSuite does not call
+    solved is redone cold within the same call; one that fails the caller's
+    certificate is redone when the caller asks again with ``cold=True``
+    (:func:`grasp_torque_opt.methods.dispatch.solve` does). ``warm_solves`` and
+    ``fallbacks`` count them, as for DAQP.
+
+    Args:
+        settings: ProxSuite's settings.
+        warm_start: start from the previous result.
+    """
 
     name = "proxsuite"
 
-    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+    def __init__(self, settings: ProxSuiteSettings | None = None,
+                 warm_start: bool = False) -> None:
         self.settings = settings or ProxSuiteSettings()
+        self.warm_start = warm_start
+        self.warm_solves = 0
+        self.fallbacks = 0
+        #: Whether the last answer came from a warm start (not redone cold).
+        self.last_warm = False
         self._qp = None
         self._dims: tuple | None = None
 
@@ -72,48 +98,53 @@ class TauQPSolver:
             return "Dense"
         return self.settings.hessian_type
 
-    def solve(self, qp: TauQP) -> RawResult:
-        """Solve a built tau-QP from a cold start.
+    def solve(self, qp: TauQP, cold: bool = False) -> RawResult:
+        """Solve a built tau-QP (warm if enabled and the size is unchanged, else cold).
+
+        Args:
+            qp: the QP.
+            cold: start cold even with ``warm_start`` (the caller's redo of a warm
+                answer that failed its certificate; counted in ``fallbacks``).
 
         Returns:
             The raw result; the caller certifies it.
 
         Raises:
-            SolverError: ProxSuite raised (chained).
+            SolverError: ProxSuite raised (chained); the next call starts anew.
         """
+        if cold and self.last_warm:
+            self.fallbacks += 1
+        self.last_warm = False
         why = check_data(qp)
         if why:
             return RawResult("error", None, 0, 0.0, why)
         n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
-        A = qp.A if n_eq else None
-        b = qp.b if n_eq else None
-        lower = np.full(n_in, -np.inf)
+        data = dict(H=qp.H, g=qp.g, A=qp.A if n_eq else None, b=qp.b if n_eq else None,
+                    C=qp.C, l=np.full(n_in, -np.inf), u=qp.u, l_box=qp.l_box, u_box=qp.u_box)
         dims = (n, n_eq, n_in, self._hessian_type(qp.H))
+        guess = proxsuite.proxqp.InitialGuess
         t0 = time.perf_counter()
         try:
             if self._dims != dims:
-                dense = proxsuite.proxqp.dense
-                self._qp = dense.QP(n, n_eq, n_in, True,
-                                    hessian_type=getattr(dense.HessianType, dims[3]),
-                                    dense_backend=getattr(dense.DenseBackend,
-                                                          self.settings.dense_backend))
-                s = self._qp.settings
-                s.eps_abs = self.settings.eps_abs
-                s.eps_rel = self.settings.eps_rel
-                s.max_iter = self.settings.max_iter
-                s.max_iter_in = self.settings.max_iter_in
-                s.eps_primal_inf = self.settings.eps_primal_inf
-                s.check_duality_gap = True
-                s.eps_duality_gap_abs = self.settings.eps_abs
-                s.eps_duality_gap_rel = 0.0
-                s.initial_guess = proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS
-                self._qp.init(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=lower, u=qp.u,
-                              l_box=qp.l_box, u_box=qp.u_box)
-                self._dims = dims
+                self._init(dims, data)
+                warm = False
             else:
-                self._qp.update(H=qp.H, g=qp.g, A=A, b=b, C=qp.C, l=lower, u=qp.u,
-                                l_box=qp.l_box, u_box=qp.u_box)
+                warm = self.warm_start and not cold
+                self._qp.settings.initial_guess = (guess.WARM_START_WITH_PREVIOUS_RESULT if warm
+                                                   else guess.NO_INITIAL_GUESS)
+                self._qp.update(**data,
+                                update_preconditioner=self.settings.preconditioner == "every")
             self._qp.solve()
+            iterations = int(self._qp.results.info.iter)
+            if warm:
+                self.warm_solves += 1
+                self.last_warm = self._qp.results.info.status == \
+                    proxsuite.proxqp.QPSolverOutput.PROXQP_SOLVED
+                if not self.last_warm:  # the same data, cold
+                    self.fallbacks += 1
+                    self._qp.settings.initial_guess = guess.NO_INITIAL_GUESS
+                    self._qp.solve()
+                    iterations += int(self._qp.results.info.iter)
         except (RuntimeError, ValueError, TypeError) as e:
             self._dims = None
             raise SolverError(f"ProxSuite failed: {e}") from e
@@ -122,5 +153,24 @@ class TauQPSolver:
         out = proxsuite.proxqp.QPSolverOutput
         status = {out.PROXQP_SOLVED: "solved",
                   out.PROXQP_PRIMAL_INFEASIBLE: "infeasible"}.get(info.status, "error")
-        return RawResult(status, np.array(self._qp.results.x), int(info.iter), elapsed,
+        return RawResult(status, np.array(self._qp.results.x), iterations, elapsed,
                          str(info.status).rsplit(".", 1)[-1])
+
+    def _init(self, dims: tuple, data: dict) -> None:
+        """A new ProxSuite QP for this problem size, set up with the settings and ``data``."""
+        dense = proxsuite.proxqp.dense
+        self._qp = dense.QP(*dims[:3], True, hessian_type=getattr(dense.HessianType, dims[3]),
+                            dense_backend=getattr(dense.DenseBackend,
+                                                  self.settings.dense_backend))
+        s = self._qp.settings
+        s.eps_abs = self.settings.eps_abs
+        s.eps_rel = self.settings.eps_rel
+        s.max_iter = self.settings.max_iter
+        s.max_iter_in = self.settings.max_iter_in
+        s.eps_primal_inf = self.settings.eps_primal_inf
+        s.check_duality_gap = True
+        s.eps_duality_gap_abs = self.settings.eps_abs
+        s.eps_duality_gap_rel = 0.0
+        s.initial_guess = proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS
+        self._qp.init(**data, compute_preconditioner=self.settings.preconditioner != "off")
+        self._dims = dims

@@ -216,8 +216,8 @@ class TorqueController:
         config: timing and safety settings.
         solver_settings: solver tolerance and iteration caps.
         backend: QP backend, one of :data:`grasp_torque_opt.backends.BACKENDS`.
-        warm_start: start each solve from the previous one (DAQP only; verified,
-            with a cold fallback in the same cycle).
+        warm_start: start each solve from the previous one (ProxSuite and DAQP;
+            verified, with a cold redo in the same cycle).
         fallback: a second backend, asked in the same cycle when the first gives
             nothing certifiable; None for none.
     """

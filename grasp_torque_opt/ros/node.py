@@ -125,11 +125,11 @@ PARAMETERS: dict[str, Spec] = {
     "solver.fallback": Spec("Backend asked in the same cycle when solver.backend gives nothing "
                             "certifiable ('none': no second try); its answer is certified "
                             "the same way and counted (diagnostics solver.fallback_solves)."),
-    "solver.warm_start": Spec("Start each DAQP solve from the previous cycle's active set; an "
-                              "answer that is not optimal (flag, KKT check) or not certified is "
-                              "redone cold in "
-                              "the same cycle and counted (diagnostics "
-                              "solver.warm_start_fallbacks). No effect on other backends."),
+    "solver.warm_start": Spec("Start each solve from the previous cycle's (ProxSuite: its "
+                              "result, preconditioner kept; DAQP: its active set); an answer "
+                              "that is not solved (DAQP: also the KKT check) or not certified "
+                              "is redone cold in the same cycle and counted (diagnostics "
+                              "solver.warm_start_fallbacks). No effect on quadprog."),
     "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
                            "[-].", 1e-12, 1e-4),
     "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 100000),
@@ -225,7 +225,7 @@ class GraspTorqueNode(Node):
             "cycle_budget": CycleConfig.cycle_budget,
             "solver.backend": BACKENDS[0],
             "solver.fallback": "daqp",
-            "solver.warm_start": False,
+            "solver.warm_start": True,
             "solver.eps_abs": ProxSuiteSettings.eps_abs,
             "solver.max_iter": ProxSuiteSettings.max_iter,
             "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
@@ -339,7 +339,7 @@ class GraspTorqueNode(Node):
     def _apply_parameters(self, params: list[Parameter]) -> None:
         p = self._params()
         with self._lock:
-            warm_loop = p["solver.warm_start"] and p["solver.backend"] == "daqp"
+            warm_loop = p["solver.warm_start"] and p["solver.backend"] != "quadprog"
             for ctrl, warm in ((self.controller, warm_loop), (self._service_controller, False)):
                 setup, config, solver = self._configure(ctrl.setup, p)
                 ctrl.setup, ctrl.config = setup, config

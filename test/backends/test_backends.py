@@ -1,12 +1,14 @@
 """Every QP backend: the same certified optimum as an independent solver, and no stall on bad data."""
 
+import copy
 import dataclasses
 
 import numpy as np
 import pytest
+from conftest import setup_from_doc
 from independent import assert_holds
 
-from grasp_torque_opt.backends import BACKENDS, DaqpSolver, make_solver
+from grasp_torque_opt.backends import BACKENDS, DaqpSolver, TauQPSolver, make_solver
 from grasp_torque_opt.backends.daqp import kkt_violation
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.tau_qp import build_tau_qp
@@ -104,31 +106,59 @@ def moving_sequence(setup, steps):
         yield dataclasses.replace(setup, external_wrench=w, q=q)
 
 
+WARM_BACKENDS = ["proxsuite", "daqp"]
+#: How close two optima of the same QP agree [N m]: ProxSuite stops within about 1e-8 of
+#: it at eps_abs 1e-9 (with the duality-gap check), DAQP within 1e-11.
+AGREE = {"proxsuite": 1e-7, "daqp": 1e-8}
+
+
+@pytest.mark.parametrize("backend", WARM_BACKENDS)
 @pytest.mark.parametrize("name", ["planar", "allegro"])
-def test_daqp_warm_start_gives_the_cold_optimum(name, request):
+def test_warm_start_gives_the_cold_optimum(name, backend, request):
     setup = request.getfixturevalue(name)
-    cold, warm = make_solver("daqp"), make_solver("daqp", warm_start=True)
+    cold, warm = make_solver(backend), make_solver(backend, warm_start=True)
     for s in moving_sequence(setup, 40):
         maps = s.maps()
         a, b = solve(s, maps=maps, solver=cold), solve(s, maps=maps, solver=warm)
         assert a.status == b.status
         if a.optimal:
-            np.testing.assert_allclose(b.tau, a.tau, atol=1e-8)
+            np.testing.assert_allclose(b.tau, a.tau, atol=AGREE[backend])
     assert warm.warm_solves == 39 and cold.warm_solves == 0
 
 
-def test_daqp_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro):
-    """From a feasible grasp's active set to an infeasible load and back: each result is the
+@pytest.mark.parametrize("backend", WARM_BACKENDS)
+def test_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro, backend):
+    """From a feasible grasp's solution to an infeasible load and back: each result is the
     cold one, and every warm answer that was not optimal was redone cold (and counted)."""
-    warm = make_solver("daqp", warm_start=True)
+    warm = make_solver(backend, warm_start=True)
     heavy = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * 1e3)
     assert solve(allegro, solver=warm).optimal
     assert solve(heavy, solver=warm).status == "infeasible"
     assert warm.fallbacks == 1  # the warm answer on the heavy load was not optimal
     back = solve(allegro, solver=warm)
     assert back.optimal
-    np.testing.assert_allclose(back.tau, solve(allegro, backend="daqp").tau, atol=1e-8)
+    np.testing.assert_allclose(back.tau, solve(allegro, backend="daqp").tau, atol=AGREE[backend])
 
+
+@pytest.mark.parametrize("backend", WARM_BACKENDS)
+def test_warm_start_across_a_change_of_polygon_sides_or_contact_count(planar_doc, backend):
+    """A QP of another size is a new workspace (cold), then warm again; always the optimum
+    of an independent cold solve."""
+    warm = make_solver(backend, warm_start=True)
+    docs = []
+    for sides in (3, 8, 8, 5):
+        doc = copy.deepcopy(planar_doc)
+        doc["friction"]["polygon_sides"] = sides
+        docs.append(doc)
+    hyper = copy.deepcopy(planar_doc)
+    hyper["grasp"]["contacts"].insert(1, {"link": "finger1_distal", "position": [0, 0.03, 0]})
+    docs += [hyper, hyper, planar_doc]
+    for doc in docs:
+        s = setup_from_doc(doc)
+        got, ref = solve(s, solver=warm), solve(s, backend="daqp")
+        assert got.status == ref.status == "optimal"
+        np.testing.assert_allclose(got.tau, ref.tau, atol=1e-7)
+    assert warm.warm_solves == 2  # the repeated 8-gon and the repeated extra contact
 
 def test_kkt_violation_sees_a_suboptimal_point(allegro):
     """The optimality check itself: the solver's point passes, a feasible detour does not."""
@@ -196,11 +226,13 @@ def test_fallback_is_not_asked_when_the_first_backend_certifies(allegro):
     assert sol.optimal and sol.backend == "proxsuite" and Counting.calls == 0
 
 
-def test_daqp_warm_answer_off_the_certificate_is_redone_cold(allegro):
-    """A warm answer that DAQP and the KKT check accept but the certificate refuses (injected:
-    the warm x moved by 5%) is solved again cold in the same call, and counted."""
+@pytest.mark.parametrize("backend", WARM_BACKENDS)
+def test_warm_answer_off_the_certificate_is_redone_cold(allegro, backend):
+    """A warm answer that the solver accepts but the certificate refuses (injected: the warm
+    x moved by 5%) is solved again cold in the same call, and counted."""
+    base = {"daqp": DaqpSolver, "proxsuite": TauQPSolver}[backend]
 
-    class WrongWhenWarm(DaqpSolver):
+    class WrongWhenWarm(base):
         def solve(self, qp, cold=False):
             raw = super().solve(qp, cold)
             return dataclasses.replace(raw, x=raw.x * 1.05) if self.last_warm else raw
@@ -211,5 +243,5 @@ def test_daqp_warm_answer_off_the_certificate_is_redone_cold(allegro):
     moved = next(first)
     sol = solve(moved, solver=warm)
     assert warm.warm_solves == 1 and warm.fallbacks == 1
-    assert sol.optimal and sol.backend == "daqp"
-    np.testing.assert_allclose(sol.tau, solve(moved, backend="daqp").tau, atol=1e-8)
+    assert sol.optimal and sol.backend == backend
+    np.testing.assert_allclose(sol.tau, solve(moved, backend="daqp").tau, atol=AGREE[backend])
