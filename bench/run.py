@@ -15,7 +15,11 @@ Runs, in this order, each writing ``OUT/<name>.json``:
 - ``planner``: grasps scored per second, one process and both cores
   (bench/planner.py);
 - ``node_load``: the node at 500 Hz and 1 kHz beside a trivial echo node, in
-  separate processes (bench/node_load.py; skipped with ``--skip-node``).
+  separate processes (bench/node_load.py; skipped with ``--skip-node``);
+- ``node_blackbox``: the node on the default params file, measured from outside
+  as a user would (joint states published, effort commands counted), beside the
+  echo node and the old cold ProxSuite default (bench/node_blackbox.py; skipped
+  with ``--skip-node``).
 
 then ``OUT/summary.md``: the machine, the date and each part's table, which the
 README's Benchmarks section shows. ``--quick`` runs everything small (a smoke
@@ -37,6 +41,7 @@ sys.path.insert(0, str(HERE))
 
 import cycle  # noqa: E402
 import linearization  # noqa: E402
+import node_blackbox  # noqa: E402
 import node_load  # noqa: E402
 import planner  # noqa: E402
 import solvers  # noqa: E402
@@ -74,17 +79,18 @@ def main() -> int:
         print(text, flush=True)
         summary.append(f"## {name} ({time.monotonic() - t0:.0f} s)\n\n{text}\n")
     if not args.skip_node:
-        print("== node_load", flush=True)
-        cmd = [sys.executable, str(HERE / "node_load.py"), "--out",
-               str(args.out / "node_load.json")]
-        if args.quick:
-            cmd += ["--duration", "2", "--hands", "allegro"]
-        t0 = time.monotonic()
-        done = subprocess.run(cmd)
-        path = args.out / "node_load.json"
-        table = node_load.table(json.loads(path.read_text())["cases"]) if path.exists() \
-            else f"node_load failed (exit {done.returncode}); see its output above"
-        summary.append(f"## node_load ({time.monotonic() - t0:.0f} s)\n\n{table}\n")
+        for name, module, quick in (("node_load", node_load, ["--hands", "allegro"]),
+                                    ("node_blackbox", node_blackbox, [])):
+            print(f"== {name}", flush=True)
+            path = args.out / f"{name}.json"
+            cmd = [sys.executable, str(HERE / f"{name}.py"), "--out", str(path)]
+            if args.quick:
+                cmd += ["--duration", "2"] + quick
+            t0 = time.monotonic()
+            done = subprocess.run(cmd)
+            table = module.table(json.loads(path.read_text())["cases"]) if path.exists() \
+                else f"{name} failed (exit {done.returncode}); see its output above"
+            summary.append(f"## {name} ({time.monotonic() - t0:.0f} s)\n\n{table}\n")
     (args.out / "summary.md").write_text("\n".join(summary))
     print(f"written: {args.out}/*.json and {args.out / 'summary.md'}")
     return 0

@@ -1,0 +1,206 @@
+"""The node measured as a user measures it: joint states in, effort commands counted, from outside.
+
+Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000] [--runs 1]
+
+Each case starts one answering process exactly as a user would, with nothing
+added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
+(the default executor; the default backend, ProxSuite with its verified warm
+start), then the same with ``-p solver.warm_start:=false`` (the cold ProxSuite
+default before the warm start), with ``-p solver.backend:=daqp``, and the trivial
+echo node of ``bench/node_load.py`` (one zero command per joint state). A
+separate process publishes Allegro joint states at the rate with sensor-data
+QoS for ``--duration`` seconds once the answering node is discovered and has
+answered once, and counts the ``effort_commands`` that arrive (a plain
+subscriber, reliable, depth 10, as ``ros2 topic hz`` would see them) until 0.5 s
+after its last joint state. "answered" is commands over joint states published.
+
+This differs from ``node_load.py`` on purpose: no stamped second topic (the node
+publishes only what a user's controller reads), no warm-up excluded, no stamp
+matching; it gives no latency. Speed is measured here, never asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ros_load import (  # noqa: E402
+    CONFIG,
+    Child,
+    CpuShare,
+    Pacer,
+    interrupt_on_signals,
+    isolated_env,
+    private_domains,
+)
+
+PARAMS = CONFIG / "allegro_right_node.yaml"
+SCENARIO = CONFIG / "allegro_right.yaml"
+#: Answering processes: name -> extra node arguments (None: the echo node).
+TARGETS = {"echo": None, "grasp_torque_node (default)": [],
+           "grasp_torque_node warm_start:=false": ["-p", "solver.warm_start:=false"],
+           "grasp_torque_node backend:=daqp": ["-p", "solver.backend:=daqp"]}
+DRAIN_S = 0.5
+READY_TIMEOUT_S = 15.0
+
+
+def count_main(args: argparse.Namespace) -> int:
+    """The user's process: publish joint states, count the commands, write JSON."""
+    import numpy as np
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
+
+    setup = GraspSetup.from_file(SCENARIO)
+    names = list(setup.hand.joints)
+    q0 = setup.q[setup.hand.idx_q].astype(float)
+    rclpy.init(args=[sys.argv[0]])
+    node = rclpy.create_node("blackbox_user")
+    pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    received = []
+    node.create_subscription(Float64MultiArray, "effort_commands",
+                             lambda m: received.append(len(m.data)), 10)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    pacer = Pacer(executor, args.rate)
+
+    def state(k: int) -> JointState:
+        msg = JointState(name=names, position=(q0 + 1e-3 * np.sin(
+            np.pi * k * pacer.period + 0.4 * np.arange(len(names)))).tolist())
+        msg.header.stamp = node.get_clock().now().to_msg()
+        return msg
+
+    end = time.monotonic() + READY_TIMEOUT_S
+    k = 0
+    while not received and time.monotonic() < end:  # discovered and answering once
+        pub.publish(state(k))
+        k += 1
+        pacer.spin_for(0.01)
+    if not received:
+        print("user: no effort command came back", file=sys.stderr)
+        return 1
+    pacer.spin_for(0.2)
+    received.clear()
+    published = 0
+
+    def tick(k: int, now: float) -> bool:
+        nonlocal published
+        if published >= int(args.duration * args.rate):
+            return False
+        pub.publish(state(k))
+        published += 1
+        return True
+
+    pacer.run(tick)
+    pacer.spin_for(DRAIN_S)
+    node.destroy_node()
+    rclpy.try_shutdown()
+    Path(args.result).write_text(json.dumps({
+        "published": published, "commands": len(received),
+        "wrong_length": sum(n != len(names) for n in received)}))
+    return 0
+
+
+def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) -> dict:
+    env = isolated_env(domain)
+    extra = TARGETS[target]
+    bench = Path(__file__).resolve().parent
+    if extra is None:
+        from grasp_torque_opt.core.grasp_setup import GraspSetup
+
+        joints = GraspSetup.from_file(SCENARIO).hand.joints
+        cmd = [sys.executable, str(bench / "node_load.py"), "--role", "echo",
+               "--executor", "single", "--joints", ",".join(joints)]
+    else:
+        exe = Path(sys.executable).parent / "grasp_torque_node"
+        cmd = [str(exe), "--ros-args", "--params-file", str(PARAMS)] + extra
+    tag = f"{target.split()[0]}-{len(extra or [])}-{extra[-1] if extra else ''}-{rate:g}"
+    tag = "".join(c if c.isalnum() or c in "-." else "_" for c in tag)
+    result = tmp / f"{tag}.json"
+    user = [sys.executable, str(Path(__file__).resolve()), "--role", "user", "--rate",
+            str(rate), "--duration", str(duration), "--result", str(result)]
+    share = CpuShare()
+    with open(tmp / f"{tag}.target.log", "w") as tlog, open(tmp / f"{tag}.user.log", "w") as ulog:
+        answering = Child(cmd, env, tlog)
+        counter = Child(user, env, ulog)
+        try:
+            code = counter.proc.wait(timeout=READY_TIMEOUT_S + duration + 30)
+        finally:
+            counter.stop()
+            answering.stop()
+    out = {"target": target, "rate_hz": rate, "other_processes_cores": share.others_cores()}
+    if code == 0 and result.exists():
+        r = json.loads(result.read_text())
+        out.update(r, answered_pct=100.0 * r["commands"] / r["published"])
+    else:
+        out["error"] = f"user process exit {code} (logs in {tmp})"
+    return out
+
+
+def table(cases: list[dict]) -> str:
+    lines = ["| rate [Hz] | answering process | run | joint states | commands | answered [%] "
+             "| other work [cores] |", "|---:|---|---:|---:|---:|---:|---:|"]
+    for c in cases:
+        if "error" in c:
+            lines.append(f"| {c['rate_hz']:g} | {c['target']} | {c['run']} | failed: "
+                         f"{c['error']} ||||")
+            continue
+        other = c["other_processes_cores"]
+        lines.append(f"| {c['rate_hz']:g} | {c['target']} | {c['run']} | {c['published']} | "
+                     f"{c['commands']} | {c['answered_pct']:.1f} | "
+                     f"{'-' if other is None else f'{other:.2f}'} |")
+    return "\n".join(lines)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=8.0, help="seconds published [s]")
+    parser.add_argument("--rates", type=float, nargs="+", default=[500.0, 1000.0])
+    parser.add_argument("--runs", type=int, default=1, help="runs of every case")
+    parser.add_argument("--out", type=Path,
+                        default=Path(__file__).resolve().parent / "results" / "node_blackbox.json")
+    parser.add_argument("--role", choices=["run", "user"], default="run", help=argparse.SUPPRESS)
+    parser.add_argument("--rate", type=float, help=argparse.SUPPRESS)
+    parser.add_argument("--result", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.role == "user":
+        return count_main(args)
+    from cycle import machine
+
+    interrupt_on_signals()
+    m = machine()
+    print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}",
+          flush=True)
+    keys = [(rate, target, run) for run in range(1, args.runs + 1) for rate in args.rates
+            for target in TARGETS]
+    tmp = Path(tempfile.mkdtemp(prefix="node_blackbox_"))
+    cases = []
+    for (rate, target, run), domain in zip(keys, private_domains(len(keys))):
+        c = run_case(target, rate, args.duration, domain, tmp)
+        c["run"] = run
+        cases.append(c)
+        print(f"  {rate:6g} Hz  {target:38} " + (c.get("error") or
+              f"answered {c['answered_pct']:5.1f}% ({c['commands']} of {c['published']})"),
+              flush=True)
+    print()
+    print(table(cases))
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps({"machine": m, "date_utc": datetime.now(timezone.utc)
+                                    .isoformat(timespec="seconds"), "duration_s": args.duration,
+                                    "cases": cases}, indent=2))
+    print(f"\nwritten: {args.out}")
+    return 0 if all("error" not in c for c in cases) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
