@@ -1,7 +1,7 @@
 """Time the full control cycle on the bundled scenarios, per QP backend.
 
 Usage: .venv/bin/python bench/cycle.py [--repeats 3000]
-       [--backends proxsuite,daqp,quadprog,daqp+warm] [--out FILE]
+       [--backends proxsuite,daqp,quadprog,proxsuite+warm,daqp+warm] [--out FILE]
 
 Two paths, median and p99 over the repeats, with the machine it ran on:
 
@@ -82,7 +82,7 @@ def summary(samples: list[float]) -> dict:
 
 
 def solver_of(variant: str):
-    """A solver from a variant name: a backend, ``+warm`` for DAQP's verified warm start."""
+    """A solver from a variant name: a backend, ``+warm`` for its verified warm start."""
     backend, _, warm = variant.partition("+")
     return make_solver(backend, warm_start=warm == "warm")
 
@@ -156,7 +156,7 @@ def bench_controller(setup: GraspSetup, variant: str, repeats: int) -> dict:
 
 
 #: What is timed: each backend, and DAQP with its verified warm start.
-VARIANTS = (*BACKENDS, "daqp+warm")
+VARIANTS = (*BACKENDS, "proxsuite+warm", "daqp+warm")
 
 
 def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS) -> dict:
