@@ -12,6 +12,47 @@ from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
 from grasp_torque_opt.core.tau_qp import TauQP, check_data
 
+#: Largest KKT violation (:func:`kkt_violation`) of a warm answer taken as optimal.
+KKT_TOLERANCE = 1e-6
+
+
+def kkt_violation(qp: TauQP, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> float:
+    """How far ProxSuite's (x, y, z) is from a KKT point of the tau-QP.
+
+    ProxSuite's convention: H x + g + A'y + C'z_C + z_box = 0, z = [z_C; z_box],
+    z_i > 0 on an active upper bound, < 0 on an active lower one. The cone rows
+    have no lower bound, so z_C < 0 is wrong however small the slack: that is
+    how a warm start that stopped on a stale active set shows (seen on a drifting
+    Allegro sequence: ProxSuite said solved, the certificate held, tau was 1.7e-3
+    N m off the optimum, and the most negative z_C was 14% of the largest).
+
+    Returns:
+        The largest of: the stationarity residual relative to the gradient (at
+        least 1); the cone rows' wrong-signed multipliers, the box multipliers on
+        an infinite bound, and every multiplier times its slack, each relative
+        to the largest multiplier (at least 1); the primal infeasibility.
+    """
+    n_in = qp.C.shape[0]
+    z_C, z_box = z[:n_in], z[n_in:]
+    grad = qp.H @ x + qp.g
+    residual = grad + qp.C.T @ z_C + z_box
+    if qp.A.shape[0]:
+        residual += qp.A.T @ y
+    slack = qp.u - qp.C @ x
+    to_upper, to_lower = qp.u_box - x, x - qp.l_box
+    finite_up, finite_lo = np.isfinite(to_upper), np.isfinite(to_lower)
+    scale = max(1.0, float(np.abs(z).max(initial=0.0)))
+    dual = max(-float(z_C.min(initial=0.0)),
+               float(np.abs(z_box[~(finite_up & finite_lo)]).max(initial=0.0)),
+               float(np.abs(z_C * slack).max(initial=0.0)),
+               float((np.maximum(z_box, 0.0) * np.where(finite_up, to_upper, 0.0)).max()),
+               float((np.maximum(-z_box, 0.0) * np.where(finite_lo, to_lower, 0.0)).max()))
+    primal = max(-float(slack.min(initial=0.0)), -float(to_upper.min()),
+                 -float(to_lower.min()),
+                 float(np.abs(qp.A @ x - qp.b).max(initial=0.0)) if qp.A.shape[0] else 0.0)
+    return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
+               dual / scale, primal)
+
 
 @dataclass(frozen=True)
 class ProxSuiteSettings:
@@ -68,7 +109,8 @@ class TauQPSolver:
     With ``warm_start``, each solve on a QP of the same size starts from the
     previous result (``WARM_START_WITH_PREVIOUS_RESULT``; data replaced with
     ``update``, preconditioner kept). A warm answer that ProxSuite does not call
-    solved is redone cold within the same call; one that fails the caller's
+    solved, or that fails the KKT check (:func:`kkt_violation`, to
+    :data:`KKT_TOLERANCE`), is redone cold within the same call; one that fails the caller's
     certificate is redone when the caller asks again with ``cold=True``
     (:func:`grasp_torque_opt.methods.dispatch.solve` does). ``warm_solves`` and
     ``fallbacks`` count them, as for DAQP.
@@ -138,8 +180,9 @@ class TauQPSolver:
             iterations = int(self._qp.results.info.iter)
             if warm:
                 self.warm_solves += 1
-                self.last_warm = self._qp.results.info.status == \
-                    proxsuite.proxqp.QPSolverOutput.PROXQP_SOLVED
+                r = self._qp.results
+                self.last_warm = r.info.status == proxsuite.proxqp.QPSolverOutput.PROXQP_SOLVED \
+                    and kkt_violation(qp, r.x, r.y, r.z) <= KKT_TOLERANCE
                 if not self.last_warm:  # the same data, cold
                     self.fallbacks += 1
                     self._qp.settings.initial_guess = guess.NO_INITIAL_GUESS

@@ -127,7 +127,7 @@ PARAMETERS: dict[str, Spec] = {
                             "the same way and counted (diagnostics solver.fallback_solves)."),
     "solver.warm_start": Spec("Start each solve from the previous cycle's (ProxSuite: its "
                               "result, preconditioner kept; DAQP: its active set); an answer "
-                              "that is not solved (DAQP: also the KKT check) or not certified "
+                              "that is not solved, fails the KKT check or is not certified "
                               "is redone cold in the same cycle and counted (diagnostics "
                               "solver.warm_start_fallbacks). No effect on quadprog."),
     "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "

@@ -245,3 +245,46 @@ def test_warm_answer_off_the_certificate_is_redone_cold(allegro, backend):
     assert warm.warm_solves == 1 and warm.fallbacks == 1
     assert sol.optimal and sol.backend == backend
     np.testing.assert_allclose(sol.tau, solve(moved, backend="daqp").tau, atol=AGREE[backend])
+
+def drifting_rotating(setup, steps):
+    """The load's force rotating once around base y while every joint drifts by up to 0.05 rad
+    (the sequence on which ProxSuite's warm start stopped off the optimum, saying solved)."""
+    scale = np.linalg.norm(setup.external_wrench[:3])
+    phase = np.random.default_rng(0).uniform(0, 2 * np.pi, setup.hand.m)
+    for k in range(steps):
+        th = 2 * np.pi * k / steps
+        q = setup.q.copy()
+        q[setup.hand.idx_q] += 0.05 * np.sin(th + phase)
+        w = np.array([scale * np.cos(th), 0.0, scale * np.sin(th), 0.0, 0.0, 0.0])
+        yield dataclasses.replace(setup, q=q, external_wrench=w)
+
+
+def test_proxsuite_warm_answers_are_the_optimum_on_a_drifting_grasp(allegro):
+    """Every answer of the warm solver equals an independent solver's optimum (DAQP, cold):
+    a warm answer that stopped on a stale active set is caught by the KKT check and redone."""
+    warm = make_solver("proxsuite", warm_start=True)
+    for s in drifting_rotating(allegro, 500):
+        qp = build_tau_qp(s.maps(), s.friction, s.external_wrench, *s.tau_bounds, s.weights)
+        got, ref = warm.solve(qp), make_solver("daqp").solve(qp)
+        assert got.status == ref.status == "solved"
+        np.testing.assert_allclose(qp.split(got.x)[0], qp.split(ref.x)[0], atol=1e-6)
+    assert warm.warm_solves == 499 and 0 < warm.fallbacks < 50
+
+
+def test_proxsuite_kkt_check_sees_a_suboptimal_point(allegro):
+    """The optimality check itself: ProxSuite's cold answer passes; the same point with a
+    multiplier of the wrong sign, or moved along the feasible set, does not."""
+    from grasp_torque_opt.backends.proxsuite import KKT_TOLERANCE, kkt_violation
+
+    maps = allegro.maps()
+    qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
+                      allegro.weights)
+    solver = TauQPSolver()
+    assert solver.solve(qp).status == "solved"
+    r = solver._qp.results
+    x, y, z = np.array(r.x), np.array(r.y), np.array(r.z)
+    assert kkt_violation(qp, x, y, z) <= KKT_TOLERANCE
+    wrong = z.copy()
+    wrong[int(np.argmax(z[:qp.C.shape[0]]))] *= -1.0
+    assert kkt_violation(qp, x, y, wrong) > KKT_TOLERANCE
+    assert kkt_violation(qp, 0.9 * x, y, z) > KKT_TOLERANCE
