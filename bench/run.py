@@ -22,7 +22,7 @@ Runs, in this order, each writing ``OUT/<name>.json``:
   with ``--skip-node``).
 
 then ``OUT/summary.md``: the machine, the date and each part's table, which the
-README's Benchmarks section shows. ``--quick`` runs everything small (a smoke
+docs/benchmarks.md shows. ``--quick`` runs everything small (a smoke
 test of the suite, not figures to quote). The soak run (bench/soak.py, 10
 minutes) is separate. BLAS runs single-threaded, as in the node.
 """

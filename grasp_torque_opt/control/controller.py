@@ -4,7 +4,7 @@ The node (:mod:`grasp_torque_opt.ros.node`) only converts messages to the plain
 arrays taken here and publishes what :meth:`TorqueController.cycle` and
 :meth:`TorqueController.watchdog` return.
 
-Fault policy (README, "Faults"): a command is published only from a certified
+Fault policy (docs/node.md, "Faults"): a command is published only from a certified
 solution that passes the gate (finite, one value per joint, within the torque
 limits). When a cycle cannot produce one (stale or invalid input, failed solve
 or certificate), nothing new is published: the effort controller keeps the
@@ -17,7 +17,7 @@ A cycle that fails in any way (a solver that raises, a status other than
 solved, a certificate that fails, an unexpected exception) is such a fault; so
 is a cycle that overruns ``cycle_budget``: its command is late and is dropped.
 
-Input rules (README, "Faults" and "Input checks"): every message is checked
+Input rules (docs/node.md, "Faults" and "Input checks"): every message is checked
 whole before it is kept (sizes, names, finite values, unit quaternions, known
 frames, magnitudes, header stamps); a rejected message changes nothing.
 """
@@ -267,7 +267,7 @@ class TorqueController:
             raise
 
     def _check_stamp(self, source: str, stamp: float, clock: float | None, now: float) -> None:
-        """The header stamp rule (README, "Input checks").
+        """The header stamp rule (docs/node.md, "Input checks").
 
         0 is an unstamped message: accepted, not compared. A stamp more than
         ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)

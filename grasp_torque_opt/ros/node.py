@@ -2,7 +2,7 @@
 
 A thin adapter over :class:`grasp_torque_opt.control.controller.TorqueController`:
 messages in, plain arrays to the controller, its decisions out. Interface
-pinned in docs/design.md section 4; parameters, units and defaults in docs/node.md.
+pinned in docs/design.md section 4; parameters, units and defaults in docs/design.md section 4.4.
 """
 
 from __future__ import annotations
