@@ -55,6 +55,32 @@ class Friction:
     min_normal_force: float = 0.0
 
 
+#: Object shapes and the entries of their ``size`` [m].
+SHAPES = {"sphere": ("radius",), "box": ("x", "y", "z"), "cylinder": ("radius", "length")}
+
+
+@dataclass(frozen=True)
+class ObjectSpec:
+    """The grasped object: what a simulation holds, and whose weight can be the load.
+
+    Attributes:
+        shape: ``sphere``, ``box`` or ``cylinder`` (axis along the object's z).
+        size: sphere [radius], box [x, y, z] edge lengths, cylinder [radius,
+            length] [m].
+        mass: [kg], > 0; uniform density, so the centre of mass is ``position``.
+        position: the shape's centre in the base frame [m], shape (3,); default
+            ``grasp.object_origin``.
+        rpy: orientation, roll-pitch-yaw about the fixed base x, y, z axes (as a
+            URDF origin) [rad], shape (3,).
+    """
+
+    shape: str
+    size: np.ndarray
+    mass: float
+    position: np.ndarray
+    rpy: np.ndarray
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A validated scenario.
@@ -68,8 +94,14 @@ class Scenario:
         object_origin: object origin c in the base frame [m], shape (3,).
         contacts: the contacts.
         friction: friction model.
-        external_wrench: load on the object about c, base axes, shape (6,) [N, N m].
+        external_wrench: load on the object about c, base axes, shape (6,) [N, N m]:
+            the object's weight (with ``object`` and ``gravity``) plus ``extra_wrench``.
         weights: objective weights per joint, or None for ones.
+        object: the object, or None.
+        gravity: gravity in the base frame [m/s^2], shape (3,), or None: drives the
+            object's weight and the node's default g(q) (docs/design.md section 4).
+        extra_wrench: ``load.external_wrench`` as written: the load besides the
+            object's weight, shape (6,) [N, N m].
     """
 
     urdf: str
@@ -83,6 +115,19 @@ class Scenario:
     external_wrench: np.ndarray
     weights: list[float] | None = None
     source: str = field(default="<memory>")
+    object: ObjectSpec | None = None
+    gravity: np.ndarray | None = None
+    extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+
+def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
+                  origin: np.ndarray) -> np.ndarray:
+    """The object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,);
+    zero without an object or without gravity."""
+    if obj is None or gravity is None:
+        return np.zeros(6)
+    force = obj.mass * np.asarray(gravity, dtype=float)
+    return np.concatenate((force, np.cross(obj.position - origin, force)))
 
 
 _SECTIONS = {
@@ -93,6 +138,28 @@ _SECTIONS = {
     "objective": {"weights"},
 }
 _CONTACT_KEYS = {"link", "position", "normal", "tangent"}
+_OBJECT_KEYS = {"shape", "size", "mass", "position", "rpy"}
+
+
+def _object(value: Any, origin: np.ndarray) -> ObjectSpec:
+    section = _mapping(value, "object", _OBJECT_KEYS)
+    shape = _require(section, "shape", "object")
+    if shape not in SHAPES:
+        raise InputError("object.shape", f"must be one of {', '.join(SHAPES)}, got {shape!r}")
+    entries = SHAPES[shape]
+    size = _vector(_require(section, "size", "object"), "object.size")
+    if len(size) != len(entries):
+        raise InputError("object.size", f"must have {len(entries)} entries for a {shape} "
+                         f"({', '.join(entries)}), got {len(size)}")
+    for i, x in enumerate(size):
+        if x <= 0.0:
+            raise InputError(f"object.size[{i}]", f"must be > 0, got {x}")
+    mass = _positive(_require(section, "mass", "object"), "object.mass")
+    position = (_vector(section["position"], "object.position", 3)
+                if section.get("position") is not None else origin.copy())
+    rpy = (_vector(section["rpy"], "object.rpy", 3) if section.get("rpy") is not None
+           else np.zeros(3))
+    return ObjectSpec(shape=shape, size=size, mass=mass, position=position, rpy=rpy)
 
 
 def _mapping(value: Any, name: str, allowed: set[str]) -> dict:
@@ -162,13 +229,17 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
     Raises:
         InputError: naming the first invalid field.
     """
-    top = _mapping(data, "", set(_SECTIONS))
+    top = _mapping(data, "", set(_SECTIONS) | {"object", "gravity"})
     hand = _mapping(_require(top, "hand", ""), "hand", _SECTIONS["hand"])
     grasp = _mapping(_require(top, "grasp", ""), "grasp",
                      _SECTIONS["grasp"])
     friction = _mapping(_require(top, "friction", ""), "friction",
                         _SECTIONS["friction"])
-    load = _mapping(_require(top, "load", ""), "load", _SECTIONS["load"])
+    gravity = _vector(top["gravity"], "gravity", 3) if top.get("gravity") is not None else None
+    # With an object and gravity the load is the object's weight; load is then optional.
+    weighed = gravity is not None and top.get("object") is not None
+    load = _mapping(top.get("load") or {} if weighed else _require(top, "load", ""), "load",
+                    _SECTIONS["load"])
     objective = _mapping(top.get("objective") or {}, "objective", _SECTIONS["objective"])
 
     urdf = _require(hand, "urdf", "hand")
@@ -240,7 +311,12 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
         min_normal_force=fmin,
     )
 
-    wrench = _vector(_require(load, "external_wrench", "load"), "load.external_wrench", 6)
+    if weighed and load.get("external_wrench") is None:
+        extra = np.zeros(6)
+    else:
+        extra = _vector(_require(load, "external_wrench", "load"), "load.external_wrench", 6)
+    obj = _object(top["object"], origin) if top.get("object") is not None else None
+    wrench = extra + weight_wrench(obj, gravity, origin)
 
     weights = None
     if objective.get("weights") is not None:
@@ -253,7 +329,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
 
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
                     joint_positions=positions, object_origin=origin, contacts=contacts,
-                    friction=fric, external_wrench=wrench, weights=weights, source=source)
+                    friction=fric, external_wrench=wrench, weights=weights, source=source,
+                    object=obj, gravity=gravity, extra_wrench=extra)
 
 
 def load_scenario(path: str | Path) -> Scenario:

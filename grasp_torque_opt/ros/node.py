@@ -96,7 +96,8 @@ PARAMETERS: dict[str, Spec] = {
     "weights": Spec("Objective weights W (diagonal), per joint [-].", length="joints"),
     "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
                                  "limits then bound the sum."),
-    "gravity": Spec("Gravity in the base frame [m/s^2].", length="3"),
+    "gravity": Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
+                    "gravity, else [0, 0, -9.81].", length="3"),
     "joint_state_timeout": Spec("Joint states older than this stop commands [s].", 1e-4, 10.0),
     "contacts_timeout": Spec("Once contacts arrived, older than this stop commands [s]; "
                              "0: never stale.", 0.0, 60.0),
@@ -211,7 +212,9 @@ class GraspTorqueNode(Node):
             "torque_limits": [float(x) for x in setup.hand.torque_limits],
             "weights": [float(x) for x in setup.weights],
             "gravity_compensation": False,
-            "gravity": [0.0, 0.0, -9.81],
+            # One place for gravity: the scenario's, which also gives its load.
+            "gravity": ([float(x) for x in self._scenario_gravity]
+                        if self._scenario_gravity is not None else [0.0, 0.0, -9.81]),
             "joint_state_timeout": 0.1,
             "contacts_timeout": 0.5,
             "wrench_timeout": 0.5,
@@ -288,6 +291,7 @@ class GraspTorqueNode(Node):
             raise InputError("scenario", "parameter not set (a scenario file gives the "
                              "default contacts and load)")
         scenario = load_scenario(find_config(name))
+        self._scenario_gravity = scenario.gravity
         if urdf and not urdf.lstrip().startswith("<"):
             urdf = find_config(urdf, "robot_description").read_text()
         setup = GraspSetup.from_scenario(scenario, urdf or None)
