@@ -50,6 +50,8 @@ setup(
         "test": ["pytest", "hypothesis"],
         # bench/: the other solvers compared, and process memory.
         "bench": ["osqp", "psutil"],
+        # grasp_torque_opt.sim and grasp-torque-sim: the hand in MuJoCo (docs/simulation.md).
+        "sim": ["mujoco>=3.2"],
     },
     zip_safe=True,
     maintainer="grasp_torque_opt developers",
@@ -60,9 +62,11 @@ setup(
         "console_scripts": [
             "grasp-torque-opt = grasp_torque_opt.cli:main",
             "grasp-torque-demo = grasp_torque_opt.ros.demo_driver:main",
+            "grasp-torque-sim = grasp_torque_opt.ros.sim_driver:main",
             # ROS executables (ros2 run grasp_torque_opt ...), installed into lib/<pkg>.
             "grasp_torque_node = grasp_torque_opt.ros.node:main",
             "grasp_demo_driver = grasp_torque_opt.ros.demo_driver:main",
+            "grasp_sim_driver = grasp_torque_opt.ros.sim_driver:main",
         ],
     },
 )

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Create .venv/ at the repository root and install grasp_torque_opt into it
 # (editable), with ROS 2 Jazzy from the registry's ros-jazzy-* wheels, Pinocchio,
-# ProxSuite, the test tools and the benchmarks' extra solvers. Idempotent: a
-# second run only checks.
+# ProxSuite, the test tools, the benchmarks' extra solvers and MuJoCo (the
+# simulated hand). Idempotent: a second run only checks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,6 +29,6 @@ fi
 stamp=.venv/.installed
 if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ]; then
     .venv/bin/python -m pip install -q --upgrade pip
-    .venv/bin/python -m pip install -q -e '.[ros,test,bench]'
+    .venv/bin/python -m pip install -q -e '.[ros,test,bench,sim]'
     touch "$stamp"
 fi

@@ -7,8 +7,8 @@ from conftest import ROOT
 
 PACKAGE = ROOT / "grasp_torque_opt"
 #: Family -> rank; a module may import its own family and families of a lower rank.
-RANKS = {"core": 0, "backends": 1, "reference": 1, "methods": 2, "control": 3, "ros": 4,
-         "cli": 4}
+RANKS = {"core": 0, "backends": 1, "reference": 1, "methods": 2, "control": 3, "sim": 3,
+         "ros": 4, "cli": 4}
 
 
 def family(module: str) -> str:

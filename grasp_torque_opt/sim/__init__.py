@@ -1,0 +1,19 @@
+"""The hand in MuJoCo: a physics check of the certified torques (docs/simulation.md).
+
+Optional: needs the ``sim`` extra (``pip install -e '.[sim]'``, which
+``scripts/setup.sh`` installs). Nothing outside this family and
+:mod:`grasp_torque_opt.ros.sim_driver` imports MuJoCo. Same rank as
+:mod:`~grasp_torque_opt.control`: it uses the core and :func:`~grasp_torque_opt.methods.solve`.
+
+- :mod:`~grasp_torque_opt.sim.model`: the MuJoCo model of a scenario (hand URDF plus object);
+- :mod:`~grasp_torque_opt.sim.simulator`: stepping with a joint impedance, pinning
+  the object while the fingers settle, contact and object measurements;
+- :mod:`~grasp_torque_opt.sim.hold`: a hold episode of the certified torques and its report;
+- :mod:`~grasp_torque_opt.sim.render`: one offscreen picture with contact force arrows.
+"""
+
+import os
+
+# Offscreen rendering needs no display: EGL (Mesa's software EGL will do). MuJoCo reads
+# this when it is first imported, so it is set before any module here imports it.
+os.environ.setdefault("MUJOCO_GL", "egl")

@@ -1,0 +1,230 @@
+"""The MuJoCo model of a scenario: the hand from its URDF and the scenario's object.
+
+The URDF is adapted before MuJoCo compiles it (docs/simulation.md, "The model"):
+
+- joint ``dynamics friction`` is zeroed: example-robot-data's Allegro declares 5 to
+  12 N m per joint, far above its 0.7 N m torque limits, which locks the fingers so
+  that any torque "holds"; joint ``damping`` is replaced by ``joint_damping`` for
+  the same reason (3 to 10 N m s/rad in that URDF, unmeasured; with it even pure
+  torque control holds) -- the driver's impedance damping is added on top;
+- ``balanceinertia``: some link inertias of that URDF break the triangle
+  inequality (mass and centre of mass are unchanged, so g(q) is too);
+- ``fusestatic`` off: otherwise the fixed ``*_tip`` links that the scenario's
+  contacts name are merged away;
+- visuals are discarded (their ``package://`` meshes need not resolve);
+- the hand's own bodies do not collide with each other (MuJoCo's parent-child
+  filter does not apply to links welded to the world, so the palm box would
+  collide with the fingers' base links), only with the object.
+
+Contacts use MuJoCo's elliptic soft-finger model (condim 4: two tangential and one
+torsional friction direction) with the scenario's mu_tangential and mu_torsional,
+stiff (``solref`` 2 ms instead of MuJoCo's 20 ms, with which the ball creeps out of
+the bundled grasp), ``impratio`` 10 and a few noslip iterations.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.core.scenario import ObjectSpec, Scenario
+
+#: Contact bits: hand geoms (type 1, affinity 2) touch the object (type 2, affinity 1) only.
+_HAND_BITS, _OBJECT_BITS = (1, 2), (2, 1)
+OBJECT_BODY = "object"
+
+
+@dataclass(frozen=True)
+class SimSettings:
+    """How the scenario is simulated.
+
+    Attributes:
+        timestep: integration step [s] (the driver steps at 1 kHz).
+        contact_timeconst: ``solref`` time constant of every contact [s].
+        impratio: MuJoCo's ratio of frictional to normal constraint impedance [-].
+        noslip_iterations: MuJoCo's noslip solver iterations [-].
+        mu_tangential: simulated tangential friction [-]; None: the scenario's.
+        mu_torsional: simulated torsional friction [m]; None: the scenario's.
+        joint_damping: passive viscous damping of every joint in place of the
+            URDF's [N m s/rad].
+        mass: simulated object mass [kg]; None: the scenario's.
+    """
+
+    timestep: float = 1e-3
+    contact_timeconst: float = 0.002
+    impratio: float = 10.0
+    noslip_iterations: int = 5
+    mu_tangential: float | None = None
+    mu_torsional: float | None = None
+    joint_damping: float = 0.0
+    mass: float | None = None
+
+
+@dataclass(frozen=True)
+class SimModel:
+    """A compiled model and where the scenario's parts are in it.
+
+    Attributes:
+        model: the MuJoCo model (base frame = MuJoCo world).
+        joints: actuated joints in command order.
+        qpos_adr: their qpos addresses, shape (m,).
+        dof_adr: their dof addresses, shape (m,).
+        object_body: body id of the object.
+        object_qpos: qpos address of the object's free joint (position, then
+            quaternion w, x, y, z).
+        object_dof: dof address of the object's free joint.
+        contact_bodies: per scenario contact, the body id of its link.
+        gravity: gravity in the base frame [m/s^2], shape (3,).
+        mu_tangential: simulated tangential friction [-].
+        mu_torsional: simulated torsional friction [m].
+    """
+
+    model: mujoco.MjModel
+    joints: tuple[str, ...]
+    qpos_adr: np.ndarray
+    dof_adr: np.ndarray
+    object_body: int
+    object_qpos: int
+    object_dof: int
+    contact_bodies: tuple[int, ...]
+    gravity: np.ndarray
+    mu_tangential: float
+    mu_torsional: float
+
+
+def adapt_urdf(xml: str) -> str:
+    """The URDF as MuJoCo should load it: no joint friction or damping, no visuals,
+    and a ``<mujoco><compiler .../></mujoco>`` extension (see the module docstring).
+
+    Raises:
+        InputError: the document is not XML with a ``robot`` root (field ``hand.urdf``).
+    """
+    try:
+        root = ET.fromstring(xml)
+    except ET.ParseError as e:
+        raise InputError("hand.urdf", f"is not valid XML: {e}") from e
+    if root.tag != "robot":
+        raise InputError("hand.urdf", f"root element must be <robot>, got <{root.tag}>")
+    for link in root.iter("link"):
+        for visual in link.findall("visual"):
+            link.remove(visual)
+    for dynamics in root.iter("dynamics"):
+        dynamics.set("friction", "0")
+        dynamics.set("damping", "0")
+    for old in root.findall("mujoco"):
+        root.remove(old)
+    ext = ET.SubElement(root, "mujoco")
+    ET.SubElement(ext, "compiler", balanceinertia="true", fusestatic="false",
+                  discardvisual="true", angle="radian")
+    return ET.tostring(root, encoding="unicode")
+
+
+def rpy_quaternion(rpy: np.ndarray) -> np.ndarray:
+    """Quaternion [w, x, y, z] of roll-pitch-yaw about fixed x, y, z (URDF's convention)."""
+    quat = np.zeros(4)
+    mujoco.mju_euler2Quat(quat, np.asarray(rpy, dtype=float), "XYZ")
+    return quat
+
+
+def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec, mass: float, friction: list[float],
+                timeconst: float) -> None:
+    body = spec.worldbody.add_body(name=OBJECT_BODY, pos=list(obj.position),
+                                   quat=list(rpy_quaternion(obj.rpy)))
+    body.add_freejoint(name=f"{OBJECT_BODY}_free")
+    if obj.shape == "sphere":
+        kind, size = mujoco.mjtGeom.mjGEOM_SPHERE, [obj.size[0], 0.0, 0.0]
+    elif obj.shape == "box":
+        kind, size = mujoco.mjtGeom.mjGEOM_BOX, list(np.asarray(obj.size) / 2)
+    else:
+        kind, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [obj.size[0], obj.size[1] / 2, 0.0]
+    # Uniform density: the centre of mass is the shape's centre, the object's position.
+    body.add_geom(name=f"{OBJECT_BODY}_geom", type=kind, size=size, mass=mass,
+                  friction=friction, condim=4, solref=[timeconst, 1.0],
+                  contype=_OBJECT_BITS[0], conaffinity=_OBJECT_BITS[1],
+                  rgba=[0.85, 0.45, 0.15, 1.0])
+
+
+def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
+                urdf_xml: str | None = None) -> SimModel:
+    """Compile the scenario's hand and object into a MuJoCo model.
+
+    Args:
+        scenario: a validated scenario with ``object`` and ``gravity``.
+        settings: simulation settings (friction and mass overrides included).
+        urdf_xml: a URDF document to use instead of the scenario's ``hand.urdf``.
+
+    Returns:
+        The model, with the object at its pose and every joint at 0.
+
+    Raises:
+        InputError: naming the field: no object or gravity in the scenario, a
+            URDF MuJoCo cannot load, a joint or contact link not in the model, a
+            contact link without collision geometry.
+    """
+    if scenario.object is None:
+        raise InputError("object", "the simulation needs the scenario's object "
+                         "(shape, size, mass)")
+    if scenario.gravity is None:
+        raise InputError("gravity", "the simulation needs the scenario's gravity")
+    if urdf_xml is None:
+        urdf_xml = resolve_urdf(scenario.urdf, scenario.base_dir).read_text()
+    try:
+        spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml))
+    except (ValueError, RuntimeError) as e:
+        raise InputError("hand.urdf", f"MuJoCo cannot load it: "
+                         f"{str(e).strip().splitlines()[0]}") from e
+    mu1 = scenario.friction.mu1 if settings.mu_tangential is None else settings.mu_tangential
+    mu2 = scenario.friction.mu2 if settings.mu_torsional is None else settings.mu_torsional
+    mass = scenario.object.mass if settings.mass is None else settings.mass
+    friction = [mu1, mu2, 0.0]
+    spec.option.timestep = settings.timestep
+    spec.option.gravity = [float(x) for x in scenario.gravity]
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = settings.impratio
+    spec.option.noslip_iterations = settings.noslip_iterations
+    for geom in spec.geoms:
+        geom.friction = friction
+        geom.condim = 4
+        geom.solref = [settings.contact_timeconst, 1.0]
+        geom.contype, geom.conaffinity = _HAND_BITS
+    _add_object(spec, scenario.object, mass, friction, settings.contact_timeconst)
+    try:
+        model = spec.compile()
+    except (ValueError, RuntimeError) as e:
+        raise InputError("hand.urdf", f"MuJoCo cannot compile it: "
+                         f"{str(e).strip().splitlines()[0]}") from e
+
+    names = [model.joint(j).name for j in range(model.njnt)
+             if int(model.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_HINGE),
+                                           int(mujoco.mjtJoint.mjJNT_SLIDE))]
+    joints = scenario.joints if scenario.joints is not None else names
+    for i, name in enumerate(joints):
+        if name not in names:
+            raise InputError(f"hand.joints[{i}]", f"'{name}' is not a 1-DoF joint of the "
+                             "MuJoCo model")
+    bodies = []
+    for i, contact in enumerate(scenario.contacts):
+        field = f"grasp.contacts[{i}].link"
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
+        if body < 0:
+            raise InputError(field, f"'{contact.link}' is not a link of the MuJoCo model "
+                             "(the simulation needs contacts on URDF links)")
+        if model.body_geomnum[body] == 0:
+            raise InputError(field, f"link '{contact.link}' has no collision geometry to "
+                             "touch the object with")
+        bodies.append(body)
+    free = model.joint(f"{OBJECT_BODY}_free")
+    hand_dofs = [model.jnt_dofadr[j] for j in range(model.njnt) if model.joint(j).name in names]
+    model.dof_damping[hand_dofs] = settings.joint_damping
+    return SimModel(
+        model=model, joints=tuple(joints),
+        qpos_adr=np.array([model.joint(n).qposadr[0] for n in joints]),
+        dof_adr=np.array([model.joint(n).dofadr[0] for n in joints]),
+        object_body=model.body(OBJECT_BODY).id, object_qpos=int(free.qposadr[0]),
+        object_dof=int(free.dofadr[0]), contact_bodies=tuple(bodies),
+        gravity=np.array(scenario.gravity, dtype=float), mu_tangential=mu1, mu_torsional=mu2)

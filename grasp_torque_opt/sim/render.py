@@ -1,0 +1,105 @@
+"""One offscreen picture of the simulated grasp, contact forces drawn as arrows.
+
+Rendering is offscreen through EGL (``MUJOCO_GL=egl``, set by
+:mod:`grasp_torque_opt.sim` unless already set): no display and no GPU needed,
+Mesa's software EGL does. The PNG is written with zlib, no imaging library.
+"""
+
+from __future__ import annotations
+
+import struct
+import zlib
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from grasp_torque_opt.sim.simulator import HandSim
+
+#: Arrow colours: simulated force on the object, certified (predicted) force.
+SIMULATED_RGBA = np.array([1.0, 0.55, 0.0, 1.0], dtype=np.float32)
+PREDICTED_RGBA = np.array([0.1, 0.8, 0.2, 0.35], dtype=np.float32)
+
+
+class RenderUnavailable(RuntimeError):
+    """No offscreen OpenGL context could be made (the reason is the message)."""
+
+
+def write_png(path: str | Path, rgb: np.ndarray) -> None:
+    """Write an RGB image, shape (h, w, 3) uint8, as PNG."""
+    h, w, _ = rgb.shape
+    rows = b"".join(b"\x00" + np.ascontiguousarray(rgb[y]).tobytes() for y in range(h))
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    Path(path).write_bytes(b"\x89PNG\r\n\x1a\n"
+                           + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                           + chunk(b"IDAT", zlib.compress(rows, 6)) + chunk(b"IEND", b""))
+
+
+def _arrow(scene: mujoco.MjvScene, start: np.ndarray, end: np.ndarray, rgba: np.ndarray,
+           width: float) -> None:
+    if scene.ngeom >= scene.maxgeom or np.linalg.norm(end - start) < 1e-6:
+        return
+    geom = scene.geoms[scene.ngeom]
+    mujoco.mjv_initGeom(geom, mujoco.mjtGeom.mjGEOM_ARROW, np.zeros(3), np.zeros(3),
+                        np.eye(3).ravel(), rgba)
+    mujoco.mjv_connector(geom, mujoco.mjtGeom.mjGEOM_ARROW, width, start, end)
+    scene.ngeom += 1
+
+
+def render_grasp(hsim: HandSim, path: str | Path, predicted: list[np.ndarray] | None = None,
+                 scale: float = 0.03, size: tuple[int, int] = (800, 600),
+                 azimuth: float = -90.0, elevation: float = -20.0, distance: float = 0.25
+                 ) -> Path:
+    """Render the grasp and write it as PNG.
+
+    Args:
+        hsim: the simulation, in the state to draw.
+        path: the PNG to write.
+        predicted: certified contact forces on the object, base axes [N], one per
+            planned contact, drawn beside the simulated ones.
+        scale: arrow length per newton [m/N].
+        size: width and height [px].
+
+    Returns:
+        The path written.
+
+    Raises:
+        RenderUnavailable: no offscreen OpenGL context (e.g. no EGL library).
+    """
+    model = hsim.model
+    width, height = size
+    model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
+    model.vis.global_.offheight = max(model.vis.global_.offheight, height)
+    model.vis.headlight.ambient[:] = 0.4
+    model.vis.headlight.diffuse[:] = 0.7
+    try:
+        renderer = mujoco.Renderer(model, height, width)
+    except Exception as e:  # noqa: BLE001 -- whatever the GL backend raises, say why
+        raise RenderUnavailable(f"{type(e).__name__}: {str(e).strip().splitlines()[0]}"
+                                if str(e).strip() else type(e).__name__) from e
+    geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == hsim.sim.object_body]
+    alpha = model.geom_rgba[geoms, 3].copy()
+    model.geom_rgba[geoms, 3] = 0.35  # see-through, so that the arrows inside show
+    try:
+        camera = mujoco.MjvCamera()
+        camera.lookat[:] = hsim.data.xpos[hsim.sim.object_body]
+        camera.distance, camera.azimuth, camera.elevation = distance, azimuth, elevation
+        renderer.update_scene(hsim.data, camera=camera)
+        readings, _ = hsim.readings()
+        for i, r in enumerate(readings):
+            if r.touching:
+                # From the contact into the (see-through) object: the push it gets.
+                if predicted is not None:
+                    _arrow(renderer.scene, r.position, r.position + scale * predicted[i],
+                           PREDICTED_RGBA, 0.004)
+                _arrow(renderer.scene, r.position, r.position + scale * r.force,
+                       SIMULATED_RGBA, 0.002)
+        write_png(path, renderer.render())
+    finally:
+        model.geom_rgba[geoms, 3] = alpha
+        renderer.close()
+    return Path(path)
