@@ -1,0 +1,395 @@
+"""A simulated hand driver: the scenario's hand and object in MuJoCo, on the node's topics.
+
+What a real hand with a ros2_control effort controller would be (docs/simulation.md):
+MuJoCo steps in real time at 1 kHz; ``joint_states`` carries positions,
+velocities and the efforts applied; the latest ``effort_commands`` is applied
+as joint torques and held until the next one (no timeout, as the effort
+controller does), plus a joint impedance Kp, Kd around the configuration the
+fingers settled in, as real hand drivers add. Until the first command the
+fingers hold their grasp configuration and the object is pinned; the commands
+then press the fingers on it for ``--settle`` seconds before it is released.
+
+Each second it prints the object's drift [mm] and rotation [deg], the contact
+forces measured against the node's predicted contact wrenches (from its
+``~/solve`` service) and the friction usage; at the end, held or not and why, and
+one rendered picture of the grasp. ``--with-node`` starts ``grasp_torque_node`` in a
+child process first, on a private ROS domain with localhost-only discovery.
+Exit code: 0 held, 1 not held (or no commands), 2 bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from grasp_torque_opt.ros.demo_driver import _isolate, _scenario_of
+
+PROG = "grasp-torque-sim"
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog=PROG, description=__doc__.splitlines()[0])
+    p.add_argument("--params", default="allegro_right_node.yaml",
+                   help="node params file (bundled name or path); its scenario is simulated")
+    p.add_argument("--duration", type=float, default=3.0,
+                   help="seconds to hold after release [s]")
+    p.add_argument("--settle", type=float, default=0.3,
+                   help="seconds the commands press on the pinned object before release [s]")
+    p.add_argument("--kp", type=float, default=1.0, help="joint impedance stiffness [N m/rad]")
+    p.add_argument("--kd", type=float, default=0.01,
+                   help="joint impedance damping [N m s/rad]")
+    p.add_argument("--rate", type=float, default=250.0, help="joint state rate [Hz]")
+    p.add_argument("--contacts", action="store_true",
+                   help="publish the contact frames measured in the simulation on 'contacts'")
+    p.add_argument("--mu-tangential", type=float, default=None,
+                   help="simulated tangential friction [-] (default: the scenario's)")
+    p.add_argument("--mu-torsional", type=float, default=None,
+                   help="simulated torsional friction [m] (default: the scenario's)")
+    p.add_argument("--drift-limit", type=float, default=1.0,
+                   help="the object counts as held while it moves less than this [mm]")
+    p.add_argument("--picture", default="grasp_sim.png",
+                   help="PNG of the grasp written at the end (default: grasp_sim.png here)")
+    p.add_argument("--no-picture", action="store_true", help="write no picture")
+    p.add_argument("--with-node", action="store_true",
+                   help="start grasp_torque_node in a child process")
+    p.add_argument("--wait", type=float, default=30.0,
+                   help="how long to wait for the node and its first command [s]")
+    return p
+
+
+def _check(args: argparse.Namespace) -> str:
+    for name in ("duration", "rate", "wait", "drift_limit"):
+        if not getattr(args, name) > 0:
+            return f"--{name.replace('_', '-')}: must be > 0"
+    for name in ("settle", "kp", "kd"):
+        if not getattr(args, name) >= 0:
+            return f"--{name}: must be >= 0"
+    for name in ("mu_tangential", "mu_torsional"):
+        value = getattr(args, name)
+        if value is not None and not value > 0:
+            return f"--{name.replace('_', '-')}: must be > 0"
+    return ""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the simulated hand; exit code 0 when the object stayed held."""
+    args = _parser().parse_args(argv)
+    reason = _check(args)
+    if reason:
+        print(f"{PROG}: error: {reason}", file=sys.stderr)
+        return 2
+    try:
+        import grasp_torque_opt.sim  # noqa: F401 -- sets MUJOCO_GL before MuJoCo loads
+        import mujoco  # noqa: F401
+    except ImportError:
+        print(f"{PROG}: error: MuJoCo is not installed (the 'sim' extra: "
+              "pip install -e '.[sim]', or bash scripts/setup.sh)", file=sys.stderr)
+        return 2
+    from grasp_torque_opt.core.exceptions import InputError
+    from grasp_torque_opt.core.resources import find_config
+    from grasp_torque_opt.core.scenario import load_scenario
+    from grasp_torque_opt.sim.model import SimSettings, build_model
+
+    if args.with_node:
+        _isolate()
+    try:
+        params = find_config(args.params, "--params")
+        scenario = load_scenario(find_config(_scenario_of(params)))
+        sim_model = build_model(scenario, SimSettings(mu_tangential=args.mu_tangential,
+                                                      mu_torsional=args.mu_torsional))
+    except InputError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 2
+    child = None
+    if args.with_node:
+        child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node",
+                                  "--ros-args", "--params-file", str(params),
+                                  "--log-level", "error"])
+    try:
+        return _run(args, scenario, sim_model)
+    finally:
+        if child is not None:
+            child.send_signal(signal.SIGINT)
+            try:
+                child.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                child.kill()
+
+
+def _predicted(message: str) -> list[np.ndarray] | None:
+    """Contact forces on the object in base axes [N] from the node's ~/solve JSON."""
+    try:
+        doc = json.loads(message)
+        out = []
+        for c in doc["contacts"]:
+            if c["wrench"] is None:
+                return None
+            x, z = np.array(c["tangent"]), np.array(c["normal"])
+            R = np.column_stack((x, np.cross(z, x), z))
+            out.append(R @ np.array(c["wrench"][:3]))
+        return out
+    except (ValueError, KeyError, TypeError):
+        return None
+
+
+def _run(args: argparse.Namespace, scenario, sim_model) -> int:
+    import rclpy
+    from geometry_msgs.msg import Pose, PoseArray
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    from std_srvs.srv import Trigger
+
+    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
+    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME, SERVICE_QOS
+    from grasp_torque_opt.sim.simulator import HandSim, friction_usage
+
+    setup = GraspSetup.from_scenario(scenario)
+    hand = setup.hand
+    hsim = HandSim(sim_model, setup.q[hand.idx_q], args.kp, args.kd)
+    names = list(sim_model.joints)
+    m = len(names)
+    mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
+
+    rclpy.init()
+    node = rclpy.create_node("grasp_sim_driver")
+    js_pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    contacts_pub = node.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
+    solve = node.create_client(Trigger, f"{NODE_NAME}/solve", qos_profile=SERVICE_QOS)
+    state = {"command": None, "commands": 0, "malformed": 0, "predicted": None,
+             "pending": None}
+
+    def on_command(msg: Float64MultiArray) -> None:
+        cmd = np.array(msg.data, dtype=float)
+        if cmd.shape != (m,) or not np.all(np.isfinite(cmd)):
+            state["malformed"] += 1
+            return
+        state["command"] = cmd
+        state["commands"] += 1
+
+    node.create_subscription(Float64MultiArray, "effort_commands", on_command, COMMAND_QOS)
+
+    def close(code: int) -> int:
+        node.destroy_node()
+        rclpy.try_shutdown()
+        return code
+
+    def ask_prediction() -> None:
+        if state["pending"] is None and solve.service_is_ready():
+            state["pending"] = solve.call_async(Trigger.Request())
+
+    def take_prediction() -> None:
+        future = state["pending"]
+        if future is not None and future.done():
+            state["pending"] = None
+            result = future.result()
+            if result is not None and result.success:
+                state["predicted"] = _predicted(result.message) or state["predicted"]
+
+    print(f"{PROG}: {Path(scenario.source).name} in MuJoCo {_mujoco_version()}, {m} joints, "
+          f"1 kHz physics, joint states at {args.rate:g} Hz, impedance Kp {args.kp:g} N m/rad "
+          f"Kd {args.kd:g} N m s/rad")
+    deadline = time.monotonic() + args.wait
+    while js_pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+        rclpy.spin_once(node, timeout_sec=0.1)
+    if js_pub.get_subscription_count() == 0:
+        print(f"{PROG}: no {NODE_NAME} is listening on joint_states (start one, or "
+              "use --with-node)", file=sys.stderr)
+        return close(1)
+
+    dt = sim_model.model.opt.timestep
+    period = 1.0 / args.rate
+    base = hand.base_frame
+
+    def publish() -> None:
+        stamp = node.get_clock().now().to_msg()
+        js = JointState(name=names, position=[float(x) for x in hsim.q],
+                        velocity=[float(x) for x in hsim.qdot],
+                        effort=[float(x) for x in hsim.effort()])
+        js.header.stamp = stamp
+        js_pub.publish(js)
+        if args.contacts:
+            _publish_contacts(hsim, setup, contacts_pub, base, stamp, compute_grasp_maps,
+                              Pose, PoseArray)
+
+    def run_for(seconds: float, until=None, each_second=None) -> bool:
+        """Step in real time; publish joint states, apply commands; stop early on until()."""
+        t0_wall, t0_sim = time.monotonic(), hsim.time
+        next_pub, next_second = t0_wall, t0_wall + 1.0
+        while (now := time.monotonic()) < t0_wall + seconds:
+            if state["command"] is not None:
+                hsim.command = state["command"]
+                hsim.hold_joints = False
+            behind = round((now - t0_wall - (hsim.time - t0_sim)) / dt)
+            if behind > 0:
+                hsim.step(min(behind, 20))  # at most 20 ms per pass, then catch up
+            if now >= next_pub:
+                next_pub += period
+                publish()
+            if until is not None and until():
+                return True
+            if each_second is not None and now >= next_second:
+                next_second += 1.0
+                each_second()
+            rclpy.spin_once(node, timeout_sec=max(0.0, min(next_pub, t0_wall + seconds)
+                                                   - time.monotonic()))
+            take_prediction()
+        return False
+
+    # 1. Fingers held at the grasp configuration (as a driver's position mode would),
+    #    object pinned, until the node commands.
+    hsim.hold_joints = True
+    if not run_for(args.wait, until=lambda: state["commands"] > 0):
+        print(f"{PROG}: no effort command from {NODE_NAME} within {args.wait:g} s",
+              file=sys.stderr)
+        return close(1)
+    # 2. The commands press the fingers on the pinned object, then it is let go.
+    ask_prediction()
+    run_for(args.settle)
+    hsim.release()
+    t_release_wall, sim_release = time.monotonic(), hsim.time
+    counted_at_release = state["commands"]
+    limit = args.drift_limit * 1e-3
+    track = {"passed": None, "max_drift": 0.0, "lost": {}, "errors": [], "usage": []}
+
+    def every_second() -> None:
+        t = hsim.time - sim_release
+        drift, rotation = hsim.motion()
+        readings, unplanned = hsim.readings()
+        pred = state["predicted"]
+        parts = [f"t={t:4.1f} s  drift {drift * 1e3:7.3f} mm  rotation "
+                 f"{np.degrees(rotation):6.3f} deg"]
+        forces, usage = [], []
+        for i, r in enumerate(readings):
+            if not r.touching:
+                track["lost"].setdefault(setup.contacts[i].link, t)
+                forces.append("-/" + (f"{np.linalg.norm(pred[i]):.2f}" if pred else "?"))
+                continue
+            forces.append(f"{np.linalg.norm(r.force):.2f}/"
+                          + (f"{np.linalg.norm(pred[i]):.2f}" if pred else "?"))
+            normal = r.normal
+            fn = float(r.force @ normal)
+            ft = float(np.linalg.norm(r.force - fn * normal))
+            usage.append(friction_usage(np.array([ft, 0.0, fn, float(r.torque @ normal)]),
+                                        mu1, mu2))
+        parts.append("forces sim/pred [N] " + " ".join(forces))
+        if pred and all(r.touching for r in readings):
+            err = max(np.linalg.norm(r.force - p) / np.linalg.norm(p)
+                      for r, p in zip(readings, pred))
+            track["errors"].append(err)
+            parts.append(f"(max error {100 * err:.1f}%)")
+        if usage:
+            track["usage"].append(max(usage))
+            parts.append("friction " + " ".join(f"{100 * u:.0f}" for u in usage) + " %")
+        if unplanned > 1e-3:
+            parts.append(f"other contacts {unplanned:.2f} N")
+        print("  ".join(parts), flush=True)
+        ask_prediction()
+
+    def watch() -> bool:
+        drift, _ = hsim.motion()
+        track["max_drift"] = max(track["max_drift"], drift)
+        if drift > limit and track["passed"] is None:
+            track["passed"] = hsim.time - sim_release
+        return drift > max(20e-3, 10 * limit)  # fallen: no point in going on
+
+    run_for(args.duration, until=watch, each_second=every_second)
+    every_second()
+    wall = time.monotonic() - t_release_wall
+    simulated = hsim.time - sim_release
+    commands = state["commands"] - counted_at_release
+    drift, rotation = hsim.motion()
+    held = track["passed"] is None
+    if held:
+        why = (f"held: drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg "
+               f"after {simulated:.1f} s (limit {args.drift_limit:g} mm)")
+    else:
+        why = (f"NOT held: drift passed {args.drift_limit:g} mm at t = {track['passed']:.2f} s"
+               f", {track['max_drift'] * 1e3:.1f} mm at most")
+        if track["lost"]:
+            first = min(track["lost"], key=track["lost"].get)
+            why += f"; contact lost first at {first}"
+        why += ("; the torques did not hold the object with this impedance and friction"
+                if commands else "; no command arrived after release")
+    extra = []
+    if track["errors"]:
+        extra.append(f"contact forces within {100 * max(track['errors']):.1f}% of the node's "
+                     "predicted wrenches")
+    if track["usage"]:
+        extra.append(f"friction usage up to {100 * max(track['usage']):.0f}% of the planned "
+                     "cone")
+    extra.append(f"{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed "
+                 f"{state['malformed']})")
+    extra.append(f"real-time factor {simulated / max(wall, 1e-9):.2f}")
+    print("summary: " + why + "; " + "; ".join(extra))
+    if not args.no_picture:
+        print(_picture(hsim, args.picture, state["predicted"]))
+    return close(0 if held and commands > 0 else 1)
+
+
+def _publish_contacts(hsim, setup, pub, base, stamp, compute_grasp_maps, Pose, PoseArray
+                      ) -> None:
+    """The contact frames measured in the simulation: the measured point and normal, the
+    x axis from the planned frame at the current configuration. Nothing while a planned
+    contact does not touch (the node's contacts_timeout then applies)."""
+    readings, _ = hsim.readings()
+    if not all(r.touching for r in readings):
+        return
+    q = setup.q.copy()
+    q[setup.hand.idx_q] = hsim.q
+    maps = compute_grasp_maps(setup.hand, q, setup.contacts, setup.object_origin)
+    msg = PoseArray()
+    msg.header.frame_id, msg.header.stamp = base, stamp
+    for r, R_plan in zip(readings, maps.rotations):
+        z = r.normal
+        x = R_plan[:, 0] - (R_plan[:, 0] @ z) * z
+        x /= np.linalg.norm(x)
+        R = np.column_stack((x, np.cross(z, x), z))
+        qx, qy, qz, qw = _quaternion(R)
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = (float(v) for v in r.position)
+        pose.orientation.x, pose.orientation.y = qx, qy
+        pose.orientation.z, pose.orientation.w = qz, qw
+        msg.poses.append(pose)
+    pub.publish(msg)
+
+
+def _quaternion(R: np.ndarray) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a rotation matrix."""
+    import mujoco
+
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(R).ravel())
+    w, x, y, z = quat
+    return float(x), float(y), float(z), float(w)
+
+
+def _mujoco_version() -> str:
+    import mujoco
+
+    return mujoco.__version__
+
+
+def _picture(hsim, path: str, predicted) -> str:
+    from grasp_torque_opt.sim.render import RenderUnavailable, render_grasp
+
+    try:
+        written = render_grasp(hsim, path, predicted)
+    except RenderUnavailable as e:
+        return f"picture: not written, offscreen rendering is unavailable ({e})"
+    except OSError as e:
+        return f"picture: not written, cannot write {path}: {e.strerror}"
+    return (f"picture: {written.resolve()} (simulated contact forces orange, the node's "
+            "predicted green)")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
