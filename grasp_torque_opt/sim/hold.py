@@ -57,6 +57,7 @@ class ContactReport:
         usage_predicted: share of the planned friction cone the certified wrench uses [-].
         usage_simulated: share of the planned friction cone the simulated wrench uses [-].
         touching: the link touched the object when measured.
+        rotation: the contact frame, columns x, y, z in base axes, shape (3, 3).
     """
 
     link: str
@@ -65,6 +66,7 @@ class ContactReport:
     usage_predicted: float
     usage_simulated: float
     touching: bool
+    rotation: np.ndarray
 
     @property
     def force_error(self) -> float:
@@ -195,7 +197,8 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
         w_pred = sol.wrenches[i]
         mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
         contacts.append(ContactReport(link, w_pred, w_sim, friction_usage(w_pred, mu1, mu2),
-                                      friction_usage(w_sim, mu1, mu2), r.touching))
+                                      friction_usage(w_sim, mu1, mu2), r.touching,
+                                      maps.rotations[i]))
     drift, rotation = hsim.motion()
     t_end = hsim.time - hsim.release_time
     limit_mm = settings.drift_limit * 1e3
