@@ -67,9 +67,13 @@ def episode(scenario: Scenario, duration: float, kp: float, kd: float,
 
 
 def cell(e: dict) -> str:
+    """held with its largest drift and final rotation; fell (left the grasp, > 20 mm) or
+    slid (moved more than 1 mm, stayed in the hand), with when it passed 1 mm."""
     if e["held"]:
         return f"held, {e['drift_mm']:.3f} mm, {e['rotation_deg']:.2f} deg"
-    return f"**fell** at {_passed(e['reason'])} s"
+    if e["drift_mm"] > 20.0:
+        return f"**fell** (1 mm at {_passed(e['reason'])} s)"
+    return f"**slid** {e['drift_mm']:.2f} mm (1 mm at {_passed(e['reason'])} s)"
 
 
 def _passed(reason: str) -> str:
@@ -165,11 +169,14 @@ def tables(r: dict) -> str:
         e = row["episodes"]
         lines.append(f"| {row['kp']:g} | {cell(e['1.0'])} | {cell(e['0.9'])} | "
                      f"{cell(e['1.1'])} |")
-    errors = [e["max_force_error"] for row in r["directions"] if "episodes" in row
-              for e in row["episodes"].values() if e["max_force_error"] is not None]
-    if errors:
-        lines += ["", f"Held episodes of (a): simulated contact forces within "
-                  f"{100 * max(errors):.1f}% of the certified wrenches (largest error)."]
+    for k in gains:
+        errors = {row["direction"]: row["episodes"][k]["max_force_error"]
+                  for row in r["directions"] if "episodes" in row
+                  and row["episodes"][k]["max_force_error"] is not None}
+        if errors:
+            lines += ["", f"Held episodes of (a) at Kp {k}: largest error of a simulated "
+                      "contact force against its certified one, per direction: "
+                      + ", ".join(f"{d} {100 * x:.1f}%" for d, x in errors.items()) + "."]
     return "\n".join(lines)
 
 

@@ -288,7 +288,8 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
             parts.append(f"(max error {100 * err:.1f}%)")
         if usage:
             track["usage"].append(max(usage))
-            parts.append("friction " + " ".join(f"{100 * u:.0f}" for u in usage) + " %")
+            parts.append("friction (planned cone) " + " ".join(f"{100 * u:.0f}" for u in usage)
+                         + " %")
         if unplanned > 1e-3:
             parts.append(f"other contacts {unplanned:.2f} N")
         print("  ".join(parts), flush=True)
@@ -325,7 +326,7 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
                      "predicted wrenches")
     if track["usage"]:
         extra.append(f"friction usage up to {100 * max(track['usage']):.0f}% of the planned "
-                     "cone")
+                     "cone (MuJoCo's elliptic cone is wider)")
     extra.append(f"{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed "
                  f"{state['malformed']})")
     extra.append(f"real-time factor {simulated / max(wall, 1e-9):.2f}")
