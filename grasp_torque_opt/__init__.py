@@ -10,6 +10,7 @@ below it:
   :mod:`~grasp_torque_opt.reference` (the reference methods and the feasibility LP);
 - :mod:`~grasp_torque_opt.methods`: :func:`solve` over every method, and the comparison;
 - :mod:`~grasp_torque_opt.control`: the node's cycle on plain arrays, its diagnostics;
+  beside it :mod:`~grasp_torque_opt.sim`, the hand in MuJoCo (optional extra ``sim``);
 - :mod:`~grasp_torque_opt.ros` (the ROS 2 node and demo driver) and
   :mod:`~grasp_torque_opt.cli` (the command line).
 

@@ -114,6 +114,9 @@ def main(argv: list[str] | None = None) -> int:
                                   "--log-level", "error"])
     try:
         return _run(args, scenario, sim_model)
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
     finally:
         if child is not None:
             child.send_signal(signal.SIGINT)
