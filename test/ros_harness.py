@@ -32,6 +32,8 @@ class Harness:
         # A generous cycle budget unless a test is about it: other processes may load
         # this machine, and an overrun drops the command by design.
         params.setdefault("cycle_budget", 5.0)
+        # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
+        params.setdefault("diagnostics_period", 0.1)
         overrides = [Parameter("scenario", value=str(scenario))]
         overrides += [Parameter(k.replace("__", "."), value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
@@ -63,7 +65,8 @@ class Harness:
         for s in msg.status:
             if s.name.startswith("grasp_torque_node"):
                 self.diagnostics.append({**{kv.key: kv.value for kv in s.values},
-                                         "_level": s.level[0], "_message": s.message})
+                                         "_level": s.level[0], "_message": s.message,
+                                         "_hardware_id": s.hardware_id})
 
     def spin_until(self, predicate, timeout: float) -> bool:
         end = time.monotonic() + timeout

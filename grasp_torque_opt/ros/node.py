@@ -137,8 +137,10 @@ PARAMETERS: dict[str, Spec] = {
     "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
     "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
                                   1e-12, 1e-2),
-    "diagnostics_period": Spec("Period of /diagnostics and ~/contact_wrenches [s].",
+    "diagnostics_period": Spec("Period of /diagnostics [s] (1 Hz, as diagnostic_updater).",
                                1e-3, 60.0, read_only=True),
+    "marker_period": Spec("Period of ~/contact_wrenches [s]; each arrow lives three periods, "
+                          "so they vanish when the node stops.", 1e-3, 60.0, read_only=True),
     "watchdog_period": Spec("Period of the staleness check between joint states [s].",
                             1e-4, 1.0, read_only=True),
     "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
@@ -233,7 +235,8 @@ class GraspTorqueNode(Node):
             "solver.max_iter": ProxSuiteSettings.max_iter,
             "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
             "certificate_tolerance": CycleConfig.certificate_tolerance,
-            "diagnostics_period": 0.1,
+            "diagnostics_period": 1.0,
+            "marker_period": 0.1,
             "watchdog_period": 0.01,
             "marker_scale": 0.02,
             "publish_stamped_command": False,
@@ -277,6 +280,7 @@ class GraspTorqueNode(Node):
         self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
         self.create_timer(self.get_parameter("diagnostics_period").value,
                           self._on_diagnostics)
+        self.create_timer(self.get_parameter("marker_period").value, self._on_markers)
         self.get_logger().info(
             f"{self._m} joints, {len(setup.contacts)} default contacts; "
             f"commands on {self._command_pub.topic_name}")
@@ -432,16 +436,20 @@ class GraspTorqueNode(Node):
     def _on_diagnostics(self) -> None:
         with self._lock:
             rep = diagnostics.report(self.controller, time.monotonic())
-            last = self.controller.last
-            base = self.controller.setup.hand.base_frame
-        stamp = self.get_clock().now().to_msg()
+            # The hand's name from its URDF (e.g. allegro_hand_right), as hardware_id asks.
+            hand = self.controller.setup.hand.model.name
         status = DiagnosticStatus(level=bytes([rep.level]), name=f"{self.get_name()}: grasp "
-                                  "torques", message=rep.message, hardware_id=base,
+                                  "torques", message=rep.message, hardware_id=hand,
                                   values=[KeyValue(key=k, value=v) for k, v in rep.values])
         msg = DiagnosticArray(status=[status])
-        msg.header.stamp = stamp
+        msg.header.stamp = self.get_clock().now().to_msg()
         self._diag_pub.publish(msg)
-        self._marker_pub.publish(self._markers(last, base, stamp))
+
+    def _on_markers(self) -> None:
+        with self._lock:
+            last = self.controller.last
+            base = self.controller.setup.hand.base_frame
+        self._marker_pub.publish(self._markers(last, base, self.get_clock().now().to_msg()))
 
     def _markers(self, last: CycleResult | None, base: str, stamp) -> MarkerArray:
         clear = Marker(action=Marker.DELETEALL)
@@ -459,6 +467,7 @@ class GraspTorqueNode(Node):
             m.pose.orientation.w = 1.0
             m.scale.x, m.scale.y, m.scale.z = 0.002, 0.004, 0.004
             m.color.g, m.color.a = 0.8, 1.0
+            m.lifetime = Duration(seconds=3 * self.get_parameter("marker_period").value).to_msg()
             markers.append(m)
         return MarkerArray(markers=markers)
 

@@ -86,8 +86,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: error: {reason}", file=sys.stderr)
         return 2
     try:
-        import grasp_torque_opt.sim  # noqa: F401 -- sets MUJOCO_GL before MuJoCo loads
         import mujoco  # noqa: F401
+
+        import grasp_torque_opt.sim  # noqa: F401 -- sets MUJOCO_GL before MuJoCo loads
     except ImportError:
         print(f"{PROG}: error: MuJoCo is not installed (the 'sim' extra: "
               "pip install -e '.[sim]', or bash scripts/setup.sh)", file=sys.stderr)

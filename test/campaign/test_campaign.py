@@ -31,7 +31,7 @@ from sensor_msgs.msg import JointState
 from grasp_torque_opt.cli import main as cli_main
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.core import scenario as schema
-from grasp_torque_opt.ros.node import GraspTorqueNode
+from grasp_torque_opt.ros.node import PARAMETERS, GraspTorqueNode
 
 #: No cycle may take longer than this, whatever the input (the solver is capped).
 STALL = 1.0
@@ -66,9 +66,7 @@ class Rig:
         overrides += [Parameter(k, value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
         self.defaults = [Parameter(n, value=v) for n, v in self.node._params().items()
-                         if n not in ("scenario", "robot_description", "joints",
-                                      "diagnostics_period", "watchdog_period",
-                                      "publish_stamped_command")]
+                         if not PARAMETERS[n].read_only]
         self.recorder = Recorder(self.node)
         self.setup = setup
         names, pos = joint_state(setup)

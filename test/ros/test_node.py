@@ -15,6 +15,7 @@ import pytest
 import rclpy
 from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
 from cycle_inputs import base_poses, joint_state
+from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import ReliabilityPolicy, qos_profile_sensor_data
@@ -61,6 +62,11 @@ def test_published_torques_are_the_cores_solution(planar_node, planar):
                                               for m in planar_node.markers), 2.0)
     arrows = [m for m in planar_node.markers[-1].markers if m.action == Marker.ADD]
     assert len(arrows) == 2 and arrows[0].header.frame_id == "palm"
+    # They vanish if the node dies: a finite lifetime of three marker periods (0.1 s).
+    assert all(Duration.from_msg(m.lifetime).nanoseconds == 300_000_000 for m in arrows)
+    # Diagnostics name the hand of the URDF.
+    assert planar_node.spin_until(lambda: planar_node.diagnostics, 2.0)
+    assert planar_node.diagnostics[-1]["_hardware_id"] == planar.hand.model.name
     maps = dataclasses.replace(planar, q=q).maps()
     start = arrows[0].points[0]
     np.testing.assert_allclose([start.x, start.y, start.z], maps.contacts[0].position,
