@@ -18,12 +18,27 @@ has its iterations capped, so one cycle can never stall.
 
 from __future__ import annotations
 
+import importlib.util
+import warnings
+
 from grasp_torque_opt.backends.daqp import DaqpSolver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings, TauQPSolver
 from grasp_torque_opt.backends.quadprog import QuadprogSolver
 
 #: Selectable backends; the first is the default.
 BACKENDS = ("proxsuite", "daqp", "quadprog")
+
+
+def available(backend: str) -> bool:
+    """Whether the Python module of a backend can be imported here.
+
+    ProxSuite is a dependency; DAQP and quadprog are optional (pip installs them, a
+    ROS distribution may not have them).
+    """
+    try:
+        return importlib.util.find_spec(backend) is not None
+    except (ValueError, ImportError):  # e.g. blocked as sys.modules[name] = None
+        return False
 
 
 def single_threaded_math() -> None:
@@ -35,8 +50,12 @@ def single_threaded_math() -> None:
     8 ms. A library user running the cycle in a loop should do the same
     (``threadpoolctl.threadpool_limits(1)`` or ``OPENBLAS_NUM_THREADS=1``).
     """
-    from threadpoolctl import threadpool_limits
-
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # optional: a ROS distribution may not have it
+        warnings.warn("threadpoolctl is not installed: BLAS keeps its own thread count "
+                      "(pip install threadpoolctl, or set OPENBLAS_NUM_THREADS=1)", stacklevel=2)
+        return
     threadpool_limits(1)
 
 
@@ -48,8 +67,11 @@ def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None =
     and redoes a bad one cold); quadprog has none.
 
     Raises:
-        ValueError: an unknown backend, naming the known ones.
+        ValueError: an unknown backend, naming the known ones, or one whose
+            module is not installed, saying how to install it.
     """
+    if backend in BACKENDS and not available(backend):
+        raise ValueError(f"backend {backend!r} is not installed (pip install {backend})")
     if backend == "proxsuite":
         return TauQPSolver(settings, warm_start)
     if backend == "daqp":

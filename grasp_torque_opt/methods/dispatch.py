@@ -26,10 +26,7 @@ from grasp_torque_opt.core.solution import (
     Solution,
 )
 from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp
-from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp
-from grasp_torque_opt.reference.exact_socp import solve_exact_socp
 from grasp_torque_opt.reference.feasibility import linearized_feasible
-from grasp_torque_opt.reference.force_qp import solve_force_qp
 
 #: Methods: the product's (``tau-qp``) and the references.
 METHODS = ("tau-qp", "force-qp", "socp", "nlp")
@@ -101,11 +98,16 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         raw, tau, f = qp_answer(qp, raw)
     else:
         t2 = time.perf_counter()
+        # The reference methods' solvers (Clarabel, SciPy's SLSQP) are imported where
+        # they are used: the node runs the tau-QP without them.
         if method == "force-qp":
+            from grasp_torque_opt.reference.force_qp import solve_force_qp
             raw = solve_force_qp(*args, objective="force")
         elif method == "socp":
+            from grasp_torque_opt.reference.exact_socp import solve_exact_socp
             raw = solve_exact_socp(*args)
         else:
+            from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp
             raw = solve_exact_nlp(*args)
         f = None if raw.x is None else raw.x[:J.shape[0]]
         tau = None if f is None else J.T @ f

@@ -43,7 +43,12 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
-from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
+from grasp_torque_opt.backends import (
+    BACKENDS,
+    available,
+    make_solver,
+    single_threaded_math,
+)
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control import diagnostics
 from grasp_torque_opt.control.controller import (
@@ -167,8 +172,9 @@ FALLBACKS = (*BACKENDS, "none")
 
 
 def _fallback(backend: str, fallback: str) -> str | None:
-    """The fallback backend to build: None for 'none' or the backend itself."""
-    return None if fallback in ("none", backend) else fallback
+    """The fallback backend to build: None for 'none', the backend itself, or one not installed
+    (a ROS distribution may lack DAQP; the node then runs without a second try)."""
+    return None if fallback in ("none", backend) or not available(fallback) else fallback
 
 
 def check(name: str, value: Any, m: int) -> str:
@@ -177,7 +183,9 @@ def check(name: str, value: Any, m: int) -> str:
     if name == "fault_policy":
         return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
     if name == "solver.backend":
-        return "" if value in BACKENDS else f"{name}: must be one of {', '.join(BACKENDS)}"
+        if value not in BACKENDS:
+            return f"{name}: must be one of {', '.join(BACKENDS)}"
+        return "" if available(value) else f"{name}: {value} is not installed (pip install {value})"
     if name == "solver.fallback":
         return "" if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
     if spec.length is not None:
@@ -251,6 +259,7 @@ class GraspTorqueNode(Node):
         backend = self.get_parameter("solver.backend").value
         warm = self.get_parameter("solver.warm_start").value
         fallback = _fallback(backend, self.get_parameter("solver.fallback").value)
+        self._warn_missing_fallback()
         self.controller = TorqueController(*self._configure(setup, self._params()), backend,
                                            warm, fallback)
         # The service solves snapshots out of sequence: always cold.
@@ -356,9 +365,17 @@ class GraspTorqueNode(Node):
                         warm != getattr(ctrl.solver, "warm_start", False):
                     ctrl.solver = make_solver(p["solver.backend"], solver, warm)
                 fallback = _fallback(p["solver.backend"], p["solver.fallback"])
+                if ctrl is self.controller and any(x.name == "solver.fallback" for x in params):
+                    self._warn_missing_fallback()
                 if fallback != getattr(ctrl.fallback, "name", None) or \
                         (ctrl.fallback is not None and ctrl.fallback.settings != solver):
                     ctrl.fallback = make_solver(fallback, solver) if fallback else None
+
+    def _warn_missing_fallback(self) -> None:
+        name = self.get_parameter("solver.fallback").value
+        if name != "none" and not available(name):
+            self.get_logger().warning(f"solver.fallback: {name} is not installed (pip install "
+                                      f"{name}); running without a fallback backend")
 
     # -- inputs and cycle -----------------------------------------------------------------
 
