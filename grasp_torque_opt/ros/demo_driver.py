@@ -16,20 +16,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import random
-import signal
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-
-def _isolate() -> None:
-    """A private ROS domain (unless one is set) and localhost-only discovery."""
-    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
-    os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -47,13 +40,6 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def _scenario_of(params: Path) -> str:
-    import yaml
-
-    doc = yaml.safe_load(params.read_text())
-    return next(iter(doc.values()))["ros__parameters"]["scenario"]
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the demo; exit code 0 when certified commands flowed and all were well-formed."""
     args = _parser().parse_args(argv)
@@ -62,29 +48,18 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return 2
     if not args.watch:
-        _isolate()
+        isolate()
     from grasp_torque_opt.core.exceptions import InputError
     from grasp_torque_opt.core.resources import find_config
 
     try:
         params = find_config(args.params, "--params")
-        scenario = find_config(_scenario_of(params))
+        scenario = find_config(scenario_of(params))
     except InputError as e:
         print(f"grasp-torque-demo: error: {e}", file=sys.stderr)
         return 2
-    child = None
-    if args.with_node:
-        child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--ros-args",
-                                  "--params-file", str(params), "--log-level", "error"])
-    try:
+    with node_process(params, args.with_node):
         return _play(args, scenario)
-    finally:
-        if child is not None:
-            child.send_signal(signal.SIGINT)
-            try:
-                child.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                child.kill()
 
 
 def _play(args: argparse.Namespace, scenario: Path) -> int:

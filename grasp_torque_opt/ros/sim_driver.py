@@ -21,15 +21,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from grasp_torque_opt.ros.demo_driver import _isolate, _scenario_of
+from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 
 PROG = "grasp-torque-sim"
 
@@ -99,32 +97,21 @@ def main(argv: list[str] | None = None) -> int:
     from grasp_torque_opt.sim.model import SimSettings, build_model
 
     if args.with_node:
-        _isolate()
+        isolate()
     try:
         params = find_config(args.params, "--params")
-        scenario = load_scenario(find_config(_scenario_of(params)))
+        scenario = load_scenario(find_config(scenario_of(params)))
         sim_model = build_model(scenario, SimSettings(mu_tangential=args.mu_tangential,
                                                       mu_torsional=args.mu_torsional))
     except InputError as e:
         print(f"{PROG}: error: {e}", file=sys.stderr)
         return 2
-    child = None
-    if args.with_node:
-        child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node",
-                                  "--ros-args", "--params-file", str(params),
-                                  "--log-level", "error"])
     try:
-        return _run(args, scenario, sim_model)
+        with node_process(params, args.with_node):
+            return _run(args, scenario, sim_model)
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
-    finally:
-        if child is not None:
-            child.send_signal(signal.SIGINT)
-            try:
-                child.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                child.kill()
 
 
 def _predicted(message: str) -> list[np.ndarray] | None:
