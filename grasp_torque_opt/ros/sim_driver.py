@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -83,10 +84,10 @@ def main(argv: list[str] | None = None) -> int:
     if reason:
         print(f"{PROG}: error: {reason}", file=sys.stderr)
         return 2
+    # Offscreen rendering through EGL: MuJoCo reads this when it is first imported.
+    os.environ.setdefault("MUJOCO_GL", "egl")
     try:
         import mujoco  # noqa: F401
-
-        import grasp_torque_opt.sim  # noqa: F401 -- sets MUJOCO_GL before MuJoCo loads
     except ImportError:
         print(f"{PROG}: error: MuJoCo is not installed (the 'sim' extra: "
               "pip install -e '.[sim]', or bash scripts/setup.sh)", file=sys.stderr)

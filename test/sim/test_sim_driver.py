@@ -10,6 +10,9 @@ from ros_harness import DOMAIN
 
 def run(*args, timeout=120):
     env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    # As a user starts it: MuJoCo's GL backend not chosen beforehand (this process may have
+    # set it by importing grasp_torque_opt.sim).
+    env.pop("MUJOCO_GL", None)
     return subprocess.run([sys.executable, "-m", "grasp_torque_opt.ros.sim_driver", *args],
                           capture_output=True, text=True, timeout=timeout, env=env)
 
