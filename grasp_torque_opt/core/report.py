@@ -19,8 +19,11 @@ def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
     ``torque_norm`` [N m], ``solve_time_s``, ``certificate``, ``contacts`` (per
     contact ``link``, ``position``, ``normal``, ``tangent`` in the base frame and
     ``wrench`` [fx, fy, fz, mz] in the contact frame). Added: ``message``,
-    ``iterations``, ``timings_s``. ``tau``, ``torque_norm`` and every ``wrench``
-    are null unless the status is ``optimal``.
+    ``iterations``, ``timings_s``, ``bounds`` (``tau-qp-adaptive``: ``lower``,
+    ``upper`` [N m] on the exact-cone optimum of sqrt(tau^T W tau), ``gap``,
+    ``tolerance``, ``converged``, ``rounds``, ``qp_solves``, ``source``; null for
+    the other methods). ``tau``, ``torque_norm`` and every ``wrench`` are null
+    unless the status is ``optimal``.
     """
     contacts = []
     for i, frame in enumerate(maps.contacts):
@@ -43,4 +46,5 @@ def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
         "message": solution.message,
         "iterations": solution.iterations,
         "timings_s": dict(solution.timings),
+        "bounds": None if solution.bounds is None else solution.bounds.as_dict(),
     }

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from grasp_torque_opt.core.bounds import Bounds
 from grasp_torque_opt.core.certificate import Certificate
 
 OPTIMAL = "optimal"
@@ -24,7 +25,7 @@ class Solution:
 
     Attributes:
         status: ``optimal``, ``infeasible`` or ``failed``.
-        method: ``tau-qp``, ``force-qp``, ``socp`` or ``nlp``.
+        method: ``tau-qp``, ``tau-qp-adaptive``, ``force-qp``, ``socp`` or ``nlp``.
         joints: actuated joints, the order of tau.
         tau: joint torques [N m], shape (m,).
         wrenches: contact wrenches [fx, fy, fz, mz] in contact frames, shape (p, 4).
@@ -35,6 +36,8 @@ class Solution:
         timings: seconds per stage (``maps``, ``build``, ``solve``, ``certify``).
         backend: who solved: the QP backend for ``tau-qp`` (the fallback's name
             when the first backend failed), else the method.
+        bounds: for ``tau-qp-adaptive``, the certified bounds on the exact-cone
+            optimum and the gap (None for the other methods).
     """
 
     status: str
@@ -48,6 +51,7 @@ class Solution:
     message: str = ""
     timings: dict[str, float] = field(default_factory=dict)
     backend: str = ""
+    bounds: Bounds | None = None
 
     @property
     def optimal(self) -> bool:
