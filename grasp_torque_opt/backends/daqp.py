@@ -7,6 +7,7 @@ proximal-point iterations.
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -177,3 +178,123 @@ class DaqpSolver:
         if int(flag) != 1:
             return float("inf")
         return kkt_violation(H, g, A, lower, upper, np.asarray(x), info["lam"])
+
+
+class DaqpWorkspace:
+    """One DAQP workspace for a sequence of QPs of one size, each started from the last.
+
+    The QP: minimize 1/2 x'Hx + g'x subject to A_eq x = b_eq, C x <= u and
+    l_box <= x <= u_box. :meth:`load` sets every datum (a new workspace when
+    the size changes); :meth:`solve` replaces H, g, C and u, keeps the rest and
+    starts from the previous active set unless ``cold``. This is the adaptive
+    method's solver (:mod:`grasp_torque_opt.methods.adaptive`): its rounds keep
+    the size, only their rows and curvature change, and it needs the
+    multipliers. No answer is trusted here and none is KKT-checked: the method
+    certifies every candidate against the exact cone and checks every bound it
+    draws from the multipliers itself (docs/adaptive.md).
+
+    Args:
+        eps_abs: DAQP's primal tolerance.
+        max_iter: DAQP's iteration cap (one QP can never stall).
+    """
+
+    name = "daqp"
+
+    def __init__(self, eps_abs: float = ProxSuiteSettings.eps_abs,
+                 max_iter: int = ProxSuiteSettings.max_iter) -> None:
+        import daqp  # imported here: the core runs without the optional backends
+
+        self._daqp = daqp
+        self.eps_abs, self.max_iter = eps_abs, max_iter
+        self._model = None
+        self._dims: tuple[int, int, int, bool] | None = None
+        #: The last answer's multipliers, DAQP's order and sign: bounds on x, then
+        #: A_eq's rows, then C's; > 0 on an active upper bound. None before one.
+        self.multipliers: np.ndarray | None = None
+
+    def load(self, H: np.ndarray, g: np.ndarray, A_eq: np.ndarray, b_eq: np.ndarray,
+             C: np.ndarray, u: np.ndarray, l_box: np.ndarray, u_box: np.ndarray,
+             semidefinite: bool, warm: bool = False) -> None:
+        """Set every datum of the QP; the next solve starts cold unless ``warm``.
+
+        Args:
+            semidefinite: H may be singular (DAQP's proximal-point iterations on).
+            warm: a QP of the same size may start from the last one's active set.
+        """
+        n, n_eq, n_in = H.shape[0], A_eq.shape[0], C.shape[0]
+        self._A = np.empty((n_eq + n_in, n))
+        self._A[:n_eq], self._A[n_eq:] = A_eq, C
+        self._upper = np.empty(n + n_eq + n_in)
+        self._lower = np.empty(n + n_eq + n_in)
+        self._upper[:n], self._lower[:n] = np.minimum(u_box, DAQP_INF), np.maximum(l_box,
+                                                                                   -DAQP_INF)
+        self._upper[n:n + n_eq] = self._lower[n:n + n_eq] = b_eq
+        self._upper[n + n_eq:], self._lower[n + n_eq:] = u, -DAQP_INF
+        self._sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
+        self._sense[n:n + n_eq] = 5  # equality
+        self._H, self._g = np.array(H, dtype=float), np.array(g, dtype=float)
+        self._n_eq = n_eq
+        dims = (n, n_eq, n_in, semidefinite)
+        if self._dims != dims:
+            self._model, self._dims = None, dims
+        self._cold = not warm
+
+    def solve(self, H: np.ndarray | None = None, g: np.ndarray | None = None,
+              C: np.ndarray | None = None, u: np.ndarray | None = None,
+              cold: bool = False) -> RawResult:
+        """Solve with the given H, g, C, u (None: keep the last), warm unless ``cold``.
+
+        Returns:
+            The raw result; ``multipliers`` holds its multipliers when solved.
+
+        Raises:
+            SolverError: DAQP raised (chained); the next solve starts anew.
+        """
+        self.multipliers = None
+        n_eq = self._n_eq
+        n = self._H.shape[0]
+        for new, old in ((H, self._H), (g, self._g)):
+            if new is not None:
+                np.copyto(old, new)
+        if C is not None:
+            self._A[n_eq:] = C
+        if u is not None:
+            self._upper[n + n_eq:] = u
+        # One sum per array: NaN or Inf anywhere makes it non-finite.
+        if not math.isfinite(self._H.sum() + self._g.sum() + self._A.sum()
+                             + self._upper[n:].sum()):
+            return RawResult("error", None, 0, 0.0, "QP data not finite")
+        t0 = time.perf_counter()
+        try:
+            if self._model is None:
+                self._model = self._daqp.Model()
+                flag, _ = self._model.setup(self._H, self._g, self._A, self._upper,
+                                            self._lower, self._sense)
+                if flag < 0:
+                    self._model = None
+                    return RawResult("error", None, 0, time.perf_counter() - t0,
+                                     f"DAQP setup failed (exit flag {flag})")
+                s = self._model.settings
+                s.update(primal_tol=self.eps_abs, iter_limit=self.max_iter,
+                         eps_prox=-1e-6 if self._dims[3] else 0.0)
+                self._model.settings = s
+            else:
+                # Without sense, DAQP keeps the previous active set: a warm start.
+                flag = self._model.update(H=self._H, f=self._g, A=self._A, bupper=self._upper,
+                                          blower=self._lower,
+                                          sense=self._sense if cold or self._cold else None)
+                if flag is not None and flag < 0:
+                    self._model = None
+                    return RawResult("error", None, 0, time.perf_counter() - t0,
+                                     f"DAQP update failed (exit flag {flag})")
+            x, _, flag, info = self._model.solve()
+        except RuntimeError as e:
+            self._model = None
+            raise SolverError(f"DAQP failed: {e}") from e
+        self._cold = False
+        elapsed = time.perf_counter() - t0
+        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
+        if status == "solved":
+            self.multipliers = np.asarray(info["lam"], dtype=float)
+        return RawResult(status, np.asarray(x, dtype=float), int(info["iterations"]), elapsed,
+                         f"DAQP exit flag {int(flag)}")
