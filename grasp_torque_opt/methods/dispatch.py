@@ -2,7 +2,9 @@
 
 The status of a :class:`Solution` is decided here, never by a solver alone:
 ``optimal`` needs the certificate; ``infeasible`` from a polygon method needs
-the independent LP of :mod:`grasp_torque_opt.reference.feasibility` to agree.
+the independent LP of :mod:`grasp_torque_opt.reference.feasibility` to agree
+(for ``tau-qp-adaptive``, the LP on the circumscribed polygon: no torque holds
+the load even with the exact cone).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import numpy as np
 
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
+from grasp_torque_opt.core.bounds import make_bounds
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE, Certificate, certify
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -26,10 +29,12 @@ from grasp_torque_opt.core.solution import (
     Solution,
 )
 from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp
+from grasp_torque_opt.methods.adaptive import Refiner
 from grasp_torque_opt.reference.feasibility import linearized_feasible
 
-#: Methods: the product's (``tau-qp``) and the references.
-METHODS = ("tau-qp", "force-qp", "socp", "nlp")
+#: Methods: the product's (``tau-qp``; ``tau-qp-adaptive``, its refinement to the
+#: exact cone with certified bounds, docs/adaptive.md) and the references.
+METHODS = ("tau-qp", "tau-qp-adaptive", "force-qp", "socp", "nlp")
 #: Methods whose feasible set is the linearized (polygon) one.
 LINEARIZED = ("tau-qp", "force-qp")
 
@@ -53,27 +58,33 @@ def qp_answer(qp: TauQP, raw: RawResult
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
           solver: TauQPSolver | None = None, backend: str = "proxsuite",
           fallback: TauQPSolver | None = None,
-          tolerance: float = DEFAULT_TOLERANCE) -> Solution:
+          tolerance: float = DEFAULT_TOLERANCE, refiner: Refiner | None = None) -> Solution:
     """Solve one grasp with one method and certify the result.
 
     Args:
         setup: the grasp.
         method: one of :data:`METHODS`.
         maps: G and J if already computed (else computed here).
-        solver: a tau-QP solver to reuse across calls (tau-qp only), any backend
+        solver: a tau-QP solver to reuse across calls (tau-qp; for
+            tau-qp-adaptive, the paper's N-gon it falls back to), any backend
             of :mod:`grasp_torque_opt.backends`.
-        backend: the backend to use when no solver is given (tau-qp only).
+        backend: the backend to use when no solver is given (as ``solver``).
         fallback: a second tau-QP solver, asked only when the first gives nothing
             certifiable (ProxSuite called some holdable Allegro loads
             PRIMAL_INFEASIBLE or hit its cap; DAQP solved them). Its answer is
             certified the same way; ``Solution.backend`` says who solved.
         tolerance: certificate tolerance, SI units.
+        refiner: tau-qp-adaptive's rounds (its settings: gap tolerance, rounds),
+            reusable across calls; default :class:`Refiner` ().
 
     Returns:
         A solution whose status is ``optimal`` only if certified.
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if method == "tau-qp-adaptive":
+        return _solve_adaptive(setup, maps, solver, backend, fallback, tolerance,
+                               refiner or Refiner())
     timings = {}
     t0 = time.perf_counter()
     if maps is None:
@@ -162,4 +173,58 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         out.status, out.message = INFEASIBLE, f"infeasible ({why})"
     else:
         out.message = f"not certified ({why})"
+    return out
+
+
+def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: str,
+                    fallback, tolerance: float, refiner: Refiner) -> Solution:
+    """tau-qp-adaptive: the rounds of :mod:`~grasp_torque_opt.methods.adaptive`, certified
+    bounds attached; the paper's N-gon (the tau-qp path) when no round gave a candidate."""
+    t0 = time.perf_counter()
+    if maps is None:
+        maps = setup.maps()
+    t1 = time.perf_counter()
+    tau_min, tau_max = setup.tau_bounds
+    qp = build_tau_qp(maps, setup.friction, setup.external_wrench, tau_min, tau_max,
+                      setup.weights)
+    t2 = time.perf_counter()
+    settings = refiner.settings
+    try:
+        ref = refiner.refine(setup, maps, qp, tolerance)
+        why = ref.message
+    except SolverError as e:  # a failed round is answered by the polygon below
+        ref, why = None, str(e)
+    t3 = time.perf_counter()
+    timings = {"maps": t1 - t0, "build": t2 - t1, "solve": t3 - t2}
+    lower = -float("inf") if ref is None else ref.lower
+    rounds, qps = (0, 0) if ref is None else (ref.rounds, ref.qp_solves)
+    joints = list(setup.hand.joints)
+    if ref is not None and ref.tau is not None:
+        cert = ref.certificate  # certified in the rounds, with this tolerance
+        bounds = make_bounds(lower, ref.upper, settings.gap_tolerance, rounds, qps, ref.source)
+        gap = "no lower bound" if bounds.gap is None else f"gap {100 * bounds.gap:.3g}%"
+        return Solution(status=OPTIMAL, method="tau-qp-adaptive", joints=joints, tau=ref.tau,
+                        wrenches=ref.f.reshape(-1, 4), iterations=ref.iterations,
+                        solve_time_s=ref.solve_time_s, certificate=cert,
+                        message=f"certified ({ref.source}, {rounds} rounds, {qps} QPs, {gap}: "
+                                f"{why})", timings=timings, backend="daqp", bounds=bounds)
+    # No certified candidate: the paper's N-gon answers (never nothing when it can).
+    poly = solve(setup, "tau-qp", maps=maps, solver=solver, backend=backend,
+                 fallback=fallback, tolerance=tolerance)
+    timings.update({f"polygon_{k}": v for k, v in poly.timings.items() if k != "maps"})
+    upper = None if poly.tau is None else float(poly.tau @ (setup.weights * poly.tau))
+    out = dataclasses.replace(poly, method="tau-qp-adaptive", timings=timings,
+                              bounds=make_bounds(lower, upper, settings.gap_tolerance, rounds,
+                                                 qps, "polygon"))
+    if poly.optimal:
+        out.message = f"{poly.message}; the paper's N-gon, as the rounds gave none ({why})"
+    elif ref is not None and ref.outer_infeasible and linearized_feasible(
+            maps, setup.friction, setup.external_wrench, tau_min, tau_max,
+            circumscribed=True) is False:
+        out.status = INFEASIBLE
+        out.message = ("infeasible even for the circumscribed polygon, which contains the "
+                       f"exact cone; confirmed by LP ({why})")
+    else:
+        out.status = FAILED
+        out.message = f"not certified: the rounds ({why}) and the paper's N-gon ({poly.message})"
     return out

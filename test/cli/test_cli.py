@@ -78,7 +78,7 @@ def test_compare_table_and_json(capsys):
         assert label in out
     code, out, _ = run(["compare", str(PLANAR), "--json"], capsys)
     d = json.loads(out)
-    assert set(d["methods"]) == {"tau-qp", "force-qp", "socp", "nlp"}
+    assert set(d["methods"]) == {"tau-qp", "tau-qp-adaptive", "force-qp", "socp", "nlp"}
     norms = {m: s["torque_norm"] for m, s in d["methods"].items()}
     assert d["excess_over_exact"] == pytest.approx(norms["tau-qp"] / norms["socp"] - 1)
     assert d["reduction_vs"]["force-qp"] == pytest.approx(1 - norms["tau-qp"] / norms["force-qp"])

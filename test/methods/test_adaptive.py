@@ -1,0 +1,188 @@
+"""tau-qp-adaptive: bounds bracket the independent SOCP, the answer is certified and within its
+gap of it, the planar excess is closed, a failed round falls back to the paper's polygon."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from independent import assert_holds
+
+from grasp_torque_opt.backends.daqp import DaqpWorkspace
+from grasp_torque_opt.core.exceptions import SolverError
+from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
+from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.reference.exact_socp import solve_exact_socp
+
+CASES = ["planar", "hyperstatic", "allegro"]
+#: Clarabel's optimum is as exact as its tolerances (1e-10): the bracket allows this much.
+SLACK = 1e-8
+
+
+def exact_norm(setup, maps):
+    """sqrt(tau^T W tau) at the exact-cone optimum, from reference.exact_socp (Clarabel)."""
+    raw = solve_exact_socp(maps, setup.friction, setup.external_wrench, *setup.tau_bounds,
+                           setup.weights)
+    assert raw.status == "solved", raw.message
+    tau = maps.J.T @ raw.x[:4 * maps.p]
+    return math.sqrt(float(tau @ (setup.weights * tau)))
+
+
+def weighted_norm(setup, tau):
+    return math.sqrt(float(tau @ (setup.weights * tau)))
+
+
+def check_against_socp(setup, maps, sol):
+    """Certified, holds the load (independent check), bounds bracket E, within its gap of E."""
+    assert sol.status == "optimal", sol.message
+    assert sol.certificate.ok
+    assert_holds(setup, maps, sol.tau, sol.wrenches)
+    E, b = exact_norm(setup, maps), sol.bounds
+    assert b.lower is not None and b.lower <= E * (1 + SLACK), (b, E)
+    assert b.upper >= E * (1 - SLACK), (b, E)
+    assert b.upper == pytest.approx(weighted_norm(setup, sol.tau), rel=1e-12)
+    assert weighted_norm(setup, sol.tau) <= E * (1 + b.gap + SLACK)
+    return E
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_bounds_bracket_the_socp_and_the_gap_is_met(name, request):
+    setup = request.getfixturevalue(name)
+    maps = setup.maps()
+    sol = solve(setup, "tau-qp-adaptive", maps=maps)
+    check_against_socp(setup, maps, sol)
+    assert sol.bounds.converged and sol.bounds.gap <= 1e-3
+    assert sol.bounds.source in ("refined", "circumscribed")
+
+
+def test_random_allegro_loads_one_refiner(allegro):
+    """Seeded loads, one Refiner reused (its workspace carries over): every answer is
+    certified, bracketed and within its gap; each equals a fresh Refiner's."""
+    rng = np.random.default_rng(11)
+    maps = allegro.maps()
+    refiner = Refiner()
+    checked = 0
+    for _ in range(20):
+        w = allegro.external_wrench * rng.uniform(0.3, 1.5) + np.concatenate(
+            (rng.normal(scale=0.3, size=3), rng.normal(scale=0.01, size=3)))
+        setup = dataclasses.replace(allegro, external_wrench=w)
+        sol = solve(setup, "tau-qp-adaptive", maps=maps, refiner=refiner)
+        if sol.status == "infeasible":
+            continue
+        check_against_socp(setup, maps, sol)
+        fresh = solve(setup, "tau-qp-adaptive", maps=maps)
+        np.testing.assert_allclose(sol.tau, fresh.tau, atol=1e-9)
+        checked += 1
+    assert checked >= 15
+
+
+def test_lower_bound_never_above_the_socp_for_any_polygon(planar, allegro):
+    """Round 0 alone (max_rounds 0): the circumscribed N-gon's bound, for several N."""
+    for setup in (planar, allegro):
+        maps = setup.maps()
+        E = exact_norm(setup, maps)
+        for sides in (3, 4, 8, 16):
+            refiner = Refiner(AdaptiveSettings(max_rounds=0, first_sides=sides))
+            sol = solve(setup, "tau-qp-adaptive", maps=maps, refiner=refiner)
+            assert sol.optimal
+            assert sol.bounds.lower <= E * (1 + SLACK)
+            assert sol.bounds.upper >= E * (1 - SLACK)
+
+
+def test_planar_case_closes_the_excess_of_the_papers_triangle(planar):
+    """N = 3 (the paper's): the polygon's torque is about 80% above the exact optimum; the
+    adaptive one is within 0.1% of it, and its certified gap says so."""
+    maps = planar.maps()
+    E = exact_norm(planar, maps)
+    polygon = solve(planar, maps=maps)
+    sol = solve(planar, "tau-qp-adaptive", maps=maps)
+    assert polygon.torque_norm / E - 1 > 0.5
+    assert weighted_norm(planar, sol.tau) / E - 1 < 1e-3
+    assert sol.bounds.gap < 1e-3
+    check_against_socp(planar, maps, sol)
+
+
+def test_round_zero_bound_is_the_circumscribed_polygon_of_the_scenario(planar):
+    """max_rounds 0 with the scenario's N: the answer is the paper's N-gon (or the outer
+    polygon's own, if certified) and the lower bound comes from the same N scaled out."""
+    maps = planar.maps()
+    sol = solve(planar, "tau-qp-adaptive", maps=maps,
+                refiner=Refiner(AdaptiveSettings(max_rounds=0, first_sides=None)))
+    polygon = solve(planar, maps=maps)
+    assert sol.bounds.source == "polygon" and sol.bounds.rounds == 0
+    np.testing.assert_allclose(sol.tau, polygon.tau, atol=1e-9)
+    E = exact_norm(planar, maps)
+    assert sol.bounds.lower <= E <= sol.bounds.upper
+    assert sol.bounds.gap > 0.5  # the triangle's gap is wide: that is what the rounds close
+
+
+def test_a_failing_solver_falls_back_to_the_papers_polygon(allegro):
+    """Real DAQP with a cap of one iteration fails every round: the answer is the paper's
+    N-gon's (certified), never nothing."""
+    maps = allegro.maps()
+    refiner = Refiner(AdaptiveSettings(max_iter=1))
+    sol = solve(allegro, "tau-qp-adaptive", maps=maps, refiner=refiner)
+    polygon = solve(allegro, maps=maps)
+    assert sol.status == "optimal" and sol.bounds.source == "polygon"
+    assert "round 0" in sol.message
+    np.testing.assert_allclose(sol.tau, polygon.tau, atol=1e-9)
+    assert sol.bounds.lower is None and sol.bounds.upper == pytest.approx(
+        weighted_norm(allegro, polygon.tau))
+    assert_holds(allegro, maps, sol.tau, sol.wrenches)
+
+
+class RaisesOnSecondSolve(DaqpWorkspace):
+    """DAQP itself, raising on its second QP of a grasp: the real solver cannot be made to
+    fail on demand in one round only (its settings apply to every round)."""
+
+    def load(self, *args, **kwargs):
+        self.calls = 0
+        super().load(*args, **kwargs)
+
+    def solve(self, *args, **kwargs):
+        self.calls += 1
+        if self.calls == 2:
+            raise SolverError("DAQP failed: injected in round 1")
+        return super().solve(*args, **kwargs)
+
+
+def test_a_round_that_raises_keeps_round_zeros_bound_and_falls_back(allegro):
+    maps = allegro.maps()
+    sol = solve(allegro, "tau-qp-adaptive", maps=maps,
+                refiner=Refiner(workspace=RaisesOnSecondSolve()))
+    polygon = solve(allegro, maps=maps)
+    assert sol.status == "optimal" and sol.bounds.source == "polygon"
+    assert "injected in round 1" in sol.message
+    np.testing.assert_allclose(sol.tau, polygon.tau, atol=1e-9)
+    E = exact_norm(allegro, maps)
+    assert sol.bounds.lower is not None and sol.bounds.lower <= E * (1 + SLACK)
+    assert sol.bounds.upper >= E
+
+
+def test_heavy_load_is_infeasible_even_for_the_outer_polygon(planar):
+    heavy = dataclasses.replace(planar, external_wrench=planar.external_wrench * 200.0)
+    sol = solve(heavy, "tau-qp-adaptive")
+    assert sol.status == "infeasible", sol.message
+    assert sol.tau is None and "circumscribed" in sol.message
+    assert solve(heavy, "socp").status == "infeasible"
+
+
+def test_holds_a_load_the_papers_triangle_cannot(allegro):
+    """With N = 3 some loads are lost to the polygon but not to the exact cone; the adaptive
+    method, whose outer polygon contains the exact cone, still finds the exact optimum."""
+    rng = np.random.default_rng(5)
+    tri = dataclasses.replace(allegro, friction=dataclasses.replace(allegro.friction, sides=3))
+    maps = tri.maps()
+    weight = float(np.linalg.norm(tri.external_wrench[:3]))
+    for _ in range(40):  # loads of random direction, up to three times the ball's weight
+        d = rng.normal(size=3)
+        w = np.concatenate((d / np.linalg.norm(d) * weight * rng.uniform(0.3, 3.0),
+                            rng.normal(scale=0.004, size=3)))
+        setup = dataclasses.replace(tri, external_wrench=w)
+        if solve(setup, maps=maps).status == "infeasible" and \
+                solve(setup, "socp", maps=maps).optimal:
+            break
+    else:
+        pytest.fail("no load lost to the triangle in 40 draws")
+    sol = solve(setup, "tau-qp-adaptive", maps=maps)
+    check_against_socp(setup, maps, sol)
