@@ -12,6 +12,8 @@ Runs, in this order, each writing ``OUT/<name>.json``:
   feasible Allegro grasps, ProxSuite tuning, warm starts (bench/solvers.py);
 - ``linearization``: the polygon's torque excess over the exact cone for N = 3
   to 32 (bench/linearization.py);
+- ``adaptive``: tau-qp-adaptive's excess, certified gap and time against the
+  fixed polygons and the SOCP, planar case and 200 grasps (bench/adaptive.py);
 - ``planner``: grasps scored per second, one process and both cores
   (bench/planner.py);
 - ``node_load``: the node at 500 Hz and 1 kHz beside a trivial echo node, in
@@ -39,6 +41,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+import adaptive  # noqa: E402
 import cycle  # noqa: E402
 import linearization  # noqa: E402
 import node_blackbox  # noqa: E402
@@ -65,6 +68,8 @@ def main() -> int:
                                         steps=50 if args.quick else 500), solvers.table),
         ("linearization", lambda: linearization.run(grasps=grasps, backend="daqp"),
          linearization.table),
+        ("adaptive", lambda: adaptive.run(grasps=grasps, repeats=3 if args.quick else 7),
+         adaptive.table),
         ("planner", lambda: planner.run(grasps=grasps, rounds=1 if args.quick else 5),
          planner.table),
     ]
