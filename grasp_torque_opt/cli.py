@@ -15,6 +15,7 @@ from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.report import solution_dict
 from grasp_torque_opt.core.solution import INFEASIBLE, OPTIMAL
+from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.compare import compare, format_table
 from grasp_torque_opt.methods.dispatch import METHODS, solve
 
@@ -35,11 +36,31 @@ def _parser() -> argparse.ArgumentParser:
     p_solve.add_argument("--fallback", choices=(*BACKENDS, "none"), default="daqp",
                          help="backend asked when the first gives nothing certifiable "
                               "(default: daqp)")
+    p_solve.add_argument("--gap", type=_gap, default=AdaptiveSettings.gap_tolerance,
+                         help="tau-qp-adaptive: stop at this certified gap to the exact "
+                              f"optimum (default: {AdaptiveSettings.gap_tolerance})")
+    p_solve.add_argument("--max-rounds", type=_rounds, default=AdaptiveSettings.max_rounds,
+                         help="tau-qp-adaptive: refinement rounds at most, 0 to 100 "
+                              f"(default: {AdaptiveSettings.max_rounds})")
     p_solve.add_argument("--json", action="store_true", help="print one JSON object")
     p_cmp = sub.add_parser("compare", help="every method side by side (the paper's Table 2)")
     p_cmp.add_argument("scenario", help="scenario YAML file")
     p_cmp.add_argument("--json", action="store_true", help="print one JSON object")
     return parser
+
+
+def _gap(text: str) -> float:
+    value = float(text)
+    if not 0.0 < value < 1.0:  # False for NaN as well
+        raise argparse.ArgumentTypeError(f"must be in (0, 1), got {text}")
+    return value
+
+
+def _rounds(text: str) -> int:
+    value = int(text)
+    if not 0 <= value <= 100:
+        raise argparse.ArgumentTypeError(f"must be in [0, 100], got {text}")
+    return value
 
 
 def _exit_code(status: str) -> int:
@@ -59,6 +80,14 @@ def _print_solution(d: dict) -> None:
         print("certificate: " + ", ".join(
             f"{k} {c[k]:.1e}" for k in ("equilibrium", "torque", "cone", "normal_force",
                                         "torque_limit")) + f" (tolerance {c['tolerance']:.0e})")
+    b = d.get("bounds")
+    if b is not None:
+        gap = "-" if b["gap"] is None else f"{100 * b['gap']:.3g}%"
+        lower = "none" if b["lower"] is None else f"{b['lower']:.6f}"
+        print(f"bounds on the exact optimum of sqrt(tau^T W tau): lower {lower} N m, "
+              f"this torque {b['upper']:.6f} N m, gap {gap} ({b['rounds']} rounds, "
+              f"{b['qp_solves']} QPs, from {b['source']})" if b["upper"] is not None else
+              f"bounds: lower {lower} N m, no certified torque")
 
 
 def _one_line(text: str) -> str:
@@ -81,7 +110,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "solve":
             fallback = None if args.fallback in ("none", args.backend) else \
                 make_solver(args.fallback)
-            sol = solve(setup, args.method, backend=args.backend, fallback=fallback)
+            refiner = Refiner(AdaptiveSettings(gap_tolerance=args.gap,
+                                               max_rounds=args.max_rounds))
+            sol = solve(setup, args.method, backend=args.backend, fallback=fallback,
+                        refiner=refiner)
             d = solution_dict(sol, setup.maps())
             if args.json:
                 print(json.dumps(d))

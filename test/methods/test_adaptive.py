@@ -107,7 +107,7 @@ def test_round_zero_bound_is_the_circumscribed_polygon_of_the_scenario(planar):
     polygon's own, if certified) and the lower bound comes from the same N scaled out."""
     maps = planar.maps()
     sol = solve(planar, "tau-qp-adaptive", maps=maps,
-                refiner=Refiner(AdaptiveSettings(max_rounds=0, first_sides=None)))
+                refiner=Refiner(AdaptiveSettings(max_rounds=0)))
     polygon = solve(planar, maps=maps)
     assert sol.bounds.source == "polygon" and sol.bounds.rounds == 0
     np.testing.assert_allclose(sol.tau, polygon.tau, atol=1e-9)
