@@ -69,6 +69,9 @@ STRICT = 1e-9
 RESTORE_MARGIN = 1e-8
 #: A multiplier above this marks its row active (for the restoration).
 ACTIVE = 1e-12
+#: A tangential force below this share of the normal one is at the cone's apex for
+#: the restoration (zeroing it costs at most about this share of the objective).
+APEX = 1e-6
 #: Round 0's polygon when refining: its directions are then close enough that one
 #: round closes the gap for most grasps (bench/adaptive.py: 169 of 200 with 16
 #: sides, fewer with 8; 24 or 32 sides cost as much in larger QPs as they save).
@@ -89,11 +92,16 @@ class AdaptiveSettings:
             :data:`FIRST_SIDES`.
         eps_abs: DAQP's primal tolerance.
         max_iter: DAQP's iteration cap per QP.
+        warm_start: a grasp of the same size as the last one starts with a step
+            at the last answer's directions and multipliers, skipping round 0,
+            from the last QP's active set (a moving grasp, as in the node); if
+            that gives no certified candidate, the grasp is solved cold.
     """
 
     gap_tolerance: float = 1e-3
     max_rounds: int = 4
     first_sides: int | None = None
+    warm_start: bool = False
     eps_abs: float = ProxSuiteSettings.eps_abs
     max_iter: int = ProxSuiteSettings.max_iter
 
@@ -173,6 +181,11 @@ class Refiner:
         self.settings = settings or AdaptiveSettings()
         self.workspace = workspace or DaqpWorkspace(self.settings.eps_abs,
                                                     self.settings.max_iter)
+        #: The last answer's (size key, directions, ||f_t||, defined, multipliers)
+        #: for a warm start; None before one.
+        self.last: tuple | None = None
+        #: Grasps started warm, and those of them redone cold.
+        self.warm_solves = self.warm_fallbacks = 0
 
     def refine(self, setup: GraspSetup, maps: GraspMaps, base: TauQP,
                tolerance: float = DEFAULT_TOLERANCE) -> Refined:
@@ -194,7 +207,7 @@ class _Rounds:
 
     def __init__(self, refiner: Refiner, setup: GraspSetup, maps: GraspMaps, base: TauQP,
                  tolerance: float) -> None:
-        self.s = refiner.settings
+        self.refiner, self.s = refiner, refiner.settings
         self.ws = refiner.workspace
         self.setup, self.maps, self.base, self.tolerance = setup, maps, base, tolerance
         fr = self.fr = setup.friction
@@ -290,48 +303,58 @@ class _Rounds:
         """Gauss-Newton steps (min-norm) onto the active or violated exact-cone pieces.
 
         Kept: the compatibility rows, the active torque bounds and f_min rows. A
-        second step only if the first left a piece outside (by more than STRICT/10).
+        contact whose tangential force is below :data:`APEX` of its normal one is
+        at the cone's apex in f_t, where ||f_t|| has no gradient: its f_t is
+        driven to zero instead and its pieces are |mz|/mu2 <= fz alone. A second
+        step only if the first left a piece outside (by more than STRICT/10).
         Each step's Gram matrix also gives, for one more right-hand side, the
         least-squares multipliers that make the point a KKT point of the exact
         problem with those rows (:meth:`_kkt_bound`).
 
         Returns:
-            x, its _point (f, u, ||f_t||, ok), and the last step's (rows on f of
-            the held pieces and f_min, shape (p, 3, 4), the least-squares
-            multipliers of its rows, and where they go), or None.
+            x, its _point (f, u, ||f_t||, ok), and the last step's rows on f with
+            their least-squares multipliers (or None), for :meth:`_kkt_bound`.
         """
-        fr, p = self.fr, self.p
+        fr, p, n = self.fr, self.p, self.n
         act = lam @ self.pieces > ACTIVE  # (p, 2)
         at_fmin = lam[:, -1] > ACTIVE
         at_box = np.abs(box[:self.m]) > ACTIVE
         fixed = np.concatenate((self.base.A, -self.MN[at_fmin, 2], self.eye[at_box]))
         n_eq, n_fix = self.n_eq, fixed.shape[0]
         k_f = n_eq + int(at_fmin.sum())
-        rows = np.empty((p, 3, 4))  # the cone pieces' gradients on f, then f_min's row
-        rows[:, :2, 2] = -1.0
+        # Rows on f: the two cone pieces (gradients), f_min's, then +-e_x, +-e_y (for
+        # the multipliers of the apex rows f_t = 0, which have either sign).
+        rows = np.zeros((p, 7, 4))
+        rows[:, :3, 2] = -1.0
         rows[:, 0, 3], rows[:, 1, 3] = 1.0 / fr.mu2, -1.0 / fr.mu2
-        rows[:, 2] = (0.0, 0.0, -1.0, 0.0)
+        rows[:, 3:, :2] = ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0))
         torsion = rows[0, :2, 3]
         duals = None
         for step in range(3):
             f, u, nt, ok = point = self._point(x)
-            c = (nt / fr.mu1)[:, None] + f[:, 3:4] * torsion - f[:, 2:3]
-            use = (act | (c > 0.0)) & ok[:, None]
+            apex = nt <= APEX * np.maximum(1.0, np.abs(f[:, 2]))
+            c_t = f[:, 3:4] * torsion - f[:, 2:3]  # (p, 2): the pieces without ||f_t||
+            c = c_t + (nt / fr.mu1)[:, None]
+            use = act | (c > 0.0)
+            at_apex = apex & use.any(axis=1)
             fz = f[at_fmin, 2]
             if step == 2 or (step and c[use].max(initial=0.0) <= STRICT / 10 and
                              fz.min(initial=np.inf) >= fr.min_normal_force - STRICT / 10):
                 return x, point, duals
-            rows[:, :2, :2] = u[:, None, :] * (1.0 / fr.mu1)
-            Jc = np.concatenate((fixed, np.matmul(rows[:, :2], self.MN)[use]))
+            rows[:, :2, :2] = np.where(apex[:, None, None], 0.0, u[:, None, :] * (1 / fr.mu1))
+            Jc = np.concatenate((fixed, self.MN[at_apex, :2].reshape(-1, n),
+                                 np.matmul(rows[:, :2], self.MN)[use]))
+            k_a = n_fix + 2 * int(at_apex.sum())
             rhs = np.zeros((Jc.shape[0], 2))
             rhs[n_eq:k_f, 0] = fz - fr.min_normal_force - RESTORE_MARGIN
-            rhs[n_fix:, 0] = -RESTORE_MARGIN - c[use]
+            rhs[n_fix:k_a, 0] = -f[at_apex, :2].ravel()
+            rhs[k_a:, 0] = -RESTORE_MARGIN - np.where(apex[:, None], c_t, c)[use]
             rhs[:, 1] = -Jc @ (self.base.H @ x)  # stationarity: H x + Jc^T theta = 0
             _, sol, info = dposv(Jc @ Jc.T, rhs)  # LAPACK directly: numpy's solve costs 10 us
             if info != 0:  # dependent rows (a degenerate active set): least squares
                 sol = np.linalg.lstsq(Jc @ Jc.T, rhs, rcond=None)[0]
             x = x + Jc.T @ sol[:, 0]
-            duals = (rows.copy(), sol[:, 1], use, at_fmin, n_eq, k_f, n_fix)
+            duals = (rows.copy(), sol[:, 1], use, at_fmin, at_apex, (n_eq, k_f, n_fix, k_a))
         raise AssertionError("unreachable")
 
     def _kkt_bound(self, duals) -> float:
@@ -347,10 +370,13 @@ class _Rounds:
         """
         if duals is None:
             return -math.inf
-        rows, theta, use, at_fmin, n_eq, k_f, n_fix = duals
-        mult = np.zeros((self.p, 3))
-        mult[:, :2][use] = theta[n_fix:]
+        rows, theta, use, at_fmin, at_apex, (n_eq, k_f, n_fix, k_a) = duals
+        mult = np.zeros((self.p, 7))
+        mult[:, :2][use] = theta[k_a:]
         mult[at_fmin, 2] = theta[n_eq:k_f]
+        alpha = theta[n_fix:k_a].reshape(-1, 2)  # the apex rows', either sign
+        mult[at_apex, 3:] = np.column_stack((alpha[:, 0], -alpha[:, 0], alpha[:, 1],
+                                             -alpha[:, 1]))
         rows[:, :2, :2] *= 1.0 / (1.0 + INFLATION)  # strictly inside K* (INFLATION)
         rows[:, :2, 3] *= 1.0 / (1.0 + INFLATION)
         eta, v = relaxation_duals(self.base, rows, mult, theta[:n_eq])
@@ -376,31 +402,61 @@ class _Rounds:
 
     # -- the rounds -------------------------------------------------------------------
 
+    def _key(self) -> tuple:
+        """What a warm start needs to be the same: sizes and the cone."""
+        return self.p, self.n, self.m, self.R, self.fr.mu1, self.fr.mu2
+
     def run(self) -> Refined:
-        base, s = self.base, self.s
+        s = self.s
+        last = self.refiner.last
+        if s.warm_start and last is not None and last[0] == self._key():
+            self.refiner.warm_solves += 1
+            self._load(warm=True)
+            out = self._rounds(-math.inf, None, "refined", (None,) + last[1:4], last[4], 1)
+            if out.tau is not None:
+                return out
+            self.refiner.warm_fallbacks += 1
+            self.rows[:, :2] = self.spare  # the cold round 0's rows again
+            self.C[:, :2] = np.matmul(self.rows[:, :2], self.MN)
+            self.u[:, :2] = -np.matmul(self.rows[:, :2], self.f0[:, :, None])[:, :, 0]
+        self._load(warm=False)
+        raw, x, lam, y = self._qp()
+        if x is None:
+            return self._done(None, -math.inf, 0, "circumscribed", f"round 0: {raw.message}",
+                              raw.status == "infeasible")
+        point = self._point(x)
+        best = self._candidate(x, point)
+        lower = -math.inf
+        # Round 0's bound is only needed if nothing better comes (rows change below).
+        first = (self.rows.copy(), lam.copy(), y.copy())
+        if best is not None or s.max_rounds == 0:
+            lower = self._bound(lam, y)
+        out = self._rounds(lower, best, "circumscribed" if best is not None else "refined",
+                           point, np.maximum(lam[:, :-1], 0.0).sum(axis=1), 0, first)
+        return out
+
+    def _load(self, warm: bool) -> None:
+        base = self.base
         self.ws.load(base.H, base.g, base.A, base.b, self.C.reshape(-1, self.n), self.u.ravel(),
-                     base.l_box, base.u_box, semidefinite=self.n > self.m)
-        lower, best, source, rounds = -math.inf, None, "refined", 0
+                     base.l_box, base.u_box, semidefinite=self.n > self.m, warm=warm)
+
+    def _rounds(self, lower: float, best, source: str, point, nu: np.ndarray, start: int,
+                first=None) -> Refined:
+        """The refinement rounds from a point's directions and multipliers nu.
+
+        Args:
+            start: 0 after round 0 (a gap check first), 1 for a warm start (a step
+                first, at the last answer's directions).
+            first: round 0's (rows, multipliers) for a bound if no round gives one.
+        """
+        base, s = self.base, self.s
 
         def gap() -> float:
             return math.sqrt(best[0] / lower) - 1.0 if best is not None and lower > 0 \
                 else math.inf
 
-        raw, x, lam, y = self._qp()
-        if x is None:
-            return self._done(None, lower, 0, "circumscribed", f"round 0: {raw.message}",
-                              raw.status == "infeasible")
-        point = self._point(x)
-        best = self._candidate(x, point)
-        if best is not None:
-            source = "circumscribed"
-        # Round 0's bound is only needed if nothing better comes (rows change below).
-        first = (self.rows.copy(), lam.copy(), y.copy())
-        if best is not None or s.max_rounds == 0:
-            lower = self._bound(lam, y)
-        message = "max rounds"
-        nu = np.maximum(lam[:, :-1], 0.0).sum(axis=1)
-        for rounds in range(1, s.max_rounds + 1):
+        message, rounds, last_nu = "max rounds", 0, None
+        for rounds in range(1, max(s.max_rounds, start) + 1):
             if gap() <= s.gap_tolerance:
                 rounds -= 1
                 message = "gap within tolerance"
@@ -411,12 +467,14 @@ class _Rounds:
             if xs is None:
                 message = f"round {rounds} step: {raw.message}"
                 break
+            last_nu = np.maximum(lam_s[:, :-1], 0.0).sum(axis=1)
             xh, point, duals = self._restore(xs, lam_s, self.ws.multipliers[:self.n])
             if not np.all(np.isfinite(xh)):
                 xh, point, duals = xs, self._point(xs), None
             cand = self._candidate(xh, point)
             if cand is not None and (best is None or cand[0] < best[0]):
                 best, source = cand, "refined"
+                self.refiner.last = (self._key(), point[1], point[2], point[3], last_nu)
             if best is not None:  # without a candidate no bound closes the gap
                 lower = max(lower, self._kkt_bound(duals))
                 if gap() <= s.gap_tolerance:
@@ -425,7 +483,6 @@ class _Rounds:
             # The restored point's own multipliers bound loosely while it is still a
             # step away (about ten times its excess, measured): the relaxation with
             # the facets at its directions, solved warm, has exact multipliers.
-            x = xh
             self._turn(point[1], point[3])
             raw, xl, lam_l, y_l = self._qp(base.H, base.g)
             if xl is None:
@@ -436,7 +493,7 @@ class _Rounds:
         else:
             if gap() <= s.gap_tolerance:
                 message = "gap within tolerance"
-        if lower == -math.inf:
+        if lower == -math.inf and first is not None:
             self.rows = first[0]
             lower = self._bound(first[1], first[2])
         return self._done(best, lower, rounds, source, message, False)

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from grasp_torque_opt.backends import make_solver
+from grasp_torque_opt.backends import available, make_solver
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.core.bounds import make_bounds
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE, Certificate, certify
@@ -29,7 +29,7 @@ from grasp_torque_opt.core.solution import (
     Solution,
 )
 from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp
-from grasp_torque_opt.methods.adaptive import Refiner
+from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.reference.feasibility import linearized_feasible
 
 #: Methods: the product's (``tau-qp``; ``tau-qp-adaptive``, its refinement to the
@@ -83,8 +83,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     if method == "tau-qp-adaptive":
-        return _solve_adaptive(setup, maps, solver, backend, fallback, tolerance,
-                               refiner or Refiner())
+        return _solve_adaptive(setup, maps, solver, backend, fallback, tolerance, refiner)
     timings = {}
     t0 = time.perf_counter()
     if maps is None:
@@ -177,9 +176,10 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
 
 
 def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: str,
-                    fallback, tolerance: float, refiner: Refiner) -> Solution:
+                    fallback, tolerance: float, refiner: Refiner | None) -> Solution:
     """tau-qp-adaptive: the rounds of :mod:`~grasp_torque_opt.methods.adaptive`, certified
-    bounds attached; the paper's N-gon (the tau-qp path) when no round gave a candidate."""
+    bounds attached; the paper's N-gon (the tau-qp path) when no round gave a candidate
+    (or DAQP, which the rounds need, is not installed)."""
     t0 = time.perf_counter()
     if maps is None:
         maps = setup.maps()
@@ -188,10 +188,15 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
     qp = build_tau_qp(maps, setup.friction, setup.external_wrench, tau_min, tau_max,
                       setup.weights)
     t2 = time.perf_counter()
-    settings = refiner.settings
+    if refiner is None and available("daqp"):
+        refiner = Refiner()
+    settings = AdaptiveSettings() if refiner is None else refiner.settings
     try:
-        ref = refiner.refine(setup, maps, qp, tolerance)
-        why = ref.message
+        if refiner is None:
+            ref, why = None, "the rounds need DAQP, which is not installed (pip install daqp)"
+        else:
+            ref = refiner.refine(setup, maps, qp, tolerance)
+            why = ref.message
     except SolverError as e:  # a failed round is answered by the polygon below
         ref, why = None, str(e)
     t3 = time.perf_counter()

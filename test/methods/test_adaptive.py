@@ -186,3 +186,41 @@ def test_holds_a_load_the_papers_triangle_cannot(allegro):
         pytest.fail("no load lost to the triangle in 40 draws")
     sol = solve(setup, "tau-qp-adaptive", maps=maps)
     check_against_socp(setup, maps, sol)
+
+
+def test_a_contact_in_pure_torsion_is_restored_in_the_first_round(allegro):
+    """A load for which one fingertip's optimum is pure torsion at f_min (f_t = 0, the
+    apex of ||f_t||, where the cone has no gradient): the first round's candidate is
+    already certified and inside the exact cone (without the apex rows it was not)."""
+    th = 2 * np.pi * 58 / 400
+    w = allegro.external_wrench.copy()
+    w[:3] = np.linalg.norm(w[:3]) * np.array([np.cos(th), 0.3 * np.sin(th), np.sin(th)])
+    setup = dataclasses.replace(allegro, external_wrench=w)
+    maps = setup.maps()
+    exact = solve(setup, "socp", maps=maps)
+    ft = np.hypot(exact.wrenches[:, 0], exact.wrenches[:, 1])
+    assert (ft / exact.wrenches[:, 2]).min() < 1e-8, "the load no longer puts a contact at it"
+    sol = solve(setup, "tau-qp-adaptive", maps=maps)
+    check_against_socp(setup, maps, sol)
+    assert sol.bounds.source == "refined" and sol.bounds.rounds == 1
+
+
+def test_warm_start_follows_a_moving_grasp(allegro):
+    """The node's case: a grasp moving by 1 mrad per cycle and a turning load. Warm, each
+    cycle starts at the last answer's directions: every answer certified and bracketed."""
+    rng = np.random.default_rng(3)
+    refiner = Refiner(AdaptiveSettings(warm_start=True))
+    q = allegro.q.copy()
+    for k in range(25):
+        q = q.copy()
+        q[allegro.hand.idx_q] += rng.normal(scale=1e-3, size=allegro.hand.m)
+        th = 2 * np.pi * k / 25
+        w = allegro.external_wrench.copy()
+        w[:3] = np.linalg.norm(w[:3]) * np.array([np.cos(th), 0.3 * np.sin(th), np.sin(th)])
+        setup = dataclasses.replace(allegro, q=q, external_wrench=w)
+        maps = setup.maps()
+        sol = solve(setup, "tau-qp-adaptive", maps=maps, refiner=refiner)
+        check_against_socp(setup, maps, sol)
+        assert sol.bounds.converged
+    assert refiner.warm_solves == 24  # every cycle after the first
+    assert refiner.warm_fallbacks <= 2
