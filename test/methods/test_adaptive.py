@@ -224,3 +224,26 @@ def test_warm_start_follows_a_moving_grasp(allegro):
         assert sol.bounds.converged
     assert refiner.warm_solves == 24  # every cycle after the first
     assert refiner.warm_fallbacks <= 2
+
+
+def test_without_daqp_the_papers_polygon_answers():
+    """A ROS distribution may lack DAQP (docs/ros2_control.md): the method then answers
+    with the paper's N-gon, certified, and says why; nothing raises."""
+    import subprocess
+    import sys
+
+    from conftest import ALLEGRO
+
+    script = f"""
+import sys
+sys.modules["daqp"] = None  # any import of it now raises ImportError
+from grasp_torque_opt import GraspSetup, solve
+setup = GraspSetup.from_file({str(ALLEGRO)!r})
+sol = solve(setup, "tau-qp-adaptive")
+assert sol.optimal and sol.bounds.source == "polygon", sol.message
+assert "DAQP, which is not installed" in sol.message, sol.message
+print("ok")
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
