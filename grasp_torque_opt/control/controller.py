@@ -41,6 +41,7 @@ from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import ContactSpec
 from grasp_torque_opt.core.solution import Solution
+from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.dispatch import solve
 
 POLICIES = ("hold", "zero")
@@ -78,6 +79,8 @@ class CycleConfig:
         stamp_future_tolerance: a header stamp more than this ahead of the clock
             is rejected [s].
         cycle_budget: a cycle that takes longer publishes nothing (overrun) [s].
+        method: ``tau-qp`` (the paper's polygon) or ``tau-qp-adaptive`` (the
+            exact-cone optimum with certified bounds, docs/adaptive.md; DAQP).
     """
 
     joint_state_timeout: float = 0.1
@@ -94,6 +97,7 @@ class CycleConfig:
     max_contact_distance: float = 1.0
     stamp_future_tolerance: float = 0.5
     cycle_budget: float = 0.05
+    method: str = "tau-qp"
 
 
 @dataclass(frozen=True)
@@ -229,6 +233,7 @@ class TorqueController:
         self.setup = setup
         self.config = config or CycleConfig()
         self.solver = make_solver(backend, solver_settings, warm_start)
+        self.refiner: Refiner | None = None  # tau-qp-adaptive's, made when first used
         self.fallback = make_solver(fallback, solver_settings) if fallback else None
         self.inputs = Inputs()
         self.counters = Counters()
@@ -511,9 +516,24 @@ class TorqueController:
         """
         setup, g = self.grasp_at(inputs)
         maps = setup.maps()
-        sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback,
-                    tolerance=self.config.certificate_tolerance)
+        sol = solve(setup, self.config.method, maps=maps, solver=self.solver,
+                    fallback=self.fallback, tolerance=self.config.certificate_tolerance,
+                    refiner=self._refiner())
         return sol, maps, g
+
+    def _refiner(self) -> Refiner | None:
+        """tau-qp-adaptive's rounds (kept across cycles, warm as the solver is), else None."""
+        if self.config.method != "tau-qp-adaptive":
+            return None
+        warm = getattr(self.solver, "warm_start", False)
+        settings = getattr(self.solver, "settings", None)
+        wanted = AdaptiveSettings(warm_start=warm,
+                                  eps_abs=getattr(settings, "eps_abs", AdaptiveSettings.eps_abs),
+                                  max_iter=getattr(settings, "max_iter",
+                                                   AdaptiveSettings.max_iter))
+        if self.refiner is None or self.refiner.settings != wanted:
+            self.refiner = Refiner(wanted)
+        return self.refiner
 
     def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
         """The last check before a command leaves: certified, finite, sized, within limits."""

@@ -125,6 +125,10 @@ PARAMETERS: dict[str, Spec] = {
                                    "is rejected [s].", 0.0, 3600.0),
     "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun) [s].",
                          1e-4, 10.0),
+    "solver.method": Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
+                          "exact-cone optimum from QPs with a certified gap to it, "
+                          "docs/adaptive.md; needs DAQP; about 3 times tau-qp's cycle with "
+                          "DAQP, well within the default cycle_budget)."),
     "solver.backend": Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
                            "without internal-force variables only); every result is "
                            "certified whichever solves it."),
@@ -167,6 +171,8 @@ def descriptor(name: str) -> ParameterDescriptor:
     return d
 
 
+#: Values of ``solver.method``: the product's methods (the references are not for a cycle).
+CYCLE_METHODS = ("tau-qp", "tau-qp-adaptive")
 #: Values of ``solver.fallback``.
 FALLBACKS = (*BACKENDS, "none")
 
@@ -188,6 +194,11 @@ def check(name: str, value: Any, m: int) -> str:
         return "" if available(value) else f"{name}: {value} is not installed (pip install {value})"
     if name == "solver.fallback":
         return "" if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
+    if name == "solver.method":
+        if value not in CYCLE_METHODS:
+            return f"{name}: must be one of {', '.join(CYCLE_METHODS)}"
+        return "" if value == "tau-qp" or available("daqp") else \
+            f"{name}: {value} needs daqp, which is not installed (pip install daqp)"
     if spec.length is not None:
         n = m if spec.length == "joints" else int(spec.length)
         values = list(value)
@@ -236,6 +247,7 @@ class GraspTorqueNode(Node):
             "max_contact_distance": CycleConfig.max_contact_distance,
             "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
             "cycle_budget": CycleConfig.cycle_budget,
+            "solver.method": "tau-qp",
             "solver.backend": BACKENDS[0],
             "solver.fallback": "daqp",
             "solver.warm_start": True,
@@ -340,7 +352,7 @@ class GraspTorqueNode(Node):
             max_wrench_force=p["max_wrench_force"], max_wrench_torque=p["max_wrench_torque"],
             max_contact_distance=p["max_contact_distance"],
             stamp_future_tolerance=p["stamp_future_tolerance"],
-            cycle_budget=p["cycle_budget"])
+            cycle_budget=p["cycle_budget"], method=p["solver.method"])
         solver = ProxSuiteSettings(eps_abs=p["solver.eps_abs"], max_iter=p["solver.max_iter"],
                                    max_iter_in=p["solver.max_iter_in"])
         return setup, config, solver
