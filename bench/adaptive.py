@@ -1,7 +1,7 @@
 """tau-qp-adaptive against the fixed polygons and the exact SOCP: excess, bounds, time.
 
 Usage: .venv/bin/python bench/adaptive.py [--grasps 200] [--seed 0] [--repeats 7]
-       [--gap 1e-3] [--out bench/results/adaptive.json]
+       [--gap 1e-3] [--steps 500] [--out bench/results/adaptive.json]
 
 Cases: the paper's planar case (config/planar_two_finger.yaml, N = 3) and the
 seeded Allegro grasp set of bench/grasps.py (N = 8). Per grasp, G and J are
@@ -13,6 +13,11 @@ solver=...) (build, solve, certify; solvers reused across grasps), the median of
   inscribed polygon (tau-qp);
 - ``socp``: the exact cone, Clarabel (the reference optimum E);
 - ``adaptive``: tau-qp-adaptive with its default settings (DAQP inside).
+
+A third case is the node's: the bundled Allegro grasp with the fingers walking
+by 1 mrad per cycle and the load turning once in ``steps`` cycles, each cycle
+timed once: tau-qp-adaptive warm (each cycle starts at the last answer's
+directions) against the tau-QP with DAQP and ProxSuite warm (the node's default).
 
 Reported: the adaptive torque's excess over E, ||tau|| / ||tau_E|| - 1 (every
 case has W = I), its certified gap, and whether its bounds bracket E (lower <=
@@ -42,6 +47,7 @@ from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner  # noqa:
 from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
 
 PLANAR = ROOT / "config" / "planar_two_finger.yaml"
+SCENARIO_ALLEGRO = ROOT / "config" / "allegro_right.yaml"
 #: Relative slack of the bracket check lower <= E <= upper (Clarabel's own accuracy).
 BRACKET = 1e-9
 #: Timed columns: the case's own N, then N = 32, per backend; the SOCP; the method.
@@ -131,8 +137,62 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
     }
 
 
-def run(grasps: int = 200, seed: int = 0, repeats: int = 7, gap: float = 1e-3) -> dict:
-    """Both cases (JSON-able)."""
+def walking(setup: GraspSetup, steps: int, seed: int = 0) -> list[GraspSetup]:
+    """The grasp with the fingers walking by 1 mrad per cycle, the load turning once."""
+    rng = np.random.default_rng(seed)
+    out, q = [], setup.q.copy()
+    weight = float(np.linalg.norm(setup.external_wrench[:3]))
+    for k in range(steps):
+        q = q.copy()
+        q[setup.hand.idx_q] += rng.normal(scale=1e-3, size=setup.hand.m)
+        th = 2 * np.pi * k / steps
+        w = setup.external_wrench.copy()
+        w[:3] = weight * np.array([np.cos(th), 0.3 * np.sin(th), np.sin(th)])
+        out.append(dataclasses.replace(setup, q=q, external_wrench=w))
+    return out
+
+
+def moving_case(steps: int, settings: AdaptiveSettings) -> dict:
+    """The node's case, warm (JSON-able); the exact optimum on every tenth cycle."""
+    seq = walking(GraspSetup.from_file(SCENARIO_ALLEGRO), steps)
+    variants = {"adaptive warm": None, "tau-qp daqp warm": make_solver("daqp", warm_start=True),
+                "tau-qp proxsuite warm": make_solver("proxsuite", warm_start=True)}
+    fallback = make_solver("daqp")
+    refiner = Refiner(dataclasses.replace(settings, warm_start=True))
+    times = {k: [] for k in variants}
+    gaps, excess, qps, failed = [], [], [], 0
+    for k, setup in enumerate(seq):
+        maps = setup.maps()
+        for name, solver in variants.items():
+            t0 = time.perf_counter()
+            if solver is None:
+                sol = solve(setup, "tau-qp-adaptive", maps=maps, refiner=refiner,
+                            solver=variants["tau-qp proxsuite warm"], fallback=fallback)
+            else:
+                sol = solve(setup, maps=maps, solver=solver, fallback=fallback)
+            times[name].append(time.perf_counter() - t0)
+            if solver is None:
+                failed += not sol.optimal
+                if sol.optimal:
+                    gaps.append(np.inf if sol.bounds.gap is None else sol.bounds.gap)
+                    qps.append(sol.bounds.qp_solves)
+                    if k % 10 == 0:
+                        exact = solve(setup, "socp", maps=maps)
+                        if exact.optimal:
+                            excess.append(sol.torque_norm / exact.torque_norm - 1.0)
+    skip = 20  # warm-up
+    t = {k: np.asarray(v[skip:]) for k, v in times.items()}
+    return {"steps": steps, "failed": failed,
+            "gap_max": float(max(gaps)), "qp_solves_mean": float(np.mean(qps)),
+            "excess_max": float(max(excess)), "excess_checked": len(excess),
+            "warm_solves": refiner.warm_solves, "warm_fallbacks": refiner.warm_fallbacks,
+            "times_s": {k: {"median": float(np.median(v)), "p99": float(np.percentile(v, 99)),
+                            "max": float(v.max())} for k, v in t.items()}}
+
+
+def run(grasps: int = 200, seed: int = 0, repeats: int = 7, gap: float = 1e-3,
+        steps: int = 500) -> dict:
+    """Every case (JSON-able)."""
     settings = AdaptiveSettings(gap_tolerance=gap)
     planar = GraspSetup.from_file(PLANAR)
     return {"machine": machine(), "blas_threads": blas_threads(), "seed": seed,
@@ -140,7 +200,8 @@ def run(grasps: int = 200, seed: int = 0, repeats: int = 7, gap: float = 1e-3) -
             "cases": {"planar (N=3)": one_case([planar], repeats, settings,
                                                (planar.friction.sides, 32)),
                       f"allegro, {grasps} grasps (N=8)": one_case(
-                          allegro_grasps(grasps, seed), repeats, settings, (8, 32))}}
+                          allegro_grasps(grasps, seed), repeats, settings, (8, 32))},
+            "moving": moving_case(steps, settings)}
 
 
 def table(results: dict) -> str:
@@ -169,6 +230,17 @@ def table(results: dict) -> str:
     lines.append("")
     lines.append("Times: median / p99 over the grasps of each grasp's median [us] of "
                  "solve(); own N: the scenario's polygon (planar 3, Allegro 8).")
+    mv = results.get("moving")
+    if mv:
+        lines += ["", f"Moving Allegro grasp, {mv['steps']} cycles, warm: adaptive gap max "
+                  f"{100 * mv['gap_max']:.2g}%, excess over the SOCP max "
+                  f"{100 * mv['excess_max']:.2g}% ({mv['excess_checked']} cycles checked), "
+                  f"{mv['qp_solves_mean']:.2f} QPs per cycle, {mv['warm_fallbacks']} of "
+                  f"{mv['warm_solves']} warm starts redone cold, {mv['failed']} failed.", "",
+                  "| per cycle [us] | median | p99 | max |", "|---|---:|---:|---:|"]
+        for k, v in mv["times_s"].items():
+            lines.append(f"| {k} | {1e6 * v['median']:.0f} | {1e6 * v['p99']:.0f} | "
+                         f"{1e6 * v['max']:.0f} |")
     return "\n".join(lines)
 
 
@@ -178,10 +250,11 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--repeats", type=int, default=7)
     parser.add_argument("--gap", type=float, default=1e-3)
+    parser.add_argument("--steps", type=int, default=500, help="cycles of the moving case")
     parser.add_argument("--out", type=Path, help="write the results as JSON here")
     args = parser.parse_args()
     single_threaded_math()
-    res = run(args.grasps, args.seed, args.repeats, args.gap)
+    res = run(args.grasps, args.seed, args.repeats, args.gap, args.steps)
     report(res, table(res), args.out,
            f"{args.grasps} grasps, seed {args.seed}; threads: {res['blas_threads']}")
 
