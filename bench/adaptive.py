@@ -23,8 +23,9 @@ Reported: the adaptive torque's excess over E, ||tau|| / ||tau_E|| - 1 (every
 case has W = I), its certified gap, and whether its bounds bracket E (lower <=
 E <= upper up to 1e-9 relative: the SOCP is only as exact as its tolerance);
 QPs and rounds; per method the median and p99 over the grasps of the per-grasp
-times, and the ratio adaptive / own N per grasp. BLAS runs single-threaded, as in
-the node.
+times, and the ratio adaptive / own N per grasp (of the medians, and of each
+grasp's fastest call, which a loaded machine touches least). BLAS runs
+single-threaded, as in the node.
 """
 
 from __future__ import annotations
@@ -58,12 +59,15 @@ def _sides(setup: GraspSetup, n: int) -> GraspSetup:
     return dataclasses.replace(setup, friction=dataclasses.replace(setup.friction, sides=n))
 
 
-def _median_time(fn, repeats: int) -> float:
+def _median_time(fn, repeats: int, fastest: list | None = None) -> float:
+    """The median of ``repeats`` calls [s]; their fastest appended to ``fastest``."""
     samples = []
     for _ in range(repeats):
         t0 = time.perf_counter()
         fn()
         samples.append(time.perf_counter() - t0)
+    if fastest is not None:
+        fastest.append(min(samples))
     return float(np.median(samples))
 
 
@@ -73,6 +77,7 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
     daqp, prox = make_solver("daqp"), make_solver("proxsuite")
     refiner = Refiner(settings)
     rows, times = [], {k: [] for k in TIMED}
+    fastest = {"own N daqp": [], "adaptive": []}  # least touched by a shared machine
     counts = {"optimal": 0, "infeasible": 0, "failed": 0}
     for setup in setups:
         maps = setup.maps()
@@ -84,14 +89,14 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
         for n, col in zip(fixed_sides, ("own N", "N=32")):
             s = _sides(setup, n)
             fixed[n] = solve(s, maps=maps, solver=daqp)
-            times[f"{col} daqp"].append(
-                _median_time(lambda: solve(s, maps=maps, solver=daqp), repeats))
+            times[f"{col} daqp"].append(_median_time(
+                lambda: solve(s, maps=maps, solver=daqp), repeats, fastest.get(f"{col} daqp")))
             times[f"{col} proxsuite"].append(
                 _median_time(lambda: solve(s, maps=maps, solver=prox), repeats))
         times["socp"].append(_median_time(lambda: solve(setup, "socp", maps=maps), repeats))
         times["adaptive"].append(_median_time(
             lambda: solve(setup, "tau-qp-adaptive", maps=maps, refiner=refiner, solver=prox,
-                          fallback=daqp), repeats))
+                          fallback=daqp), repeats, fastest["adaptive"]))
         if not (exact.optimal and ada.optimal):
             continue
         E, b = exact.torque_norm, ada.bounds
@@ -106,6 +111,7 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
     t = {k: np.asarray(v) for k, v in times.items()}
     ratio = t["adaptive"] / t["own N daqp"]
     ratio_prox = t["adaptive"] / t["own N proxsuite"]
+    ratio_fastest = np.asarray(fastest["adaptive"]) / np.asarray(fastest["own N daqp"])
     ex = np.array([r["excess"] for r in rows])
     gaps = np.array([np.inf if r["gap"] is None else r["gap"] for r in rows])
     qps = np.array([r["qp_solves"] for r in rows])
@@ -133,6 +139,8 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
                              "p99": float(np.percentile(ratio, 99)), "max": float(ratio.max())},
         "ratio_to_n8_proxsuite": {"median": float(np.median(ratio_prox)),
                                   "p99": float(np.percentile(ratio_prox, 99))},
+        "fastest_ratio_to_n8_daqp": {"median": float(np.median(ratio_fastest)),
+                                     "p99": float(np.percentile(ratio_fastest, 99))},
         "faster_than_socp": int(np.sum(t["adaptive"] < t["socp"])),
     }
 
@@ -218,18 +226,22 @@ def table(results: dict) -> str:
             f"{c['compared'] - c['bracket_violations']}/{c['compared']} | "
             f"{c['qp_solves']['median']:.0f} / {c['qp_solves']['max']} | {fixed} |")
     lines += ["", "| case | " + " | ".join(TIMED) + " | adaptive / own N daqp | "
-              "adaptive / own N proxsuite | faster than socp |",
-              "|---|" + "---:|" * (len(TIMED) + 3)]
+              "fastest / fastest | adaptive / own N proxsuite | faster than socp |",
+              "|---|" + "---:|" * (len(TIMED) + 4)]
     for name, c in results["cases"].items():
         ts = c["times_s"]
         cells = [f"{1e6 * ts[k]['median']:.0f} / {1e6 * ts[k]['p99']:.0f}" for k in TIMED]
-        r, rp = c["ratio_to_n8_daqp"], c["ratio_to_n8_proxsuite"]
+        r, rp, rf = (c["ratio_to_n8_daqp"], c["ratio_to_n8_proxsuite"],
+                     c["fastest_ratio_to_n8_daqp"])
         lines.append(f"| {name} | " + " | ".join(cells) +
-                     f" | {r['median']:.2f} (p99 {r['p99']:.2f}) | {rp['median']:.2f} "
+                     f" | {r['median']:.2f} (p99 {r['p99']:.2f}) | {rf['median']:.2f} "
+                     f"(p99 {rf['p99']:.2f}) | {rp['median']:.2f} "
                      f"(p99 {rp['p99']:.2f}) | {c['faster_than_socp']}/{c['grasps']} |")
     lines.append("")
     lines.append("Times: median / p99 over the grasps of each grasp's median [us] of "
-                 "solve(); own N: the scenario's polygon (planar 3, Allegro 8).")
+                 "solve(); own N: the scenario's polygon (planar 3, Allegro 8); fastest / "
+                 "fastest: the ratio of each grasp's fastest calls, adaptive over own N "
+                 "daqp (the figure a shared machine touches least).")
     mv = results.get("moving")
     if mv:
         lines += ["", f"Moving Allegro grasp, {mv['steps']} cycles, warm: adaptive gap max "

@@ -488,7 +488,7 @@ class _Rounds:
                     message = "gap within tolerance"
                     break
             # The restored point's own multipliers bound loosely while it is still a
-            # step away (about ten times its excess, measured): the relaxation with
+            # step away (10 to 100 times its excess, measured): the relaxation with
             # the facets at its directions, solved warm, has exact multipliers.
             self._turn(point[1], point[3])
             raw, xl, lam_l, y_l = self._qp(base.H, base.g)
