@@ -37,6 +37,9 @@ _EXPORTS = {
     "make_solver": "grasp_torque_opt.backends",
     "ProxSuiteSettings": "grasp_torque_opt.backends.proxsuite",
     "METHODS": "grasp_torque_opt.methods.dispatch",
+    "Refiner": "grasp_torque_opt.methods.adaptive",
+    "AdaptiveSettings": "grasp_torque_opt.methods.adaptive",
+    "Bounds": "grasp_torque_opt.core.bounds",
     "solve": "grasp_torque_opt.methods.dispatch",
     "compare": "grasp_torque_opt.methods.compare",
 }
