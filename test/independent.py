@@ -49,3 +49,70 @@ def assert_holds(setup, maps, tau, wrenches, tol=1e-6):
     np.testing.assert_allclose(tau, tau_from_f, atol=tol)
     off = 0.0 if setup.torque_offset is None else setup.torque_offset
     assert np.all(np.abs(tau + off) <= setup.hand.torque_limits + tol)
+
+
+def _planned_mu(fr):
+    """mu1, mu2 of the cone planned with the friction margin k: mu / (1 + k) (docs/planner.md)."""
+    k = getattr(fr, "margin", 0.0)
+    return fr.mu1 / (1.0 + k), fr.mu2 / (1.0 + k)
+
+
+def _f_space(setup, maps):
+    """Polygon rows S f <= b of the planned cones and the torque bounds on J^T f (+ offset)."""
+    fr = setup.friction
+    mu1, mu2 = _planned_mu(fr)
+    S_i, b_i = polygon_rows(mu1, mu2, fr.sides, fr.min_normal_force)
+    p = maps.p
+    S = np.kron(np.eye(p), S_i)
+    lim = setup.hand.torque_limits
+    off = np.zeros(setup.hand.m) if setup.torque_offset is None else setup.torque_offset
+    return S, np.tile(b_i, p), lim, off
+
+
+def lp_capacity(setup, maps, load):
+    """HiGHS in contact-force space: max alpha with G f + alpha load = 0, the planned
+    polygons and |J^T f + offset| <= limits. Returns (alpha, f) or (None, None)."""
+    S, b, lim, off = _f_space(setup, maps)
+    nf = 4 * maps.p
+    c = np.zeros(nf + 1)
+    c[-1] = -1.0
+    A_ub = np.vstack((np.hstack((S, np.zeros((S.shape[0], 1)))),
+                      np.hstack((maps.J.T, np.zeros((setup.hand.m, 1)))),
+                      np.hstack((-maps.J.T, np.zeros((setup.hand.m, 1))))))
+    b_ub = np.concatenate((b, lim - off, lim + off))
+    A_eq = np.hstack((maps.G, np.asarray(load, float)[:, None]))
+    res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=np.zeros(6),
+                  bounds=[(None, None)] * nf + [(0, None)], method="highs")
+    if res.status != 0:
+        return None, None
+    return float(res.x[-1]), res.x[:nf]
+
+
+def lp_minmax(setup, maps, weights=None):
+    """HiGHS in contact-force space: min t with G f + w_ext = 0, the planned polygons,
+    w_i |(J^T f)_i + offset_i| <= t limit_i and |J^T f + offset| <= limits. Returns t or None."""
+    S, b, lim, off = _f_space(setup, maps)
+    m = setup.hand.m
+    w = np.ones(m) if weights is None else np.asarray(weights, float)
+    nf = 4 * maps.p
+    c = np.zeros(nf + 1)
+    c[-1] = 1.0
+    JT = maps.J.T
+    zero = np.zeros((m, 1))
+    A_ub = np.vstack((np.hstack((S, np.zeros((S.shape[0], 1)))),
+                      np.hstack((JT, zero)), np.hstack((-JT, zero)),
+                      np.hstack((w[:, None] * JT, -lim[:, None])),
+                      np.hstack((-w[:, None] * JT, -lim[:, None]))))
+    b_ub = np.concatenate((b, lim - off, lim + off, -w * off, w * off))
+    res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=np.hstack((maps.G, np.zeros((6, 1)))),
+                  b_eq=-setup.external_wrench, bounds=[(None, None)] * nf + [(0, None)],
+                  method="highs")
+    return float(res.x[-1]) if res.status == 0 else None
+
+
+def polygon_slack(setup, wrench):
+    """Largest value of one contact's planned polygon rows on its wrench (0 on the polygon)."""
+    fr = setup.friction
+    mu1, mu2 = _planned_mu(fr)
+    S_i, _ = polygon_rows(mu1, mu2, fr.sides, fr.min_normal_force)
+    return float((S_i[:-1] @ np.asarray(wrench, float)).max())

@@ -33,6 +33,8 @@ class GraspSetup:
         torque_offset: torque added to the solution before it is commanded, e.g.
             the fingers' own gravity torques g(q), shape (m,) [N m], or None.
             The torque limits then bound the sum: -limit <= tau + offset <= limit.
+        objective: ``sum-of-squares`` (the paper's tau^T W tau) or ``min-max``
+            (max_i w_i |tau_i + offset_i| / limit_i, docs/planner.md).
     """
 
     hand: Hand
@@ -43,6 +45,7 @@ class GraspSetup:
     external_wrench: np.ndarray
     weights: np.ndarray
     torque_offset: np.ndarray | None = None
+    objective: str = "sum-of-squares"
 
     @property
     def tau_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -75,7 +78,7 @@ class GraspSetup:
         setup = cls(hand=hand, q=hand.configuration(scenario.joint_positions),
                     contacts=scenario.contacts, object_origin=scenario.object_origin,
                     friction=scenario.friction, external_wrench=scenario.external_wrench,
-                    weights=weights)
+                    weights=weights, objective=scenario.objective)
         setup.maps()  # names unknown frames and bad normals now, not at solve time
         return setup
 

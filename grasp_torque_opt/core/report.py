@@ -22,9 +22,13 @@ def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
     ``iterations``, ``timings_s``, ``bounds`` (``tau-qp-adaptive``: ``lower``,
     ``upper`` [N m] on the exact-cone optimum of sqrt(tau^T W tau), ``gap``,
     ``tolerance``, ``converged``, ``rounds``, ``qp_solves``, ``source``; null for
-    the other methods). ``tau``, ``torque_norm`` and every ``wrench`` are null
-    unless the status is ``optimal``.
+    the other methods); ``objective``, ``friction_margin``, ``max_torque_ratio``,
+    ``friction_usage_max``, per contact ``friction_usage`` (on the unreduced
+    cone) and ``infeasibility`` (docs/planner.md). ``tau``, ``torque_norm``,
+    every ``wrench``, the usages and the ratio are null unless the status is
+    ``optimal``.
     """
+    usage = solution.friction_usage
     contacts = []
     for i, frame in enumerate(maps.contacts):
         contacts.append({
@@ -33,6 +37,7 @@ def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
             "normal": _floats(frame.normal),
             "tangent": _floats(frame.tangent),
             "wrench": None if solution.wrenches is None else _floats(solution.wrenches[i]),
+            "friction_usage": None if usage is None else float(usage[i]),
         })
     return {
         "status": solution.status,
@@ -47,4 +52,9 @@ def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
         "iterations": solution.iterations,
         "timings_s": dict(solution.timings),
         "bounds": None if solution.bounds is None else solution.bounds.as_dict(),
+        "objective": solution.objective,
+        "friction_margin": solution.friction_margin,
+        "max_torque_ratio": solution.max_torque_ratio,
+        "friction_usage_max": None if usage is None else float(max(usage)),
+        "infeasibility": solution.infeasibility,
     }

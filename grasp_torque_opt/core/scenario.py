@@ -47,13 +47,20 @@ class Friction:
         mu2: torsional friction coefficient [m].
         sides: number of sides N of the inscribed polygon (N >= 3).
         min_normal_force: lower bound on every normal force [N].
+        margin: friction margin k >= 0 [-]: plan inside the cone of mu1/(1+k),
+            mu2/(1+k) (:func:`grasp_torque_opt.core.margin.planned_friction`).
     """
 
     mu1: float
     mu2: float
     sides: int
     min_normal_force: float = 0.0
+    margin: float = 0.0
 
+
+#: Objectives of the tau-QP (docs/planner.md): the paper's sum of squared torques, and
+#: the min-max of |tau_i| / limit_i (an LP, then the sum of squares among its optima).
+OBJECTIVES = ("sum-of-squares", "min-max")
 
 #: Object shapes and the entries of their ``size`` [m].
 SHAPES = {"sphere": ("radius",), "box": ("x", "y", "z"), "cylinder": ("radius", "length")}
@@ -118,6 +125,7 @@ class Scenario:
     object: ObjectSpec | None = None
     gravity: np.ndarray | None = None
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    objective: str = "sum-of-squares"
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
@@ -133,9 +141,10 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 _SECTIONS = {
     "hand": {"urdf", "joints", "torque_limits"},
     "grasp": {"joint_positions", "object_origin", "contacts"},
-    "friction": {"mu_tangential", "mu_torsional", "polygon_sides", "min_normal_force"},
+    "friction": {"mu_tangential", "mu_torsional", "polygon_sides", "min_normal_force",
+                 "margin"},
     "load": {"external_wrench"},
-    "objective": {"weights"},
+    "objective": {"weights", "type"},
 }
 _CONTACT_KEYS = {"link", "position", "normal", "tangent"}
 _OBJECT_KEYS = {"shape", "size", "mass", "position", "rpy"}
@@ -200,6 +209,14 @@ def _positive(value: Any, name: str) -> float:
     if x <= 0.0:
         raise InputError(name, f"must be > 0, got {value!r}")
     return x
+
+
+def _margin(value: Any, name: str = "friction.margin") -> float:
+    """A friction margin k: finite and >= 0 [-]."""
+    k = _number(value, name)
+    if k < 0.0:
+        raise InputError(name, f"must be >= 0, got {value!r}")
+    return k
 
 
 def _names(value: Any, name: str) -> list[str]:
@@ -309,6 +326,7 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
         mu2=_positive(_require(friction, "mu_torsional", "friction"), "friction.mu_torsional"),
         sides=sides,
         min_normal_force=fmin,
+        margin=_margin(friction.get("margin", 0.0)),
     )
 
     if weighed and load.get("external_wrench") is None:
@@ -327,10 +345,15 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
                              f"must have {len(joints)} entries (one per joint), "
                              f"got {len(weights)}")
 
+    kind = objective.get("type", OBJECTIVES[0])
+    if kind not in OBJECTIVES:
+        raise InputError("objective.type", f"must be one of {', '.join(OBJECTIVES)}, "
+                         f"got {kind!r}")
+
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
                     joint_positions=positions, object_origin=origin, contacts=contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,
-                    object=obj, gravity=gravity, extra_wrench=extra)
+                    object=obj, gravity=gravity, extra_wrench=extra, objective=kind)
 
 
 def load_scenario(path: str | Path) -> Scenario:

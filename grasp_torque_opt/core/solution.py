@@ -38,6 +38,13 @@ class Solution:
             when the first backend failed), else the method.
         bounds: for ``tau-qp-adaptive``, the certified bounds on the exact-cone
             optimum and the gap (None for the other methods).
+        objective: ``sum-of-squares`` or ``min-max`` (docs/planner.md).
+        friction_margin: the margin k planned with [-] (cone of mu/(1+k)).
+        friction_usage: per contact (||f_t||/mu1 + |m_z|/mu2)/f_z on the unreduced
+            cone, shape (p,) [-]; None unless optimal.
+        max_torque_ratio: max_i |tau_i + offset_i| / limit_i [-]; None unless optimal.
+        infeasibility: why infeasible (:mod:`grasp_torque_opt.methods.explain`,
+            plain data) when it was asked for, else None.
     """
 
     status: str
@@ -52,6 +59,11 @@ class Solution:
     timings: dict[str, float] = field(default_factory=dict)
     backend: str = ""
     bounds: Bounds | None = None
+    objective: str = "sum-of-squares"
+    friction_margin: float = 0.0
+    friction_usage: np.ndarray | None = None
+    max_torque_ratio: float | None = None
+    infeasibility: dict | None = None
 
     @property
     def optimal(self) -> bool:

@@ -18,9 +18,10 @@ from grasp_torque_opt.backends import available, make_solver
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.core.bounds import make_bounds
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE, Certificate, certify
-from grasp_torque_opt.core.exceptions import SolverError
+from grasp_torque_opt.core.exceptions import InputError, SolverError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.margin import cone_usage, planned_friction, torque_ratio
 from grasp_torque_opt.core.solution import (
     FAILED,
     INFEASIBLE,
@@ -30,6 +31,7 @@ from grasp_torque_opt.core.solution import (
 )
 from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
+from grasp_torque_opt.methods.minmax import minmax_stage
 from grasp_torque_opt.reference.feasibility import linearized_feasible
 
 #: Methods: the product's (``tau-qp``; ``tau-qp-adaptive``, its refinement to the
@@ -55,6 +57,18 @@ def qp_answer(qp: TauQP, raw: RawResult
     return raw, qp.split(raw.x)[0], qp.wrenches(raw.x)
 
 
+def planner_metrics(out: Solution, setup: GraspSetup) -> Solution:
+    """Fill the planner's numbers of a solution (docs/planner.md): the objective and the
+    margin planned with, and for an optimum the friction usage on the *unreduced* cone and
+    max |tau + offset| / limit."""
+    out.objective, out.friction_margin = setup.objective, setup.friction.margin
+    if out.optimal:
+        out.friction_usage = cone_usage(out.wrenches, setup.friction.mu1, setup.friction.mu2)
+        out.max_torque_ratio = torque_ratio(out.tau, setup.hand.torque_limits,
+                                            setup.torque_offset)
+    return out
+
+
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
           solver: TauQPSolver | None = None, backend: str = "proxsuite",
           fallback: TauQPSolver | None = None,
@@ -77,13 +91,25 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         refiner: tau-qp-adaptive's rounds (its settings: gap tolerance, rounds),
             reusable across calls; default :class:`Refiner` ().
 
+    The setup's friction margin k plans and certifies inside the cone of
+    mu/(1+k) (:func:`~grasp_torque_opt.core.margin.planned_friction`); its
+    ``objective`` ``min-max`` first solves the min-max LP
+    (:mod:`grasp_torque_opt.methods.minmax`, tau-qp only).
+
     Returns:
         A solution whose status is ``optimal`` only if certified.
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if setup.objective == "min-max" and method != "tau-qp":
+        raise InputError("objective.type", f"min-max is solved by the tau-qp method only, "
+                         f"not {method}")
     if method == "tau-qp-adaptive":
-        return _solve_adaptive(setup, maps, solver, backend, fallback, tolerance, refiner)
+        # The adaptive refinement plans in the margin's reduced cone; the usage and the
+        # ratio are then measured as for tau-qp.
+        planned = dataclasses.replace(setup, friction=planned_friction(setup.friction))
+        return planner_metrics(_solve_adaptive(planned, maps, solver, backend, fallback,
+                                               tolerance, refiner), setup)
     timings = {}
     t0 = time.perf_counter()
     if maps is None:
@@ -91,20 +117,33 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     t1 = time.perf_counter()
     timings["maps"] = t1 - t0
     tau_min, tau_max = setup.tau_bounds
-    args = (maps, setup.friction, setup.external_wrench, tau_min, tau_max, setup.weights)
+    friction = planned_friction(setup.friction)  # the margin's reduced cone, or itself
+    args = (maps, friction, setup.external_wrench, tau_min, tau_max, setup.weights)
     J = maps.J
     used = method
     if method == "tau-qp":
         qp = build_tau_qp(*args)
+        stage = None
+        if setup.objective == "min-max":
+            # The LP's t*, then the sum of squares within |tau + offset| <= t* limit / w.
+            stage = minmax_stage(qp, setup.hand.torque_limits, setup.weights,
+                                 setup.torque_offset)
+            qp = stage.qp
         t2 = time.perf_counter()
         solver = solver or make_solver(backend)
         used = getattr(solver, "name", backend)
-        try:
-            raw = solver.solve(qp)
-        except SolverError as e:
-            if fallback is None:
-                raise
-            raw = RawResult("error", None, 0, 0.0, str(e))
+        if stage is not None and stage.status not in ("optimal", "infeasible"):
+            raw = RawResult("error", None, 0, 0.0, stage.message)  # no min-max optimum: none
+            fallback = None
+        else:
+            try:
+                raw = solver.solve(qp)
+            except SolverError as e:
+                if fallback is None:
+                    raise
+                raw = RawResult("error", None, 0, 0.0, str(e))
+            if stage is not None:
+                raw = dataclasses.replace(raw, message=f"{stage.message}; {raw.message}")
         raw, tau, f = qp_answer(qp, raw)
     else:
         t2 = time.perf_counter()
@@ -127,7 +166,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
 
     def certified(tau, f) -> Certificate | None:
         return None if f is None else certify(maps.G, J, setup.external_wrench,
-                                               setup.friction, tau_min, tau_max, tau, f,
+                                               friction, tau_min, tau_max, tau, f,
                                                tolerance)
 
     cert = certified(tau, f)
@@ -152,15 +191,16 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
 
     out = Solution(status=FAILED, method=method, joints=list(setup.hand.joints),
                    iterations=raw.iterations, solve_time_s=raw.solve_time_s,
-                   certificate=cert, timings=timings, backend=used)
+                   certificate=cert, timings=timings, backend=used,
+                   objective=setup.objective, friction_margin=setup.friction.margin)
     if raw.status == "solved" and cert is not None and cert.ok:
         out.status, out.tau, out.wrenches = OPTIMAL, tau, f.reshape(-1, 4)
         out.message = f"certified (solver: {raw.message})"
-        return out
+        return planner_metrics(out, setup)
     why = (f"solver: {raw.message}" if cert is None or cert.ok or raw.status != "solved"
            else f"solver: {raw.message}, certificate failed (worst residual {cert.worst:.3g})")
     if method in LINEARIZED:
-        feasible = linearized_feasible(maps, setup.friction, setup.external_wrench,
+        feasible = linearized_feasible(maps, friction, setup.external_wrench,
                                        tau_min, tau_max)
         if feasible is False:
             out.status, out.message = INFEASIBLE, f"infeasible, confirmed by LP ({why})"

@@ -1,0 +1,148 @@
+"""Small dense LPs for the planner's metrics: DAQP, KKT-checked, with SciPy HiGHS behind it.
+
+The capacity and min-max LPs (docs/planner.md) have a few dozen variables and
+about a hundred rows. DAQP solves them in tens of microseconds (SciPy's HiGHS:
+about 3 ms through ``linprog``); an LP has a zero Hessian, which DAQP handles
+by proximal-point iterations. No answer is trusted alone: DAQP's is checked
+against the KKT conditions with its own multipliers
+(:func:`grasp_torque_opt.backends.daqp.kkt_violation`, which with H = 0 proves
+an LP optimum), and when that fails, or DAQP says infeasible or unbounded, HiGHS
+solves the same LP and its verdict is taken. The callers certify the primal
+answer against the exact problem as well.
+
+Form (DAQP's): minimize c^T x subject to lower <= x <= upper (the first n
+entries of ``lower``/``upper``) and lower <= A x <= upper (the rest); a row
+with lower == upper is an equality. Infinite bounds are allowed.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linprog
+
+from grasp_torque_opt.backends.daqp import DAQP_INF, KKT_TOLERANCE, kkt_violation
+
+#: DAQP's primal tolerance on these LPs (the backends' default eps_abs).
+PRIMAL_TOL = 1e-9
+#: Iteration cap of either solver: the LPs here need about a hundred.
+MAX_ITER = 2000
+#: DAQP's proximal weight for an LP (measured: 1e-4 to 1 all converge on the Allegro).
+EPS_PROX = 1e-2
+
+
+@dataclass(frozen=True)
+class LPResult:
+    """An LP's answer.
+
+    Attributes:
+        status: ``optimal``, ``infeasible``, ``unbounded`` or ``failed``.
+        x: the primal solution, shape (n,), or None.
+        lam: multipliers, shape (n + rows,): bounds on x first, then rows of A;
+            > 0 where an upper bound binds, < 0 at a lower one (DAQP's sign; for
+            HiGHS's answer the same convention), or None.
+        solver: ``daqp`` or ``highs``.
+        message: what happened, in words.
+        solve_time_s: wall time of the solver calls [s].
+    """
+
+    status: str
+    x: np.ndarray | None
+    lam: np.ndarray | None
+    solver: str
+    message: str
+    solve_time_s: float
+
+
+def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+             highs_only: bool = False) -> LPResult:
+    """Minimize c^T x subject to the bounds and rows of the module docstring.
+
+    Args:
+        c: cost, shape (n,).
+        A: rows, shape (r, n).
+        lower: lower bounds, shape (n + r,) (-inf allowed).
+        upper: upper bounds, shape (n + r,) (inf allowed); lower == upper: equality.
+        highs_only: skip DAQP (the fallback alone; tests and odd problems).
+    """
+    t0 = time.perf_counter()
+    why = ""
+    if not highs_only:
+        out = _daqp(c, A, lower, upper)
+        if out is not None and out[0] == "optimal":
+            return LPResult("optimal", out[1], out[2], "daqp", out[3],
+                            time.perf_counter() - t0)
+        why = out[3] if out is not None else "DAQP raised"
+    res = _highs(c, A, lower, upper)
+    msg = res.message if not why else f"{res.message} (after DAQP: {why})"
+    return LPResult(res.status, res.x, res.lam, "highs", msg, time.perf_counter() - t0)
+
+
+def _daqp(c, A, lower, upper):
+    try:
+        import daqp  # a selectable backend: a ROS distribution may not have it
+    except ImportError:
+        return ("failed", None, None, "DAQP is not installed")
+
+    n, r = c.size, A.shape[0]
+    sense = np.zeros(n + r, dtype=np.int32)
+    sense[n:][lower[n:] == upper[n:]] = 5
+    bu = np.minimum(upper, DAQP_INF)
+    bl = np.maximum(lower, -DAQP_INF)
+    H = np.zeros((n, n))
+    try:
+        x, _, flag, info = daqp.solve(H, np.ascontiguousarray(c, dtype=float),
+                                      np.ascontiguousarray(A, dtype=float), bu, bl, sense,
+                                      primal_tol=PRIMAL_TOL, iter_limit=MAX_ITER,
+                                      eps_prox=EPS_PROX)
+    except (RuntimeError, ValueError) as e:
+        return ("failed", None, None, f"DAQP raised: {e}")
+    if flag not in (1, 2) or x is None or not np.isfinite(x).all():
+        return ("failed", None, None, f"DAQP exit flag {flag}")
+    lam = np.asarray(info["lam"], dtype=float)
+    violation = kkt_violation(H, c, A, bl, bu, x, lam)
+    if not violation <= KKT_TOLERANCE:
+        return ("failed", None, None, f"DAQP answer off the KKT conditions by {violation:.2g}")
+    return ("optimal", np.asarray(x, dtype=float), lam,
+            f"DAQP optimal, KKT-checked ({info['iterations']} iterations)")
+
+
+@dataclass(frozen=True)
+class _Highs:
+    status: str
+    x: np.ndarray | None
+    lam: np.ndarray | None
+    message: str
+
+
+def _highs(c, A, lower, upper) -> _Highs:
+    n, r = c.size, A.shape[0]
+    lo_r, up_r = lower[n:], upper[n:]
+    eq = lo_r == up_r
+    has_up = ~eq & np.isfinite(up_r)
+    has_lo = ~eq & np.isfinite(lo_r)
+    A_ub = np.vstack((A[has_up], -A[has_lo]))
+    b_ub = np.concatenate((up_r[has_up], -lo_r[has_lo]))
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(up) else up)
+              for lo, up in zip(lower[:n], upper[:n])]
+    res = linprog(c, A_ub=A_ub if A_ub.size else None, b_ub=b_ub if b_ub.size else None,
+                  A_eq=A[eq] if eq.any() else None, b_eq=up_r[eq] if eq.any() else None,
+                  bounds=bounds, method="highs", options={"maxiter": MAX_ITER})
+    status = {0: "optimal", 2: "infeasible", 3: "unbounded"}.get(res.status, "failed")
+    if status != "optimal":
+        return _Highs(status, None, None, f"HiGHS: {res.message}")
+    # HiGHS's marginals are d(objective)/d(bound), <= 0 on a binding upper bound of a
+    # minimization: DAQP's lam is their negative.
+    lam = np.zeros(n + r)
+    lam[:n] = -(res.upper.marginals + res.lower.marginals)
+    row = np.zeros(r)
+    k_up = int(has_up.sum())
+    marg = res.ineqlin.marginals if A_ub.size else np.zeros(0)
+    row[has_up] -= marg[:k_up]
+    row[has_lo] += marg[k_up:]
+    if eq.any():
+        row[eq] = -res.eqlin.marginals
+    lam[n:] = row
+    return _Highs("optimal", np.asarray(res.x, dtype=float), lam, "HiGHS optimal")

@@ -1,0 +1,84 @@
+"""Min-max torque objective: certified, and no certified torque has a smaller max ratio."""
+
+import copy
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import CONFIG, setup_from_doc
+from independent import assert_holds, lp_minmax
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.scenario import parse_scenario
+from grasp_torque_opt.methods.dispatch import solve
+
+LOADS = [[1.4715, 0, 0, 0, 0, 0], [-1.4715, 0, 0, 0, 0, 0], [0, 1.4715, 0, 0, 0, 0],
+         [0, 0, 1.4715, 0, 0.01, 0], [3.0, 0.5, -1.0, 0, 0, 0.005]]
+
+
+def ratio(setup, tau, weights=None):
+    w = np.ones(setup.hand.m) if weights is None else weights
+    off = 0.0 if setup.torque_offset is None else setup.torque_offset
+    return float((w * np.abs(tau + off) / setup.hand.torque_limits).max())
+
+
+@pytest.mark.parametrize("load", LOADS)
+def test_minmax_is_certified_and_optimal_against_a_force_space_lp(allegro, load):
+    setup = dataclasses.replace(allegro, external_wrench=np.array(load, float),
+                                objective="min-max")
+    maps = setup.maps()
+    sol = solve(setup, maps=maps)
+    assert sol.optimal and sol.objective == "min-max", sol.message
+    assert_holds(setup, maps, sol.tau, sol.wrenches)
+    best = lp_minmax(setup, maps)
+    assert ratio(setup, sol.tau) <= best * (1 + 1e-6) + 1e-9
+    assert ratio(setup, sol.tau) >= best * (1 - 1e-6) - 1e-9  # else the LP above is wrong
+    assert sol.max_torque_ratio == pytest.approx(ratio(setup, sol.tau), rel=1e-12)
+    # Among min-max optima it is the least effort, so never below the sum-of-squares optimum.
+    sos = solve(dataclasses.replace(setup, objective="sum-of-squares"), maps=maps)
+    assert sol.torque_norm >= sos.torque_norm - 1e-9
+    assert ratio(setup, sos.tau) >= best * (1 - 1e-6) - 1e-9
+
+
+def test_minmax_with_weights_and_a_torque_offset(allegro):
+    rng = np.random.default_rng(3)
+    weights = rng.uniform(0.5, 2.0, allegro.hand.m)
+    offset = rng.uniform(-0.05, 0.05, allegro.hand.m)
+    setup = dataclasses.replace(allegro, weights=weights, torque_offset=offset,
+                                objective="min-max",
+                                external_wrench=np.array([-1.4715, 0, 0, 0, 0, 0]))
+    maps = setup.maps()
+    sol = solve(setup, maps=maps)
+    assert sol.optimal
+    assert_holds(setup, maps, sol.tau, sol.wrenches)
+    best = lp_minmax(setup, maps, weights)
+    assert ratio(setup, sol.tau, weights) == pytest.approx(best, rel=1e-6, abs=1e-9)
+
+
+def test_minmax_on_the_planar_hand(planar):
+    setup = dataclasses.replace(planar, objective="min-max")
+    maps = setup.maps()
+    sol = solve(setup, maps=maps)
+    assert sol.optimal
+    assert ratio(setup, sol.tau) == pytest.approx(lp_minmax(setup, maps), rel=1e-6, abs=1e-9)
+
+
+def test_an_infeasible_load_is_infeasible_for_minmax_too(allegro):
+    setup = dataclasses.replace(allegro, objective="min-max",
+                                external_wrench=10 * allegro.external_wrench)
+    assert solve(setup).status == "infeasible"
+
+
+def test_the_objective_key_of_the_scenario(allegro_doc):
+    doc = copy.deepcopy(allegro_doc)
+    doc["objective"] = {"type": "min-max"}
+    assert setup_from_doc(doc).objective == "min-max"
+    doc["objective"] = {"type": "minimax"}
+    with pytest.raises(InputError, match="objective.type: must be one of sum-of-squares, "
+                                         "min-max"):
+        parse_scenario(doc, CONFIG)
+
+
+def test_minmax_with_a_reference_method_is_refused(allegro):
+    with pytest.raises(InputError, match="objective.type: min-max is solved by the tau-qp"):
+        solve(dataclasses.replace(allegro, objective="min-max"), "socp")
