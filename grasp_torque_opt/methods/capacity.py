@@ -1,0 +1,236 @@
+"""Load capacity: how many times over a grasp holds its load, and how much along each axis.
+
+The capacity of a grasp for a load w_ext is the largest factor alpha such that
+alpha w_ext is holdable within the torque limits and the (margined) linearized
+cones, an LP over the contact wrenches f and alpha (docs/planner.md):
+
+    maximize    alpha
+    subject to  G f + alpha w_ext = 0
+                S f <= b                        polygon cones of the planned friction, f_z >= f_min
+                tau_min <= J^T f <= tau_max     torque limits (after any offset g(q))
+                0 <= alpha <= ALPHA_MAX
+
+Solved by :func:`grasp_torque_opt.methods.lp.solve_lp` (DAQP, KKT-checked, HiGHS
+behind it) and certified like every other result: the f it returns is checked
+against the exact problem at the load alpha w_ext (:func:`certify`), so the grasp
+provably holds alpha times the load. alpha < 1: the load itself cannot be held,
+and alpha is the largest holdable fraction of it (:mod:`.explain` says what binds).
+
+The 12 axis capacities are the same LP for the unit loads +-e_i, about the object
+origin in base axes: +Fx is the largest force [N] along +x that the environment
+may apply on the object (a weight with gravity along +x), +Mx the largest moment
+[N m] about +x; the scenario's own load is replaced, not added.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE, Certificate, certify
+from grasp_torque_opt.core.friction import friction_matrix
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.margin import planned_friction
+from grasp_torque_opt.methods.lp import LPResult, solve_lp
+
+#: Cap on alpha, so that the LP stays bounded; reaching it reports ``unbounded``.
+ALPHA_MAX = 1e6
+#: The 12 axis directions: name -> (wrench index, sign); F in N, M in N m.
+DIRECTIONS = {f"{s}{a}": (i, 1.0 if s == "+" else -1.0)
+              for i, a in enumerate(("Fx", "Fy", "Fz", "Mx", "My", "Mz")) for s in "+-"}
+#: A multiplier counts as binding above this share of the largest one.
+BINDING_RTOL = 1e-6
+
+
+@dataclass(frozen=True)
+class Binding:
+    """What limits a capacity: the constraints with a nonzero multiplier at the LP optimum.
+
+    Every one of them is active at every optimal point (complementary slackness).
+
+    Attributes:
+        joints: (joint name, ``upper`` or ``lower`` limit), largest multiplier first.
+        contacts: (link, ``friction cone`` or ``min normal force``), largest first.
+    """
+
+    joints: list[tuple[str, str]] = field(default_factory=list)
+    contacts: list[tuple[str, str]] = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        """Plain data (JSON)."""
+        return {"joints": [{"joint": j, "limit": s} for j, s in self.joints],
+                "contacts": [{"link": c, "constraint": s} for c, s in self.contacts]}
+
+    def text(self) -> str:
+        """One sentence: joints at their limit and contacts on their cone, by name."""
+        parts = []
+        if self.joints:
+            parts.append("joints at their torque limit: " + ", ".join(
+                f"{j} ({s})" for j, s in self.joints))
+        cones = [c for c, s in self.contacts if s == "friction cone"]
+        normals = [c for c, s in self.contacts if s != "friction cone"]
+        if cones:
+            parts.append("contacts on their friction cone: " + ", ".join(cones))
+        if normals:
+            parts.append("contacts at the minimum normal force: " + ", ".join(normals))
+        return "; ".join(parts) if parts else "nothing identified"
+
+
+@dataclass(frozen=True)
+class Capacity:
+    """One capacity.
+
+    Attributes:
+        status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds: the
+            minimum normal force cannot be produced within the limits), ``unbounded``
+            (alpha reached :data:`ALPHA_MAX`) or ``failed``.
+        value: alpha: a factor on the load [-], or for an axis direction the largest
+            load along it [N or N m]; None unless ``optimal``.
+        unit: ``-``, ``N`` or ``N m``.
+        tau: joint torques holding value times the load [N m], or None.
+        wrenches: the contact wrenches then, shape (p, 4) [N, N m], or None.
+        certificate: of (tau, f) at the load value * w_ext, or None.
+        binding: what limits it, or None.
+        solver: the LP solver that answered.
+        message: what happened.
+    """
+
+    status: str
+    value: float | None
+    unit: str
+    tau: np.ndarray | None = None
+    wrenches: np.ndarray | None = None
+    certificate: Certificate | None = None
+    binding: Binding | None = None
+    solver: str = ""
+    message: str = ""
+
+    def as_dict(self) -> dict:
+        """Plain data (JSON): ``status``, ``value``, ``unit``, ``binding``, ``certified``."""
+        return {"status": self.status, "value": self.value, "unit": self.unit,
+                "certified": self.certificate is not None and self.certificate.ok,
+                "binding": None if self.binding is None else self.binding.as_dict()}
+
+
+class CapacityLP:
+    """The capacity LP of one grasp, built once and solved for any load direction.
+
+    Variables x = [f (4p); alpha]; rows: G f + alpha d = 0 (6), J^T f in the torque
+    bounds (m), S f <= b (the planned polygons and f_min).
+    """
+
+    def __init__(self, setup: GraspSetup, maps: GraspMaps,
+                 tolerance: float = DEFAULT_TOLERANCE) -> None:
+        self.setup, self.maps, self.tolerance = setup, maps, tolerance
+        self.friction = fr = planned_friction(setup.friction)
+        G, J = maps.G, maps.J
+        self.S, b_S = friction_matrix(maps.p, fr.mu1, fr.mu2, fr.sides, fr.min_normal_force)
+        self.tau_min, self.tau_max = setup.tau_bounds
+        nf, m = G.shape[1], J.shape[1]
+        self.nf, self.m = nf, m
+        n = nf + 1
+        self.A = np.zeros((6 + m + self.S.shape[0], n))
+        self.A[:6, :nf] = G
+        self.A[6:6 + m, :nf] = J.T
+        self.A[6 + m:, :nf] = self.S
+        inf = np.inf
+        self.lower = np.concatenate((np.full(nf, -inf), [0.0], np.zeros(6), self.tau_min,
+                                     np.full(self.S.shape[0], -inf)))
+        self.upper = np.concatenate((np.full(nf, inf), [ALPHA_MAX], np.zeros(6), self.tau_max,
+                                     b_S))
+        self.c = np.zeros(n)
+        self.c[-1] = -1.0
+
+    def solve(self, load: np.ndarray, unit: str = "-", highs_only: bool = False) -> Capacity:
+        """The largest alpha with alpha * load holdable, certified.
+
+        Args:
+            load: the load direction w_ext, shape (6,) [N, N m] (about the object
+                origin, base axes).
+            unit: unit of alpha, for the record.
+            highs_only: solve with HiGHS alone.
+        """
+        load = np.asarray(load, dtype=float)
+        self.A[:6, -1] = load
+        res = solve_lp(self.c, self.A, self.lower, self.upper, highs_only=highs_only)
+        out = self._capacity(res, load, unit)
+        if out.status == "failed" and res.solver == "daqp" and not highs_only:
+            out = self._capacity(solve_lp(self.c, self.A, self.lower, self.upper,
+                                          highs_only=True), load, unit)
+        return out
+
+    def _capacity(self, res: LPResult, load: np.ndarray, unit: str) -> Capacity:
+        if res.status == "infeasible":
+            return Capacity("infeasible", None, unit, solver=res.solver, message=(
+                "not even zero load can be held: the minimum normal force cannot be "
+                f"produced within the torque limits ({res.message})"))
+        if res.status != "optimal":
+            return Capacity("failed", None, unit, solver=res.solver, message=res.message)
+        f, alpha = res.x[:self.nf], float(res.x[-1])
+        if alpha >= (1.0 - 1e-9) * ALPHA_MAX:
+            return Capacity("unbounded", None, unit, solver=res.solver, message=(
+                f"alpha reached its cap {ALPHA_MAX:g}: the grasp holds this load "
+                "direction without bound"))
+        tau = self.maps.J.T @ f
+        cert = certify(self.maps.G, self.maps.J, alpha * load, self.friction, self.tau_min,
+                       self.tau_max, tau, f, self.tolerance)
+        if not cert.ok:
+            return Capacity("failed", None, unit, certificate=cert, solver=res.solver,
+                            message=f"{res.message}, certificate failed (worst residual "
+                                    f"{cert.worst:.3g})")
+        return Capacity("optimal", alpha, unit, tau=tau, wrenches=f.reshape(-1, 4),
+                        certificate=cert, binding=self._binding(res, f), solver=res.solver,
+                        message=f"certified ({res.message})")
+
+    def _binding(self, res: LPResult, f: np.ndarray) -> Binding:
+        n = self.nf + 1
+        lam = res.lam[n + 6:]  # the torque rows, then the friction rows
+        scale = float(np.abs(lam).max()) if lam.size else 0.0
+        if scale == 0.0:
+            return Binding()
+        thresh = BINDING_RTOL * scale
+        m = self.m
+        lam_tau, lam_S = lam[:m], lam[m:]
+        joints = [(self.setup.hand.joints[j], "upper" if lam_tau[j] > 0 else "lower")
+                  for j in np.argsort(-np.abs(lam_tau)) if abs(lam_tau[j]) > thresh]
+        rows = self.S.shape[0] // self.maps.p
+        per_contact: dict[tuple[int, str], float] = {}
+        for r in np.flatnonzero(np.abs(lam_S) > thresh):
+            i, kind = divmod(int(r), rows)
+            key = (i, "min normal force" if kind == rows - 1 else "friction cone")
+            per_contact[key] = per_contact.get(key, 0.0) + abs(float(lam_S[r]))
+        contacts = [(self.maps.links[i], kind) for (i, kind), _ in
+                    sorted(per_contact.items(), key=lambda kv: -kv[1])]
+        return Binding(joints, contacts)
+
+
+def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
+                  load: np.ndarray | None = None, highs_only: bool = False) -> Capacity:
+    """How many times over the grasp holds its load (alpha [-], certified).
+
+    Args:
+        setup: the grasp (its friction margin and torque offset apply).
+        maps: G and J if already computed.
+        load: w_ext instead of the setup's load [N, N m].
+        highs_only: HiGHS alone, no DAQP.
+    """
+    lp = CapacityLP(setup, maps if maps is not None else setup.maps())
+    return lp.solve(setup.external_wrench if load is None else load, "-", highs_only)
+
+
+def direction_capacities(setup: GraspSetup, maps: GraspMaps | None = None,
+                         lp: CapacityLP | None = None) -> dict[str, Capacity]:
+    """The largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
+
+    Returns:
+        Direction name -> capacity; forces in N, moments in N m.
+    """
+    lp = lp or CapacityLP(setup, maps if maps is not None else setup.maps())
+    out = {}
+    for name, (i, sign) in DIRECTIONS.items():
+        d = np.zeros(6)
+        d[i] = sign
+        out[name] = lp.solve(d, "N" if i < 3 else "N m")
+    return out

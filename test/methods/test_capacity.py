@@ -1,0 +1,90 @@
+"""Load capacity: feasible at alpha, infeasible just above, by independent solvers."""
+
+import copy
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import setup_from_doc
+from independent import assert_holds, lp_capacity, lp_feasible
+
+from grasp_torque_opt.methods.capacity import DIRECTIONS, direction_capacities, load_capacity
+from grasp_torque_opt.methods.dispatch import solve
+
+
+def holds(setup, maps, load) -> bool:
+    """The tau-QP certifies torques for this load."""
+    return solve(dataclasses.replace(setup, external_wrench=np.asarray(load, float)),
+                 maps=maps, backend="daqp").optimal
+
+
+def reduced(setup):
+    """The setup with the cone of mu/(1+k) and no margin, written here."""
+    fr, k = setup.friction, setup.friction.margin
+    return dataclasses.replace(setup, friction=dataclasses.replace(
+        fr, mu1=fr.mu1 / (1 + k), mu2=fr.mu2 / (1 + k), margin=0.0))
+
+
+def above_is_infeasible(setup, maps, load) -> bool:
+    """HiGHS (test/independent.py) finds no wrench for this load in the planned cones."""
+    return not lp_feasible(dataclasses.replace(reduced(setup),
+                                               external_wrench=np.asarray(load, float)), maps)
+
+
+@pytest.mark.parametrize("margin", [0.0, 0.3])
+def test_allegro_capacity_holds_at_alpha_and_not_just_above(allegro_doc, margin):
+    doc = copy.deepcopy(allegro_doc)
+    doc["friction"]["margin"] = margin
+    setup = setup_from_doc(doc)
+    maps = setup.maps()
+    cap = load_capacity(setup, maps)
+    assert cap.status == "optimal" and cap.certificate.ok and cap.value > 1
+    w = setup.external_wrench
+    assert holds(setup, maps, (1 - 1e-6) * cap.value * w)
+    assert above_is_infeasible(setup, maps, (1 + 1e-4) * cap.value * w)
+    # The LP's own holding wrenches, checked independently at alpha w_ext.
+    assert_holds(dataclasses.replace(reduced(setup), external_wrench=cap.value * w), maps,
+                 cap.tau, cap.wrenches)
+    alpha, _ = lp_capacity(setup, maps, w)
+    assert cap.value == pytest.approx(alpha, rel=1e-6)
+    assert load_capacity(setup, maps, highs_only=True).value == pytest.approx(alpha, rel=1e-6)
+
+
+def test_a_margin_lowers_the_capacity(allegro):
+    maps = allegro.maps()
+    plain = load_capacity(allegro, maps).value
+    fr = dataclasses.replace(allegro.friction, margin=0.5)
+    assert load_capacity(dataclasses.replace(allegro, friction=fr), maps).value < plain
+
+
+def test_axis_capacities_hold_at_their_value_and_not_above(allegro):
+    maps = allegro.maps()
+    caps = direction_capacities(allegro, maps)
+    assert list(caps) == list(DIRECTIONS) and len(caps) == 12
+    for name, cap in caps.items():
+        i, sign = DIRECTIONS[name]
+        d = np.zeros(6)
+        d[i] = sign
+        assert cap.status == "optimal", (name, cap.message)
+        assert cap.unit == ("N" if name[1] == "F" else "N m")
+        assert holds(allegro, maps, (1 - 1e-6) * cap.value * d), name
+        assert above_is_infeasible(allegro, maps, (1 + 1e-4) * cap.value * d), name
+
+
+def test_planar_capacity_with_internal_forces(planar):
+    """The rank-deficient planar hand (null-space internal forces): the same two checks."""
+    maps = planar.maps()
+    cap = load_capacity(planar, maps)
+    assert cap.status == "optimal" and cap.certificate.ok
+    w = planar.external_wrench
+    assert holds(planar, maps, (1 - 1e-6) * cap.value * w)
+    assert above_is_infeasible(planar, maps, (1 + 1e-4) * cap.value * w)
+
+
+def test_no_capacity_when_not_even_zero_load_holds(allegro_doc):
+    doc = copy.deepcopy(allegro_doc)
+    doc["friction"]["min_normal_force"] = 50.0  # no joint can squeeze this hard
+    setup = setup_from_doc(doc)
+    cap = load_capacity(setup)
+    assert cap.status == "infeasible" and cap.value is None
+    assert "minimum normal force" in cap.message
