@@ -52,6 +52,9 @@ setup(
         "bench": ["osqp", "psutil"],
         # grasp_torque_opt.sim and grasp-torque-sim: the hand in MuJoCo (docs/simulation.md).
         "sim": ["mujoco>=3.2"],
+        # grasp-torque-opt score --engine dask: candidate sets that outgrow one machine
+        # (docs/planner.md).
+        "distributed": ["dask", "distributed"],
     },
     zip_safe=True,
     maintainer="grasp_torque_opt developers",

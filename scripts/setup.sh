@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Create .venv/ at the repository root and install grasp_torque_opt into it
 # (editable), with ROS 2 Jazzy from the registry's ros-jazzy-* wheels, Pinocchio,
-# ProxSuite, the test tools, the benchmarks' extra solvers and MuJoCo (the
-# simulated hand). Idempotent: a second run only checks.
+# ProxSuite, the test tools, the benchmarks' extra solvers, MuJoCo (the
+# simulated hand) and Dask distributed (batch scoring on a cluster). Idempotent:
+# a second run only checks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,6 +30,6 @@ fi
 stamp=.venv/.installed
 if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ]; then
     .venv/bin/python -m pip install -q --upgrade pip
-    .venv/bin/python -m pip install -q -e '.[ros,test,bench,sim]'
+    .venv/bin/python -m pip install -q -e '.[ros,test,bench,sim,distributed]'
     touch "$stamp"
 fi

@@ -1,0 +1,431 @@
+"""Batch scoring for grasp planners: many candidate grasps of one hand, in parallel.
+
+A batch is a base scenario (the hand, and every default) and candidates, one
+JSON object per line (JSON Lines, docs/planner.md). Each line is a partial
+scenario, merged into the base one: a mapping merges key by key (so
+``{"grasp": {"joint_positions": {"joint_0.0": 0.1}}}`` moves one joint), anything
+else replaces (a ``contacts`` list replaces the base's list), and ``null``
+removes the key from the base (``"gravity": null`` with a
+``load.external_wrench`` makes that wrench the whole load). ``id`` (any JSON
+value) names the candidate; the line number is always kept. ``hand`` cannot be
+given (one hand per batch). The merged document is validated as a scenario
+file, so a bad line fails with the scenario's own message, prefixed
+``line N:``, e.g. ``line 7: grasp.contacts[0].link: frame 'tip' not found ...``,
+and the batch goes on.
+
+Each candidate is solved (tau-QP, the batch's backend and objective) and, with
+``metrics="full"``, gets its load capacity and the 12 axis capacities
+(:mod:`.capacity`). A record (plain data) per candidate: ``line``, ``id``,
+``status`` (``optimal``, ``infeasible``, ``failed``, or ``error`` for a bad
+line), ``error``, ``torque_norm`` [N m], ``max_torque_ratio`` [-],
+``friction_usage_max`` [-], ``friction_usage`` (per contact), ``capacity``
+[-] and ``capacity_status``, ``capacities`` (direction -> N or N m, null where
+not certified), ``holdable_fraction`` (infeasible candidates: their capacity)
+and ``time_s`` (the candidate's scoring time [s]).
+
+Parallel over processes (``engine="processes"``, the default, multiprocessing
+with ``workers`` processes) or over a Dask distributed cluster
+(``engine="dask"``: a scheduler address, or a local cluster), with the same
+chunk function; each worker binds the base scenario once and reuses one solver.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from grasp_torque_opt.backends import make_solver, single_threaded_math
+from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
+from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
+from grasp_torque_opt.methods.dispatch import solve
+
+#: Metrics: ``basic`` (solve: status, norms, ratio, usage) or ``full`` (plus capacities).
+METRICS = ("basic", "full")
+#: Engines: this process, a multiprocessing pool, or a Dask distributed cluster.
+ENGINES = ("serial", "processes", "dask")
+#: Keys a candidate line may hold: ``id`` and the scenario's sections except ``hand``.
+CANDIDATE_KEYS = ("id", "grasp", "friction", "load", "gravity", "object", "objective")
+#: A longer line is refused unread (bounded memory per candidate) [characters].
+MAX_LINE = 1_000_000
+#: Candidates per task sent to a worker.
+CHUNK = 64
+#: What a rank key sorts by: True for "larger is better".
+RANK_KEYS = {"capacity": True, "torque_norm": False, "max_torque_ratio": False,
+             "friction_usage_max": False}
+
+
+@dataclass(frozen=True)
+class ScoreJob:
+    """What every worker needs: the base scenario's text and the batch's options.
+
+    Attributes:
+        scenario_text: the base scenario file's contents (YAML).
+        base_dir: the folder its relative paths are relative to (must exist on workers).
+        source: the base scenario's name, for messages.
+        metrics: one of :data:`METRICS`.
+        backend: the tau-QP backend (default DAQP, the fastest here).
+        fallback: the backend asked when the first gives nothing certifiable, or None.
+        objective: override of the scenario's ``objective.type``, or None.
+    """
+
+    scenario_text: str
+    base_dir: str
+    source: str = "<scenario>"
+    metrics: str = "full"
+    backend: str = "daqp"
+    fallback: str | None = "proxsuite"
+    objective: str | None = None
+
+    @classmethod
+    def from_file(cls, path: str | Path, **options: Any) -> ScoreJob:
+        """The job of a base scenario file.
+
+        Raises:
+            InputError: the file cannot be read (field ``scenario``).
+        """
+        path = Path(path)
+        try:
+            text = path.read_text()
+        except OSError as e:
+            raise InputError("scenario", f"cannot read {path}: {e.strerror}") from e
+        return cls(scenario_text=text, base_dir=str(path.resolve().parent), source=str(path),
+                   **options)
+
+    @property
+    def key(self) -> str:
+        """A digest that identifies the job (a worker's cache key)."""
+        return hashlib.sha256(repr(self).encode()).hexdigest()
+
+
+def merge(base: Any, override: Any) -> Any:
+    """A candidate merged into the base document: mappings key by key, ``None`` removes.
+
+    Copies only what changes; the base is never modified.
+    """
+    if not (isinstance(base, dict) and isinstance(override, dict)):
+        return override
+    out = dict(base)
+    for key, value in override.items():
+        if value is None:
+            out.pop(key, None)
+        else:
+            out[key] = merge(base.get(key), value)
+    return out
+
+
+class Scorer:
+    """Scores candidates of one job in this process (one bound hand, one solver)."""
+
+    def __init__(self, job: ScoreJob) -> None:
+        if job.metrics not in METRICS:
+            raise ValueError(f"metrics must be one of {', '.join(METRICS)}, got {job.metrics!r}")
+        if job.objective is not None and job.objective not in OBJECTIVES:
+            raise InputError("objective", f"must be one of {', '.join(OBJECTIVES)}, "
+                             f"got {job.objective!r}")
+        self.job = job
+        try:
+            doc = yaml.safe_load(job.scenario_text)
+        except yaml.YAMLError as e:
+            raise InputError("scenario", f"{job.source} is not valid YAML: {e}"
+                             .splitlines()[0]) from e
+        self.base_dir = Path(job.base_dir)
+        self.doc = doc
+        self.base = GraspSetup.from_scenario(parse_scenario(doc, self.base_dir, job.source))
+        self.solver = make_solver(job.backend)
+        self.fallback = (make_solver(job.fallback) if job.fallback not in (None, job.backend)
+                         else None)
+
+    def candidate(self, lineno: int, text: str) -> tuple[Any, GraspSetup]:
+        """The candidate of one line, bound to the base hand.
+
+        Raises:
+            InputError: naming the line and the field.
+        """
+        if len(text) > MAX_LINE:
+            raise InputError(f"line {lineno}", f"longer than {MAX_LINE} characters")
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise InputError(f"line {lineno}", f"not valid JSON: {e}") from e
+        if not isinstance(data, dict):
+            raise InputError(f"line {lineno}", f"must be a JSON object, got "
+                             f"{type(data).__name__}")
+        for key in data:
+            if key not in CANDIDATE_KEYS:
+                raise InputError(f"line {lineno}: {key}", "unknown or fixed field (allowed: "
+                                 f"{', '.join(CANDIDATE_KEYS)}; the hand is the base "
+                                 "scenario's)")
+        ident = data.pop("id", lineno)
+        try:
+            scenario = parse_scenario(merge(self.doc, data), self.base_dir, f"line {lineno}")
+            base = self.base
+            hand = base.hand
+            weights = (np.ones(hand.m) if scenario.weights is None
+                       else np.asarray(scenario.weights, dtype=float))
+            if weights.shape != (hand.m,):
+                raise InputError("objective.weights", f"must have {hand.m} entries (one per "
+                                 f"joint), got {weights.size}")
+            setup = GraspSetup(
+                hand=hand, q=hand.configuration(scenario.joint_positions),
+                contacts=scenario.contacts, object_origin=scenario.object_origin,
+                friction=scenario.friction, external_wrench=scenario.external_wrench,
+                weights=weights, objective=self.job.objective or scenario.objective)
+        except InputError as e:
+            raise InputError(f"line {lineno}: {e.field}", e.problem) from e
+        return ident, setup
+
+    def score_line(self, lineno: int, text: str) -> dict[str, Any]:
+        """The record of one line (a bad line gives status ``error``; never raises)."""
+        t0 = time.perf_counter()
+        record: dict[str, Any] = {"line": lineno, "id": None}
+        try:
+            record["id"], setup = self.candidate(lineno, text)
+            maps = setup.maps()
+        except InputError as e:
+            msg = str(e)
+            if not msg.startswith(f"line {lineno}"):
+                msg = f"line {lineno}: {msg}"
+            return {**record, "status": "error", "error": msg,
+                    "time_s": time.perf_counter() - t0}
+        except GraspTorqueError as e:
+            return {**record, "status": "error", "error": f"line {lineno}: {e}",
+                    "time_s": time.perf_counter() - t0}
+        try:
+            record.update(self.score(setup, maps))
+        except GraspTorqueError as e:
+            record.update(status="failed", error=f"line {lineno}: {e}")
+        record["time_s"] = time.perf_counter() - t0
+        return record
+
+    def score(self, setup: GraspSetup, maps) -> dict[str, Any]:
+        """The metrics of one bound candidate (plain data)."""
+        sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback)
+        usage = sol.friction_usage
+        out: dict[str, Any] = {
+            "status": sol.status, "error": None, "torque_norm": sol.torque_norm,
+            "max_torque_ratio": sol.max_torque_ratio,
+            "friction_usage_max": None if usage is None else float(usage.max()),
+            "friction_usage": None if usage is None else [float(u) for u in usage],
+            "backend": sol.backend, "solve_time_s": sol.solve_time_s,
+        }
+        if self.job.metrics == "full":
+            lp = CapacityLP(setup, maps)
+            cap = lp.solve(setup.external_wrench)
+            out["capacity"] = cap.value
+            out["capacity_status"] = cap.status
+            out["holdable_fraction"] = (cap.value if sol.status == "infeasible" else None)
+            out["capacities"] = {k: c.value for k, c in
+                                 direction_capacities(setup, maps, lp).items()}
+        return out
+
+    def score_lines(self, lines: Iterable[tuple[int, str]]) -> list[dict[str, Any]]:
+        """Records of (line number, text) pairs, in order."""
+        return [self.score_line(n, t) for n, t in lines]
+
+
+_SCORERS: dict[str, Scorer] = {}
+
+
+def score_chunk(job: ScoreJob, chunk: Sequence[tuple[int, str]]) -> list[dict[str, Any]]:
+    """Score a chunk in this process, binding the job's hand on first use (any engine's task)."""
+    scorer = _SCORERS.get(job.key)
+    if scorer is None:
+        single_threaded_math()
+        scorer = _SCORERS[job.key] = Scorer(job)
+    return scorer.score_lines(chunk)
+
+
+def read_candidates(path: str | Path) -> list[tuple[int, str]]:
+    """(line number, text) of every non-blank line of a JSON Lines file (1-based).
+
+    Raises:
+        InputError: the file cannot be read (field ``candidates``).
+    """
+    path = Path(path)
+    try:
+        with path.open(encoding="utf-8", errors="replace") as fh:
+            return [(i, line) for i, line in enumerate(fh, 1) if line.strip()]
+    except OSError as e:
+        raise InputError("candidates", f"cannot read {path}: {e.strerror}") from e
+
+
+def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tuple[int, str]]]:
+    """The lines cut into tasks of ``size``."""
+    return [list(lines[i:i + size]) for i in range(0, len(lines), size)]
+
+
+#: Thread variables set to 1 in spawned workers (two workers with a multi-threaded
+#: BLAS each oversubscribe two cores).
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int | None = None,
+                engine: str = "processes", scheduler: str | None = None,
+                progress: Callable[[int, int], None] | None = None,
+                chunk: int = CHUNK) -> list[dict[str, Any]]:
+    """Score every candidate line, in parallel; records in input order.
+
+    Args:
+        job: the base scenario and options.
+        lines: (line number, text) pairs (:func:`read_candidates`).
+        workers: processes (``processes``; a local Dask cluster's workers); default
+            the machine's cores.
+        engine: one of :data:`ENGINES`.
+        scheduler: a Dask scheduler address (``tcp://host:8786``); None starts a
+            local cluster (``dask`` only).
+        progress: called with (candidates done, total) as chunks finish.
+        chunk: candidates per task.
+
+    Raises:
+        InputError: the base scenario is bad (the batch cannot start).
+        ValueError: an unknown engine.
+    """
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    Scorer(job)  # a bad base scenario fails here, once, in this process
+    workers = max(1, workers or os.cpu_count() or 1)
+    tasks = chunks(lines, chunk)
+    total = len(lines)
+    results: list[list[dict] | None] = [None] * len(tasks)
+    done = 0
+
+    def finished(i: int, records: list[dict]) -> None:
+        nonlocal done
+        results[i] = records
+        done += len(records)
+        if progress is not None:
+            progress(done, total)
+
+    if engine == "serial" or (engine == "processes" and (workers == 1 or len(tasks) <= 1)):
+        for i, t in enumerate(tasks):
+            finished(i, score_chunk(job, t))
+    elif engine == "processes":
+        _pool_map(job, tasks, workers, finished)
+    else:
+        _dask_map(job, tasks, workers, scheduler, finished)
+    return [r for records in results for r in records]
+
+
+def _pool_map(job: ScoreJob, tasks: list, workers: int, finished) -> None:
+    import multiprocessing as mp
+
+    ctx = mp.get_context("spawn")  # fork after Pinocchio and BLAS threads is not safe
+    saved = {k: os.environ.get(k) for k in THREAD_VARS}
+    os.environ.update({k: "1" for k in THREAD_VARS})  # spawned workers read these at import
+    try:
+        pool = ctx.Pool(min(workers, len(tasks)))
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    with pool:
+        pending = [(i, pool.apply_async(score_chunk, (job, t))) for i, t in enumerate(tasks)]
+        for i, res in pending:
+            finished(i, res.get())
+
+
+def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
+              finished) -> None:
+    try:
+        from dask.distributed import Client, LocalCluster, as_completed
+    except ImportError as e:
+        raise InputError("engine", "dask needs the optional extra 'distributed' "
+                         "(pip install 'grasp_torque_opt[distributed]')") from e
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=None,
+                               env={k: "1" for k in THREAD_VARS})
+    try:
+        with Client(scheduler or cluster) as client:
+            job_ref = client.scatter(job, broadcast=True)
+            futures = [client.submit(score_chunk, job_ref, t, pure=False) for t in tasks]
+            index = {f.key: i for i, f in enumerate(futures)}
+            for fut in as_completed(futures):
+                finished(index[fut.key], fut.result())
+    finally:
+        if cluster is not None:
+            cluster.close()
+
+
+def rank(records: Sequence[dict[str, Any]], by: str = "capacity") -> list[dict[str, Any]]:
+    """Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
+
+    Without capacities (``metrics="basic"``) ``capacity`` falls back to ``torque_norm``.
+    """
+    if by not in RANK_KEYS:
+        raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
+    if by == "capacity" and not any("capacity" in r for r in records):
+        by = "torque_norm"
+    larger = RANK_KEYS[by]
+
+    def key(r: dict) -> tuple:
+        v = r.get(by)
+        ok = r.get("status") == "optimal" and v is not None and math.isfinite(v)
+        order = {"optimal": 0, "infeasible": 1, "failed": 2}.get(r.get("status"), 3)
+        return (not ok, order, (-v if larger else v) if ok else 0.0, r["line"])
+
+    return sorted(records, key=key)
+
+
+def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
+    """One line: how many of each status, and the rate."""
+    counts: dict[str, int] = {}
+    for r in records:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    parts = ", ".join(f"{counts.get(s, 0)} {s}" for s in ("optimal", "infeasible", "failed",
+                                                           "error"))
+    rate = len(records) / seconds if seconds > 0 else float("inf")
+    return f"scored {len(records)} candidates in {seconds:.2f} s ({rate:.0f}/s): {parts}"
+
+
+def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
+    """The ranked table (text, not a contract)."""
+    def num(v, fmt):
+        return format(v, fmt) if v is not None else "-".rjust(int(fmt.split(".")[0]))
+
+    full = any("capacity" in r for r in ranked)
+    head = f"{'rank':>4}  {'line':>6}  {'id':<12} {'status':<10} {'|tau| N m':>9} " \
+           f"{'max tau/lim':>11} {'friction':>8}"
+    if full:
+        head += f" {'capacity':>8} {'worst axis':>18}"
+    lines = [head]
+    for i, r in enumerate(ranked[:top], 1):
+        row = (f"{i:>4}  {r['line']:>6}  {str(r.get('id'))[:12]:<12} {r['status']:<10} "
+               f"{num(r.get('torque_norm'), '9.4f')} {num(r.get('max_torque_ratio'), '11.3f')} "
+               f"{num(r.get('friction_usage_max'), '8.3f')}")
+        if full:
+            caps = {k: v for k, v in (r.get("capacities") or {}).items() if v is not None}
+            worst = min(caps, key=caps.get) if caps else None
+            unit = "N m" if worst and worst[1] == "M" else "N"
+            row += (f" {num(r.get('capacity'), '8.3f')} "
+                    f"{(f'{worst} {caps[worst]:.3g} {unit}' if worst else '-'):>18}")
+        lines.append(row)
+    return "\n".join(lines)
+
+
+def record_json(record: dict[str, Any]) -> str:
+    """One record as strict JSON (a non-finite number becomes null)."""
+    def clean(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [clean(x) for x in v]
+        return v
+    return json.dumps(clean(record))
