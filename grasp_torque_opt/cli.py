@@ -1,4 +1,4 @@
-"""Command line: ``grasp-torque-opt solve|compare SCENARIO``.
+"""Command line: ``grasp-torque-opt solve|compare SCENARIO``, ``grasp-torque-opt score CANDIDATES``.
 
 Exit codes: 0 optimal, 3 infeasible, 2 bad input (one line on stderr naming
 the field), 4 the solver gave nothing certifiable (no torque is printed).
@@ -7,8 +7,10 @@ the field), 4 the solver gave nothing certifiable (no torque is printed).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
+import time
 
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
@@ -17,7 +19,8 @@ from grasp_torque_opt.core.report import solution_dict
 from grasp_torque_opt.core.solution import INFEASIBLE, OPTIMAL
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.compare import compare, format_table
-from grasp_torque_opt.methods.dispatch import METHODS, solve
+from grasp_torque_opt.core.scenario import OBJECTIVES
+from grasp_torque_opt.methods.dispatch import LINEARIZED, METHODS, solve
 
 EXIT_OPTIMAL, EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_FAILED = 0, 2, 3, 4
 PROG = "grasp-torque-opt"
@@ -43,9 +46,17 @@ def _parser() -> argparse.ArgumentParser:
                          help="tau-qp-adaptive: refinement rounds at most, 0 to 100 "
                               f"(default: {AdaptiveSettings.max_rounds})")
     p_solve.add_argument("--json", action="store_true", help="print one JSON object")
+    p_solve.add_argument("--objective", choices=OBJECTIVES,
+                         help="objective instead of the scenario's objective.type")
+    p_solve.add_argument("--margin", type=_margin, metavar="K",
+                         help="friction margin k >= 0 instead of the scenario's friction.margin: "
+                              "plan in the cone of mu/(1+k)")
+    p_solve.add_argument("--capacity", action="store_true",
+                         help="also the load capacity and the 12 axis capacities")
     p_cmp = sub.add_parser("compare", help="every method side by side (the paper's Table 2)")
     p_cmp.add_argument("scenario", help="scenario YAML file")
     p_cmp.add_argument("--json", action="store_true", help="print one JSON object")
+    _score_parser(sub)
     return parser
 
 
@@ -61,6 +72,24 @@ def _rounds(text: str) -> int:
     if not 0 <= value <= 100:
         raise argparse.ArgumentTypeError(f"must be in [0, 100], got {text}")
     return value
+def _margin(text: str) -> float:
+    try:
+        k = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not k >= 0.0 or k == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be finite and >= 0, got {text!r}")
+    return k
+
+
+def _overridden(setup: GraspSetup, args: argparse.Namespace) -> GraspSetup:
+    """The setup with the command line's --objective and --margin."""
+    if getattr(args, "objective", None):
+        setup = dataclasses.replace(setup, objective=args.objective)
+    if getattr(args, "margin", None) is not None:
+        setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
+                                                                        margin=args.margin))
+    return setup
 
 
 def _exit_code(status: str) -> int:
@@ -69,6 +98,8 @@ def _exit_code(status: str) -> int:
 
 def _print_solution(d: dict) -> None:
     print(f"status: {d['status']} ({d['method']}; {d['message']})")
+    if d.get("infeasibility"):
+        print(f"why: {d['infeasibility']['text']}")
     if d["tau"] is not None:
         width = max(len(j) for j in d["joints"])
         for name, t in zip(d["joints"], d["tau"]):
@@ -88,6 +119,35 @@ def _print_solution(d: dict) -> None:
               f"this torque {b['upper']:.6f} N m, gap {gap} ({b['rounds']} rounds, "
               f"{b['qp_solves']} QPs, from {b['source']})" if b["upper"] is not None else
               f"bounds: lower {lower} N m, no certified torque")
+    if d["tau"] is not None:
+        usage = " ".join(f"{100 * c['friction_usage']:.0f}%" for c in d["contacts"])
+        print(f"objective: {d['objective']}, max |tau|/limit {d['max_torque_ratio']:.3f}, "
+              f"friction usage per contact {usage} of the cone (margin "
+              f"{d['friction_margin']:g})")
+    if d.get("capacity"):
+        cap = d["capacity"]
+        load = cap["load"]
+        print(f"capacity: {_cap(load['value'], 'times the load', load['status'])}; "
+              f"holding it, {load['binding_text']}")
+        print("axis capacities (largest load along each, alone): " + ", ".join(
+            f"{k} {_cap(v['value'], v['unit'], v['status'])}"
+            for k, v in cap["directions"].items()))
+
+
+def _cap(value, unit: str, status: str) -> str:
+    return f"{value:.4g} {unit}" if value is not None else status
+
+
+def _capacity_dict(setup: GraspSetup, maps) -> dict:
+    """The solve --capacity JSON: ``load`` and ``directions`` (docs/planner.md)."""
+    from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
+
+    lp = CapacityLP(setup, maps)
+    load = lp.solve(setup.external_wrench)
+    return {"load": {**load.as_dict(), "binding_text": None if load.binding is None
+                     else load.binding.text()},
+            "directions": {k: c.as_dict() for k, c in
+                           direction_capacities(setup, maps, lp).items()}}
 
 
 def _one_line(text: str) -> str:
@@ -105,8 +165,10 @@ def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
     args = _parser().parse_args(argv)
     single_threaded_math()
+    if args.command == "score":
+        return _score(args)
     try:
-        setup = GraspSetup.from_file(args.scenario)
+        setup = _overridden(GraspSetup.from_file(args.scenario), args)
         if args.command == "solve":
             fallback = None if args.fallback in ("none", args.backend) else \
                 make_solver(args.fallback)
@@ -114,7 +176,14 @@ def main(argv: list[str] | None = None) -> int:
                                                max_rounds=args.max_rounds))
             sol = solve(setup, args.method, backend=args.backend, fallback=fallback,
                         refiner=refiner)
-            d = solution_dict(sol, setup.maps())
+            maps = setup.maps()
+            if sol.status == INFEASIBLE and args.method in LINEARIZED:
+                from grasp_torque_opt.methods.explain import explain
+
+                sol.infeasibility = explain(setup, maps).as_dict()
+            d = solution_dict(sol, maps)
+            if args.capacity:
+                d["capacity"] = _capacity_dict(setup, maps)
             if args.json:
                 print(json.dumps(d))
             else:
@@ -134,6 +203,112 @@ def main(argv: list[str] | None = None) -> int:
     except GraspTorqueError as e:
         print(_one_line(f"{PROG}: error: {e}"), file=sys.stderr)
         return EXIT_FAILED
+
+
+def _score_parser(sub) -> None:
+    from grasp_torque_opt.methods.score import ENGINES, METRICS, RANK_KEYS
+
+    p = sub.add_parser("score", help="score candidate grasps of one hand (JSON Lines), in "
+                       "parallel, ranked", description=(
+                           "Score candidate grasps: each line of CANDIDATES is a JSON object, "
+                           "a partial scenario merged into --scenario (docs/planner.md)."))
+    p.add_argument("candidates", help="JSON Lines file, one candidate per line")
+    p.add_argument("--scenario", required=True, help="base scenario YAML file (the hand and "
+                   "every default)")
+    p.add_argument("--out", help="write one JSON record per candidate here (JSON Lines, "
+                   "input order, with its rank)")
+    p.add_argument("--json", action="store_true", help="print the records (JSON Lines, "
+                   "ranked) instead of the table")
+    p.add_argument("--top", type=int, default=10, help="rows of the ranked table (default 10)")
+    p.add_argument("--rank-by", choices=tuple(RANK_KEYS), default="capacity",
+                   help="capacity (largest first, the default) or torque_norm, "
+                        "max_torque_ratio, friction_usage_max (smallest first)")
+    p.add_argument("--metrics", choices=METRICS, default="full",
+                   help="full (with the capacities, the default) or basic (solve only)")
+    p.add_argument("--workers", type=int, help="processes (default: the machine's cores)")
+    p.add_argument("--engine", choices=ENGINES, default="processes",
+                   help="processes (default), serial, or dask (Dask distributed)")
+    p.add_argument("--scheduler", help="Dask scheduler address (engine dask; default: a "
+                   "local cluster)")
+    p.add_argument("--backend", choices=BACKENDS, default="daqp",
+                   help="QP backend (default: daqp, the fastest on these grasps)")
+    p.add_argument("--objective", choices=OBJECTIVES, help="objective instead of the "
+                   "scenario's")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+class _Progress:
+    """A progress bar on stderr, drawn only on a terminal."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.enabled = enabled and sys.stderr.isatty()
+        self.t0 = time.perf_counter()
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled:
+            return
+        width = 30
+        filled = width * done // max(total, 1)
+        rate = done / max(time.perf_counter() - self.t0, 1e-9)
+        sys.stderr.write(f"\rscoring [{'#' * filled}{'.' * (width - filled)}] {done}/{total} "
+                         f"({rate:.0f}/s)")
+        if done >= total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def _score(args: argparse.Namespace) -> int:
+    from grasp_torque_opt.methods.score import (
+        ScoreJob,
+        format_table,
+        rank,
+        read_candidates,
+        record_json,
+        score_batch,
+        summary,
+    )
+
+    where = args.scenario
+    try:
+        job = ScoreJob.from_file(args.scenario, backend=args.backend, metrics=args.metrics,
+                                 objective=args.objective)
+        where = args.candidates
+        lines = read_candidates(args.candidates)
+        where = args.scenario
+        t0 = time.perf_counter()
+        records = score_batch(job, lines, workers=args.workers, engine=args.engine,
+                              scheduler=args.scheduler,
+                              progress=_Progress(not args.no_progress))
+        seconds = time.perf_counter() - t0
+    except InputError as e:
+        print(_one_line(f"{PROG}: error: {where}: {e}"), file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except (GraspTorqueError, OSError) as e:
+        print(_one_line(f"{PROG}: error: {e}"), file=sys.stderr)
+        return EXIT_FAILED
+    ranked = rank(records, args.rank_by)
+    for i, r in enumerate(ranked, 1):
+        r["rank"] = i
+    bad = [r for r in records if r["status"] == "error"]
+    for r in bad:
+        print(_one_line(f"{PROG}: error: {args.candidates}: {r['error']}"), file=sys.stderr)
+    if args.out:
+        try:
+            with open(args.out, "w") as fh:
+                fh.writelines(record_json(r) + "\n" for r in records)
+        except OSError as e:
+            print(_one_line(f"{PROG}: error: --out: cannot write {args.out}: {e.strerror}"),
+                  file=sys.stderr)
+            return EXIT_FAILED
+    if args.json:
+        for r in ranked:
+            print(record_json(r))
+    else:
+        print(f"{args.candidates}: {len(records)} candidates on {args.scenario} "
+              f"(ranked by {args.rank_by})")
+        print(format_table(ranked, args.top))
+        print(summary(records, seconds))
+    return EXIT_BAD_INPUT if bad else EXIT_OPTIMAL
 
 
 if __name__ == "__main__":
