@@ -64,10 +64,15 @@ def report(controller: TorqueController, now: float) -> Report:
             values.append(("certificate.ok", str(sol.certificate.ok).lower()))
         if sol.optimal and last.maps is not None:
             values.append(("torque_norm", f"{sol.torque_norm:.6f}"))
+            values += [("objective", sol.objective),
+                       ("friction_margin", f"{sol.friction_margin:g}"),
+                       ("max_torque_ratio", f"{sol.max_torque_ratio:.4f}"),
+                       ("friction_usage_max", f"{float(sol.friction_usage.max()):.4f}")]
             usage = friction_usage(sol.wrenches, c.setup.friction.mu1, c.setup.friction.mu2)
             for i, (frame, (ut, ur)) in enumerate(zip(last.maps.contacts, usage)):
                 key = f"contact{i}.{frame.link}"
                 values += [(f"{key}.normal_force_N", f"{sol.wrenches[i, 2]:.4f}"),
+                           (f"{key}.friction_usage", f"{sol.friction_usage[i]:.4f}"),
                            (f"{key}.tangential_usage", f"{ut:.4f}"),
                            (f"{key}.torsional_usage", f"{ur:.4f}")]
     if last is not None and last.gravity_torque is not None:

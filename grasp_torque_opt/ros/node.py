@@ -62,7 +62,7 @@ from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.report import solution_dict
 from grasp_torque_opt.core.resources import find_config
-from grasp_torque_opt.core.scenario import load_scenario
+from grasp_torque_opt.core.scenario import OBJECTIVES, load_scenario
 
 NODE_NAME = "grasp_torque_node"
 #: Commands: reliable, only the newest matters.
@@ -99,6 +99,12 @@ PARAMETERS: dict[str, Spec] = {
     "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint.",
                           length="joints"),
     "weights": Spec("Objective weights W (diagonal), per joint [-].", length="joints"),
+    "friction_margin": Spec("Friction margin k: plan inside the cone of mu/(1+k), so the "
+                            "commanded wrenches hold with up to (1+k) times less friction "
+                            "(docs/planner.md) [-].", 0.0, 100.0),
+    "objective": Spec("'sum-of-squares' (the paper's, default: the scenario's) or 'min-max' "
+                      "(max |tau_i + g_i| / limit_i, an LP, then the sum of squares among its "
+                      "optima; docs/planner.md)."),
     "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
                                  "limits then bound the sum."),
     "gravity": Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
@@ -199,6 +205,8 @@ def check(name: str, value: Any, m: int) -> str:
             return f"{name}: must be one of {', '.join(CYCLE_METHODS)}"
         return "" if value == "tau-qp" or available("daqp") else \
             f"{name}: {value} needs daqp, which is not installed (pip install daqp)"
+    if name == "objective":
+        return "" if value in OBJECTIVES else f"{name}: must be one of {', '.join(OBJECTIVES)}"
     if spec.length is not None:
         n = m if spec.length == "joints" else int(spec.length)
         values = list(value)
@@ -232,6 +240,8 @@ class GraspTorqueNode(Node):
             "min_normal_force": setup.friction.min_normal_force,
             "torque_limits": [float(x) for x in setup.hand.torque_limits],
             "weights": [float(x) for x in setup.weights],
+            "friction_margin": setup.friction.margin,
+            "objective": setup.objective,
             "gravity_compensation": False,
             # One place for gravity: the scenario's, which also gives its load.
             "gravity": ([float(x) for x in self._scenario_gravity]
@@ -338,10 +348,11 @@ class GraspTorqueNode(Node):
             hand = dataclasses.replace(hand, torque_limits=np.array(p["torque_limits"]))
         setup = dataclasses.replace(
             setup, hand=hand, object_origin=np.array(p["object_origin"]),
-            weights=np.array(p["weights"]),
+            weights=np.array(p["weights"]), objective=p["objective"],
             friction=dataclasses.replace(setup.friction, mu1=p["mu_tangential"],
                                          mu2=p["mu_torsional"], sides=p["polygon_sides"],
-                                         min_normal_force=p["min_normal_force"]))
+                                         min_normal_force=p["min_normal_force"],
+                                         margin=p["friction_margin"]))
         config = CycleConfig(
             joint_state_timeout=p["joint_state_timeout"],
             contacts_timeout=p["contacts_timeout"], wrench_timeout=p["wrench_timeout"],
@@ -524,6 +535,10 @@ class GraspTorqueNode(Node):
                 return
             sol, maps, g = ctrl.solve_inputs(inputs)
             cmd, _ = ctrl.gate(sol, g)
+            if sol.status == "infeasible":  # what can be held, and what binds (docs/planner.md)
+                from grasp_torque_opt.methods.explain import explain
+
+                sol.infeasibility = explain(ctrl.grasp_at(inputs)[0], maps).as_dict()
             d = solution_dict(sol, maps)
             d["command"] = None if cmd is None else [float(x) for x in cmd]
             d["gravity_torque"] = None if g is None else [float(x) for x in g]
