@@ -16,6 +16,8 @@ Runs, in this order, each writing ``OUT/<name>.json``:
   fixed polygons and the SOCP, planar case and 200 grasps (bench/adaptive.py);
 - ``planner``: grasps scored per second, one process and both cores
   (bench/planner.py);
+- ``score``: ``grasp-torque-opt score``'s candidates per second, basic and full
+  metrics (capacities), serial and over both cores (bench/score.py);
 - ``node_load``: the node at 500 Hz and 1 kHz beside a trivial echo node, in
   separate processes (bench/node_load.py; skipped with ``--skip-node``);
 - ``node_blackbox``: the node on the default params file, measured from outside
@@ -47,6 +49,7 @@ import linearization  # noqa: E402
 import node_blackbox  # noqa: E402
 import node_load  # noqa: E402
 import planner  # noqa: E402
+import score  # noqa: E402
 import solvers  # noqa: E402
 
 from grasp_torque_opt.backends import single_threaded_math  # noqa: E402
@@ -73,6 +76,7 @@ def main() -> int:
          adaptive.table),
         ("planner", lambda: planner.run(grasps=grasps, rounds=1 if args.quick else 5),
          planner.table),
+        ("score", lambda: score.run(count=400 if args.quick else 4000), score.table),
     ]
     machine = cycle.machine()
     summary = [f"# Benchmark summary\n\n{cycle.machine_line(machine)}\n"]

@@ -56,8 +56,20 @@ class LPResult:
     solve_time_s: float
 
 
+class DaqpForm:
+    """DAQP's view of the bounds (clipped to its infinity, equality flags, zero Hessian),
+    built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp)."""
+
+    def __init__(self, n: int, lower: np.ndarray, upper: np.ndarray) -> None:
+        self.sense = np.zeros(lower.size, dtype=np.int32)
+        self.sense[n:][lower[n:] == upper[n:]] = 5
+        self.bu = np.minimum(upper, DAQP_INF)
+        self.bl = np.maximum(lower, -DAQP_INF)
+        self.H = np.zeros((n, n))
+
+
 def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-             highs_only: bool = False) -> LPResult:
+             highs_only: bool = False, form: DaqpForm | None = None) -> LPResult:
     """Minimize c^T x subject to the bounds and rows of the module docstring.
 
     Args:
@@ -66,11 +78,12 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
         lower: lower bounds, shape (n + r,) (-inf allowed).
         upper: upper bounds, shape (n + r,) (inf allowed); lower == upper: equality.
         highs_only: skip DAQP (the fallback alone; tests and odd problems).
+        form: the bounds in DAQP's form if already built (:class:`DaqpForm`).
     """
     t0 = time.perf_counter()
     why = ""
     if not highs_only:
-        out = _daqp(c, A, lower, upper)
+        out = _daqp(c, A, form or DaqpForm(c.size, lower, upper))
         if out is not None and out[0] == "optimal":
             return LPResult("optimal", out[1], out[2], "daqp", out[3],
                             time.perf_counter() - t0)
@@ -80,18 +93,13 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
     return LPResult(res.status, res.x, res.lam, "highs", msg, time.perf_counter() - t0)
 
 
-def _daqp(c, A, lower, upper):
+def _daqp(c, A, form: DaqpForm):
     try:
         import daqp  # a selectable backend: a ROS distribution may not have it
     except ImportError:
         return ("failed", None, None, "DAQP is not installed")
 
-    n, r = c.size, A.shape[0]
-    sense = np.zeros(n + r, dtype=np.int32)
-    sense[n:][lower[n:] == upper[n:]] = 5
-    bu = np.minimum(upper, DAQP_INF)
-    bl = np.maximum(lower, -DAQP_INF)
-    H = np.zeros((n, n))
+    H, bu, bl, sense = form.H, form.bu, form.bl, form.sense
     try:
         x, _, flag, info = daqp.solve(H, np.ascontiguousarray(c, dtype=float),
                                       np.ascontiguousarray(A, dtype=float), bu, bl, sense,

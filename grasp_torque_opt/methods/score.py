@@ -222,12 +222,12 @@ class Scorer:
         }
         if self.job.metrics == "full":
             lp = CapacityLP(setup, maps)
-            cap = lp.solve(setup.external_wrench)
+            cap = lp.solve(setup.external_wrench, binding=False)
             out["capacity"] = cap.value
             out["capacity_status"] = cap.status
             out["holdable_fraction"] = (cap.value if sol.status == "infeasible" else None)
             out["capacities"] = {k: c.value for k, c in
-                                 direction_capacities(setup, maps, lp).items()}
+                                 direction_capacities(setup, maps, lp, binding=False).items()}
         return out
 
     def score_lines(self, lines: Iterable[tuple[int, str]]) -> list[dict[str, Any]]:
