@@ -18,7 +18,14 @@ held = the ball moved less than 1 mm. Tables (markdown, for docs/simulation.md):
     one until the ball slips, at two impedance gains;
 (d) the control: the impedance alone (no feedforward torque), at several gains;
 (e) the impedance the bundled grasp needs, and the certified torques scaled by
-    0.9 and 1.1 (the margin of the minimum-effort torques).
+    0.9 and 1.1 (the margin of the minimum-effort torques);
+(f) friction margin (docs/planner.md): torques planned with margin k (the cone of
+    mu/(1+k)) against the simulated friction lowered to 1/(1+k') of the planned
+    one, for k, k' in 0, 0.1, 0.25, 0.5, at two gains;
+(g) load capacity: the capacity LP's largest ball mass (alpha times the ball,
+    with g(q0) as the node's offset) against the simulation: the ball's simulated
+    mass set to a multiple of it, commanded the certified torques for that mass or,
+    above the capacity, for 0.999 of it (the most the optimizer certifies).
 """
 
 from __future__ import annotations
@@ -38,7 +45,11 @@ from cycle import machine, report  # noqa: E402
 from grasp_torque_opt.core.resources import find_config  # noqa: E402
 from grasp_torque_opt.core.scenario import Scenario, load_scenario, weight_wrench  # noqa: E402
 from grasp_torque_opt.sim.hold import HoldSettings, certified_torques, hold  # noqa: E402
+from grasp_torque_opt.methods.capacity import load_capacity  # noqa: E402
 from grasp_torque_opt.sim.model import SimSettings  # noqa: E402
+
+MARGINS = (0.0, 0.1, 0.25, 0.5)
+CAPACITY_FACTORS = (0.9, 0.95, 0.999, 1.01, 1.02, 1.05, 1.1, 1.2)
 
 DIRECTIONS = {"+x": (1, 0, 0), "-x": (-1, 0, 0), "+y": (0, 1, 0), "-y": (0, -1, 0),
               "+z": (0, 0, 1), "-z": (0, 0, -1)}
@@ -53,10 +64,11 @@ def loaded(scenario: Scenario, gravity=None, mass=None) -> Scenario:
 
 
 def episode(scenario: Scenario, duration: float, kp: float, kd: float,
-            feedforward: float = 1.0, friction: float = 1.0) -> dict:
-    """One hold episode as a JSON-able record."""
+            feedforward: float = 1.0, friction: float = 1.0, mass: float | None = None) -> dict:
+    """One hold episode as a JSON-able record (``mass``: the ball's simulated mass [kg]
+    instead of the planned one)."""
     sim = SimSettings(mu_tangential=friction * scenario.friction.mu1,
-                      mu_torsional=friction * scenario.friction.mu2)
+                      mu_torsional=friction * scenario.friction.mu2, mass=mass)
     r = hold(scenario, HoldSettings(kp=kp, kd=kd, duration=duration, feedforward=feedforward),
              sim)
     errors = [c.force_error for c in r.contacts if c.touching]
@@ -124,11 +136,50 @@ def run(duration: float = 2.0, kd: float = 0.01, gains: tuple[float, float] = (0
     out["control"] = [{"kp": kp, "episode": episode(base, duration, kp, kd, feedforward=0.0)}
                       for kp in (0.3, 1.0, 3.0, 5.0)]
 
+    out["margin"] = margin_rows(base, duration, kd, gains)
+    out["capacity"] = capacity_rows(base, duration, kd)
+
     out["impedance"] = [{"kp": kp, "episodes": {str(ff): episode(base, duration, kp, kd,
                                                                  feedforward=ff)
                                                 for ff in (1.0, 0.9, 1.1)}}
                         for kp in (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 3.0)]
     return out
+
+
+def with_margin(scenario: Scenario, k: float) -> Scenario:
+    return dataclasses.replace(scenario, friction=dataclasses.replace(scenario.friction,
+                                                                      margin=k))
+
+
+def margin_rows(base: Scenario, duration: float, kd: float, gains) -> list[dict]:
+    """(f): plan with margin k, simulate with the friction 1/(1+k') of the planned one."""
+    rows = []
+    for k in MARGINS:
+        s = with_margin(base, k)
+        _, _, sol, grav = certified_torques(s)
+        rows.append({"margin": k, "status": sol.status,
+                     "usage_max": float(sol.friction_usage.max()),
+                     "torque_norm": sol.torque_norm,
+                     "max_command_Nm": float(np.abs(sol.tau + grav).max()),
+                     "episodes": {f"{k2:g}": {str(kp): episode(s, duration, kp, kd,
+                                                               friction=1 / (1 + k2))
+                                              for kp in gains} for k2 in MARGINS}})
+    return rows
+
+
+def capacity_rows(base: Scenario, duration: float, kd: float, kp: float = 1.0) -> dict:
+    """(g): the capacity LP's mass against the mass the simulated ball falls at."""
+    setup, maps, _, _ = certified_torques(base)  # g(q0) as the offset, as the node
+    cap = load_capacity(setup, maps)
+    m_star = cap.value * base.object.mass
+    rows = []
+    for f in CAPACITY_FACTORS:
+        m = f * m_star
+        plan = loaded(base, mass=min(m, 0.999 * m_star))
+        rows.append({"factor": f, "mass": m, "planned_mass": plan.object.mass,
+                     "episode": episode(plan, duration, kp, kd, mass=m)})
+    return {"alpha": cap.value, "capacity_kg": m_star, "kp": kp,
+            "binding": cap.binding.text(), "rows": rows}
 
 
 def tables(r: dict) -> str:
@@ -169,6 +220,28 @@ def tables(r: dict) -> str:
         e = row["episodes"]
         lines.append(f"| {row['kp']:g} | {cell(e['1.0'])} | {cell(e['0.9'])} | "
                      f"{cell(e['1.1'])} |")
+    lines += ["", "(f) friction margin: torques planned with margin k (the cone of mu/(1+k)) "
+              "against simulated friction 1/(1+k') of the planned one "
+              f"(Kp {' / '.join(gains)} N m/rad)", "",
+              "| planned margin k | usage of the cone | norm tau [N m] | "
+              + " | ".join(f"friction {100 / (1 + float(k2)):.0f}%" for k2 in
+                           r["margin"][0]["episodes"]) + " |",
+              "|---|---|---|" + "---|" * len(r["margin"][0]["episodes"])]
+    for row in r["margin"]:
+        lines.append(f"| {row['margin']:g} | {100 * row['usage_max']:.0f}% | "
+                     f"{row['torque_norm']:.4f} | "
+                     + " | ".join(" / ".join(_short(e[k]) for k in gains)
+                                  for e in row["episodes"].values()) + " |")
+    c = r["capacity"]
+    lines += ["", f"(g) load capacity: the capacity LP holds {c['alpha']:.3f} times the "
+              f"0.15 kg ball, {c['capacity_kg']:.3f} kg ({c['binding']}); the simulated ball "
+              f"at multiples of it, Kp {c['kp']:g} N m/rad, commanded the certified torques "
+              "for its mass (above the capacity: for 0.999 of it)", "",
+              "| mass / capacity | simulated mass [kg] | planned for [kg] | outcome |",
+              "|---|---|---|---|"]
+    for row in c["rows"]:
+        lines.append(f"| {row['factor']:g} | {row['mass']:.3f} | {row['planned_mass']:.3f} | "
+                     f"{cell(row['episode'])} |")
     for k in gains:
         errors = {row["direction"]: row["episodes"][k]["max_force_error"]
                   for row in r["directions"] if "episodes" in row
@@ -180,7 +253,17 @@ def tables(r: dict) -> str:
     return "\n".join(lines)
 
 
+def _short(e: dict) -> str:
+    """held / slid / fell in one word, for the margin grid."""
+    return "held" if e["held"] else ("**fell**" if e["drift_mm"] > 20.0 else "**slid**")
+
+
 def _episodes(r: dict):
+    for row in r["margin"]:
+        for per_gain in row["episodes"].values():
+            yield from per_gain.values()
+    for row in r["capacity"]["rows"]:
+        yield row["episode"]
     for row in r["directions"]:
         yield from row.get("episodes", {}).values()
     for row in r["mass"]["rows"] + r["friction"] + r["impedance"]:
