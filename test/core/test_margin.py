@@ -67,3 +67,12 @@ def test_margined_torques_satisfy_the_reduced_cone(allegro_doc, k):
     plain = solve(dataclasses.replace(setup, friction=dataclasses.replace(fr, margin=0.0)),
                   maps=maps)
     assert plain.friction_usage.max() > 1 / (1 + k) + 1e-3
+
+
+def test_the_adaptive_method_plans_with_the_margin_too(allegro):
+    k = 0.25
+    setup = dataclasses.replace(allegro, friction=dataclasses.replace(allegro.friction,
+                                                                      margin=k))
+    sol = solve(setup, "tau-qp-adaptive")
+    assert sol.optimal and sol.friction_margin == k
+    assert sol.friction_usage.max() <= 1 / (1 + k) + 1e-7
