@@ -42,6 +42,14 @@ _EXPORTS = {
     "Bounds": "grasp_torque_opt.core.bounds",
     "solve": "grasp_torque_opt.methods.dispatch",
     "compare": "grasp_torque_opt.methods.compare",
+    # The planner's numbers (docs/planner.md).
+    "load_capacity": "grasp_torque_opt.methods.capacity",
+    "direction_capacities": "grasp_torque_opt.methods.capacity",
+    "Capacity": "grasp_torque_opt.methods.capacity",
+    "explain": "grasp_torque_opt.methods.explain",
+    "ScoreJob": "grasp_torque_opt.methods.score",
+    "score_batch": "grasp_torque_opt.methods.score",
+    "read_candidates": "grasp_torque_opt.methods.score",
 }
 
 __all__ = sorted(_EXPORTS)
