@@ -10,7 +10,8 @@ cones, an LP over the contact wrenches f and alpha (docs/planner.md):
                 tau_min <= J^T f <= tau_max     torque limits (after any offset g(q))
                 0 <= alpha <= ALPHA_MAX
 
-Solved by :func:`grasp_torque_opt.methods.lp.solve_lp` (DAQP, KKT-checked, HiGHS
+on the unit direction w_ext/||w_ext|| (alpha rescaled after, so that the LP's
+numbers do not depend on the load's size). Solved by :func:`grasp_torque_opt.methods.lp.solve_lp` (DAQP, KKT-checked, HiGHS
 behind it) and certified like every other result: the f it returns is checked
 against the exact problem at the load alpha w_ext (:func:`certify`), so the grasp
 provably holds alpha times the load. alpha < 1: the load itself cannot be held,
@@ -34,6 +35,7 @@ from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.methods.lp import DaqpForm, LPResult, solve_lp
+from grasp_torque_opt.reference.feasibility import linearized_feasible
 
 #: Cap on alpha, so that the LP stays bounded; reaching it reports ``unbounded``.
 ALPHA_MAX = 1e6
@@ -84,8 +86,9 @@ class Capacity:
 
     Attributes:
         status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds: the
-            minimum normal force cannot be produced within the limits), ``unbounded``
-            (alpha reached :data:`ALPHA_MAX`) or ``failed``.
+            minimum normal force cannot be produced within the limits; confirmed by the
+            independent feasibility LP), ``unbounded`` (alpha reached :data:`ALPHA_MAX`
+            on the unit direction, or the load is zero) or ``failed``.
         value: alpha: a factor on the load [-], or for an axis direction the largest
             load along it [N or N m]; None unless ``optimal``.
         unit: ``-``, ``N`` or ``N m``.
@@ -157,21 +160,36 @@ class CapacityLP:
                 the time of a capacity).
         """
         load = np.asarray(load, dtype=float)
-        self.A[:6, -1] = load
+        scale = float(np.abs(load).max())  # the max norm: no overflow at 1e300
+        if not np.isfinite(scale):
+            return Capacity("failed", None, unit, message="load not finite")
+        if scale == 0.0:
+            return Capacity("unbounded", None, unit, message=(
+                "zero load: any multiple of it is the same load"))
+        # The LP on the unit direction, alpha rescaled after: a load of 1e-6 or 1e6 N
+        # gives the LP the same numbers.
+        self.A[:6, -1] = load / scale
         res = solve_lp(self.c, self.A, self.lower, self.upper, highs_only=highs_only,
                        form=self.form)
-        out = self._capacity(res, load, unit, binding)
+        out = self._capacity(res, load, scale, unit, binding)
         if out.status == "failed" and res.solver == "daqp" and not highs_only:
             out = self._capacity(solve_lp(self.c, self.A, self.lower, self.upper,
-                                          highs_only=True), load, unit, binding)
+                                          highs_only=True), load, scale, unit, binding)
         return out
 
-    def _capacity(self, res: LPResult, load: np.ndarray, unit: str,
+    def _capacity(self, res: LPResult, load: np.ndarray, scale: float, unit: str,
                   binding: bool = True) -> Capacity:
         if res.status == "infeasible":
-            return Capacity("infeasible", None, unit, solver=res.solver, message=(
-                "not even zero load can be held: the minimum normal force cannot be "
-                f"produced within the torque limits ({res.message})"))
+            # Said only when the independent feasibility LP agrees that zero load cannot
+            # be held either (else the capacity LP's verdict is numerics, not the grasp).
+            if linearized_feasible(self.maps, self.friction, np.zeros(6), self.tau_min,
+                                   self.tau_max) is False:
+                return Capacity("infeasible", None, unit, solver=res.solver, message=(
+                    "not even zero load can be held: the minimum normal force cannot be "
+                    f"produced within the torque limits ({res.message})"))
+            return Capacity("failed", None, unit, solver=res.solver, message=(
+                f"{res.message}, but the feasibility LP does not confirm that zero load "
+                "cannot be held"))
         if res.status != "optimal":
             return Capacity("failed", None, unit, solver=res.solver, message=res.message)
         f, alpha = res.x[:self.nf], float(res.x[-1])
@@ -179,6 +197,7 @@ class CapacityLP:
             return Capacity("unbounded", None, unit, solver=res.solver, message=(
                 f"alpha reached its cap {ALPHA_MAX:g}: the grasp holds this load "
                 "direction without bound"))
+        alpha /= scale
         tau = self.maps.J.T @ f
         cert = certify(self.maps.G, self.maps.J, alpha * load, self.friction, self.tau_min,
                        self.tau_max, tau, f, self.tolerance)

@@ -88,3 +88,16 @@ def test_no_capacity_when_not_even_zero_load_holds(allegro_doc):
     cap = load_capacity(setup)
     assert cap.status == "infeasible" and cap.value is None
     assert "minimum normal force" in cap.message
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1e-6, 1e6, 1e200])
+def test_the_capacity_scales_with_the_load(allegro, scale):
+    """alpha(s w) = alpha(w) / s: the LP runs on the unit direction whatever the load's size."""
+    maps = allegro.maps()
+    base = load_capacity(allegro, maps).value
+    cap = load_capacity(allegro, maps, load=scale * allegro.external_wrench)
+    assert cap.status == "optimal" and cap.value == pytest.approx(base / scale, rel=1e-9)
+
+
+def test_a_zero_load_has_no_finite_capacity(allegro):
+    assert load_capacity(allegro, load=np.zeros(6)).status == "unbounded"
