@@ -159,6 +159,8 @@ class Scorer:
             data = json.loads(text)
         except json.JSONDecodeError as e:
             raise InputError(f"line {lineno}", f"not valid JSON: {e}") from e
+        except RecursionError as e:  # '[[[[...' nested beyond Python's stack
+            raise InputError(f"line {lineno}", "nested too deeply") from e
         if not isinstance(data, dict):
             raise InputError(f"line {lineno}", f"must be a JSON object, got "
                              f"{type(data).__name__}")
@@ -206,6 +208,8 @@ class Scorer:
             record.update(self.score(setup, maps))
         except GraspTorqueError as e:
             record.update(status="failed", error=f"line {lineno}: {e}")
+        except Exception as e:  # noqa: BLE001 -- one candidate never stops the batch
+            record.update(status="failed", error=f"line {lineno}: {type(e).__name__}: {e}")
         record["time_s"] = time.perf_counter() - t0
         return record
 

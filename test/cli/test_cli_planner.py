@@ -107,3 +107,14 @@ def test_score_json_and_bad_files(tmp_path, capsys):
     assert code == 2 and err.count("\n") == 1 and "candidates: cannot read" in err
     code, _, err = run(["score", str(batch), "--scenario", str(tmp_path / "none.yaml")], capsys)
     assert code == 2 and "scenario: cannot read" in err
+
+
+def test_the_progress_bar_is_drawn_on_a_terminal_only(tmp_path, capsys, monkeypatch):
+    batch = tmp_path / "c.jsonl"
+    batch.write_text('{"id": 1}\n{"id": 2}\n')
+    argv = ["score", str(batch), "--scenario", str(ALLEGRO), "--engine", "serial",
+            "--metrics", "basic"]
+    assert run(argv, capsys)[2] == ""  # captured stderr is no terminal
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    code, _, err = run(argv, capsys)
+    assert code == 0 and "\rscoring [" in err and "2/2" in err
