@@ -10,11 +10,12 @@ cones, an LP over the contact wrenches f and alpha (docs/planner.md):
                 tau_min <= J^T f <= tau_max     torque limits (after any offset g(q))
                 0 <= alpha <= ALPHA_MAX
 
-on the unit direction w_ext/||w_ext|| (alpha rescaled after, so that the LP's
-numbers do not depend on the load's size). Solved by :func:`grasp_torque_opt.methods.lp.solve_lp` (DAQP, KKT-checked, HiGHS
-behind it) and certified like every other result: the f it returns is checked
-against the exact problem at the load alpha w_ext (:func:`certify`), so the grasp
-provably holds alpha times the load. alpha < 1: the load itself cannot be held,
+on the unit direction w_ext / max|w_ext| (alpha rescaled after, so that the LP's
+numbers do not depend on the load's size). Solved by
+:func:`grasp_torque_opt.methods.lp.solve_lp` (DAQP, KKT-checked, HiGHS behind it)
+and certified like every other result: the f it returns is checked against the
+exact problem at the load alpha w_ext (:func:`certify`), so the grasp provably
+holds alpha times the load. alpha < 1: the load itself cannot be held,
 and alpha is the largest holdable fraction of it (:mod:`.explain` says what binds).
 
 The 12 axis capacities are the same LP for the unit loads +-e_i, about the object

@@ -50,7 +50,8 @@ class Explanation:
                 f"{c.binding.text()}")
 
     def as_dict(self) -> dict:
-        """Plain data (JSON): ``holdable_fraction``, ``binding``, ``status``, ``certified``, ``text``."""
+        """Plain data (JSON): ``holdable_fraction``, ``binding``, ``status``, ``certified``,
+        ``text``."""
         d = self.capacity.as_dict()
         return {"holdable_fraction": d["value"], "status": d["status"],
                 "certified": d["certified"], "binding": d["binding"], "text": self.text}
