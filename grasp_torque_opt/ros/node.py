@@ -374,6 +374,13 @@ class GraspTorqueNode(Node):
                 reason = check(param.name, param.value, self._m)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
+        # min-max is the tau-QP's objective only (docs/planner.md): refuse the pair.
+        new = {param.name: param.value for param in params}
+        objective = new.get("objective", self.get_parameter("objective").value)
+        method = new.get("solver.method", self.get_parameter("solver.method").value)
+        if objective == "min-max" and method != "tau-qp":
+            return SetParametersResult(successful=False, reason=(
+                f"objective: min-max needs solver.method tau-qp, not {method}"))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list[Parameter]) -> None:

@@ -47,6 +47,9 @@ def test_margin_and_minmax_parameters_over_ros(allegro):
                      np.array([c["wrench"] for c in d["contacts"]]))
         refused = h.node.set_parameters([Parameter("objective", value="fastest")])[0]
         assert not refused.successful and "objective: must be one of" in refused.reason
+        refused = h.node.set_parameters([Parameter("solver.method",
+                                                   value="tau-qp-adaptive")])[0]
+        assert not refused.successful and "min-max needs solver.method tau-qp" in refused.reason
         # An infeasible load (limits a tenth of the bundled ones): the service says why.
         assert h.node.set_parameters([Parameter("torque_limits", value=[0.07] * 16)])[0]\
             .successful
