@@ -82,6 +82,19 @@ def _margin(text: str) -> float:
     return k
 
 
+def _count(low: int, high: int):
+    """An argparse type: an integer in [low, high]."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be in [{low}, {high}], got {value}")
+        return value
+    return parse
+
+
 def _overridden(setup: GraspSetup, args: argparse.Namespace) -> GraspSetup:
     """The setup with the command line's --objective and --margin."""
     if getattr(args, "objective", None):
@@ -219,13 +232,15 @@ def _score_parser(sub) -> None:
                    "input order, with its rank)")
     p.add_argument("--json", action="store_true", help="print the records (JSON Lines, "
                    "ranked) instead of the table")
-    p.add_argument("--top", type=int, default=10, help="rows of the ranked table (default 10)")
+    p.add_argument("--top", type=_count(0, 10**9), default=10,
+                   help="rows of the ranked table (default 10)")
     p.add_argument("--rank-by", choices=tuple(RANK_KEYS), default="capacity",
                    help="capacity (largest first, the default) or torque_norm, "
                         "max_torque_ratio, friction_usage_max (smallest first)")
     p.add_argument("--metrics", choices=METRICS, default="full",
                    help="full (with the capacities, the default) or basic (solve only)")
-    p.add_argument("--workers", type=int, help="processes (default: the machine's cores)")
+    p.add_argument("--workers", type=_count(1, 256), help="processes (default: the machine's "
+                   "cores), 1 to 256")
     p.add_argument("--engine", choices=ENGINES, default="processes",
                    help="processes (default), serial, or dask (Dask distributed)")
     p.add_argument("--scheduler", help="Dask scheduler address (engine dask; default: a "

@@ -64,11 +64,18 @@ def test_an_infeasible_load_is_explained(tmp_path, allegro_doc, capsys):
     assert code == 3 and "why: at most" in text and "% of this load can be held" in text
 
 
-@pytest.mark.parametrize("argv, fragment", [(["--margin", "-1"], "--margin"),
-                                            (["--objective", "max"], "--objective")])
+@pytest.mark.parametrize("argv, fragment", [
+    (["solve", str(ALLEGRO), "--margin", "-1"], "--margin"),
+    (["solve", str(ALLEGRO), "--margin", "nan"], "--margin"),
+    (["solve", str(ALLEGRO), "--objective", "max"], "--objective"),
+    (["score", "c.jsonl", "--scenario", str(ALLEGRO), "--workers", "0"], "--workers"),
+    (["score", "c.jsonl", "--scenario", str(ALLEGRO), "--workers", "100000"], "--workers"),
+    (["score", "c.jsonl", "--scenario", str(ALLEGRO), "--top", "-1"], "--top"),
+    (["score", "c.jsonl"], "--scenario"),
+])
 def test_bad_planner_flags_are_usage_errors(argv, fragment, capsys):
     with pytest.raises(SystemExit) as e:
-        main(["solve", str(ALLEGRO), *argv])
+        main(argv)
     assert e.value.code == 2 and fragment in capsys.readouterr().err
 
 
