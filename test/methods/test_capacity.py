@@ -101,3 +101,25 @@ def test_the_capacity_scales_with_the_load(allegro, scale):
 
 def test_a_zero_load_has_no_finite_capacity(allegro):
     assert load_capacity(allegro, load=np.zeros(6)).status == "unbounded"
+
+
+def random_grasps(base, count, seed):
+    """Seeded grasps near the bundled one: joints moved up to 0.08 rad, a random load."""
+    rng = np.random.default_rng(seed)
+    hand = base.hand
+    for _ in range(count):
+        q = base.q.copy()
+        q[hand.idx_q] += rng.uniform(-0.08, 0.08, hand.m)
+        d = rng.normal(size=3)
+        w = np.concatenate((1.47 * rng.uniform(0.3, 2.0) * d / np.linalg.norm(d),
+                            rng.normal(size=3) * 0.004))
+        yield dataclasses.replace(base, q=q, external_wrench=w)
+
+
+def test_capacity_equals_an_independent_lp_on_random_grasps(allegro):
+    for setup in random_grasps(allegro, 8, seed=11):
+        maps = setup.maps()
+        cap = load_capacity(setup, maps)
+        alpha, _ = lp_capacity(setup, maps, setup.external_wrench)
+        assert cap.status == "optimal" and cap.certificate.ok
+        assert cap.value == pytest.approx(alpha, rel=1e-6)

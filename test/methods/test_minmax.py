@@ -82,3 +82,18 @@ def test_the_objective_key_of_the_scenario(allegro_doc):
 def test_minmax_with_a_reference_method_is_refused(allegro):
     with pytest.raises(InputError, match="objective.type: min-max is solved by the tau-qp"):
         solve(dataclasses.replace(allegro, objective="min-max"), "socp")
+
+
+def test_minmax_equals_an_independent_lp_on_random_grasps(allegro):
+    from test_capacity import random_grasps
+
+    for setup in random_grasps(dataclasses.replace(allegro, objective="min-max"), 8, seed=12):
+        maps = setup.maps()
+        sol = solve(setup, maps=maps)
+        best = lp_minmax(setup, maps)
+        if best is None:
+            assert sol.status == "infeasible"
+            continue
+        assert sol.optimal, sol.message
+        assert_holds(setup, maps, sol.tau, sol.wrenches)
+        assert ratio(setup, sol.tau) == pytest.approx(best, rel=1e-6, abs=1e-9)
