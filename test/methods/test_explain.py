@@ -10,10 +10,9 @@ from grasp_torque_opt.methods.explain import explain
 from grasp_torque_opt.methods.dispatch import solve
 
 
-@pytest.mark.parametrize("load", [[14.715, 0, 0, 0, 0, 0], [0, 0, -12.0, 0, 0, 0],
-                                  [-9.0, 0, 0, 0.0, 0.2, 0]])
-def test_the_named_constraints_are_active_in_an_independent_solve(allegro, load):
-    setup = dataclasses.replace(allegro, external_wrench=np.array(load, float))
+def named_are_active(setup):
+    """The explanation's fraction equals an independent HiGHS LP's, and every constraint it
+    names is active at that LP's optimum."""
     maps = setup.maps()
     assert solve(setup, maps=maps).status == "infeasible"
     why = explain(setup, maps)
@@ -38,6 +37,19 @@ def test_the_named_constraints_are_active_in_an_independent_solve(allegro, load)
     assert f"{100 * alpha:.1f}%" in why.text
     for name, _ in binding.joints:
         assert name in why.text
+
+
+@pytest.mark.parametrize("load", [[14.715, 0, 0, 0, 0, 0], [0, 0, -12.0, 0, 0, 0],
+                                  [-9.0, 0, 0, 0.0, 0.2, 0]])
+def test_the_named_constraints_are_active_in_an_independent_solve(allegro, load):
+    named_are_active(dataclasses.replace(allegro, external_wrench=np.array(load, float)))
+
+
+def test_the_same_on_random_infeasible_grasps(allegro):
+    from test_capacity import random_grasps
+
+    for setup in random_grasps(allegro, 6, seed=21):
+        named_are_active(dataclasses.replace(setup, external_wrench=25 * setup.external_wrench))
 
 
 def test_a_holdable_load_is_explained_as_holdable(allegro):
