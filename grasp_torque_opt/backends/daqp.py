@@ -91,17 +91,24 @@ class DaqpSolver:
         self._dims: tuple[int, int, int] | None = None
         self._keep: tuple = ()
 
-    def solve(self, qp: TauQP, cold: bool = False) -> RawResult:
+    def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
+              ) -> RawResult:
         """Solve a built tau-QP (warm if enabled and verified, else cold).
 
         Args:
             qp: the QP.
             cold: start cold even with ``warm_start`` (the caller's redo of a warm
                 answer that failed its certificate; counted in ``fallbacks``).
+            deadline: ``time.perf_counter()`` value [s]: past it, no solve starts
+                (an error result). A DAQP solve itself is bounded by ``max_iter``
+                iterations of a few microseconds each; DAQP 0.11's ``time_limit``
+                setting did not stop a plain QP here (docs/design.md section 2.2).
         """
         if cold and self.last_warm:
             self.fallbacks += 1
         self.last_warm = False
+        if deadline is not None and time.perf_counter() >= deadline:
+            return RawResult("error", None, 0, 0.0, "time budget spent before DAQP started")
         why = check_data(qp)
         if why:
             return RawResult("error", None, 0, 0.0, why)

@@ -16,6 +16,10 @@ solution after a fault is published at once (recovery).
 A cycle that fails in any way (a solver that raises, a status other than
 solved, a certificate that fails, an unexpected exception) is such a fault; so
 is a cycle that overruns ``cycle_budget``: its command is late and is dropped.
+The solvers are given the cycle's budget (:meth:`TorqueController.budget`) as
+a deadline that they keep themselves, so a cycle ends within about its budget
+whatever the parameters; and the inputs are checked fresh again when the
+command leaves, not only when the cycle starts.
 
 Input rules (docs/node.md, "Faults" and "Input checks"): every message is checked
 whole before it is kept (sizes, names, finite values, unit quaternions, known
@@ -79,6 +83,7 @@ class CycleConfig:
         stamp_future_tolerance: a header stamp more than this ahead of the clock
             is rejected [s].
         cycle_budget: a cycle that takes longer publishes nothing (overrun) [s].
+            Its solvers stop by the budget (with joint_state_timeout if smaller).
         method: ``tau-qp`` (the paper's polygon) or ``tau-qp-adaptive`` (the
             exact-cone optimum with certified bounds, docs/adaptive.md; DAQP).
     """
@@ -507,8 +512,20 @@ class TorqueController:
         return dataclasses.replace(setup, q=q, contacts=contacts, external_wrench=wrench,
                                    torque_offset=g), g
 
-    def solve_inputs(self, inputs: Inputs) -> tuple[Solution, GraspMaps, np.ndarray | None]:
+    def budget(self) -> float:
+        """The time a cycle's solvers may take [s]: ``cycle_budget``, or
+        ``joint_state_timeout`` if smaller (a command later than that would answer a
+        stale joint state)."""
+        return min(self.config.cycle_budget, self.config.joint_state_timeout)
+
+    def solve_inputs(self, inputs: Inputs, deadline: float | None = None
+                     ) -> tuple[Solution, GraspMaps, np.ndarray | None]:
         """Solve the grasp of a snapshot of inputs with the tau-QP (certified).
+
+        Args:
+            inputs: the snapshot.
+            deadline: ``time.perf_counter()`` value by which the solvers stop [s]
+                (None: only their iteration caps).
 
         Raises:
             InputError: the inputs do not make a grasp (e.g. a tangent parallel to
@@ -518,7 +535,7 @@ class TorqueController:
         maps = setup.maps()
         sol = solve(setup, self.config.method, maps=maps, solver=self.solver,
                     fallback=self.fallback, tolerance=self.config.certificate_tolerance,
-                    refiner=self._refiner())
+                    refiner=self._refiner(), deadline=deadline)
         return sol, maps, g
 
     def _refiner(self) -> Refiner | None:
@@ -553,13 +570,15 @@ class TorqueController:
     def cycle(self, now: float) -> CycleResult:
         """One cycle on the latest inputs (run it on each new joint state).
 
-        Never raises: every failure is a fault, handled by the policy. A
-        certified command from a cycle that took longer than ``cycle_budget``
-        is not published (it answers a joint state older than the budget).
+        Never raises: every failure is a fault, handled by the policy. The
+        solvers stop by :meth:`budget`. A certified command from a cycle that
+        took longer than ``cycle_budget`` is not published (it answers a joint
+        state older than the budget), nor one whose inputs went stale while it
+        was computed (checked at ``now`` plus the cycle's time).
         """
         t0 = time.perf_counter()
         self.counters.cycles += 1
-        result = self._attempt(now)
+        result = self._attempt(now, t0 + self.budget())
         elapsed = time.perf_counter() - t0
         self.counters.max_cycle_time = max(self.counters.max_cycle_time, elapsed)
         if elapsed > self.config.cycle_budget:
@@ -568,6 +587,10 @@ class TorqueController:
                 result = self._faulted(now, f"cycle overrun ({1e3 * elapsed:.1f} ms > "
                                        f"cycle_budget {1e3 * self.config.cycle_budget:.1f} ms)",
                                        result.solution, result.maps, result.gravity_torque)
+        late = self.stale(now + elapsed) if result.kind == "solution" else ""
+        if late:
+            result = self._faulted(now + elapsed, f"inputs went stale during the cycle: {late}",
+                                   result.solution, result.maps, result.gravity_torque)
         if result.kind == "solution":
             if self.fault:
                 self.counters.recoveries += 1
@@ -580,13 +603,13 @@ class TorqueController:
         result.cycle_time = elapsed
         return result
 
-    def _attempt(self, now: float) -> CycleResult:
+    def _attempt(self, now: float, deadline: float) -> CycleResult:
         """Solve and gate; a certified command is returned, not yet committed."""
         reason = self.stale(now)
         if reason:
             return self._faulted(now, reason)
         try:
-            sol, maps, g = self.solve_inputs(self.inputs)
+            sol, maps, g = self.solve_inputs(self.inputs, deadline)
         except InputError as e:
             return self._faulted(now, f"inputs do not make a grasp: {e}")
         except GraspTorqueError as e:

@@ -10,6 +10,7 @@ the load even with the exact cone).
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import time
 
 import numpy as np
@@ -37,6 +38,27 @@ from grasp_torque_opt.reference.feasibility import linearized_feasible
 METHODS = ("tau-qp", "tau-qp-adaptive", "force-qp", "socp", "nlp")
 #: Methods whose feasible set is the linearized (polygon) one.
 LINEARIZED = ("tau-qp", "force-qp")
+#: Under a deadline, the share of the time left that the first backend may use; the
+#: fallback gets the rest (DAQP answered the Allegro's QPs in under 1 ms here).
+PRIMARY_SHARE = 0.8
+
+
+_TAKES_DEADLINE: dict[type, bool] = {}
+
+
+def _timed(solver, qp: TauQP, deadline: float | None, **kwargs) -> RawResult:
+    """``solver.solve(qp)``, with the deadline passed when there is one and the solver
+    takes it (every backend does; a solver of the caller's own that does not runs on
+    its iteration caps alone)."""
+    if deadline is not None:
+        takes = _TAKES_DEADLINE.get(type(solver))
+        if takes is None:
+            params = inspect.signature(solver.solve).parameters
+            takes = _TAKES_DEADLINE[type(solver)] = "deadline" in params or any(
+                p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+        if takes:
+            kwargs["deadline"] = deadline
+    return solver.solve(qp, **kwargs)
 
 
 def qp_answer(qp: TauQP, raw: RawResult
@@ -58,7 +80,8 @@ def qp_answer(qp: TauQP, raw: RawResult
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
           solver: TauQPSolver | None = None, backend: str = "proxsuite",
           fallback: TauQPSolver | None = None,
-          tolerance: float = DEFAULT_TOLERANCE, refiner: Refiner | None = None) -> Solution:
+          tolerance: float = DEFAULT_TOLERANCE, refiner: Refiner | None = None,
+          deadline: float | None = None) -> Solution:
     """Solve one grasp with one method and certify the result.
 
     Args:
@@ -76,6 +99,12 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         tolerance: certificate tolerance, SI units.
         refiner: tau-qp-adaptive's rounds (its settings: gap tolerance, rounds),
             reusable across calls; default :class:`Refiner` ().
+        deadline: ``time.perf_counter()`` value by which the tau-QP's solvers must
+            stop [s] (the node's cycle budget; None: only their iteration caps).
+            The first solver may use :data:`PRIMARY_SHARE` of the time left, the
+            fallback the rest; past it, the independent LP that tells an
+            infeasible load from a failed solve is skipped (status ``failed``,
+            "LP skipped").
 
     Returns:
         A solution whose status is ``optimal`` only if certified.
@@ -99,8 +128,10 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         t2 = time.perf_counter()
         solver = solver or make_solver(backend)
         used = getattr(solver, "name", backend)
+        first = None if deadline is None else \
+            t2 + PRIMARY_SHARE * max(0.0, deadline - t2)
         try:
-            raw = solver.solve(qp)
+            raw = _timed(solver, qp, first)
         except SolverError as e:
             if fallback is None:
                 raise
@@ -134,13 +165,13 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     if method == "tau-qp" and getattr(solver, "last_warm", False) and \
             raw.status == "solved" and cert is not None and not cert.ok:
         # A warm start that lands off the certificate is redone cold in the same call.
-        raw, tau, f = qp_answer(qp, solver.solve(qp, cold=True))
+        raw, tau, f = qp_answer(qp, _timed(solver, qp, first, cold=True))
         cert = certified(tau, f)
     timings["certify"] = time.perf_counter() - t3
     if method == "tau-qp" and fallback is not None and \
             not (raw.status == "solved" and cert is not None and cert.ok):
         t4 = time.perf_counter()
-        raw2, tau2, f2 = qp_answer(qp, fallback.solve(qp))
+        raw2, tau2, f2 = qp_answer(qp, _timed(fallback, qp, deadline))
         if raw2.status == "solved" and f2 is not None:
             cert2 = certified(tau2, f2)
             if cert2.ok:
@@ -159,7 +190,9 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         return out
     why = (f"solver: {raw.message}" if cert is None or cert.ok or raw.status != "solved"
            else f"solver: {raw.message}, certificate failed (worst residual {cert.worst:.3g})")
-    if method in LINEARIZED:
+    if method in LINEARIZED and deadline is not None and time.perf_counter() >= deadline:
+        out.message = f"not certified, LP skipped: time budget spent ({why})"
+    elif method in LINEARIZED:
         feasible = linearized_feasible(maps, setup.friction, setup.external_wrench,
                                        tau_min, tau_max)
         if feasible is False:

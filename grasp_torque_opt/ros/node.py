@@ -98,7 +98,8 @@ PARAMETERS: dict[str, Spec] = {
     "min_normal_force": Spec("Minimum normal force per contact [N].", 0.0, 1000.0),
     "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint.",
                           length="joints"),
-    "weights": Spec("Objective weights W (diagonal), per joint [-].", length="joints"),
+    "weights": Spec("Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the "
+                    "largest at most 1e6 times the smallest [-].", length="joints"),
     "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
                                  "limits then bound the sum."),
     "gravity": Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
@@ -123,8 +124,9 @@ PARAMETERS: dict[str, Spec] = {
                                  "stops commands [m].", 1e-3, 100.0),
     "stamp_future_tolerance": Spec("A header stamp more than this ahead of the node's clock "
                                    "is rejected [s].", 0.0, 3600.0),
-    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun) [s].",
-                         1e-4, 10.0),
+    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun); its "
+                         "solvers stop by it (or by joint_state_timeout if smaller) [s].",
+                         1e-4, 1.0),
     "solver.method": Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
                           "exact-cone optimum from QPs with a certified gap to it, "
                           "docs/adaptive.md; needs DAQP; about 3 times tau-qp's cycle with "
@@ -142,8 +144,10 @@ PARAMETERS: dict[str, Spec] = {
                               "solver.warm_start_fallbacks). No effect on quadprog."),
     "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
                            "[-].", 1e-12, 1e-4),
-    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 100000),
-    "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
+    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 10000),
+    "solver.max_iter_in": Spec("ProxSuite inner iteration cap; one outer iteration, up to "
+                               "this many inner ones, is how far a solve can run past its "
+                               "budget [-].", 1, 200),
     "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
                                   1e-12, 1e-2),
     "diagnostics_period": Spec("Period of /diagnostics [s] (1 Hz, as diagnostic_updater).",
@@ -175,6 +179,13 @@ def descriptor(name: str) -> ParameterDescriptor:
 CYCLE_METHODS = ("tau-qp", "tau-qp-adaptive")
 #: Values of ``solver.fallback``.
 FALLBACKS = (*BACKENDS, "none")
+#: Each weight's range, and the largest ratio of two weights: W's condition number
+#: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
+WEIGHT_RANGE = (1e-6, 1e6)
+MAX_WEIGHT_RATIO = 1e6
+#: Longest ProxSuite call of a ``~/solve`` request [s]: the service's worker shares
+#: Python's interpreter lock with the control loop, which ProxSuite holds while it runs.
+SERVICE_SLICE_S = 0.005
 
 
 def _fallback(backend: str, fallback: str) -> str | None:
@@ -208,6 +219,13 @@ def check(name: str, value: Any, m: int) -> str:
             return f"{name}: must be finite"
         if name in ("torque_limits", "weights") and not all(v > 0 for v in values):
             return f"{name}: every entry must be > 0"
+        if name == "weights":
+            low, high = WEIGHT_RANGE
+            if not all(low <= v <= high for v in values):
+                return f"{name}: every entry must be in [{low:g}, {high:g}]"
+            if max(values) > MAX_WEIGHT_RATIO * min(values):
+                return (f"{name}: the largest entry may be at most {MAX_WEIGHT_RATIO:g} times "
+                        f"the smallest, got {max(values) / min(values):.3g}")
         return ""
     if isinstance(value, float) and not math.isfinite(value):
         return f"{name}: must be finite"
@@ -278,6 +296,8 @@ class GraspTorqueNode(Node):
         self._service_controller = TorqueController(*self._configure(
             dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
             backend, False, fallback)
+        self._service_controller.solver = make_solver(
+            backend, self._service_controller.solver.settings, False, SERVICE_SLICE_S)
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
@@ -369,13 +389,14 @@ class GraspTorqueNode(Node):
         p = self._params()
         with self._lock:
             warm_loop = p["solver.warm_start"] and p["solver.backend"] != "quadprog"
-            for ctrl, warm in ((self.controller, warm_loop), (self._service_controller, False)):
+            for ctrl, warm, slice_s in ((self.controller, warm_loop, None),
+                                        (self._service_controller, False, SERVICE_SLICE_S)):
                 setup, config, solver = self._configure(ctrl.setup, p)
                 ctrl.setup, ctrl.config = setup, config
                 if solver != ctrl.solver.settings or \
                         p["solver.backend"] != getattr(ctrl.solver, "name", None) or \
                         warm != getattr(ctrl.solver, "warm_start", False):
-                    ctrl.solver = make_solver(p["solver.backend"], solver, warm)
+                    ctrl.solver = make_solver(p["solver.backend"], solver, warm, slice_s)
                 fallback = _fallback(p["solver.backend"], p["solver.fallback"])
                 if ctrl is self.controller and any(x.name == "solver.fallback" for x in params):
                     self._warn_missing_fallback()
@@ -522,7 +543,7 @@ class GraspTorqueNode(Node):
             if stale:
                 done.set_result((False, f"cannot solve: {stale}"))
                 return
-            sol, maps, g = ctrl.solve_inputs(inputs)
+            sol, maps, g = ctrl.solve_inputs(inputs, time.perf_counter() + ctrl.budget())
             cmd, _ = ctrl.gate(sol, g)
             d = solution_dict(sol, maps)
             d["command"] = None if cmd is None else [float(x) for x in cmd]

@@ -261,13 +261,63 @@ def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar)
     ctrl = fresh(planar, cycle_budget=1e-4, hold_time=1.0)
     ctrl.update_joint_state(*joint_state(planar), 0.0)
     r = ctrl.cycle(0.0)
-    assert r.command is None and r.fault.startswith("cycle overrun (") and r.cycle_time > 1e-4
+    # The solvers stop by the budget (a failed solve), or the cycle overruns it after a
+    # certified one: either way nothing is published.
+    assert r.command is None and r.cycle_time > 1e-4
+    assert r.fault.startswith("cycle overrun (") or "time budget spent" in r.fault, r.fault
     assert ctrl.counters.overruns == 1 and ctrl.counters.commands == 0
     assert ctrl.last_command is None and ctrl.counters.max_cycle_time == r.cycle_time
     ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=10.0)
     ctrl.update_joint_state(*joint_state(planar), 0.01)
     r = ctrl.cycle(0.01)
     assert r.kind == "solution" and ctrl.counters.recoveries == 1 and ctrl.fault == ""
+
+
+def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
+    """The issue's freeze: caps 100000 x 100000 and weights 1e-12/1e12 kept one ProxSuite
+    solve going for over 11 minutes. The cycle's solvers stop by its budget instead."""
+    from grasp_torque_opt.backends import make_solver
+    from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+
+    hard = dataclasses.replace(allegro, hand=dataclasses.replace(allegro.hand),
+                               weights=np.array([1e-12, 1e12] * 8))
+    ctrl = fresh(hard, cycle_budget=0.05, joint_state_timeout=1.0)
+    settings = ProxSuiteSettings(max_iter=100000, max_iter_in=100)
+    ctrl.solver = make_solver("proxsuite", settings)
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    t0 = time.perf_counter()
+    r = ctrl.cycle(0.0)
+    assert time.perf_counter() - t0 < 0.05 + 0.5
+    assert r.command is None and "time budget spent" in r.fault
+
+
+class Slow:
+    """A solver that answers correctly, late (it does not take a deadline)."""
+
+    def __init__(self, delay):
+        from grasp_torque_opt.backends.proxsuite import TauQPSolver
+
+        self.inner, self.delay = TauQPSolver(), delay
+        self.settings = self.inner.settings
+
+    def solve(self, qp):
+        time.sleep(self.delay)
+        return self.inner.solve(qp)
+
+
+def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar):
+    """Staleness is checked when the command leaves: cycle_budget 10 s but joint states
+    stale after 50 ms (the issue's command 4.2 s late)."""
+    ctrl = fresh(planar, cycle_budget=10.0, joint_state_timeout=0.05, hold_time=1.0)
+    ctrl.solver = Slow(0.08)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None and r.fault.startswith("inputs went stale during the cycle: "
+                                                     "joint_states stale")
+    assert ctrl.counters.commands == 0 and ctrl.last_command is None
+    ctrl.solver = Slow(0.0)
+    ctrl.update_joint_state(*joint_state(planar), 1.0)
+    assert ctrl.cycle(1.0).kind == "solution"
 
 
 # -- fault injection: solvers that fail in every way ----------------------------------------

@@ -110,6 +110,13 @@ def test_service_says_why_without_inputs(planar_node):
     ("fault_policy", "explode", "fault_policy: must be one of hold, zero"),
     ("mu_tangential", 0.0, "mu_tangential"),
     ("joints", ["joint1"], "read-only parameter: joints"),
+    # The freeze: accepted as in range, they let one solve run for minutes.
+    ("solver.max_iter", 100000, "solver.max_iter"),
+    ("solver.max_iter_in", 100000, "solver.max_iter_in"),
+    ("weights", [1e-12, 1e12, 1e-12, 1e12], "weights: every entry must be in [1e-06, 1e+06]"),
+    ("weights", [1e-4, 1e3, 1.0, 1.0], "weights: the largest entry may be at most 1e+06 times "
+     "the smallest, got 1e+07"),
+    ("cycle_budget", 10.0, "cycle_budget"),
 ])
 def test_bad_parameter_is_refused_with_its_reason(planar_node, name, value, reason):
     before = planar_node.node.get_parameter(name).value
