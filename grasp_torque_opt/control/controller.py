@@ -244,6 +244,9 @@ class TorqueController:
         self.counters = Counters()
         self.last_command: np.ndarray | None = None
         self.last_command_time: float | None = None
+        #: The last command returned for publishing, certified or the zero policy's: what
+        #: the effort controller holds (it has no timeout) [N m].
+        self.in_force: np.ndarray | None = None
         self.last: CycleResult | None = None
         self.fault = ""
         self.last_rejection = ""
@@ -596,6 +599,7 @@ class TorqueController:
                 self.counters.recoveries += 1
             self.fault = ""
             self.last_command, self.last_command_time = result.command, now
+            self.in_force = result.command
             self.counters.commands += 1
             if self.fallback is not None and result.solution.backend == self.fallback.name:
                 self.counters.fallback_solves += 1
@@ -645,10 +649,49 @@ class TorqueController:
         held = (self.last_command_time is not None
                 and now - self.last_command_time <= self.config.hold_time)
         if not held and self.config.fault_policy == "zero":
-            cmd = np.zeros(self.setup.hand.m)
-            self.counters.zero_commands += 1
-            result = CycleResult(cmd, "zero", sol, maps, g, reason)
+            result = self._zero(reason, sol, maps, g)
         else:
             result = CycleResult(None, "none", sol, maps, g, reason)
         self.last = result
         return result
+
+    def _zero(self, reason: str, sol: Solution | None = None, maps: GraspMaps | None = None,
+              g: np.ndarray | None = None) -> CycleResult:
+        cmd = np.zeros(self.setup.hand.m)
+        self.counters.zero_commands += 1
+        self.in_force = cmd
+        return CycleResult(cmd, "zero", sol, maps, g, reason)
+
+    def reconfigured(self, now: float) -> CycleResult | None:
+        """After a parameter change: make the command in force valid at once.
+
+        The rule (docs/node.md, "Faults"): the cycle runs again at once on the
+        latest inputs with the new parameters, and a certified command is
+        returned for publishing. If none comes out (stale inputs, an
+        unholdable grasp, a failed solve) and the command in force exceeds the
+        new torque limits, zero torques are returned, whatever
+        ``fault_policy`` says: the effort controller would otherwise hold a
+        torque the user has just forbidden. Otherwise the usual fault path
+        applies (hold, then the policy).
+
+        Returns:
+            The result to publish, or None (nothing was ever commanded, or
+            nothing to publish now).
+        """
+        if self.in_force is None:
+            return None
+        result = None
+        if self.inputs.q is not None and not self.stale(now):
+            result = self.cycle(now)
+            if result.kind == "solution":
+                return result
+        lim = self.setup.hand.torque_limits
+        if self.in_force.shape == lim.shape and np.all(np.abs(self.in_force) <= lim):
+            return result if result is not None and result.command is not None else None
+        why = result.fault if result is not None else self.stale(now)
+        reason = "the command in force exceeds the new torque_limits" + (f" ({why})" if why else "")
+        if not self.fault:
+            self.counters.faults += 1
+        self.fault = reason
+        self.last = self._zero(reason)
+        return self.last

@@ -240,6 +240,7 @@ class GraspTorqueNode(Node):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.Lock()
+        self._last_stamp = None  # header stamp of the last accepted joint state
         setup = self._load_setup()
         self._m = setup.hand.m
         defaults = {
@@ -403,6 +404,11 @@ class GraspTorqueNode(Node):
                 if fallback != getattr(ctrl.fallback, "name", None) or \
                         (ctrl.fallback is not None and ctrl.fallback.settings != solver):
                     ctrl.fallback = make_solver(fallback, solver) if fallback else None
+            # The change acts on the command in force at once (a new certified command,
+            # or zeros if the one in force is now over the limits), not at the next cycle.
+            result = self.controller.reconfigured(time.monotonic())
+            if result is not None:
+                self._publish(result, self._last_stamp)
 
     def _warn_missing_fallback(self) -> None:
         name = self.get_parameter("solver.fallback").value
@@ -429,6 +435,7 @@ class GraspTorqueNode(Node):
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
                 return
+            self._last_stamp = msg.header.stamp
             self._publish(self.controller.cycle(now), msg.header.stamp)
 
     def _on_contacts(self, msg: PoseArray) -> None:

@@ -320,6 +320,52 @@ def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar)
     assert ctrl.cycle(1.0).kind == "solution"
 
 
+def with_limits(ctrl, limit):
+    """The controller after a torque_limits change (as the node applies one)."""
+    hand = dataclasses.replace(ctrl.setup.hand,
+                               torque_limits=np.full(ctrl.setup.hand.m, float(limit)))
+    ctrl.setup = dataclasses.replace(ctrl.setup, hand=hand)
+
+
+@pytest.mark.parametrize("policy", ["hold", "zero"])
+def test_lowered_limits_act_on_the_command_in_force_at_once(allegro, policy):
+    """The issue: 0.63 N m in force, limits lowered to 0.2 N m (the grasp unholdable), hold
+    policy: nothing new was published and the controller kept 0.63 N m forever."""
+    ctrl = fresh(allegro, fault_policy=policy, hold_time=1.0, joint_state_timeout=1.0)
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    w = allegro.external_wrench * 6.2
+    ctrl.update_wrench("", w[:3], w[3:], 0.0)
+    first = ctrl.cycle(0.0)
+    assert first.kind == "solution" and 0.6 < np.abs(first.command).max() < 0.7
+    # Still holdable within 0.65: the new certified command at once.
+    with_limits(ctrl, 0.65)
+    r = ctrl.reconfigured(0.01)
+    assert r.kind == "solution" and np.all(np.abs(r.command) <= 0.65)
+    # Unholdable within 0.2: zeros at once, whatever the policy (within hold_time too).
+    with_limits(ctrl, 0.2)
+    r = ctrl.reconfigured(0.02)
+    assert r.kind == "zero" and np.all(r.command == 0.0)
+    assert r.fault.startswith("the command in force exceeds the new torque_limits")
+    np.testing.assert_array_equal(ctrl.in_force, np.zeros(allegro.hand.m))
+    # Zeros are within any limit: a further change publishes nothing new.
+    with_limits(ctrl, 0.1)
+    assert ctrl.reconfigured(0.03) is None
+    # Raised again: the next cycle recovers.
+    with_limits(ctrl, 0.7)
+    ctrl.update_joint_state(*joint_state(allegro), 0.04)
+    assert ctrl.cycle(0.04).kind == "solution" and ctrl.fault == ""
+
+
+def test_lowered_limits_with_stale_inputs_zero_at_once(planar):
+    ctrl = fresh(planar, fault_policy="hold", joint_state_timeout=0.05, hold_time=10.0)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    cmd = ctrl.cycle(0.0).command
+    assert ctrl.reconfigured(1.0) is None  # stale, but the command in force is within limits
+    with_limits(ctrl, 0.5 * float(np.abs(cmd).max()))
+    r = ctrl.reconfigured(1.0)
+    assert r.kind == "zero" and "joint_states stale" in r.fault
+
+
 # -- fault injection: solvers that fail in every way ----------------------------------------
 
 

@@ -15,6 +15,7 @@ import pytest
 import rclpy
 from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
 from cycle_inputs import base_poses, joint_state
+from geometry_msgs.msg import WrenchStamped
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
@@ -394,5 +395,26 @@ def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, ba
         np.testing.assert_allclose(after, before, atol=1e-6)
         refused = h.node.set_parameters([Parameter("solver.backend", value="osqp")])[0]
         assert not refused.successful and "solver.backend" in refused.reason
+    finally:
+        h.close()
+
+
+def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegro):
+    """Hold policy, 0.63 N m in force, torque_limits lowered to 0.2 N m (unholdable): zeros
+    reach the effort controller at once, without another joint state; before, nothing new
+    was published and the controller kept 0.63 N m forever."""
+    h = Harness(ALLEGRO, fault_policy="hold", hold_time=10.0, joint_state_timeout=10.0)
+    try:
+        w = WrenchStamped()
+        w.wrench.force.x = float(allegro.external_wrench[0] * 6.2)
+        h.wrench_pub.publish(w)
+        h.spin_for(0.2)
+        h.send_joint_state(*joint_state(allegro))
+        cmd = h.next_command()
+        assert cmd is not None and np.abs(cmd).max() > 0.6
+        n = len(h.commands)
+        assert h.node.set_parameters([Parameter("torque_limits", value=[0.2] * 16)])[0].successful
+        assert h.spin_until(lambda: len(h.commands) > n, 2.0)
+        assert np.all(h.commands[-1][1] == 0.0) and len(h.commands) == n + 1
     finally:
         h.close()
