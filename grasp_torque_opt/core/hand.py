@@ -14,6 +14,9 @@ import pinocchio as pin
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
 
 ERD_PREFIX = "example-robot-data:"
+#: Largest torque limit accepted at all [N m], also when a limit above the URDF's effort
+#: limit is allowed: a bound on what any command can be (1e300 was accepted once).
+MAX_TORQUE_LIMIT = 1e4
 
 
 def example_robot_data_dir() -> Path:
@@ -121,9 +124,37 @@ class Hand:
         return [model.names[j] for j in range(1, model.njoints)
                 if model.joints[j].nq == 1 and model.joints[j].nv == 1]
 
+    @property
+    def effort_limits(self) -> np.ndarray:
+        """The URDF's effort limit of each actuated joint [N m], inf where it gives none."""
+        e = np.asarray(self.model.effortLimit, dtype=float)[self.idx_v]
+        return np.where(np.isfinite(e) & (e > 0.0), e, np.inf)
+
+    @staticmethod
+    def check_limits(limits: np.ndarray, joints: list[str], bounds: np.ndarray,
+                     field: str, override: str) -> None:
+        """Each limit finite, > 0 and at most its bound (the URDF's effort limit).
+
+        Raises:
+            InputError: naming ``field`` and the first joint over its bound, and the
+                setting ``override`` that allows more.
+        """
+        if not np.all(np.isfinite(limits) & (limits > 0.0)):
+            raise InputError(field, "must be finite and > 0")
+        over = np.flatnonzero(limits > bounds)
+        if over.size:
+            i = int(over[0])
+            what = ("the URDF effort limit" if bounds[i] < MAX_TORQUE_LIMIT
+                    else "the largest limit accepted")
+            raise InputError(field, f"{limits[i]:g} N m for joint '{joints[i]}' exceeds "
+                             f"{what} ({bounds[i]:g} N m)" + (
+                                 f"; set {override}: true to allow it"
+                                 if bounds[i] < MAX_TORQUE_LIMIT else ""))
+
     @classmethod
     def from_model(cls, model: pin.Model, joints: list[str] | None = None,
-                   torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+                   torque_limits: float | list[float] | np.ndarray | None = None,
+                   above_urdf: bool = False) -> Hand:
         """Bind actuated joints and limits to a model.
 
         Args:
@@ -131,10 +162,13 @@ class Hand:
             joints: actuated joints in command order; None for every 1-DoF joint.
             torque_limits: scalar or per-joint bound [N m]; None for the URDF
                 effort limits.
+            above_urdf: allow limits above the URDF's effort limits (up to
+                :data:`MAX_TORQUE_LIMIT`).
 
         Raises:
             JointNotFound: a joint is not a 1-DoF joint of the model (``hand.joints[i]``).
-            InputError: a limit is missing or not positive (``hand.torque_limits``).
+            InputError: a limit is missing, not positive, or above the joint's URDF
+                effort limit without ``above_urdf`` (``hand.torque_limits``).
         """
         available = cls.one_dof_joints(model)
         if joints is None:
@@ -159,30 +193,37 @@ class Hand:
                                  f"must have {len(joints)} entries (one per joint), "
                                  f"got {limits.size}")
             limits = np.broadcast_to(limits, (len(joints),))
-            if not np.all(np.isfinite(limits) & (limits > 0.0)):
-                raise InputError("hand.torque_limits", "must be finite and > 0")
+            effort = np.asarray(model.effortLimit, dtype=float)[idx_v]
+            bounds = np.full(len(joints), MAX_TORQUE_LIMIT)
+            if not above_urdf:
+                known = np.isfinite(effort) & (effort > 0.0)
+                bounds[known] = np.minimum(effort[known], MAX_TORQUE_LIMIT)
+            cls.check_limits(limits, list(joints), bounds, "hand.torque_limits",
+                             "hand.torque_limits_above_urdf")
         return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
                    torque_limits=np.array(limits, dtype=float))
 
     @classmethod
     def from_urdf(cls, path: str | Path, joints: list[str] | None = None,
-                  torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+                  torque_limits: float | list[float] | np.ndarray | None = None,
+                  above_urdf: bool = False) -> Hand:
         """Load a hand from a URDF file (fixed base; meshes are not needed)."""
         try:
             model = pin.buildModelFromUrdf(str(path))
         except (RuntimeError, ValueError) as e:
             raise InputError("hand.urdf", f"cannot parse {path}: {e}") from e
-        return cls.from_model(model, joints, torque_limits)
+        return cls.from_model(model, joints, torque_limits, above_urdf)
 
     @classmethod
     def from_urdf_string(cls, xml: str, joints: list[str] | None = None,
-                         torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+                         torque_limits: float | list[float] | np.ndarray | None = None,
+                         above_urdf: bool = False) -> Hand:
         """Load a hand from a URDF document (e.g. the ``robot_description`` parameter)."""
         try:
             model = pin.buildModelFromXML(xml)
         except (RuntimeError, ValueError) as e:
             raise InputError("robot_description", f"cannot parse the URDF: {e}") from e
-        return cls.from_model(model, joints, torque_limits)
+        return cls.from_model(model, joints, torque_limits, above_urdf)
 
     def configuration(self, positions: dict[str, float],
                       field: str = "grasp.joint_positions") -> np.ndarray:

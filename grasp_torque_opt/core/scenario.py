@@ -102,6 +102,7 @@ class Scenario:
             object's weight and the node's default g(q) (docs/design.md section 4).
         extra_wrench: ``load.external_wrench`` as written: the load besides the
             object's weight, shape (6,) [N, N m].
+        torque_limits_above_urdf: allow torque limits above the URDF's effort limits.
     """
 
     urdf: str
@@ -118,6 +119,7 @@ class Scenario:
     object: ObjectSpec | None = None
     gravity: np.ndarray | None = None
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    torque_limits_above_urdf: bool = False
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
@@ -131,7 +133,7 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 
 
 _SECTIONS = {
-    "hand": {"urdf", "joints", "torque_limits"},
+    "hand": {"urdf", "joints", "torque_limits", "torque_limits_above_urdf"},
     "grasp": {"joint_positions", "object_origin", "contacts"},
     "friction": {"mu_tangential", "mu_torsional", "polygon_sides", "min_normal_force"},
     "load": {"external_wrench"},
@@ -257,6 +259,9 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
                                  f"got {len(limits)}")
         else:
             limits = _positive(limits, "hand.torque_limits")
+    above_urdf = hand.get("torque_limits_above_urdf", False)
+    if not isinstance(above_urdf, bool):
+        raise InputError("hand.torque_limits_above_urdf", "must be true or false")
 
     positions_raw = grasp.get("joint_positions") or {}
     if not isinstance(positions_raw, dict):
@@ -330,7 +335,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
                     joint_positions=positions, object_origin=origin, contacts=contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,
-                    object=obj, gravity=gravity, extra_wrench=extra)
+                    object=obj, gravity=gravity, extra_wrench=extra,
+                    torque_limits_above_urdf=above_urdf)
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -60,6 +60,7 @@ from grasp_torque_opt.control.controller import (
 )
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import MAX_TORQUE_LIMIT, Hand
 from grasp_torque_opt.core.report import solution_dict
 from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import load_scenario
@@ -96,8 +97,12 @@ PARAMETERS: dict[str, Spec] = {
     "mu_torsional": Spec("Torsional friction coefficient mu2 [m].", 1e-9, 1.0),
     "polygon_sides": Spec("Sides N of the inscribed friction polygon [-].", 3, 64),
     "min_normal_force": Spec("Minimum normal force per contact [N].", 0.0, 1000.0),
-    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint.",
-                          length="joints"),
+    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint; each at most "
+                          "the joint's URDF effort limit (the scenario's limit if the URDF "
+                          "gives none) unless torque_limits_above_urdf.", length="joints"),
+    "torque_limits_above_urdf": Spec("Allow torque_limits above the URDF's effort limits (up "
+                                     "to 1e4 N m); default: the scenario's "
+                                     "hand.torque_limits_above_urdf.", read_only=True),
     "weights": Spec("Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the "
                     "largest at most 1e6 times the smallest [-].", length="joints"),
     "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
@@ -194,8 +199,17 @@ def _fallback(backend: str, fallback: str) -> str | None:
     return None if fallback in ("none", backend) or not available(fallback) else fallback
 
 
-def check(name: str, value: Any, m: int) -> str:
-    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too."""
+def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None,
+          joints: list[str] | None = None) -> str:
+    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too.
+
+    Args:
+        name: the parameter.
+        value: its new value.
+        m: number of joints.
+        torque_bounds: the largest value of each torque limit [N m] (None: unchecked).
+        joints: joint names, for messages.
+    """
     spec = PARAMETERS[name]
     if name == "fault_policy":
         return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
@@ -219,6 +233,12 @@ def check(name: str, value: Any, m: int) -> str:
             return f"{name}: must be finite"
         if name in ("torque_limits", "weights") and not all(v > 0 for v in values):
             return f"{name}: every entry must be > 0"
+        if name == "torque_limits" and torque_bounds is not None:
+            try:
+                Hand.check_limits(np.array(values, dtype=float), joints or [], torque_bounds,
+                                  name, "torque_limits_above_urdf (read-only: at start)")
+            except InputError as e:
+                return str(e)
         if name == "weights":
             low, high = WEIGHT_RANGE
             if not all(low <= v <= high for v in values):
@@ -244,6 +264,7 @@ class GraspTorqueNode(Node):
         setup = self._load_setup()
         self._m = setup.hand.m
         defaults = {
+            "torque_limits_above_urdf": self._scenario.torque_limits_above_urdf,
             "object_origin": [float(x) for x in setup.object_origin],
             "mu_tangential": setup.friction.mu1,
             "mu_torsional": setup.friction.mu2,
@@ -282,8 +303,10 @@ class GraspTorqueNode(Node):
         }
         for name, value in defaults.items():
             self.declare_parameter(name, value, descriptor(name))
+        self._torque_bounds = self._limit_bounds(
+            setup.hand, self.get_parameter("torque_limits_above_urdf").value)
         for name in defaults:
-            reason = check(name, self.get_parameter(name).value, self._m)
+            reason = self._check(name, self.get_parameter(name).value)
             if reason:
                 raise InputError(name, reason.split(": ", 1)[1])
         self._base_setup = setup
@@ -336,7 +359,7 @@ class GraspTorqueNode(Node):
         if not name:
             raise InputError("scenario", "parameter not set (a scenario file gives the "
                              "default contacts and load)")
-        scenario = load_scenario(find_config(name))
+        scenario = self._scenario = load_scenario(find_config(name))
         self._scenario_gravity = scenario.gravity
         if urdf and not urdf.lstrip().startswith("<"):
             urdf = find_config(urdf, "robot_description").read_text()
@@ -346,7 +369,20 @@ class GraspTorqueNode(Node):
         if list(joints) != list(setup.hand.joints):
             setup = GraspSetup.from_scenario(dataclasses.replace(scenario, joints=list(joints)),
                                              urdf or None)
+        self._base_joints = list(setup.hand.joints)
         return setup
+
+    @staticmethod
+    def _limit_bounds(hand: Hand, above_urdf: bool) -> np.ndarray:
+        """The largest torque limit per joint [N m]: the URDF's effort limit, the
+        scenario's limit where the URDF gives none; MAX_TORQUE_LIMIT if allowed above."""
+        if above_urdf:
+            return np.full(hand.m, MAX_TORQUE_LIMIT)
+        effort = hand.effort_limits
+        return np.where(np.isfinite(effort), effort, hand.torque_limits)
+
+    def _check(self, name: str, value: Any) -> str:
+        return check(name, value, self._m, self._torque_bounds, self._base_joints)
 
     def _params(self) -> dict[str, Any]:
         return {name: self.get_parameter(name).value for name in PARAMETERS}
@@ -381,7 +417,7 @@ class GraspTorqueNode(Node):
     def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
         for param in params:
             if param.name in PARAMETERS:
-                reason = check(param.name, param.value, self._m)
+                reason = self._check(param.name, param.value)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
         return SetParametersResult(successful=True)

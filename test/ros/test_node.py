@@ -118,6 +118,11 @@ def test_service_says_why_without_inputs(planar_node):
     ("weights", [1e-4, 1e3, 1.0, 1.0], "weights: the largest entry may be at most 1e+06 times "
      "the smallest, got 1e+07"),
     ("cycle_budget", 10.0, "cycle_budget"),
+    # Unbounded limits: 1e6 and 1e300 N m were accepted (URDF effort limits 10, 5, 10, 5).
+    ("torque_limits", [1e6, 1.0, 1.0, 1.0], "torque_limits: 1e+06 N m for joint 'joint1' "
+     "exceeds the URDF effort limit (10 N m); set torque_limits_above_urdf"),
+    ("torque_limits", [1.0, 1.0, 1.0, 1e300], "exceeds the URDF effort limit (5 N m)"),
+    ("torque_limits", [10.0, 5.0, 10.0, 5.1], "joint 'joint4'"),
 ])
 def test_bad_parameter_is_refused_with_its_reason(planar_node, name, value, reason):
     before = planar_node.node.get_parameter(name).value
@@ -416,5 +421,19 @@ def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegr
         assert h.node.set_parameters([Parameter("torque_limits", value=[0.2] * 16)])[0].successful
         assert h.spin_until(lambda: len(h.commands) > n, 2.0)
         assert np.all(h.commands[-1][1] == 0.0) and len(h.commands) == n + 1
+    finally:
+        h.close()
+
+
+def test_limits_above_the_urdf_only_when_allowed_at_start(planar):
+    h = Harness(PLANAR, torque_limits_above_urdf=True)
+    try:
+        node = h.node
+        assert node.set_parameters([Parameter("torque_limits", value=[20.0] * 4)])[0].successful
+        refused = node.set_parameters([Parameter("torque_limits", value=[2e4] * 4)])[0]
+        assert not refused.successful and "exceeds the largest limit accepted (10000 N m)" in \
+            refused.reason
+        h.send_joint_state(*joint_state(planar))
+        assert h.next_command() is not None
     finally:
         h.close()
