@@ -168,6 +168,22 @@ PARAMETERS: dict[str, Spec] = {
 }
 
 
+def received(info: dict | None) -> float:
+    """When the middleware received a message, on the monotonic clock [s].
+
+    rmw's message info carries ``received_timestamp``: the system clock
+    (``CLOCK_REALTIME``) of this host when the subscription's middleware took the
+    message in, before it waited in the queue for the executor. Its age on the
+    system clock, taken from now on the monotonic clock, is the receipt time
+    (a clock step between the two counts as no wait; a message without it: now).
+    """
+    now = time.monotonic()
+    ns = (info or {}).get("received_timestamp") or 0
+    if ns <= 0:
+        return now
+    return now - max(0.0, (time.time_ns() - ns) * 1e-9)
+
+
 def descriptor(name: str) -> ParameterDescriptor:
     """The ParameterDescriptor of a parameter of :data:`PARAMETERS`."""
     spec = PARAMETERS[name]
@@ -257,7 +273,13 @@ def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None
 class GraspTorqueNode(Node):
     """Publishes certified effort commands on each joint state; answers ``~/solve``."""
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
+        """Args:
+            message_info: age inputs from the middleware's receipt time (rmw message
+                info); False: from the callback's time (rclpy 7.1's EventsExecutor
+                raises SystemError on subscriptions that take message info).
+            kwargs: for rclpy's Node (context, parameter_overrides, ...).
+        """
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.Lock()
         self._last_stamp = None  # header stamp of the last accepted joint state
@@ -325,12 +347,15 @@ class GraspTorqueNode(Node):
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
-        self.create_subscription(JointState, "joint_states", self._on_joint_state,
-                                 qos_profile_sensor_data)
-        self.create_subscription(PoseArray, "contacts", self._on_contacts,
-                                 qos_profile_sensor_data)
-        self.create_subscription(WrenchStamped, "external_wrench", self._on_wrench,
-                                 qos_profile_sensor_data)
+        # With message info, inputs are aged from when the middleware received them.
+        for msg_type, topic, take in ((JointState, "joint_states", self._on_joint_state),
+                                      (PoseArray, "contacts", self._on_contacts),
+                                      (WrenchStamped, "external_wrench", self._on_wrench)):
+            if message_info:
+                callback = (lambda take: lambda msg, info: take(msg, received(info)))(take)
+            else:
+                callback = take
+            self.create_subscription(msg_type, topic, callback, qos_profile_sensor_data)
         self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
                                                   COMMAND_QOS)
         self._stamped_pub = None
@@ -458,24 +483,27 @@ class GraspTorqueNode(Node):
         """Now on the node's clock (ROS time), the clock of header stamps [s]."""
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _on_joint_state(self, msg: JointState) -> None:
+    def _on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
+        """A joint state; ``receipt``: when the middleware received it (monotonic [s];
+        None: now)."""
         now = time.monotonic()
+        receipt = now if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
                 # Sizes first: an oversized message is not even copied.
                 self.controller.check_size("joint_states",
                                            max(len(msg.name), len(msg.position)))
-                self.controller.update_joint_state(list(msg.name), list(msg.position), now,
-                                                   stamp, self._clock_now())
+                self.controller.update_joint_state(list(msg.name), list(msg.position),
+                                                   receipt, stamp, self._clock_now())
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
                 return
             self._last_stamp = msg.header.stamp
             self._publish(self.controller.cycle(now), msg.header.stamp)
 
-    def _on_contacts(self, msg: PoseArray) -> None:
-        now = time.monotonic()
+    def _on_contacts(self, msg: PoseArray, receipt: float | None = None) -> None:
+        now = time.monotonic() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
@@ -488,8 +516,8 @@ class GraspTorqueNode(Node):
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
 
-    def _on_wrench(self, msg: WrenchStamped) -> None:
-        now = time.monotonic()
+    def _on_wrench(self, msg: WrenchStamped, receipt: float | None = None) -> None:
+        now = time.monotonic() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         f, t = msg.wrench.force, msg.wrench.torque
         with self._lock:
@@ -667,7 +695,7 @@ def main(args: list[str] | None = None) -> int:
     executor = None
     code = 0
     try:
-        node = GraspTorqueNode()
+        node = GraspTorqueNode(message_info=opts.executor != "events")
         # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()

@@ -437,3 +437,20 @@ def test_limits_above_the_urdf_only_when_allowed_at_start(planar):
         assert h.next_command() is not None
     finally:
         h.close()
+
+
+def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothing(planar):
+    """Inputs are aged from the middleware's receipt, not from the callback: a joint state
+    that waited 0.3 s for the executor (timeout 0.1 s) is stale when its callback runs. Before,
+    a flood or a slow cycle let commands leave 165 ms after their joint state."""
+    h = Harness(PLANAR, joint_state_timeout=0.1, hold_time=10.0)
+    try:
+        h.send_joint_state(*joint_state(planar))
+        time.sleep(0.3)  # the executor is busy elsewhere: the message waits in the queue
+        h.spin_for(0.3)
+        assert h.commands == []
+        assert h.node.controller.fault.startswith("joint_states stale")
+        h.send_joint_state(*joint_state(planar))
+        assert h.next_command() is not None  # taken at once: fresh
+    finally:
+        h.close()
