@@ -74,6 +74,8 @@ class CycleConfig:
         gravity_compensation: add the fingers' own gravity torques g(q).
         gravity: gravity in the base frame [m/s^2], shape (3,).
         certificate_tolerance: tolerance of the certificate (SI units).
+        max_message_bytes: a message whose serialized form is longer than this is
+            rejected before it is deserialized [bytes].
         max_joint_state_entries: a joint state with more names or positions than
             this is rejected unread [-].
         max_wrench_force: a load whose force norm exceeds this is rejected [N].
@@ -97,6 +99,7 @@ class CycleConfig:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     certificate_tolerance: float = DEFAULT_TOLERANCE
     max_joint_state_entries: int = 256
+    max_message_bytes: int = 65536
     max_wrench_force: float = 1000.0
     max_wrench_torque: float = 100.0
     max_contact_distance: float = 1.0
@@ -256,6 +259,19 @@ class TorqueController:
                               for j in range(1, model.njoints) if model.joints[j].nq == 1}
 
     # -- inputs ---------------------------------------------------------------------------
+
+    def check_bytes(self, source: str, n: int) -> None:
+        """Reject a message by the length of its serialized form, before it is deserialized
+        (5.6 MB of poses took 0.8 s to deserialize here, holding up the loop).
+
+        Raises:
+            InputError: more than ``max_message_bytes`` (counted as a rejection).
+        """
+        limit = self.config.max_message_bytes
+        if n > limit:
+            e = InputError(source, f"{n} bytes serialized, more than max_message_bytes ({limit})")
+            self._reject(source, e)
+            raise e
 
     def check_size(self, source: str, n: int) -> None:
         """Reject a message by its size alone, before it is read.

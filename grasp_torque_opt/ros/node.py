@@ -35,6 +35,7 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 from rclpy.utilities import remove_ros_args
@@ -119,6 +120,9 @@ PARAMETERS: dict[str, Spec] = {
     "fault_policy": Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
                          "controller keeps the last certified command) or 'zero' (publish "
                          "zero torques)."),
+    "max_message_bytes": Spec("A message on joint_states, contacts or external_wrench whose "
+                              "serialized form is longer than this is rejected before it is "
+                              "deserialized [bytes].", 1024, 16777216),
     "max_joint_state_entries": Spec("A joint state with more names or positions than this is "
                                     "rejected unread [-].", 1, 100000),
     "max_wrench_force": Spec("A load whose force norm exceeds this is rejected [N].",
@@ -303,6 +307,7 @@ class GraspTorqueNode(Node):
             "wrench_timeout": 0.5,
             "hold_time": 0.1,
             "fault_policy": "hold",
+            "max_message_bytes": CycleConfig.max_message_bytes,
             "max_joint_state_entries": CycleConfig.max_joint_state_entries,
             "max_wrench_force": CycleConfig.max_wrench_force,
             "max_wrench_torque": CycleConfig.max_wrench_torque,
@@ -347,15 +352,19 @@ class GraspTorqueNode(Node):
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
-        # With message info, inputs are aged from when the middleware received them.
+        # Serialized (raw): a message is measured before it is deserialized. With message
+        # info, inputs are aged from when the middleware received them.
         for msg_type, topic, take in ((JointState, "joint_states", self._on_joint_state),
                                       (PoseArray, "contacts", self._on_contacts),
                                       (WrenchStamped, "external_wrench", self._on_wrench)):
+            def callback(data, info=None, msg_type=msg_type, topic=topic, take=take):
+                self._on_serialized(topic, msg_type, data, take, info)
             if message_info:
-                callback = (lambda take: lambda msg, info: take(msg, received(info)))(take)
+                sub_callback = (lambda cb: lambda data, info: cb(data, info))(callback)
             else:
-                callback = take
-            self.create_subscription(msg_type, topic, callback, qos_profile_sensor_data)
+                sub_callback = (lambda cb: lambda data: cb(data))(callback)
+            self.create_subscription(msg_type, topic, sub_callback, qos_profile_sensor_data,
+                                     raw=True)
         self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
                                                   COMMAND_QOS)
         self._stamped_pub = None
@@ -431,6 +440,7 @@ class GraspTorqueNode(Node):
             gravity_compensation=p["gravity_compensation"], gravity=tuple(p["gravity"]),
             certificate_tolerance=p["certificate_tolerance"],
             max_joint_state_entries=p["max_joint_state_entries"],
+            max_message_bytes=p["max_message_bytes"],
             max_wrench_force=p["max_wrench_force"], max_wrench_torque=p["max_wrench_torque"],
             max_contact_distance=p["max_contact_distance"],
             stamp_future_tolerance=p["stamp_future_tolerance"],
@@ -482,6 +492,19 @@ class GraspTorqueNode(Node):
     def _clock_now(self) -> float:
         """Now on the node's clock (ROS time), the clock of header stamps [s]."""
         return self.get_clock().now().nanoseconds * 1e-9
+
+    def _on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
+                       info: dict | None) -> None:
+        """A message as the middleware delivered it: its length checked, then deserialized
+        and taken (``take(msg, receipt)``)."""
+        receipt = received(info) if info is not None else None
+        with self._lock:
+            try:
+                self.controller.check_bytes(topic, len(data))
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                return
+        take(deserialize_message(data, msg_type), receipt)
 
     def _on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
         """A joint state; ``receipt``: when the middleware received it (monotonic [s];

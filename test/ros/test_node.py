@@ -15,7 +15,7 @@ import pytest
 import rclpy
 from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
 from cycle_inputs import base_poses, joint_state
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import PoseArray, WrenchStamped
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
@@ -452,5 +452,23 @@ def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothin
         assert h.node.controller.fault.startswith("joint_states stale")
         h.send_joint_state(*joint_state(planar))
         assert h.next_command() is not None  # taken at once: fresh
+    finally:
+        h.close()
+
+
+def test_an_oversized_message_is_rejected_before_it_is_deserialized(planar):
+    """20000 poses (1.1 MB) on contacts: refused by its serialized length. Deserializing
+    10^5 poses took 0.8 s here, and a flood of them cut the command rate from 200 to 38 Hz."""
+    from geometry_msgs.msg import Pose
+
+    h = Harness(PLANAR)
+    try:
+        big = PoseArray(poses=[Pose() for _ in range(20000)])
+        h.contacts_pub.publish(big)
+        assert h.spin_until(lambda: h.node.controller.counters.rejected["contacts"] == 1, 5.0)
+        assert h.node.controller.last_rejection == \
+            "contacts: 1120028 bytes serialized, more than max_message_bytes (65536)"
+        h.send_joint_state(*joint_state(planar))  # the loop goes on
+        np.testing.assert_allclose(h.next_command(), solve(planar).tau, atol=1e-9)
     finally:
         h.close()
