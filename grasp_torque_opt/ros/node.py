@@ -61,9 +61,9 @@ from grasp_torque_opt.control.controller import (
 )
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.hand import MAX_TORQUE_LIMIT, Hand
+from grasp_torque_opt.core.hand import MAX_TORQUE_LIMIT, MAX_URDF_BYTES, Hand
 from grasp_torque_opt.core.report import solution_dict
-from grasp_torque_opt.core.resources import find_config
+from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
 from grasp_torque_opt.core.scenario import load_scenario
 
 NODE_NAME = "grasp_torque_node"
@@ -396,7 +396,9 @@ class GraspTorqueNode(Node):
         scenario = self._scenario = load_scenario(find_config(name))
         self._scenario_gravity = scenario.gravity
         if urdf and not urdf.lstrip().startswith("<"):
-            urdf = find_config(urdf, "robot_description").read_text()
+            path = find_config(urdf, "robot_description")
+            urdf = decode_utf8(read_bounded(path, "robot_description", MAX_URDF_BYTES), path,
+                               "robot_description")
         setup = GraspSetup.from_scenario(scenario, urdf or None)
         joints = self.declare_parameter("joints", list(setup.hand.joints),
                                         descriptor("joints")).value
