@@ -358,6 +358,11 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
                              f"must have {len(joints)} entries (one per joint), "
                              f"got {len(weights)}")
 
+    if joints is None and (isinstance(limits, list) or weights is not None):
+        per_joint = "hand.torque_limits" if isinstance(limits, list) else "objective.weights"
+        raise InputError("hand.joints", f"required when {per_joint} gives one value per joint "
+                         "(without it the values would follow Pinocchio's joint order, which "
+                         "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
                     joint_positions=positions, object_origin=origin, contacts=contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,

@@ -381,8 +381,9 @@ class GraspTorqueNode(Node):
                           self._on_diagnostics)
         self.create_timer(self.get_parameter("marker_period").value, self._on_markers)
         self.get_logger().info(
-            f"{self._m} joints, {len(setup.contacts)} default contacts; "
-            f"commands on {self._command_pub.topic_name}")
+            f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
+            f"{len(setup.contacts)} default contacts; commands on "
+            f"{self._command_pub.topic_name}")
 
     # -- configuration --------------------------------------------------------------------
 
