@@ -300,10 +300,13 @@ class TorqueController:
 
         0 is an unstamped message: accepted, not compared. A stamp more than
         ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)
-        is rejected. A stamp before the last accepted one of the same topic is
-        rejected (out of order), unless that one is itself stale by receipt
-        time: a restarted publisher or a rewound clock recovers after the
-        topic's timeout.
+        is rejected. A stamp before the topic's mark is rejected (out of order),
+        unless the mark is itself stale by receipt time: a restarted publisher
+        or a rewound clock recovers after the topic's timeout. The mark is the
+        last accepted stamp, but never later than the clock when that message
+        was accepted (:meth:`_keep_stamp`): a source stamping ahead of the clock,
+        by a fast clock or a lie, cannot push it into the future and lock out a
+        source whose stamps agree with the clock.
         """
         if stamp == 0.0:
             return
@@ -324,9 +327,10 @@ class TorqueController:
              "external_wrench": c.wrench_timeout}[source]
         return t if t > 0 else c.joint_state_timeout
 
-    def _keep_stamp(self, source: str, stamp: float, now: float) -> None:
+    def _keep_stamp(self, source: str, stamp: float, now: float, clock: float | None) -> None:
         if stamp != 0.0:
-            self._stamps[source] = (stamp, now)
+            mark = min(stamp, clock) if clock is not None and clock > 0.0 else stamp
+            self._stamps[source] = (mark, now)
 
     def update_joint_state(self, names: list[str], positions: list[float], now: float,
                            stamp: float = 0.0, clock: float | None = None) -> None:
@@ -379,7 +383,7 @@ class TorqueController:
         except InputError as e:
             self._reject("joint_states", e)
             raise
-        self._keep_stamp("joint_states", stamp, now)
+        self._keep_stamp("joint_states", stamp, now, clock)
         self.inputs = dataclasses.replace(self.inputs, q=q, q_time=now)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
@@ -421,7 +425,7 @@ class TorqueController:
         except InputError as e:
             self._reject("contacts", e)
             raise
-        self._keep_stamp("contacts", stamp, now)
+        self._keep_stamp("contacts", stamp, now, clock)
         self.inputs = dataclasses.replace(
             self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
 
@@ -465,7 +469,7 @@ class TorqueController:
         except InputError as e:
             self._reject("external_wrench", e)
             raise
-        self._keep_stamp("external_wrench", stamp, now)
+        self._keep_stamp("external_wrench", stamp, now, clock)
         # Kept in the given axes; turned into base axes at the cycle's configuration.
         self.inputs = dataclasses.replace(self.inputs, wrench=(frame, w), wrench_time=now)
 

@@ -363,8 +363,10 @@ class GraspTorqueNode(Node):
                 sub_callback = (lambda cb: lambda data, info: cb(data, info))(callback)
             else:
                 sub_callback = (lambda cb: lambda data: cb(data))(callback)
-            self.create_subscription(msg_type, topic, sub_callback, qos_profile_sensor_data,
-                                     raw=True)
+            sub = self.create_subscription(msg_type, topic, sub_callback,
+                                           qos_profile_sensor_data, raw=True)
+            if topic == "joint_states":
+                self._joint_states_topic = sub.topic_name  # remapped and resolved
         self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
                                                   COMMAND_QOS)
         self._stamped_pub = None
@@ -585,9 +587,17 @@ class GraspTorqueNode(Node):
             rep = diagnostics.report(self.controller, time.monotonic())
             # The hand's name from its URDF (e.g. allegro_hand_right), as hardware_id asks.
             hand = self.controller.setup.hand.model.name
+        # Two sources of joint states are followed as one stream (the stamp rule keeps
+        # either from locking the other out); say so, as the node cannot tell them apart.
+        publishers = self.count_publishers(self._joint_states_topic)
+        if publishers > 1:
+            self.get_logger().warn(f"{publishers} publishers on {self._joint_states_topic}: "
+                                   "their joint states are taken as one stream",
+                                   throttle_duration_sec=10.0)
+        values = [*rep.values, ("joint_states.publishers", str(publishers))]
         status = DiagnosticStatus(level=bytes([rep.level]), name=f"{self.get_name()}: grasp "
                                   "torques", message=rep.message, hardware_id=hand,
-                                  values=[KeyValue(key=k, value=v) for k, v in rep.values])
+                                  values=[KeyValue(key=k, value=v) for k, v in values])
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diag_pub.publish(msg)

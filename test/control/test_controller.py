@@ -237,7 +237,8 @@ def test_long_names_are_cut_in_messages(planar):
 
 def test_stamp_rule(planar):
     """Zero: unstamped, accepted. Ahead of the clock beyond the tolerance: rejected.
-    Backwards: rejected while the last accepted one is fresh, accepted once it is stale."""
+    Backwards from the mark (the last accepted stamp, at most the clock when it was
+    accepted): rejected while that message is fresh, accepted once it is stale."""
     ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
     js = joint_state(planar)
     ctrl.update_joint_state(*js, now=0.0, stamp=0.0, clock=100.0)
@@ -245,16 +246,37 @@ def test_stamp_rule(planar):
     with pytest.raises(InputError, match=r"^joint_states.header.stamp: is 0.600 s ahead of "
                        r"the clock \(stamp_future_tolerance 0.5 s\)$"):
         ctrl.update_joint_state(*js, now=0.02, stamp=100.6, clock=100.0)
-    with pytest.raises(InputError, match="header.stamp: goes backwards by 0.100000 s"):
-        ctrl.update_joint_state(*js, now=0.05, stamp=100.3, clock=100.05)
-    assert ctrl.inputs.q_time == 0.01  # the rejected states were not kept
+    # The mark is 100.0 (the clock when 100.4 was accepted), not 100.4.
+    ctrl.update_joint_state(*js, now=0.03, stamp=100.02, clock=100.03)
+    with pytest.raises(InputError, match="header.stamp: goes backwards by 0.020000 s"):
+        ctrl.update_joint_state(*js, now=0.05, stamp=100.0, clock=100.05)
+    assert ctrl.inputs.q_time == 0.03  # the rejected states were not kept
     ctrl.update_joint_state(*js, now=0.05, stamp=0.0, clock=100.05)  # unstamped: not compared
-    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the last stamp is stale
+    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the mark is stale
     ctrl.update_joint_state(*js, now=0.21, stamp=50.01, clock=100.21)
     with pytest.raises(InputError, match="is negative"):
         ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=-1.0)
     ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=5.0, clock=0.0)  # clock not running
     assert ctrl.counters.rejected == {"joint_states": 2, "contacts": 0, "external_wrench": 1}
+
+
+def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
+    """The issue: joint states stamped 0.4 s ahead (within the 0.5 s tolerance) at 25 Hz
+    were followed exclusively, and the real 200 Hz driver rejected as out of order."""
+    ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
+    js = joint_state(planar)
+    accepted = {"driver": 0, "skewed": 0}
+    for k in range(200):  # one second: the driver every 5 ms, the skewed source every 40 ms
+        t = 100.0 + 0.005 * k
+        for source, stamp in (("driver", t - 0.001),) + ((("skewed", t + 0.4),) if k % 8 == 0
+                                                          else ()):
+            try:
+                ctrl.update_joint_state(*js, now=t, stamp=stamp, clock=t)
+                accepted[source] += 1
+            except InputError:
+                pass
+    # Only a driver message sent before the skewed one's arrival can be refused.
+    assert accepted["skewed"] == 25 and accepted["driver"] >= 200 - 25, accepted
 
 
 def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar):
