@@ -29,12 +29,13 @@ from rcl_interfaces.msg import (
     ParameterDescriptor,
     SetParametersResult,
 )
+from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
@@ -69,8 +70,13 @@ from grasp_torque_opt.core.scenario import load_scenario
 NODE_NAME = "grasp_torque_node"
 #: Commands: reliable, only the newest matters.
 COMMAND_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
-#: ~/solve: reliable, up to 100 queued requests (the default 10 dropped a planner's burst).
-SERVICE_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+#: ~/solve: reliable, every request kept until it is taken (keep last 100 dropped 872 to
+#: 900 of 1000 concurrent calls silently); the node answers each, "busy" beyond
+#: MAX_PENDING_SOLVES.
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+#: Solves the service queues for its worker (each a snapshot of the inputs); a request
+#: beyond them is answered "busy" at once.
+MAX_PENDING_SOLVES = 100
 
 
 @dataclass(frozen=True)
@@ -377,7 +383,13 @@ class GraspTorqueNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         # The service solves in a worker thread while the executor goes on with the loop.
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
-        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS)
+        self._pending_solves = 0
+        self._busy_answers = 0
+        # A group of its own: in the node's default (mutually exclusive) group, each call
+        # held every callback of the node, the control loop's included, until its solve
+        # was done; reentrant, so that requests are taken (and answered "busy") meanwhile.
+        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS,
+                            callback_group=ReentrantCallbackGroup())
         self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
         self.create_timer(self.get_parameter("diagnostics_period").value,
                           self._on_diagnostics)
@@ -632,12 +644,25 @@ class GraspTorqueNode(Node):
 
     async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
                         ) -> Trigger.Response:
+        """Queue one solve for the worker, or answer "busy" at once when
+        MAX_PENDING_SOLVES are queued: every request gets an answer, in bounded memory.
+        (Runs in the executor's thread only, as does the count.)"""
+        if self._pending_solves >= MAX_PENDING_SOLVES:
+            self._busy_answers += 1
+            response.success = False
+            response.message = (f"busy: {self._pending_solves} solves queued (at most "
+                                f"{MAX_PENDING_SOLVES}); call again later")
+            return response
         with self._lock:
             inputs = self.controller.inputs
-        done = Future(executor=self.executor)
-        done.add_done_callback(lambda _: None)  # completion wakes the executor
-        self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
-        await done
+        self._pending_solves += 1
+        try:
+            done = Future(executor=self.executor)
+            done.add_done_callback(lambda _: None)  # completion wakes the executor
+            self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
+            await done
+        finally:
+            self._pending_solves -= 1
         response.success, response.message = done.result()
         return response
 

@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import ALLEGRO_URDF
-from cycle_inputs import FAULT_MODES, Injected, base_poses, fresh, joint_state
+from cycle_inputs import FAULT_MODES, Injected, Slow, base_poses, fresh, joint_state
 from independent import assert_holds
 
 from grasp_torque_opt.core.exceptions import InputError
@@ -311,20 +311,6 @@ def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
     r = ctrl.cycle(0.0)
     assert time.perf_counter() - t0 < 0.05 + 0.5
     assert r.command is None and "time budget spent" in r.fault
-
-
-class Slow:
-    """A solver that answers correctly, late (it does not take a deadline)."""
-
-    def __init__(self, delay):
-        from grasp_torque_opt.backends.proxsuite import TauQPSolver
-
-        self.inner, self.delay = TauQPSolver(), delay
-        self.settings = self.inner.settings
-
-    def solve(self, qp):
-        time.sleep(self.delay)
-        return self.inner.solve(qp)
 
 
 def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar):
