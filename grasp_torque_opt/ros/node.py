@@ -171,6 +171,10 @@ PARAMETERS: dict[str, Spec] = {
                           "so they vanish when the node stops.", 1e-3, 60.0, read_only=True),
     "watchdog_period": Spec("Period of the staleness check between joint states [s].",
                             1e-4, 1.0, read_only=True),
+    "startup_check_time": Spec("At start, how long grasp_torque_node looks for another node "
+                               "of its name on the domain before it takes any input; one "
+                               "found: it exits with an error (code 2). Later, one is "
+                               "reported (diagnostics ERROR) [s].", 0.0, 30.0, read_only=True),
     "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
     "publish_stamped_command": Spec("Also publish each command on ~/effort_commands_stamped "
                                     "(sensor_msgs/JointState: joints, effort, and the stamp of "
@@ -331,6 +335,7 @@ class GraspTorqueNode(Node):
             "diagnostics_period": 1.0,
             "marker_period": 0.1,
             "watchdog_period": 0.01,
+            "startup_check_time": 2.0,
             "marker_scale": 0.02,
             "publish_stamped_command": False,
         }
@@ -385,6 +390,7 @@ class GraspTorqueNode(Node):
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
         self._pending_solves = 0
         self._busy_answers = 0
+        self._duplicates = 0
         # A group of its own: in the node's default (mutually exclusive) group, each call
         # held every callback of the node, the control loop's included, until its solve
         # was done; reentrant, so that requests are taken (and answered "busy") meanwhile.
@@ -592,6 +598,27 @@ class GraspTorqueNode(Node):
             msg.header.frame_id = self.controller.setup.hand.base_frame
             self._stamped_pub.publish(msg)
 
+    # -- other nodes of this name -------------------------------------------------------
+
+    def duplicates(self) -> int:
+        """How many other nodes of this node's name and namespace the graph shows."""
+        me = (self.get_name(), self.get_namespace())
+        return sum(1 for n in self.get_node_names_and_namespaces() if tuple(n) == me) - 1
+
+    def wait_for_duplicates(self, seconds: float) -> int:
+        """Look for other nodes of this name for up to ``seconds`` (discovery took 0.2 to
+        2.8 s here), without spinning: nothing is taken or published meanwhile.
+
+        Returns:
+            How many were seen (0 after ``seconds``).
+        """
+        end = time.monotonic() + seconds
+        while True:
+            n = self.duplicates()
+            if n > 0 or time.monotonic() >= end:
+                return n
+            time.sleep(0.05)
+
     # -- outputs between cycles -----------------------------------------------------------
 
     def _on_diagnostics(self) -> None:
@@ -607,8 +634,18 @@ class GraspTorqueNode(Node):
                                    "their joint states are taken as one stream",
                                    throttle_duration_sec=10.0)
         values = [*rep.values, ("joint_states.publishers", str(publishers))]
-        status = DiagnosticStatus(level=bytes([rep.level]), name=f"{self.get_name()}: grasp "
-                                  "torques", message=rep.message, hardware_id=hand,
+        level, message = rep.level, rep.message
+        self._duplicates = self.duplicates()  # about 1 us: rmw's graph cache
+        if self._duplicates > 0:
+            name = self.get_fully_qualified_name()
+            self.get_logger().error(f"another node named {name} is on this domain: both may "
+                                    "drive effort_commands and take parameters",
+                                    throttle_duration_sec=10.0)
+            level = diagnostics.ERROR
+            message = f"another node named {name} is on this domain; {message}"
+        values.append(("duplicate_nodes", str(self._duplicates)))
+        status = DiagnosticStatus(level=bytes([level]), name=f"{self.get_name()}: grasp "
+                                  "torques", message=message, hardware_id=hand,
                                   values=[KeyValue(key=k, value=v) for k, v in values])
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
@@ -757,6 +794,15 @@ def main(args: list[str] | None = None) -> int:
     code = 0
     try:
         node = GraspTorqueNode(message_info=opts.executor != "events")
+        wait = node.get_parameter("startup_check_time").value
+        if wait > 0.0:
+            node.get_logger().info(f"looking for another {NODE_NAME} on this domain ({wait:g} s)")
+            if node.wait_for_duplicates(wait):
+                raise GraspTorqueError(
+                    f"another node named {node.get_fully_qualified_name()} is on this domain "
+                    f"(ROS_DOMAIN_ID {node.context.get_domain_id()}): refusing to run, as both "
+                    "would drive effort_commands (stop it, or give this one another name with "
+                    "--ros-args -r __node:=NAME)")
         # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()

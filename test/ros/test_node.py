@@ -517,3 +517,48 @@ def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
         assert busy and all(a.success for a in answers if a not in busy)
     finally:
         h.close()
+
+
+def test_a_second_node_of_the_same_name_refuses_to_run(planar):
+    """Two grasp_torque_nodes on one domain both drove effort_commands, and parameter reads
+    and writes went to either. One already running: a second one started exits with code 2
+    and one line naming the other, before it takes any input; the first reports it."""
+    first = Harness(PLANAR)
+    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    second = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--ros-args",
+                               "-p", f"scenario:={PLANAR}", "-p", "startup_check_time:=10.0"],
+                              env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        first.send_joint_state(*joint_state(planar))
+        assert first.next_command() is not None
+        end = time.monotonic() + 15.0
+        while second.poll() is None and time.monotonic() < end:
+            first.spin_for(0.1)
+        assert second.returncode == 2
+        err = second.stderr.read()
+        lines = [line for line in err.splitlines() if "error" in line]
+        assert lines == ["grasp_torque_node: error: another node named /grasp_torque_node is on "
+                         f"this domain (ROS_DOMAIN_ID {DOMAIN}): refusing to run, as both would "
+                         "drive effort_commands (stop it, or give this one another name with "
+                         "--ros-args -r __node:=NAME)"], err
+        first.send_joint_state(*joint_state(planar))  # the first goes on
+        assert first.next_command() is not None
+    finally:
+        if second.poll() is None:
+            second.kill()
+        first.close()
+
+
+def test_a_running_node_reports_another_of_its_name(planar):
+    h = Harness(PLANAR)
+    other = GraspTorqueNode(context=h.context,
+                            parameter_overrides=[Parameter("scenario", value=str(PLANAR))])
+    try:
+        assert h.spin_until(lambda: h.diagnostics and
+                            h.diagnostics[-1].get("duplicate_nodes") == "1", 5.0)
+        d = h.diagnostics[-1]
+        assert d["_level"] == 2 and d["_message"].startswith(
+            "another node named /grasp_torque_node is on this domain; ")
+    finally:
+        other.destroy_node()
+        h.close()
