@@ -54,4 +54,6 @@ BAD = [
     (("hand", "torque_limits"), 1e300, "hand.torque_limits", "exceeds the URDF effort limit"),
     (("hand", "torque_limits_above_urdf"), "yes", "hand.torque_limits_above_urdf",
      "must be true or false"),
+    (("friction", "polygon_sides"), 10**9, "friction.polygon_sides", "must be at most 64"),
+    (("friction", "min_normal_force"), 10**400, "friction.min_normal_force", "must be finite"),
 ]

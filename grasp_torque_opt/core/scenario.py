@@ -34,6 +34,9 @@ MAX_DEPTH = 16
 MAX_CONTACTS = 32
 #: Most actuated joints (``hand.joints``) and most entries of a per-joint list.
 MAX_JOINTS = 64
+#: Most sides of the friction polygon (the node's parameter has the same range; the QP
+#: grows with it: 2N rows per contact).
+MAX_POLYGON_SIDES = 64
 
 
 @dataclass(frozen=True)
@@ -200,7 +203,10 @@ def _require(section: dict, key: str, name: str) -> Any:
 def _number(value: Any, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(name, f"must be a number, got {quote(value)}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:  # an integer of more than 308 digits
+        x = math.inf
     if not math.isfinite(x):
         raise InputError(name, f"must be finite, got {quote(value)}")
     return x
@@ -332,6 +338,9 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
         raise InputError("friction.polygon_sides", f"must be an integer, got {quote(sides)}")
     if sides < 3:
         raise InputError("friction.polygon_sides", f"must be >= 3, got {sides}")
+    if sides > MAX_POLYGON_SIDES:
+        raise InputError("friction.polygon_sides",
+                         f"must be at most {MAX_POLYGON_SIDES}, got {quote(sides)}")
     fmin = _number(friction.get("min_normal_force", 0.0), "friction.min_normal_force")
     if fmin < 0.0:
         raise InputError("friction.min_normal_force", f"must be >= 0, got {fmin}")
