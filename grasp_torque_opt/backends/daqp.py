@@ -12,13 +12,18 @@ import time
 
 import numpy as np
 
-from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.backends.proxsuite import ESTIMATE_DECAY, ProxSuiteSettings, size_factor
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
 from grasp_torque_opt.core.tau_qp import TauQP, check_data
 
 #: DAQP's "infinite" bound.
 DAQP_INF = 1e30
+#: Seconds per DAQP iteration assumed before a solve of a size has measured it, for the
+#: Allegro's tau-QP (about 2 us here), scaled by size_factor for others (32 contacts:
+#: 50 to 90 us measured, up to 2900 iterations when it cycles).
+ITERATION_S = 3e-6
+
 #: Largest KKT violation (:func:`kkt_violation`) of an answer taken as optimal.
 KKT_TOLERANCE = 1e-6
 
@@ -89,6 +94,8 @@ class DaqpSolver:
         self.last_warm = False
         self._model = None
         self._dims: tuple[int, int, int] | None = None
+        self._limit = self.settings.max_iter
+        self._iter_s = ITERATION_S
         self._keep: tuple = ()
 
     def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
@@ -100,9 +107,10 @@ class DaqpSolver:
             cold: start cold even with ``warm_start`` (the caller's redo of a warm
                 answer that failed its certificate; counted in ``fallbacks``).
             deadline: ``time.perf_counter()`` value [s]: past it, no solve starts
-                (an error result). A DAQP solve itself is bounded by ``max_iter``
-                iterations of a few microseconds each; DAQP 0.11's ``time_limit``
-                setting did not stop a plain QP here (docs/design.md section 2.2).
+                (an error result), and before it the iteration cap is lowered to
+                the iterations that fit in the time left, at the measured time per
+                iteration (DAQP 0.11's ``time_limit`` setting did not stop a plain
+                QP here: docs/design.md section 2.2).
         """
         if cold and self.last_warm:
             self.fallbacks += 1
@@ -119,13 +127,21 @@ class DaqpSolver:
         sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
         sense[n:n + n_eq] = 5  # equality
         H = qp.H.copy()  # DAQP wants writable buffers; H is shared read-only
+        if self._dims != (n, n_eq, n_in):
+            self._iter_s = ITERATION_S * size_factor(qp)  # a new size: a guess
+        limit = self.settings.max_iter
+        if deadline is not None:
+            limit = min(limit, max(1, int((deadline - time.perf_counter()) / self._iter_s)))
         t0 = time.perf_counter()
         try:
             x, flag, info, iterations = self._run(qp, n, (n, n_eq, n_in), H, A, upper, lower,
-                                                  sense, cold)
+                                                  sense, cold, limit)
         except RuntimeError as e:  # e.g. a failed setup: the next call starts anew
             self._dims = None
             raise SolverError(f"DAQP failed: {e}") from e
+        if iterations:
+            self._iter_s = max((time.perf_counter() - t0) / iterations,
+                               ESTIMATE_DECAY * self._iter_s)
         if x is None:
             self._dims = None
             return RawResult("error", None, 0, time.perf_counter() - t0,
@@ -140,8 +156,9 @@ class DaqpSolver:
 
     def _run(self, qp: TauQP, n: int, dims: tuple[int, int, int], H: np.ndarray,
              A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray,
-             cold: bool):
-        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified).
+             cold: bool, limit: int):
+        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified),
+        with at most ``limit`` iterations per DAQP solve.
 
         Returns:
             (x, flag, info with "kkt", iterations); x None if the setup failed.
@@ -152,10 +169,11 @@ class DaqpSolver:
             if flag < 0:
                 return None, flag, {}, 0
             s = self._model.settings
-            s.update(primal_tol=self.settings.eps_abs, iter_limit=self.settings.max_iter,
+            s.update(primal_tol=self.settings.eps_abs, iter_limit=limit,
                      eps_prox=0.0 if n == qp.m else -1e-6)
             self._model.settings = s
             self._dims = dims
+            self._limit = limit
             warm = False
         else:
             warm = self.warm_start and not cold
@@ -164,6 +182,11 @@ class DaqpSolver:
                                       sense=None if warm else sense)
             if flag is not None and flag < 0:
                 return None, flag, {}, 0
+        if limit != self._limit:  # a budget's cap, or back to max_iter
+            s = self._model.settings
+            s.update(iter_limit=limit)
+            self._model.settings = s
+            self._limit = limit
         self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
         x, _, flag, info = self._model.solve()
         iterations = int(info["iterations"])
@@ -173,6 +196,13 @@ class DaqpSolver:
             self.last_warm = kkt <= KKT_TOLERANCE
             if not self.last_warm:
                 self.fallbacks += 1
+                # Under a deadline the two solves share the cap fitted to it.
+                rest = max(1, limit - iterations) if limit < self.settings.max_iter else limit
+                if rest != self._limit:
+                    s = self._model.settings
+                    s.update(iter_limit=rest)
+                    self._model.settings = s
+                    self._limit = rest
                 self._model.update(sense=sense)  # the same data, cold
                 x, _, flag, info = self._model.solve()
                 iterations += int(info["iterations"])

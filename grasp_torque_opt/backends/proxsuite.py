@@ -52,9 +52,17 @@ def kkt_violation(qp: TauQP, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> flo
                  float(np.abs(qp.A @ x - qp.b).max(initial=0.0)) if qp.A.shape[0] else 0.0)
     return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
                dual / scale, primal)
-#: Seconds per ProxSuite inner iteration assumed before a solve has measured it (the
-#: Allegro's tau-QP took 7 to 25 us per inner iteration here, setup included).
+#: Seconds per ProxSuite inner iteration assumed before a solve of a size has measured
+#: it, for the Allegro's tau-QP (7 to 25 us per inner iteration here, setup included);
+#: scaled by :func:`size_factor` for others (32 contacts: 150 to 420 us measured).
 INNER_ITERATION_S = 25e-6
+
+
+def size_factor(qp: TauQP) -> float:
+    """How much more one iteration of a dense solver costs on ``qp`` than on the Allegro's
+    four-fingertip tau-QP (16 variables, 144 rows), as n (n + rows), at least 1."""
+    n = qp.H.shape[0]
+    return max(1.0, n * (n + qp.A.shape[0] + qp.C.shape[0]) / (16 * 144))
 #: Each solve's measured time per inner iteration replaces the estimate if larger; a
 #: smaller one lowers it by at most this factor per solve (a slow solve is remembered).
 ESTIMATE_DECAY = 0.9
@@ -202,6 +210,7 @@ class TauQPSolver:
         t0 = time.perf_counter()
         try:
             if self._dims != dims:
+                self._inner_s = INNER_ITERATION_S * size_factor(qp)  # a new size: a guess
                 self._init(dims, data)
                 warm = False
             else:
