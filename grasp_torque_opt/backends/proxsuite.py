@@ -261,6 +261,7 @@ class TauQPSolver:
         cap = self.settings.max_iter
         max_reached = proxsuite.proxqp.QPSolverOutput.PROXQP_MAX_ITER_REACHED
         inner = outer = 0
+        capped = False  # ProxSuite's max_iter lowered for a slice (each write costs)
         try:
             while True:
                 left = deadline - time.perf_counter()
@@ -271,13 +272,16 @@ class TauQPSolver:
                 k = max(1, int(left / per_outer))
                 if self.max_slice_s is not None:
                     k = min(k, max(MIN_SLICE_OUTER, int(self.max_slice_s / per_outer)))
-                s.max_iter = min(cap - outer, k)
+                k = min(cap - outer, k)
+                if k != cap or capped:
+                    s.max_iter, capped = k, True
                 t0 = time.perf_counter()
                 qp.solve()
                 info = qp.results.info
-                inner += int(info.iter)
+                iters = int(info.iter)
+                inner += iters
                 outer += int(info.iter_ext)
-                per_inner = (time.perf_counter() - t0) / max(1, int(info.iter))
+                per_inner = (time.perf_counter() - t0) / max(1, iters)
                 self._inner_s = max(per_inner, ESTIMATE_DECAY * self._inner_s)
                 if info.status != max_reached or outer >= cap:
                     return inner, False
@@ -285,7 +289,8 @@ class TauQPSolver:
                 # multipliers and penalty parameters with this guess).
                 s.initial_guess = proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
         finally:
-            s.max_iter = cap
+            if capped:
+                s.max_iter = cap
 
     def _init(self, dims: tuple, data: dict) -> None:
         """A new ProxSuite QP for this problem size, set up with the settings and ``data``."""
