@@ -18,11 +18,15 @@ def quote(value: object) -> str:
     return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + "..."
 
 
-def cut(name: object) -> str:
-    """A name from the input as quoted in messages: ``str(name)`` cut to
-    :data:`QUOTE_LENGTH` characters."""
+#: Longest quotation of a path in an error message [characters].
+PATH_LENGTH = 240
+
+
+def cut(name: object, limit: int = QUOTE_LENGTH) -> str:
+    """A name from the input as quoted in messages: ``str(name)`` cut to ``limit``
+    characters (:data:`PATH_LENGTH` for paths)."""
     text = str(name) if not isinstance(name, str) else name
-    return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + "..."
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 class GraspTorqueError(Exception):

@@ -19,7 +19,13 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
+from grasp_torque_opt.core.exceptions import (
+    PATH_LENGTH,
+    FrameNotFound,
+    InputError,
+    JointNotFound,
+    cut,
+)
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
 
 ERD_PREFIX = "example-robot-data:"
@@ -80,8 +86,8 @@ def resolve_urdf(spec: str, base_dir: Path) -> Path:
         path = Path(spec).expanduser()
         if not path.is_absolute():
             path = base_dir / path
-    if not path.exists():
-        raise InputError("hand.urdf", f"file not found: {path}")
+    if not os.path.exists(path):  # False on any OSError, e.g. a name too long
+        raise InputError("hand.urdf", f"file not found: {cut(path, PATH_LENGTH)}")
     return path
 
 
@@ -251,7 +257,8 @@ class Hand:
         try:
             model = pin.buildModelFromXML(bounded_urdf(xml, "hand.urdf"))
         except (RuntimeError, ValueError) as e:
-            raise InputError("hand.urdf", f"cannot parse {path}: {e}") from e
+            raise InputError("hand.urdf",
+                             f"cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}") from e
         return cls.from_model(model, joints, torque_limits, above_urdf)
 
     @classmethod
@@ -263,7 +270,7 @@ class Hand:
         try:
             model = pin.buildModelFromXML(bounded_urdf(xml, "robot_description"))
         except (RuntimeError, ValueError) as e:
-            raise InputError("robot_description", f"cannot parse the URDF: {e}") from e
+            raise InputError("robot_description", f"cannot parse the URDF: {cut(e, 400)}") from e
         return cls.from_model(model, joints, torque_limits, above_urdf)
 
     def configuration(self, positions: dict[str, float],

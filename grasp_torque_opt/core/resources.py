@@ -8,7 +8,7 @@ import stat
 import sys
 from pathlib import Path
 
-from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.exceptions import PATH_LENGTH, InputError, cut
 
 PACKAGE = "grasp_torque_opt"
 
@@ -28,13 +28,14 @@ def find_config(name: str, field: str = "scenario") -> Path:
         InputError: naming ``field``, when neither exists.
     """
     path = Path(name).expanduser()
-    if path.exists():
+    if os.path.exists(path):  # False on any OSError, e.g. a name too long
         return path  # a directory or device is refused by its reader, saying so
     if not path.is_absolute():
         for d in config_dirs():
             if (d / path).is_file():
                 return d / path
-    raise InputError(field, f"file not found: {name} (nor in {', '.join(map(str, config_dirs()))})")
+    raise InputError(field, f"file not found: {cut(name, PATH_LENGTH)} "
+                     f"(nor in {', '.join(map(str, config_dirs()))})")
 
 
 def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
@@ -49,16 +50,17 @@ def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
         InputError: naming ``field_name``: cannot be opened, not a regular file,
             or too large.
     """
+    shown = cut(path, PATH_LENGTH)
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except OSError as e:
-        raise InputError(field_name, f"cannot read {path}: {e.strerror}") from e
+        raise InputError(field_name, f"cannot read {shown}: {e.strerror}") from e
     try:
         mode = os.fstat(fd).st_mode
         if stat.S_ISDIR(mode):
-            raise InputError(field_name, f"{path} is a directory, not a file")
+            raise InputError(field_name, f"{shown} is a directory, not a file")
         if not stat.S_ISREG(mode):
-            raise InputError(field_name, f"{path} is not a regular file (a device, pipe or "
+            raise InputError(field_name, f"{shown} is not a regular file (a device, pipe or "
                              "socket)")
         chunks, left = [], limit + 1
         while left > 0:
@@ -69,18 +71,19 @@ def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
             left -= len(chunk)
         data = b"".join(chunks)
     except OSError as e:
-        raise InputError(field_name, f"cannot read {path}: {e.strerror}") from e
+        raise InputError(field_name, f"cannot read {shown}: {e.strerror}") from e
     finally:
         os.close(fd)
     if len(data) > limit:
-        raise InputError(field_name, f"{path} is larger than {limit} bytes")
+        raise InputError(field_name, f"{shown} is larger than {limit} bytes")
     return data
 
 
 def decode_utf8(data: bytes, path: Path, field_name: str) -> str:
     """UTF-8 text, or an error that says where the first bad byte is."""
+    shown = cut(path, PATH_LENGTH)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as e:
-        raise InputError(field_name, f"{path} is not UTF-8 text (byte 0x{data[e.start]:02x} "
+        raise InputError(field_name, f"{shown} is not UTF-8 text (byte 0x{data[e.start]:02x} "
                          f"at offset {e.start})") from e

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from grasp_torque_opt.core.exceptions import InputError, cut, quote
+from grasp_torque_opt.core.exceptions import PATH_LENGTH, InputError, cut, quote
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
 
 #: Largest scenario file read [bytes] (the bundled ones are about 2 KB).
@@ -418,5 +418,6 @@ def load_scenario(path: str | Path) -> Scenario:
         data = yaml.load(text, Loader=_BoundedLoader)  # noqa: S506 -- a SafeLoader
     except (yaml.YAMLError, ValueError) as e:  # ValueError: an integer of 5000 digits
         first = (str(e).splitlines() or [""])[0]
-        raise InputError("scenario", f"{path} is not valid YAML: {cut(first)}") from e
+        raise InputError("scenario", f"{cut(path, PATH_LENGTH)} is not valid YAML: "
+                         f"{cut(first)}") from e
     return parse_scenario(data, path.resolve().parent, source=str(path))

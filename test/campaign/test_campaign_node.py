@@ -96,7 +96,10 @@ def test_burst_at_1khz_with_bad_messages_and_service_calls(planar):
             if r.success:
                 check_command(json.loads(r.message)["command"], 4,
                               h.node.controller.setup.hand.torque_limits)
-            elif not r.message.startswith(("cannot solve: ", "busy: ")):
+            elif not r.message.startswith(("cannot solve: ", "busy: ")) and \
+                    json.loads(r.message).get("command", "missing") is not None:
+                # (A solve that failed, e.g. past its budget under this load, is a JSON
+                # answer without a command, its message saying why.)
                 broken(f"service failed without a reason: {r.message[:200]}")
         check_all(h, refs, zero_allowed=False)
         c = h.node.controller.counters
