@@ -245,6 +245,8 @@ class DaqpWorkspace:
         self.eps_abs, self.max_iter = eps_abs, max_iter
         self._model = None
         self._dims: tuple[int, int, int, bool] | None = None
+        self._limit = max_iter
+        self._iter_s = ITERATION_S
         #: The last answer's multipliers, DAQP's order and sign: bounds on x, then
         #: A_eq's rows, then C's; > 0 on an active upper bound. None before one.
         self.multipliers: np.ndarray | None = None
@@ -274,12 +276,18 @@ class DaqpWorkspace:
         dims = (n, n_eq, n_in, semidefinite)
         if self._dims != dims:
             self._model, self._dims = None, dims
+            self._iter_s = ITERATION_S * max(1.0, n * (n + n_eq + n_in) / (16 * 144))
         self._cold = not warm
 
     def solve(self, H: np.ndarray | None = None, g: np.ndarray | None = None,
               C: np.ndarray | None = None, u: np.ndarray | None = None,
-              cold: bool = False) -> RawResult:
+              cold: bool = False, deadline: float | None = None) -> RawResult:
         """Solve with the given H, g, C, u (None: keep the last), warm unless ``cold``.
+
+        Args:
+            deadline: ``time.perf_counter()`` value [s]: past it no solve starts, and
+                before it the iteration cap is the iterations that fit (as
+                :class:`DaqpSolver`'s).
 
         Returns:
             The raw result; ``multipliers`` holds its multipliers when solved.
@@ -288,6 +296,12 @@ class DaqpWorkspace:
             SolverError: DAQP raised (chained); the next solve starts anew.
         """
         self.multipliers = None
+        limit = self.max_iter
+        if deadline is not None:
+            left = deadline - time.perf_counter()
+            if left <= 0.0:
+                return RawResult("error", None, 0, 0.0, "time budget spent before DAQP started")
+            limit = min(limit, max(1, int(left / self._iter_s)))
         n_eq = self._n_eq
         n = self._H.shape[0]
         for new, old in ((H, self._H), (g, self._g)):
@@ -312,9 +326,10 @@ class DaqpWorkspace:
                     return RawResult("error", None, 0, time.perf_counter() - t0,
                                      f"DAQP setup failed (exit flag {flag})")
                 s = self._model.settings
-                s.update(primal_tol=self.eps_abs, iter_limit=self.max_iter,
+                s.update(primal_tol=self.eps_abs, iter_limit=limit,
                          eps_prox=-1e-6 if self._dims[3] else 0.0)
                 self._model.settings = s
+                self._limit = limit
             else:
                 # Without sense, DAQP keeps the previous active set: a warm start.
                 flag = self._model.update(H=self._H, f=self._g, A=self._A, bupper=self._upper,
@@ -324,12 +339,19 @@ class DaqpWorkspace:
                     self._model = None
                     return RawResult("error", None, 0, time.perf_counter() - t0,
                                      f"DAQP update failed (exit flag {flag})")
+                if limit != self._limit:  # a budget's cap, or back to max_iter
+                    s = self._model.settings
+                    s.update(iter_limit=limit)
+                    self._model.settings = s
+                    self._limit = limit
             x, _, flag, info = self._model.solve()
         except RuntimeError as e:
             self._model = None
             raise SolverError(f"DAQP failed: {e}") from e
         self._cold = False
         elapsed = time.perf_counter() - t0
+        if int(info["iterations"]):
+            self._iter_s = max(elapsed / int(info["iterations"]), ESTIMATE_DECAY * self._iter_s)
         status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
         if status == "solved":
             self.multipliers = np.asarray(info["lam"], dtype=float)

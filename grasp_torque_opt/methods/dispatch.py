@@ -112,7 +112,8 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     if method == "tau-qp-adaptive":
-        return _solve_adaptive(setup, maps, solver, backend, fallback, tolerance, refiner)
+        return _solve_adaptive(setup, maps, solver, backend, fallback, tolerance, refiner,
+                               deadline)
     timings = {}
     t0 = time.perf_counter()
     if maps is None:
@@ -209,10 +210,12 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
 
 
 def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: str,
-                    fallback, tolerance: float, refiner: Refiner | None) -> Solution:
+                    fallback, tolerance: float, refiner: Refiner | None,
+                    deadline: float | None = None) -> Solution:
     """tau-qp-adaptive: the rounds of :mod:`~grasp_torque_opt.methods.adaptive`, certified
     bounds attached; the paper's N-gon (the tau-qp path) when no round gave a candidate
-    (or DAQP, which the rounds need, is not installed)."""
+    (or DAQP, which the rounds need, is not installed). Under a deadline the rounds get
+    :data:`PRIMARY_SHARE` of the time left and the polygon the rest."""
     t0 = time.perf_counter()
     if maps is None:
         maps = setup.maps()
@@ -228,7 +231,9 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
         if refiner is None:
             ref, why = None, "the rounds need DAQP, which is not installed (pip install daqp)"
         else:
-            ref = refiner.refine(setup, maps, qp, tolerance)
+            first = None if deadline is None else \
+                t2 + PRIMARY_SHARE * max(0.0, deadline - t2)
+            ref = refiner.refine(setup, maps, qp, tolerance, deadline=first)
             why = ref.message
     except SolverError as e:  # a failed round is answered by the polygon below
         ref, why = None, str(e)
@@ -248,7 +253,7 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
                                 f"{why})", timings=timings, backend="daqp", bounds=bounds)
     # No certified candidate: the paper's N-gon answers (never nothing when it can).
     poly = solve(setup, "tau-qp", maps=maps, solver=solver, backend=backend,
-                 fallback=fallback, tolerance=tolerance)
+                 fallback=fallback, tolerance=tolerance, deadline=deadline)
     timings.update({f"polygon_{k}": v for k, v in poly.timings.items() if k != "maps"})
     upper = None if poly.tau is None else float(poly.tau @ (setup.weights * poly.tau))
     out = dataclasses.replace(poly, method="tau-qp-adaptive", timings=timings,
@@ -256,7 +261,8 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
                                                  qps, "polygon"))
     if poly.optimal:
         out.message = f"{poly.message}; the paper's N-gon, as the rounds gave none ({why})"
-    elif ref is not None and ref.outer_infeasible and linearized_feasible(
+    elif ref is not None and ref.outer_infeasible and \
+            (deadline is None or time.perf_counter() < deadline) and linearized_feasible(
             maps, setup.friction, setup.external_wrench, tau_min, tau_max,
             circumscribed=True) is False:
         out.status = INFEASIBLE
