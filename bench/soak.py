@@ -16,7 +16,13 @@ process drives it, with a seeded mix (printed at the start):
   unknown frame; NaN or Inf load, unknown frame, force over ``max_wrench_force``);
 - in some 2 s blocks, either a silence (no joint states for 0.3 s) or an
   infeasible load (200 N, accepted but beyond the hand) for 0.3 s, then back to
-  a holdable load: faults and recoveries.
+  a holdable load: faults and recoveries;
+- and the inputs of issue 13, each in some blocks for 0.3 s: a second joint-state
+  source stamping 0.4 s ahead at 25 Hz (``skewed_source``); the torque limits
+  lowered to a fifth, below the command in force, then restored
+  (``limits_below``); the solver's caps, tolerance and weights' ratio at their
+  bounds, then restored (``solver_bounds``); 200 concurrent ``~/solve`` calls from
+  a keep-all client (``service_flood``).
 
 Checked from outside, on every command (invariants, must stay 0): exactly
 len(joints) finite values within the torque limits; the stamped copy names a
@@ -24,7 +30,12 @@ valid joint state this process published (or is a zero-policy command); no
 command later than joint_state_timeout + hold_time + DELIVERY_MARGIN_S into a
 silence (zero commands only under the zero policy); no command stamped more than
 DELIVERY_MARGIN_S into an infeasible-load phase and received before a holdable
-load was published again. Also reported: the node's own
+load was published again; no command over the lowered limits once the change was
+acknowledged (plus DELIVERY_MARGIN_S); at least one command from the on-clock
+joint states in every skewed-source phase; every service call answered (solved,
+busy or a reason) by the end; no command received later than
+joint_state_timeout + DELIVERY_MARGIN_S after its joint state's stamp. Also
+reported: the node's own
 counters from /diagnostics (commands, faults, recoveries, rejected.*) and its
 resident memory (VmRSS) at start, end and in between. Not in CI.
 """
@@ -88,6 +99,14 @@ P_JS_INVALID = 0.05
 P_SLOW_INVALID = 0.2
 P_SILENCE = 0.25
 P_INFEASIBLE = 0.25
+#: The phases of issue 13's inputs, each in this share of the blocks.
+ISSUE13_PHASES = ("skewed_source", "limits_below", "solver_bounds", "service_flood")
+P_ISSUE13 = 0.1
+SKEW_S = 0.4
+SKEWED_RATE_HZ = 25.0
+LIMITS_FRACTION = 0.2
+FLOOD_CALLS = 200
+BOUNDS = {"solver.max_iter": 10000, "solver.max_iter_in": 200, "solver.eps_abs": 1e-12}
 
 
 def _node_params() -> dict:
@@ -109,6 +128,10 @@ def schedule(rng: random.Random, duration: float) -> list[tuple[str, float, floa
             phases.append(("silence", start, start + PHASE_S))
         elif u < P_SILENCE + P_INFEASIBLE:
             phases.append(("infeasible_load", start, start + PHASE_S))
+        else:
+            i = int((u - P_SILENCE - P_INFEASIBLE) / P_ISSUE13)
+            if i < len(ISSUE13_PHASES):
+                phases.append((ISSUE13_PHASES[i], start, start + PHASE_S))
     return phases
 
 
@@ -149,7 +172,10 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
     from rclpy.experimental import EventsExecutor
-    from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from std_srvs.srv import Trigger
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
@@ -185,7 +211,11 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
            WRENCH_INVALID, "silences": sum(k == "silence" for k, _, _ in phases),
            "infeasible_load_phases": sum(k == "infeasible_load" for k, _, _ in phases),
            "phase_s": PHASE_S, "infeasible_force_N": INFEASIBLE_FORCE_N,
-           "holdable_load": "scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis"}
+           "holdable_load": "scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis",
+           **{f"{k}_phases": sum(kind == k for kind, _, _ in phases) for k in ISSUE13_PHASES},
+           "skew_s": SKEW_S, "skewed_rate_hz": SKEWED_RATE_HZ,
+           "limits_fraction": LIMITS_FRACTION, "flood_calls": FLOOD_CALLS,
+           "solver_bounds": BOUNDS}
     mach = machine()
     print(f"machine: {mach['cpu']}, {mach['cores']} cores, Python {mach['python']}; "
           f"{mach['date']}")
@@ -208,6 +238,11 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
 
     valid_stamps: set[int] = set()
     invalid_stamps: set[int] = set()
+    skewed_stamps: set[int] = set()  # valid joint states of the second, skewed source
+    # The limits in force: (time from which a command must meet them [ns], limits).
+    limits_in_force: list[tuple[int, np.ndarray]] = [(0, limits)]
+    flood_futures: list = []
+    param_futures: list = []
     commands: list[tuple[int, bool]] = []  # (receipt [ns], all zero)
     violations: dict[str, int] = {}
     examples: list[str] = []
@@ -229,6 +264,12 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             broken("not_finite", f"{where} {v.tolist()}")
         elif np.any(np.abs(v) > limits):
             broken("over_limit", f"{where} max |value| {np.abs(v).max():.6g}")
+        else:
+            now = time.time_ns()
+            in_force = next(lim for t, lim in reversed(limits_in_force) if t <= now)
+            if np.any(np.abs(v) > in_force):
+                broken("over_lowered_limit", f"{where} max |value| {np.abs(v).max():.6g} "
+                       f"over the lowered limit {in_force.max():.6g}")
 
     def on_command(msg: Float64MultiArray) -> None:
         commands.append((time.time_ns(), not any(msg.data)))
@@ -244,6 +285,12 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         if s in valid_stamps:
             stamped_ok += 1
             stamped_times.append((s, now))
+            if now - s > int(1e9 * (timeout + DELIVERY_MARGIN_S)):
+                broken("late_command", f"received {1e-9 * (now - s):.3f} s after its stamp")
+            phase = state["phase"]
+            if phase is not None and phase["kind"] == "skewed_source" and \
+                    s not in skewed_stamps:
+                phase["on_clock_commands"] = phase.get("on_clock_commands", 0) + 1
         elif s in invalid_stamps:
             broken("from_invalid_joint_state", f"command stamped {s} answers a rejected state")
         elif policy == "zero" and not any(msg.effort):
@@ -384,6 +431,55 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             state["infeasible_span"] = None
         wrench_pub.publish(msg)
 
+    # -- issue 13's phases: a skewed second source, parameter changes, a service flood --
+    set_params = ros.create_client(SetParameters, "/grasp_torque_node/set_parameters")
+    flood_client = ros.create_client(Trigger, "/grasp_torque_node/solve", qos_profile=QoSProfile(
+        history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
+    skewed_every = max(1, round(args.rate / SKEWED_RATE_HZ))
+    defaults = {"torque_limits": [float(x) for x in limits],
+                "weights": [float(x) for x in p.get("weights", setup.weights)],
+                "solver.max_iter": 200, "solver.max_iter_in": 50, "solver.eps_abs": 1e-9}
+
+    def set_parameters(values: dict, span: dict | None = None) -> None:
+        req = SetParameters.Request(parameters=[Parameter(k, value=v).to_parameter_msg()
+                                                for k, v in values.items()])
+        future = set_params.call_async(req)
+        param_futures.append(future)
+        if span is not None and "torque_limits" in values:
+            lowered = np.array(values["torque_limits"])
+
+            def acknowledged(_f, lowered=lowered, span=span):
+                # From the answer on (plus delivery), every command meets the new limits.
+                span["limits_acknowledged_ns"] = time.time_ns()
+                if not span.get("ended"):  # not restored already
+                    limits_in_force.append((time.time_ns() + int(1e9 * DELIVERY_MARGIN_S),
+                                            lowered))
+            future.add_done_callback(acknowledged)
+
+    def phase_event(kind: str, starting: bool, span: dict) -> None:
+        if kind == "limits_below":
+            if starting:
+                set_parameters({"torque_limits": [LIMITS_FRACTION * x for x in limits]}, span)
+            else:
+                set_parameters({"torque_limits": defaults["torque_limits"]})
+                limits_in_force.append((time.time_ns(), limits))
+        elif kind == "solver_bounds":
+            m_ = len(defaults["weights"])
+            bounded = {**BOUNDS, "weights": ([1e-3, 1e3] * m_)[:m_]}
+            set_parameters(bounded if starting else
+                           {k: defaults[k] for k in bounded})
+        elif kind == "service_flood" and starting:
+            flood_futures.extend(flood_client.call_async(Trigger.Request())
+                                 for _ in range(FLOOD_CALLS))
+
+    def skewed_joint_state() -> None:
+        msg = JointState(name=list(names), position=q0.tolist())
+        s = clock() + int(1e9 * SKEW_S)
+        set_stamp(msg.header, s)
+        valid_stamps.add(s)
+        skewed_stamps.add(s)
+        js_pub.publish(msg)
+
     # -- discovery and warm-up -------------------------------------------------------------
     deadline = time.monotonic() + 60.0
     while time.monotonic() < deadline and not (
@@ -430,11 +526,17 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
 
     def current_phase(k: int) -> str:
         while pi["i"] < len(spans) and spans[pi["i"]]["k1"] <= k:
+            span = spans[pi["i"]]
+            if "start_ns" in span and not span.get("ended"):
+                span["ended"] = True
+                phase_event(span["kind"], False, span)
             pi["i"] += 1
         if pi["i"] < len(spans) and spans[pi["i"]]["k0"] <= k:
             span = spans[pi["i"]]
             t = time.time_ns()
-            span.setdefault("start_ns", t)
+            if "start_ns" not in span:
+                span["start_ns"] = t
+                phase_event(span["kind"], True, span)
             span["end_ns"] = t + period_ns
             state["phase"] = span
             return span["kind"]
@@ -451,6 +553,8 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
                 wrench("infeasible")
             else:
                 wrench(_pick(rng, WRENCH_INVALID) if rng.random() < P_SLOW_INVALID else "valid")
+        if phase == "skewed_source" and k % skewed_every == 0:
+            skewed_joint_state()
         if phase != "silence":
             invalid = _pick(rng, JS_INVALID) if rng.random() < P_JS_INVALID else None
             if invalid == "backwards_stamp" and state["since_silence"] < 100:
@@ -466,9 +570,25 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     t_mix = time.perf_counter()
     pacer.run(mix_tick)
     mix_s = time.perf_counter() - t_mix
+    for span in spans:  # a phase that was still on when the mix ended
+        if "start_ns" in span and not span.get("ended"):
+            span["ended"] = True
+            phase_event(span["kind"], False, span)
     published_rate = n_ticks / mix_s
     end_ns = time.time_ns()
     pacer.spin_for(DRAIN_S)
+    deadline = time.monotonic() + 30.0  # every service call answered, every change too
+    while time.monotonic() < deadline and not all(f.done() for f in flood_futures +
+                                                  param_futures):
+        pacer.spin_for(0.1)
+    unanswered = sum(not f.done() for f in flood_futures)
+    if unanswered:
+        broken("service_unanswered", f"{unanswered} of {len(flood_futures)} calls")
+    answers = [f.result() for f in flood_futures if f.done()]
+    service = {"calls": len(flood_futures), "unanswered": unanswered,
+               "solved": sum(a.success for a in answers),
+               "busy": sum(a.message.startswith("busy: ") for a in answers),
+               "cannot_solve": sum(a.message.startswith("cannot solve: ") for a in answers)}
     pacer.spin_for(0.3)
     diag_end = dict(diag)
     memory.append((args.duration, vm_rss_kib(node.pid)))
@@ -482,6 +602,15 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         if "start_ns" not in span:
             continue
         kind, a, b = span["kind"], span["start_ns"], span["end_ns"]
+        if kind == "skewed_source":
+            if not span.get("on_clock_commands"):
+                broken("driver_locked_out", f"no command from the on-clock joint states in "
+                       f"the skewed-source phase at {1e-9 * (a - start_ns):.1f} s")
+            continue
+        if kind == "limits_below" and "limits_acknowledged_ns" not in span:
+            broken("limits_not_acknowledged", f"at {1e-9 * (a - start_ns):.1f} s")
+        if kind in ("limits_below", "solver_bounds", "service_flood"):
+            continue
         if kind == "silence":
             bound = a + int(1e9 * stop_bound_s)
             late = [t for t, zero in commands if bound < t <= b and not (zero and policy == "zero")]
@@ -526,7 +655,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         "zero_policy_commands": zero_policy_commands,
         "latency_ms": percentiles_ms([1e-9 * (r - s) for s, r in latencies]),
         "latency_ms_per_window": _windows(latencies, start_ns, args.duration),
-        "node_counters": node_counters,
+        "node_counters": node_counters, "service_flood": service,
         "node_fault_at_end": diag_end.get("fault"),
         "memory_kib": [{"t_s": t, "vm_rss_kib": r} for t, r in memory],
         "memory_growth_kib": (memory[-1][1] - memory[0][1])
@@ -581,6 +710,12 @@ def report(r: dict) -> str:
         f"{sum(v for k, v in wr.items() if k not in ('valid', 'infeasible'))} |",
         f"| silences / infeasible-load phases | {r['mix']['silences']} / "
         f"{r['mix']['infeasible_load_phases']} |",
+        "| skewed-source / limits-below / solver-bounds / service-flood phases | "
+        + " / ".join(str(r["mix"][f"{k}_phases"]) for k in ISSUE13_PHASES) + " |",
+        f"| service calls (solved / busy / cannot solve / unanswered) | "
+        f"{r['service_flood']['calls']} ({r['service_flood']['solved']} / "
+        f"{r['service_flood']['busy']} / {r['service_flood']['cannot_solve']} / "
+        f"{r['service_flood']['unanswered']}) |",
         f"| commands received | {r['commands_received']} |",
         f"| commands counted by the node | {during('commands')} |",
         f"| node cycles | {during('cycles')} |",

@@ -24,6 +24,8 @@ from grasp_torque_opt.methods.dispatch import LINEARIZED, METHODS, solve
 
 EXIT_OPTIMAL, EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_FAILED = 0, 2, 3, 4
 PROG = "grasp-torque-opt"
+#: Longest error line [characters].
+MAX_ERROR_LENGTH = 2000
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -170,6 +172,8 @@ def _one_line(text: str) -> str:
     breaks a line at \\x85 or \\u2028 as well as at \\n: the error stays one
     line whatever the input holds.
     """
+    if len(text) > MAX_ERROR_LENGTH:  # every quoted value is cut already; a last bound
+        text = text[:MAX_ERROR_LENGTH - 3] + "..."
     return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
                    for c in text)
 
@@ -216,6 +220,10 @@ def main(argv: list[str] | None = None) -> int:
     except GraspTorqueError as e:
         print(_one_line(f"{PROG}: error: {e}"), file=sys.stderr)
         return EXIT_FAILED
+    except (MemoryError, RecursionError) as e:  # the input bounds should make this unreachable
+        print(_one_line(f"{PROG}: error: {args.scenario}: scenario: too large to process "
+                        f"({type(e).__name__})"), file=sys.stderr)
+        return EXIT_BAD_INPUT
 
 
 def _score_parser(sub) -> None:

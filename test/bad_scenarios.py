@@ -49,4 +49,11 @@ BAD = [
     (("objective",), {"weights": [1, 1]}, "objective.weights", "must have 4 entries"),
     (("friction", "mu"), 0.5, "friction.mu", "unknown field"),
     (("grasp", "contacts"), [], "grasp.contacts", "must be a non-empty list"),
+    (("hand", "torque_limits"), [10, 6, 10, 5], "hand.torque_limits",
+     "6 N m for joint 'joint2' exceeds the URDF effort limit"),
+    (("hand", "torque_limits"), 1e300, "hand.torque_limits", "exceeds the URDF effort limit"),
+    (("hand", "torque_limits_above_urdf"), "yes", "hand.torque_limits_above_urdf",
+     "must be true or false"),
+    (("friction", "polygon_sides"), 10**9, "friction.polygon_sides", "must be at most 64"),
+    (("friction", "min_normal_force"), 10**400, "friction.min_normal_force", "must be finite"),
 ]

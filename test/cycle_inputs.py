@@ -6,6 +6,7 @@ real one can (for the fault paths; the healthy path is the real ProxSuite).
 """
 
 import dataclasses
+import time
 
 import numpy as np
 import pinocchio as pin
@@ -71,6 +72,19 @@ class Injected:
         if self.mode == "wrong-size-x":
             return RawResult("solved", good.x[:-1], 1, 0.0, "PROXQP_SOLVED")
         raise AssertionError(self.mode)
+
+
+class Slow:
+    """A solver that answers correctly, late (it takes no deadline): a cycle or a service
+    call that outlasts its budget or its inputs."""
+
+    def __init__(self, delay: float):
+        self.inner, self.delay = TauQPSolver(), delay
+        self.settings = self.inner.settings
+
+    def solve(self, qp):
+        time.sleep(self.delay)
+        return self.inner.solve(qp)
 
 
 FAULT_MODES = ["raise-solver", "raise-other", "nan-data", "inverted-bounds", "max-iter",

@@ -29,9 +29,9 @@ class Harness:
     def __init__(self, scenario: Path, **params):
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=DOMAIN)
-        # A generous cycle budget unless a test is about it: other processes may load
-        # this machine, and an overrun drops the command by design.
-        params.setdefault("cycle_budget", 5.0)
+        # The most generous cycle budget unless a test is about it: other processes may
+        # load this machine, and an overrun drops the command by design.
+        params.setdefault("cycle_budget", 1.0)
         # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
         params.setdefault("diagnostics_period", 0.1)
         overrides = [Parameter("scenario", value=str(scenario))]

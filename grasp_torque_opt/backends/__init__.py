@@ -60,11 +60,12 @@ def single_threaded_math() -> None:
 
 
 def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None,
-                warm_start: bool = False):
+                warm_start: bool = False, max_slice_s: float | None = None):
     """A tau-QP solver by backend name (one of :data:`BACKENDS`).
 
     ``warm_start`` applies to ProxSuite and DAQP (each verifies its warm answers
-    and redoes a bad one cold); quadprog has none.
+    and redoes a bad one cold); quadprog has none. ``max_slice_s`` bounds each
+    ProxSuite call under a deadline (:class:`~grasp_torque_opt.backends.proxsuite.TauQPSolver`).
 
     Raises:
         ValueError: an unknown backend, naming the known ones, or one whose
@@ -73,7 +74,7 @@ def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None =
     if backend in BACKENDS and not available(backend):
         raise ValueError(f"backend {backend!r} is not installed (pip install {backend})")
     if backend == "proxsuite":
-        return TauQPSolver(settings, warm_start)
+        return TauQPSolver(settings, warm_start, max_slice_s)
     if backend == "daqp":
         return DaqpSolver(settings, warm_start)
     if backend == "quadprog":

@@ -12,13 +12,18 @@ import time
 
 import numpy as np
 
-from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.backends.proxsuite import ESTIMATE_DECAY, ProxSuiteSettings, size_factor
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
 from grasp_torque_opt.core.tau_qp import TauQP, check_data
 
 #: DAQP's "infinite" bound.
 DAQP_INF = 1e30
+#: Seconds per DAQP iteration assumed before a solve of a size has measured it, for the
+#: Allegro's tau-QP (about 2 us here), scaled by size_factor for others (32 contacts:
+#: 50 to 90 us measured, up to 2900 iterations when it cycles).
+ITERATION_S = 3e-6
+
 #: Largest KKT violation (:func:`kkt_violation`) of an answer taken as optimal.
 KKT_TOLERANCE = 1e-6
 
@@ -89,19 +94,29 @@ class DaqpSolver:
         self.last_warm = False
         self._model = None
         self._dims: tuple[int, int, int] | None = None
+        self._limit = self.settings.max_iter
+        self._iter_s = ITERATION_S
         self._keep: tuple = ()
 
-    def solve(self, qp: TauQP, cold: bool = False) -> RawResult:
+    def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
+              ) -> RawResult:
         """Solve a built tau-QP (warm if enabled and verified, else cold).
 
         Args:
             qp: the QP.
             cold: start cold even with ``warm_start`` (the caller's redo of a warm
                 answer that failed its certificate; counted in ``fallbacks``).
+            deadline: ``time.perf_counter()`` value [s]: past it, no solve starts
+                (an error result), and before it the iteration cap is lowered to
+                the iterations that fit in the time left, at the measured time per
+                iteration (DAQP 0.11's ``time_limit`` setting did not stop a plain
+                QP here: docs/design.md section 2.2).
         """
         if cold and self.last_warm:
             self.fallbacks += 1
         self.last_warm = False
+        if deadline is not None and time.perf_counter() >= deadline:
+            return RawResult("error", None, 0, 0.0, "time budget spent before DAQP started")
         why = check_data(qp)
         if why:
             return RawResult("error", None, 0, 0.0, why)
@@ -112,13 +127,21 @@ class DaqpSolver:
         sense = np.zeros(n + n_eq + n_in, dtype=np.int32)
         sense[n:n + n_eq] = 5  # equality
         H = qp.H.copy()  # DAQP wants writable buffers; H is shared read-only
+        if self._dims != (n, n_eq, n_in):
+            self._iter_s = ITERATION_S * size_factor(qp)  # a new size: a guess
+        limit = self.settings.max_iter
+        if deadline is not None:
+            limit = min(limit, max(1, int((deadline - time.perf_counter()) / self._iter_s)))
         t0 = time.perf_counter()
         try:
             x, flag, info, iterations = self._run(qp, n, (n, n_eq, n_in), H, A, upper, lower,
-                                                  sense, cold)
+                                                  sense, cold, limit)
         except RuntimeError as e:  # e.g. a failed setup: the next call starts anew
             self._dims = None
             raise SolverError(f"DAQP failed: {e}") from e
+        if iterations:
+            self._iter_s = max((time.perf_counter() - t0) / iterations,
+                               ESTIMATE_DECAY * self._iter_s)
         if x is None:
             self._dims = None
             return RawResult("error", None, 0, time.perf_counter() - t0,
@@ -133,8 +156,9 @@ class DaqpSolver:
 
     def _run(self, qp: TauQP, n: int, dims: tuple[int, int, int], H: np.ndarray,
              A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray,
-             cold: bool):
-        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified).
+             cold: bool, limit: int):
+        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified),
+        with at most ``limit`` iterations per DAQP solve.
 
         Returns:
             (x, flag, info with "kkt", iterations); x None if the setup failed.
@@ -145,10 +169,11 @@ class DaqpSolver:
             if flag < 0:
                 return None, flag, {}, 0
             s = self._model.settings
-            s.update(primal_tol=self.settings.eps_abs, iter_limit=self.settings.max_iter,
+            s.update(primal_tol=self.settings.eps_abs, iter_limit=limit,
                      eps_prox=0.0 if n == qp.m else -1e-6)
             self._model.settings = s
             self._dims = dims
+            self._limit = limit
             warm = False
         else:
             warm = self.warm_start and not cold
@@ -157,6 +182,11 @@ class DaqpSolver:
                                       sense=None if warm else sense)
             if flag is not None and flag < 0:
                 return None, flag, {}, 0
+        if limit != self._limit:  # a budget's cap, or back to max_iter
+            s = self._model.settings
+            s.update(iter_limit=limit)
+            self._model.settings = s
+            self._limit = limit
         self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
         x, _, flag, info = self._model.solve()
         iterations = int(info["iterations"])
@@ -166,6 +196,13 @@ class DaqpSolver:
             self.last_warm = kkt <= KKT_TOLERANCE
             if not self.last_warm:
                 self.fallbacks += 1
+                # Under a deadline the two solves share the cap fitted to it.
+                rest = max(1, limit - iterations) if limit < self.settings.max_iter else limit
+                if rest != self._limit:
+                    s = self._model.settings
+                    s.update(iter_limit=rest)
+                    self._model.settings = s
+                    self._limit = rest
                 self._model.update(sense=sense)  # the same data, cold
                 x, _, flag, info = self._model.solve()
                 iterations += int(info["iterations"])
@@ -208,6 +245,8 @@ class DaqpWorkspace:
         self.eps_abs, self.max_iter = eps_abs, max_iter
         self._model = None
         self._dims: tuple[int, int, int, bool] | None = None
+        self._limit = max_iter
+        self._iter_s = ITERATION_S
         #: The last answer's multipliers, DAQP's order and sign: bounds on x, then
         #: A_eq's rows, then C's; > 0 on an active upper bound. None before one.
         self.multipliers: np.ndarray | None = None
@@ -237,12 +276,18 @@ class DaqpWorkspace:
         dims = (n, n_eq, n_in, semidefinite)
         if self._dims != dims:
             self._model, self._dims = None, dims
+            self._iter_s = ITERATION_S * max(1.0, n * (n + n_eq + n_in) / (16 * 144))
         self._cold = not warm
 
     def solve(self, H: np.ndarray | None = None, g: np.ndarray | None = None,
               C: np.ndarray | None = None, u: np.ndarray | None = None,
-              cold: bool = False) -> RawResult:
+              cold: bool = False, deadline: float | None = None) -> RawResult:
         """Solve with the given H, g, C, u (None: keep the last), warm unless ``cold``.
+
+        Args:
+            deadline: ``time.perf_counter()`` value [s]: past it no solve starts, and
+                before it the iteration cap is the iterations that fit (as
+                :class:`DaqpSolver`'s).
 
         Returns:
             The raw result; ``multipliers`` holds its multipliers when solved.
@@ -251,6 +296,12 @@ class DaqpWorkspace:
             SolverError: DAQP raised (chained); the next solve starts anew.
         """
         self.multipliers = None
+        limit = self.max_iter
+        if deadline is not None:
+            left = deadline - time.perf_counter()
+            if left <= 0.0:
+                return RawResult("error", None, 0, 0.0, "time budget spent before DAQP started")
+            limit = min(limit, max(1, int(left / self._iter_s)))
         n_eq = self._n_eq
         n = self._H.shape[0]
         for new, old in ((H, self._H), (g, self._g)):
@@ -275,9 +326,10 @@ class DaqpWorkspace:
                     return RawResult("error", None, 0, time.perf_counter() - t0,
                                      f"DAQP setup failed (exit flag {flag})")
                 s = self._model.settings
-                s.update(primal_tol=self.eps_abs, iter_limit=self.max_iter,
+                s.update(primal_tol=self.eps_abs, iter_limit=limit,
                          eps_prox=-1e-6 if self._dims[3] else 0.0)
                 self._model.settings = s
+                self._limit = limit
             else:
                 # Without sense, DAQP keeps the previous active set: a warm start.
                 flag = self._model.update(H=self._H, f=self._g, A=self._A, bupper=self._upper,
@@ -287,12 +339,19 @@ class DaqpWorkspace:
                     self._model = None
                     return RawResult("error", None, 0, time.perf_counter() - t0,
                                      f"DAQP update failed (exit flag {flag})")
+                if limit != self._limit:  # a budget's cap, or back to max_iter
+                    s = self._model.settings
+                    s.update(iter_limit=limit)
+                    self._model.settings = s
+                    self._limit = limit
             x, _, flag, info = self._model.solve()
         except RuntimeError as e:
             self._model = None
             raise SolverError(f"DAQP failed: {e}") from e
         self._cold = False
         elapsed = time.perf_counter() - t0
+        if int(info["iterations"]):
+            self._iter_s = max(elapsed / int(info["iterations"]), ESTIMATE_DECAY * self._iter_s)
         status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
         if status == "solved":
             self.multipliers = np.asarray(info["lam"], dtype=float)

@@ -52,6 +52,24 @@ def kkt_violation(qp: TauQP, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> flo
                  float(np.abs(qp.A @ x - qp.b).max(initial=0.0)) if qp.A.shape[0] else 0.0)
     return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
                dual / scale, primal)
+#: Seconds per ProxSuite inner iteration assumed before a solve of a size has measured
+#: it, for the Allegro's tau-QP (7 to 25 us per inner iteration here, setup included);
+#: scaled by :func:`size_factor` for others (32 contacts: 150 to 420 us measured).
+INNER_ITERATION_S = 25e-6
+
+
+def size_factor(qp: TauQP) -> float:
+    """How much more one iteration of a dense solver costs on ``qp`` than on the Allegro's
+    four-fingertip tau-QP (16 variables, 144 rows), as n (n + rows), at least 1."""
+    n = qp.H.shape[0]
+    return max(1.0, n * (n + qp.A.shape[0] + qp.C.shape[0]) / (16 * 144))
+#: Each solve's measured time per inner iteration replaces the estimate if larger; a
+#: smaller one lowers it by at most this factor per solve (a slow solve is remembered).
+ESTIMATE_DECAY = 0.9
+#: Fewest outer iterations in a slice cut short by ``max_slice_s``: each continuation
+#: restarts ProxSuite's inner tolerances, and slices of 1 to 3 outer iterations never
+#: converged on Allegro QPs that one call solves in 24 to 47 (10 always did, here).
+MIN_SLICE_OUTER = 20
 
 
 @dataclass(frozen=True)
@@ -106,6 +124,18 @@ class ProxSuiteSettings:
 class TauQPSolver:
     """ProxSuite dense solver for tau-QPs, allocated once per problem size.
 
+    A time budget (``deadline`` of :meth:`solve`) is kept by ProxSuite's own
+    iteration cap: ProxSuite has no wall-clock limit, so the solve runs in
+    slices of outer iterations, each sized from the measured time per inner
+    iteration so that even at ``max_iter_in`` inner iterations per outer one it
+    ends by the deadline (or after ``max_slice_s``, but never fewer than
+    :data:`MIN_SLICE_OUTER`), continued from the slice's result
+    (``WARM_START_WITH_PREVIOUS_RESULT``) until ProxSuite stops by itself,
+    ``max_iter`` outer iterations are done, or the deadline has passed. The
+    deadline is overrun by at most one outer iteration. A solve that fits in
+    its first slice (every feasible bench grasp under the node's budget) is
+    one ProxSuite call, as without a budget. docs/design.md section 2.2.
+
     With ``warm_start``, each solve on a QP of the same size starts from the
     previous result (``WARM_START_WITH_PREVIOUS_RESULT``; data replaced with
     ``update``, preconditioner kept). A warm answer that ProxSuite does not call
@@ -118,14 +148,22 @@ class TauQPSolver:
     Args:
         settings: ProxSuite's settings.
         warm_start: start from the previous result.
+        max_slice_s: longest ProxSuite call under a deadline [s] (None: up to the
+            deadline). ProxSuite holds Python's interpreter lock while it runs: a
+            solver in a worker thread (the node's service) keeps its slices short
+            so that the control loop's thread gets the lock between them.
     """
 
     name = "proxsuite"
 
     def __init__(self, settings: ProxSuiteSettings | None = None,
-                 warm_start: bool = False) -> None:
+                 warm_start: bool = False, max_slice_s: float | None = None) -> None:
         self.settings = settings or ProxSuiteSettings()
         self.warm_start = warm_start
+        self.max_slice_s = max_slice_s
+        #: Solves stopped by their deadline.
+        self.timeouts = 0
+        self._inner_s = INNER_ITERATION_S
         self.warm_solves = 0
         self.fallbacks = 0
         #: Whether the last answer came from a warm start (not redone cold).
@@ -140,13 +178,17 @@ class TauQPSolver:
             return "Dense"
         return self.settings.hessian_type
 
-    def solve(self, qp: TauQP, cold: bool = False) -> RawResult:
+    def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
+              ) -> RawResult:
         """Solve a built tau-QP (warm if enabled and the size is unchanged, else cold).
 
         Args:
             qp: the QP.
             cold: start cold even with ``warm_start`` (the caller's redo of a warm
                 answer that failed its certificate; counted in ``fallbacks``).
+            deadline: ``time.perf_counter()`` value by which to stop [s] (None: no
+                budget, only the iteration caps). A solve stopped by it is an
+                error result ("time budget ...").
 
         Returns:
             The raw result; the caller certifies it.
@@ -168,6 +210,7 @@ class TauQPSolver:
         t0 = time.perf_counter()
         try:
             if self._dims != dims:
+                self._inner_s = INNER_ITERATION_S * size_factor(qp)  # a new size: a guess
                 self._init(dims, data)
                 warm = False
             else:
@@ -176,28 +219,78 @@ class TauQPSolver:
                                                    else guess.NO_INITIAL_GUESS)
                 self._qp.update(**data,
                                 update_preconditioner=self.settings.preconditioner == "every")
-            self._qp.solve()
-            iterations = int(self._qp.results.info.iter)
+            iterations, stopped = self._solve_until(deadline)
             if warm:
                 self.warm_solves += 1
                 r = self._qp.results
                 self.last_warm = r.info.status == proxsuite.proxqp.QPSolverOutput.PROXQP_SOLVED \
                     and kkt_violation(qp, r.x, r.y, r.z) <= KKT_TOLERANCE
-                if not self.last_warm:  # the same data, cold
+                if not self.last_warm and not stopped:  # the same data, cold
                     self.fallbacks += 1
                     self._qp.settings.initial_guess = guess.NO_INITIAL_GUESS
-                    self._qp.solve()
-                    iterations += int(self._qp.results.info.iter)
+                    more, stopped = self._solve_until(deadline)
+                    iterations += more
         except (RuntimeError, ValueError, TypeError) as e:
             self._dims = None
             raise SolverError(f"ProxSuite failed: {e}") from e
         elapsed = time.perf_counter() - t0
         info = self._qp.results.info
+        if stopped:
+            self.timeouts += 1
+            x = np.array(self._qp.results.x) if iterations else None  # else the last QP's
+            return RawResult("error", x, iterations, elapsed,
+                             f"time budget spent after {iterations} iterations "
+                             f"({1e3 * elapsed:.1f} ms)")
         out = proxsuite.proxqp.QPSolverOutput
         status = {out.PROXQP_SOLVED: "solved",
                   out.PROXQP_PRIMAL_INFEASIBLE: "infeasible"}.get(info.status, "error")
         return RawResult(status, np.array(self._qp.results.x), iterations, elapsed,
                          str(info.status).rsplit(".", 1)[-1])
+
+    def _solve_until(self, deadline: float | None) -> tuple[int, bool]:
+        """ProxSuite's solve from the initial guess set, within ``deadline`` if given.
+
+        Returns:
+            (inner iterations, whether the deadline stopped it before ProxSuite did).
+        """
+        qp = self._qp
+        if deadline is None:
+            qp.solve()
+            return int(qp.results.info.iter), False
+        s = qp.settings
+        cap = self.settings.max_iter
+        max_reached = proxsuite.proxqp.QPSolverOutput.PROXQP_MAX_ITER_REACHED
+        inner = outer = 0
+        capped = False  # ProxSuite's max_iter lowered for a slice (each write costs)
+        try:
+            while True:
+                left = deadline - time.perf_counter()
+                if left <= 0.0:
+                    return inner, True
+                # The worst an outer iteration can take: max_iter_in inner ones.
+                per_outer = self.settings.max_iter_in * self._inner_s
+                k = max(1, int(left / per_outer))
+                if self.max_slice_s is not None:
+                    k = min(k, max(MIN_SLICE_OUTER, int(self.max_slice_s / per_outer)))
+                k = min(cap - outer, k)
+                if k != cap or capped:
+                    s.max_iter, capped = k, True
+                t0 = time.perf_counter()
+                qp.solve()
+                info = qp.results.info
+                iters = int(info.iter)
+                inner += iters
+                outer += int(info.iter_ext)
+                per_inner = (time.perf_counter() - t0) / max(1, iters)
+                self._inner_s = max(per_inner, ESTIMATE_DECAY * self._inner_s)
+                if info.status != max_reached or outer >= cap:
+                    return inner, False
+                # Continue from where the slice stopped (ProxSuite keeps its iterate,
+                # multipliers and penalty parameters with this guess).
+                s.initial_guess = proxsuite.proxqp.InitialGuess.WARM_START_WITH_PREVIOUS_RESULT
+        finally:
+            if capped:
+                s.max_iter = cap
 
     def _init(self, dims: tuple, data: dict) -> None:
         """A new ProxSuite QP for this problem size, set up with the settings and ``data``."""

@@ -32,8 +32,11 @@ class QuadprogSolver:
         self._quadprog = quadprog
         self.settings = settings or ProxSuiteSettings()
 
-    def solve(self, qp: TauQP) -> RawResult:
-        """Solve a built tau-QP."""
+    def solve(self, qp: TauQP, deadline: float | None = None) -> RawResult:
+        """Solve a built tau-QP (none starts past ``deadline``, a ``time.perf_counter()``
+        value [s]; a quadprog solve ends after finitely many active-set steps)."""
+        if deadline is not None and time.perf_counter() >= deadline:
+            return RawResult("error", None, 0, 0.0, "time budget spent before quadprog started")
         why = check_data(qp)
         if why:
             return RawResult("error", None, 0, 0.0, why)

@@ -16,6 +16,10 @@ solution after a fault is published at once (recovery).
 A cycle that fails in any way (a solver that raises, a status other than
 solved, a certificate that fails, an unexpected exception) is such a fault; so
 is a cycle that overruns ``cycle_budget``: its command is late and is dropped.
+The solvers are given the cycle's budget (:meth:`TorqueController.budget`) as
+a deadline that they keep themselves, so a cycle ends within about its budget
+whatever the parameters; and the inputs are checked fresh again when the
+command leaves, not only when the cycle starts.
 
 Input rules (docs/node.md, "Faults" and "Input checks"): every message is checked
 whole before it is kept (sizes, names, finite values, unit quaternions, known
@@ -70,6 +74,8 @@ class CycleConfig:
         gravity_compensation: add the fingers' own gravity torques g(q).
         gravity: gravity in the base frame [m/s^2], shape (3,).
         certificate_tolerance: tolerance of the certificate (SI units).
+        max_message_bytes: a message whose serialized form is longer than this is
+            rejected before it is deserialized [bytes].
         max_joint_state_entries: a joint state with more names or positions than
             this is rejected unread [-].
         max_wrench_force: a load whose force norm exceeds this is rejected [N].
@@ -79,6 +85,7 @@ class CycleConfig:
         stamp_future_tolerance: a header stamp more than this ahead of the clock
             is rejected [s].
         cycle_budget: a cycle that takes longer publishes nothing (overrun) [s].
+            Its solvers stop by the budget (with joint_state_timeout if smaller).
         method: ``tau-qp`` (the paper's polygon) or ``tau-qp-adaptive`` (the
             exact-cone optimum with certified bounds, docs/adaptive.md; DAQP).
     """
@@ -92,6 +99,7 @@ class CycleConfig:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     certificate_tolerance: float = DEFAULT_TOLERANCE
     max_joint_state_entries: int = 256
+    max_message_bytes: int = 65536
     max_wrench_force: float = 1000.0
     max_wrench_torque: float = 100.0
     max_contact_distance: float = 1.0
@@ -239,6 +247,9 @@ class TorqueController:
         self.counters = Counters()
         self.last_command: np.ndarray | None = None
         self.last_command_time: float | None = None
+        #: The last command returned for publishing, certified or the zero policy's: what
+        #: the effort controller holds (it has no timeout) [N m].
+        self.in_force: np.ndarray | None = None
         self.last: CycleResult | None = None
         self.fault = ""
         self.last_rejection = ""
@@ -248,6 +259,19 @@ class TorqueController:
                               for j in range(1, model.njoints) if model.joints[j].nq == 1}
 
     # -- inputs ---------------------------------------------------------------------------
+
+    def check_bytes(self, source: str, n: int) -> None:
+        """Reject a message by the length of its serialized form, before it is deserialized
+        (5.6 MB of poses took 0.8 s to deserialize here, holding up the loop).
+
+        Raises:
+            InputError: more than ``max_message_bytes`` (counted as a rejection).
+        """
+        limit = self.config.max_message_bytes
+        if n > limit:
+            e = InputError(source, f"{n} bytes serialized, more than max_message_bytes ({limit})")
+            self._reject(source, e)
+            raise e
 
     def check_size(self, source: str, n: int) -> None:
         """Reject a message by its size alone, before it is read.
@@ -276,10 +300,13 @@ class TorqueController:
 
         0 is an unstamped message: accepted, not compared. A stamp more than
         ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)
-        is rejected. A stamp before the last accepted one of the same topic is
-        rejected (out of order), unless that one is itself stale by receipt
-        time: a restarted publisher or a rewound clock recovers after the
-        topic's timeout.
+        is rejected. A stamp before the topic's mark is rejected (out of order),
+        unless the mark is itself stale by receipt time: a restarted publisher
+        or a rewound clock recovers after the topic's timeout. The mark is the
+        last accepted stamp, but never later than the clock when that message
+        was accepted (:meth:`_keep_stamp`): a source stamping ahead of the clock,
+        by a fast clock or a lie, cannot push it into the future and lock out a
+        source whose stamps agree with the clock.
         """
         if stamp == 0.0:
             return
@@ -300,9 +327,10 @@ class TorqueController:
              "external_wrench": c.wrench_timeout}[source]
         return t if t > 0 else c.joint_state_timeout
 
-    def _keep_stamp(self, source: str, stamp: float, now: float) -> None:
+    def _keep_stamp(self, source: str, stamp: float, now: float, clock: float | None) -> None:
         if stamp != 0.0:
-            self._stamps[source] = (stamp, now)
+            mark = min(stamp, clock) if clock is not None and clock > 0.0 else stamp
+            self._stamps[source] = (mark, now)
 
     def update_joint_state(self, names: list[str], positions: list[float], now: float,
                            stamp: float = 0.0, clock: float | None = None) -> None:
@@ -355,7 +383,7 @@ class TorqueController:
         except InputError as e:
             self._reject("joint_states", e)
             raise
-        self._keep_stamp("joint_states", stamp, now)
+        self._keep_stamp("joint_states", stamp, now, clock)
         self.inputs = dataclasses.replace(self.inputs, q=q, q_time=now)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
@@ -397,7 +425,7 @@ class TorqueController:
         except InputError as e:
             self._reject("contacts", e)
             raise
-        self._keep_stamp("contacts", stamp, now)
+        self._keep_stamp("contacts", stamp, now, clock)
         self.inputs = dataclasses.replace(
             self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
 
@@ -441,7 +469,7 @@ class TorqueController:
         except InputError as e:
             self._reject("external_wrench", e)
             raise
-        self._keep_stamp("external_wrench", stamp, now)
+        self._keep_stamp("external_wrench", stamp, now, clock)
         # Kept in the given axes; turned into base axes at the cycle's configuration.
         self.inputs = dataclasses.replace(self.inputs, wrench=(frame, w), wrench_time=now)
 
@@ -507,8 +535,20 @@ class TorqueController:
         return dataclasses.replace(setup, q=q, contacts=contacts, external_wrench=wrench,
                                    torque_offset=g), g
 
-    def solve_inputs(self, inputs: Inputs) -> tuple[Solution, GraspMaps, np.ndarray | None]:
+    def budget(self) -> float:
+        """The time a cycle's solvers may take [s]: ``cycle_budget``, or
+        ``joint_state_timeout`` if smaller (a command later than that would answer a
+        stale joint state)."""
+        return min(self.config.cycle_budget, self.config.joint_state_timeout)
+
+    def solve_inputs(self, inputs: Inputs, deadline: float | None = None
+                     ) -> tuple[Solution, GraspMaps, np.ndarray | None]:
         """Solve the grasp of a snapshot of inputs with the tau-QP (certified).
+
+        Args:
+            inputs: the snapshot.
+            deadline: ``time.perf_counter()`` value by which the solvers stop [s]
+                (None: only their iteration caps).
 
         Raises:
             InputError: the inputs do not make a grasp (e.g. a tangent parallel to
@@ -518,7 +558,7 @@ class TorqueController:
         maps = setup.maps()
         sol = solve(setup, self.config.method, maps=maps, solver=self.solver,
                     fallback=self.fallback, tolerance=self.config.certificate_tolerance,
-                    refiner=self._refiner())
+                    refiner=self._refiner(), deadline=deadline)
         return sol, maps, g
 
     def _refiner(self) -> Refiner | None:
@@ -553,13 +593,15 @@ class TorqueController:
     def cycle(self, now: float) -> CycleResult:
         """One cycle on the latest inputs (run it on each new joint state).
 
-        Never raises: every failure is a fault, handled by the policy. A
-        certified command from a cycle that took longer than ``cycle_budget``
-        is not published (it answers a joint state older than the budget).
+        Never raises: every failure is a fault, handled by the policy. The
+        solvers stop by :meth:`budget`. A certified command from a cycle that
+        took longer than ``cycle_budget`` is not published (it answers a joint
+        state older than the budget), nor one whose inputs went stale while it
+        was computed (checked at ``now`` plus the cycle's time).
         """
         t0 = time.perf_counter()
         self.counters.cycles += 1
-        result = self._attempt(now)
+        result = self._attempt(now, t0 + self.budget())
         elapsed = time.perf_counter() - t0
         self.counters.max_cycle_time = max(self.counters.max_cycle_time, elapsed)
         if elapsed > self.config.cycle_budget:
@@ -568,11 +610,16 @@ class TorqueController:
                 result = self._faulted(now, f"cycle overrun ({1e3 * elapsed:.1f} ms > "
                                        f"cycle_budget {1e3 * self.config.cycle_budget:.1f} ms)",
                                        result.solution, result.maps, result.gravity_torque)
+        late = self.stale(now + elapsed) if result.kind == "solution" else ""
+        if late:
+            result = self._faulted(now + elapsed, f"inputs went stale during the cycle: {late}",
+                                   result.solution, result.maps, result.gravity_torque)
         if result.kind == "solution":
             if self.fault:
                 self.counters.recoveries += 1
             self.fault = ""
             self.last_command, self.last_command_time = result.command, now
+            self.in_force = result.command
             self.counters.commands += 1
             if self.fallback is not None and result.solution.backend == self.fallback.name:
                 self.counters.fallback_solves += 1
@@ -580,13 +627,13 @@ class TorqueController:
         result.cycle_time = elapsed
         return result
 
-    def _attempt(self, now: float) -> CycleResult:
+    def _attempt(self, now: float, deadline: float) -> CycleResult:
         """Solve and gate; a certified command is returned, not yet committed."""
         reason = self.stale(now)
         if reason:
             return self._faulted(now, reason)
         try:
-            sol, maps, g = self.solve_inputs(self.inputs)
+            sol, maps, g = self.solve_inputs(self.inputs, deadline)
         except InputError as e:
             return self._faulted(now, f"inputs do not make a grasp: {e}")
         except GraspTorqueError as e:
@@ -622,10 +669,49 @@ class TorqueController:
         held = (self.last_command_time is not None
                 and now - self.last_command_time <= self.config.hold_time)
         if not held and self.config.fault_policy == "zero":
-            cmd = np.zeros(self.setup.hand.m)
-            self.counters.zero_commands += 1
-            result = CycleResult(cmd, "zero", sol, maps, g, reason)
+            result = self._zero(reason, sol, maps, g)
         else:
             result = CycleResult(None, "none", sol, maps, g, reason)
         self.last = result
         return result
+
+    def _zero(self, reason: str, sol: Solution | None = None, maps: GraspMaps | None = None,
+              g: np.ndarray | None = None) -> CycleResult:
+        cmd = np.zeros(self.setup.hand.m)
+        self.counters.zero_commands += 1
+        self.in_force = cmd
+        return CycleResult(cmd, "zero", sol, maps, g, reason)
+
+    def reconfigured(self, now: float) -> CycleResult | None:
+        """After a parameter change: make the command in force valid at once.
+
+        The rule (docs/node.md, "Faults"): the cycle runs again at once on the
+        latest inputs with the new parameters, and a certified command is
+        returned for publishing. If none comes out (stale inputs, an
+        unholdable grasp, a failed solve) and the command in force exceeds the
+        new torque limits, zero torques are returned, whatever
+        ``fault_policy`` says: the effort controller would otherwise hold a
+        torque the user has just forbidden. Otherwise the usual fault path
+        applies (hold, then the policy).
+
+        Returns:
+            The result to publish, or None (nothing was ever commanded, or
+            nothing to publish now).
+        """
+        if self.in_force is None:
+            return None
+        result = None
+        if self.inputs.q is not None and not self.stale(now):
+            result = self.cycle(now)
+            if result.kind == "solution":
+                return result
+        lim = self.setup.hand.torque_limits
+        if self.in_force.shape == lim.shape and np.all(np.abs(self.in_force) <= lim):
+            return result if result is not None and result.command is not None else None
+        why = result.fault if result is not None else self.stale(now)
+        reason = "the command in force exceeds the new torque_limits" + (f" ({why})" if why else "")
+        if not self.fault:
+            self.counters.faults += 1
+        self.fault = reason
+        self.last = self._zero(reason)
+        return self.last

@@ -1,6 +1,32 @@
 """Exceptions of grasp_torque_opt: one base class, subclasses that name the bad input."""
 
+import reprlib
 from collections.abc import Iterable
+
+#: Longest quotation of the user's input in an error message [characters].
+QUOTE_LENGTH = 80
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxtuple, _REPR.maxdict = 2, 6, 6, 4
+_REPR.maxstring = _REPR.maxother = QUOTE_LENGTH
+
+
+def quote(value: object) -> str:
+    """``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time whatever
+    its size (a value quoted whole once printed a 4.3 MB "one line")."""
+    text = _REPR.repr(value)
+    return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + "..."
+
+
+#: Longest quotation of a path in an error message [characters].
+PATH_LENGTH = 240
+
+
+def cut(name: object, limit: int = QUOTE_LENGTH) -> str:
+    """A name from the input as quoted in messages: ``str(name)`` cut to ``limit``
+    characters (:data:`PATH_LENGTH` for paths)."""
+    text = str(name) if not isinstance(name, str) else name
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 class GraspTorqueError(Exception):
@@ -23,7 +49,7 @@ class InputError(GraspTorqueError):
 
 def _choices(available: Iterable[str], limit: int = 12) -> str:
     names = sorted(available)
-    shown = ", ".join(names[:limit])
+    shown = ", ".join(cut(n) for n in names[:limit])
     return shown + (f", ... ({len(names)} in all)" if len(names) > limit else "")
 
 
@@ -34,7 +60,8 @@ class FrameNotFound(InputError):
         self.name = name
         self.available = sorted(available)
         super().__init__(field,
-                         f"unknown frame '{name}' (model frames: {_choices(self.available)})")
+                         f"unknown frame '{cut(name)}' (model frames: "
+                         f"{_choices(self.available)})")
 
 
 class JointNotFound(InputError):
@@ -44,7 +71,7 @@ class JointNotFound(InputError):
         self.name = name
         self.available = sorted(available)
         super().__init__(
-            field, f"unknown joint '{name}' (1-DoF joints: {_choices(self.available)})"
+            field, f"unknown joint '{cut(name)}' (1-DoF joints: {_choices(self.available)})"
         )
 
 

@@ -66,11 +66,13 @@ class GraspSetup:
         Raises:
             InputError: naming the field (file, joint or frame not found, ...).
         """
+        above = scenario.torque_limits_above_urdf
         if urdf_xml:
-            hand = Hand.from_urdf_string(urdf_xml, scenario.joints, scenario.torque_limits)
+            hand = Hand.from_urdf_string(urdf_xml, scenario.joints, scenario.torque_limits,
+                                         above)
         else:
             hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
-                                  scenario.joints, scenario.torque_limits)
+                                  scenario.joints, scenario.torque_limits, above)
         weights = np.ones(hand.m) if scenario.weights is None else np.asarray(scenario.weights)
         if weights.shape != (hand.m,):
             raise InputError("objective.weights",

@@ -1,8 +1,16 @@
-"""The hand: a Pinocchio model loaded from URDF, its actuated joints and torque limits."""
+"""The hand: a Pinocchio model loaded from URDF, its actuated joints and torque limits.
+
+A URDF is read within bounds (docs/design.md section 4.1): a regular file of at most
+:data:`MAX_URDF_BYTES`, UTF-8, at most :data:`MAX_URDF_ELEMENTS` ``<joint>`` and
+``<link>`` elements, a model of at most :data:`MAX_MODEL_DOF` degrees of freedom:
+Pinocchio's workspace grows as nv^3 on a chain (23 MB at 64, 142 MB at 128, 1.1 GB at
+256 here), and a 500-joint URDF of 170 KB took over 4 GB.
+"""
 
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
 from functools import cached_property
 from importlib import metadata
@@ -11,9 +19,27 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
+from grasp_torque_opt.core.exceptions import (
+    PATH_LENGTH,
+    FrameNotFound,
+    InputError,
+    JointNotFound,
+    cut,
+)
+from grasp_torque_opt.core.resources import decode_utf8, read_bounded
 
 ERD_PREFIX = "example-robot-data:"
+#: Largest torque limit accepted at all [N m], also when a limit above the URDF's effort
+#: limit is allowed: a bound on what any command can be (1e300 was accepted once).
+MAX_TORQUE_LIMIT = 1e4
+#: Largest URDF read [bytes] (example-robot-data's largest, tiago_dual, is 211 KB).
+MAX_URDF_BYTES = 2 * 1024 * 1024
+#: Most ``<joint`` and ``<link`` elements each (transmissions name joints too), counted
+#: before Pinocchio parses the document (a 256-joint chain took 0.8 s to build here).
+MAX_URDF_ELEMENTS = 512
+#: Most degrees of freedom (nv) of a model: its workspace is allocated next.
+MAX_MODEL_DOF = 64
+_ELEMENT = {tag: re.compile(rf"<{tag}[\s/>]") for tag in ("joint", "link")}
 
 
 def example_robot_data_dir() -> Path:
@@ -51,7 +77,8 @@ def resolve_urdf(spec: str, base_dir: Path) -> Path:
         base_dir: folder of the scenario file.
 
     Raises:
-        InputError: the file does not exist (field ``hand.urdf``).
+        InputError: the file does not exist (field ``hand.urdf``); an existing
+            directory or device is refused by :meth:`Hand.from_urdf`, saying so.
     """
     if spec.startswith(ERD_PREFIX):
         path = example_robot_data_dir() / spec[len(ERD_PREFIX):]
@@ -59,9 +86,25 @@ def resolve_urdf(spec: str, base_dir: Path) -> Path:
         path = Path(spec).expanduser()
         if not path.is_absolute():
             path = base_dir / path
-    if not path.is_file():
-        raise InputError("hand.urdf", f"file not found: {path}")
+    if not os.path.exists(path):  # False on any OSError, e.g. a name too long
+        raise InputError("hand.urdf", f"file not found: {cut(path, PATH_LENGTH)}")
     return path
+
+
+def bounded_urdf(xml: str, field_name: str) -> str:
+    """A URDF document within :data:`MAX_URDF_BYTES` and :data:`MAX_URDF_ELEMENTS`.
+
+    Raises:
+        InputError: naming ``field_name``.
+    """
+    if len(xml) > MAX_URDF_BYTES:
+        raise InputError(field_name, f"the URDF is larger than {MAX_URDF_BYTES} bytes")
+    for tag, pattern in _ELEMENT.items():
+        n = len(pattern.findall(xml))
+        if n > MAX_URDF_ELEMENTS:
+            raise InputError(field_name, f"the URDF has {n} <{tag}> elements, more than "
+                             f"{MAX_URDF_ELEMENTS}")
+    return xml
 
 
 @dataclass(frozen=True)
@@ -121,9 +164,37 @@ class Hand:
         return [model.names[j] for j in range(1, model.njoints)
                 if model.joints[j].nq == 1 and model.joints[j].nv == 1]
 
+    @property
+    def effort_limits(self) -> np.ndarray:
+        """The URDF's effort limit of each actuated joint [N m], inf where it gives none."""
+        e = np.asarray(self.model.effortLimit, dtype=float)[self.idx_v]
+        return np.where(np.isfinite(e) & (e > 0.0), e, np.inf)
+
+    @staticmethod
+    def check_limits(limits: np.ndarray, joints: list[str], bounds: np.ndarray,
+                     field: str, override: str) -> None:
+        """Each limit finite, > 0 and at most its bound (the URDF's effort limit).
+
+        Raises:
+            InputError: naming ``field`` and the first joint over its bound, and the
+                setting ``override`` that allows more.
+        """
+        if not np.all(np.isfinite(limits) & (limits > 0.0)):
+            raise InputError(field, "must be finite and > 0")
+        over = np.flatnonzero(limits > bounds)
+        if over.size:
+            i = int(over[0])
+            what = ("the URDF effort limit" if bounds[i] < MAX_TORQUE_LIMIT
+                    else "the largest limit accepted")
+            raise InputError(field, f"{limits[i]:g} N m for joint '{joints[i]}' exceeds "
+                             f"{what} ({bounds[i]:g} N m)" + (
+                                 f"; set {override}: true to allow it"
+                                 if bounds[i] < MAX_TORQUE_LIMIT else ""))
+
     @classmethod
     def from_model(cls, model: pin.Model, joints: list[str] | None = None,
-                   torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
+                   torque_limits: float | list[float] | np.ndarray | None = None,
+                   above_urdf: bool = False) -> Hand:
         """Bind actuated joints and limits to a model.
 
         Args:
@@ -131,11 +202,17 @@ class Hand:
             joints: actuated joints in command order; None for every 1-DoF joint.
             torque_limits: scalar or per-joint bound [N m]; None for the URDF
                 effort limits.
+            above_urdf: allow limits above the URDF's effort limits (up to
+                :data:`MAX_TORQUE_LIMIT`).
 
         Raises:
             JointNotFound: a joint is not a 1-DoF joint of the model (``hand.joints[i]``).
-            InputError: a limit is missing or not positive (``hand.torque_limits``).
+            InputError: a limit is missing, not positive, or above the joint's URDF
+                effort limit without ``above_urdf`` (``hand.torque_limits``).
         """
+        if model.nv > MAX_MODEL_DOF:
+            raise InputError("hand.urdf", f"the model has {model.nv} degrees of freedom, more "
+                             f"than {MAX_MODEL_DOF}")
         available = cls.one_dof_joints(model)
         if joints is None:
             joints = available
@@ -159,30 +236,42 @@ class Hand:
                                  f"must have {len(joints)} entries (one per joint), "
                                  f"got {limits.size}")
             limits = np.broadcast_to(limits, (len(joints),))
-            if not np.all(np.isfinite(limits) & (limits > 0.0)):
-                raise InputError("hand.torque_limits", "must be finite and > 0")
+            effort = np.asarray(model.effortLimit, dtype=float)[idx_v]
+            bounds = np.full(len(joints), MAX_TORQUE_LIMIT)
+            if not above_urdf:
+                known = np.isfinite(effort) & (effort > 0.0)
+                bounds[known] = np.minimum(effort[known], MAX_TORQUE_LIMIT)
+            cls.check_limits(limits, list(joints), bounds, "hand.torque_limits",
+                             "hand.torque_limits_above_urdf")
         return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
                    torque_limits=np.array(limits, dtype=float))
 
     @classmethod
     def from_urdf(cls, path: str | Path, joints: list[str] | None = None,
-                  torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
-        """Load a hand from a URDF file (fixed base; meshes are not needed)."""
+                  torque_limits: float | list[float] | np.ndarray | None = None,
+                  above_urdf: bool = False) -> Hand:
+        """Load a hand from a URDF file (fixed base; meshes are not needed), within the
+        module's bounds."""
+        path = Path(path)
+        xml = decode_utf8(read_bounded(path, "hand.urdf", MAX_URDF_BYTES), path, "hand.urdf")
         try:
-            model = pin.buildModelFromUrdf(str(path))
+            model = pin.buildModelFromXML(bounded_urdf(xml, "hand.urdf"))
         except (RuntimeError, ValueError) as e:
-            raise InputError("hand.urdf", f"cannot parse {path}: {e}") from e
-        return cls.from_model(model, joints, torque_limits)
+            raise InputError("hand.urdf",
+                             f"cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}") from e
+        return cls.from_model(model, joints, torque_limits, above_urdf)
 
     @classmethod
     def from_urdf_string(cls, xml: str, joints: list[str] | None = None,
-                         torque_limits: float | list[float] | np.ndarray | None = None) -> Hand:
-        """Load a hand from a URDF document (e.g. the ``robot_description`` parameter)."""
+                         torque_limits: float | list[float] | np.ndarray | None = None,
+                         above_urdf: bool = False) -> Hand:
+        """Load a hand from a URDF document (e.g. the ``robot_description`` parameter),
+        within the module's bounds."""
         try:
-            model = pin.buildModelFromXML(xml)
+            model = pin.buildModelFromXML(bounded_urdf(xml, "robot_description"))
         except (RuntimeError, ValueError) as e:
-            raise InputError("robot_description", f"cannot parse the URDF: {e}") from e
-        return cls.from_model(model, joints, torque_limits)
+            raise InputError("robot_description", f"cannot parse the URDF: {cut(e, 400)}") from e
+        return cls.from_model(model, joints, torque_limits, above_urdf)
 
     def configuration(self, positions: dict[str, float],
                       field: str = "grasp.joint_positions") -> np.ndarray:

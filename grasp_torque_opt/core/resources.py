@@ -1,12 +1,14 @@
-"""Where the package's bundled files (config/, urdf/) are, installed or in the source tree."""
+"""Where the package's bundled files (config/, urdf/) are, installed or in the source tree,
+and how any input file is read: a regular file, within a size bound."""
 
 from __future__ import annotations
 
 import os
+import stat
 import sys
 from pathlib import Path
 
-from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.exceptions import PATH_LENGTH, InputError, cut
 
 PACKAGE = "grasp_torque_opt"
 
@@ -26,10 +28,62 @@ def find_config(name: str, field: str = "scenario") -> Path:
         InputError: naming ``field``, when neither exists.
     """
     path = Path(name).expanduser()
-    if path.is_file():
-        return path
+    if os.path.exists(path):  # False on any OSError, e.g. a name too long
+        return path  # a directory or device is refused by its reader, saying so
     if not path.is_absolute():
         for d in config_dirs():
             if (d / path).is_file():
                 return d / path
-    raise InputError(field, f"file not found: {name} (nor in {', '.join(map(str, config_dirs()))})")
+    raise InputError(field, f"file not found: {cut(name, PATH_LENGTH)} "
+                     f"(nor in {', '.join(map(str, config_dirs()))})")
+
+
+def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
+    """The bytes of a regular file of at most ``limit`` bytes.
+
+    Opened without blocking and checked on the open descriptor, so a device, a
+    pipe or a symlink to one is refused before anything is read (``/dev/zero``
+    as a scenario took over 4 GB in 5 s), and at most ``limit + 1`` bytes are
+    read whatever the file does meanwhile.
+
+    Raises:
+        InputError: naming ``field_name``: cannot be opened, not a regular file,
+            or too large.
+    """
+    shown = cut(path, PATH_LENGTH)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as e:
+        raise InputError(field_name, f"cannot read {shown}: {e.strerror}") from e
+    try:
+        mode = os.fstat(fd).st_mode
+        if stat.S_ISDIR(mode):
+            raise InputError(field_name, f"{shown} is a directory, not a file")
+        if not stat.S_ISREG(mode):
+            raise InputError(field_name, f"{shown} is not a regular file (a device, pipe or "
+                             "socket)")
+        chunks, left = [], limit + 1
+        while left > 0:
+            chunk = os.read(fd, left)
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        data = b"".join(chunks)
+    except OSError as e:
+        raise InputError(field_name, f"cannot read {shown}: {e.strerror}") from e
+    finally:
+        os.close(fd)
+    if len(data) > limit:
+        raise InputError(field_name, f"{shown} is larger than {limit} bytes")
+    return data
+
+
+def decode_utf8(data: bytes, path: Path, field_name: str) -> str:
+    """UTF-8 text, or an error that says where the first bad byte is."""
+    shown = cut(path, PATH_LENGTH)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise InputError(field_name, f"{shown} is not UTF-8 text (byte 0x{data[e.start]:02x} "
+                         f"at offset {e.start})") from e

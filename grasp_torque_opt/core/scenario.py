@@ -3,7 +3,14 @@
 Validation here is structural (types, lengths, finiteness, ranges); what needs
 the model (joint and frame names, URDF limits) is checked when the scenario is
 bound to a hand in :mod:`grasp_torque_opt.core.grasp_setup`. Every error names the
-field, e.g. ``grasp.contacts[1].normal: must not be zero``.
+field, e.g. ``grasp.contacts[1].normal: must not be zero``, and quotes the input
+cut short.
+
+A file is read within bounds (docs/design.md section 4.1): a regular file of at
+most :data:`MAX_SCENARIO_BYTES`, UTF-8, YAML without aliases and nested at most
+:data:`MAX_DEPTH` deep, at most :data:`MAX_CONTACTS` contacts and
+:data:`MAX_JOINTS` joints, so that a hostile file costs bounded time and memory
+(a 2.8 KB alias bomb took over 4 GB; so did /dev/zero).
 """
 
 from __future__ import annotations
@@ -16,7 +23,20 @@ from typing import Any
 import numpy as np
 import yaml
 
-from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.exceptions import PATH_LENGTH, InputError, cut, quote
+from grasp_torque_opt.core.resources import decode_utf8, read_bounded
+
+#: Largest scenario file read [bytes] (the bundled ones are about 2 KB).
+MAX_SCENARIO_BYTES = 256 * 1024
+#: Deepest nesting of a scenario document (the schema needs 5 levels).
+MAX_DEPTH = 16
+#: Most contacts of a scenario (1000 took over 4 GB in the QP's dense matrices).
+MAX_CONTACTS = 32
+#: Most actuated joints (``hand.joints``) and most entries of a per-joint list.
+MAX_JOINTS = 64
+#: Most sides of the friction polygon (the node's parameter has the same range; the QP
+#: grows with it: 2N rows per contact).
+MAX_POLYGON_SIDES = 64
 
 
 @dataclass(frozen=True)
@@ -109,6 +129,7 @@ class Scenario:
             object's weight and the node's default g(q) (docs/design.md section 4).
         extra_wrench: ``load.external_wrench`` as written: the load besides the
             object's weight, shape (6,) [N, N m].
+        torque_limits_above_urdf: allow torque limits above the URDF's effort limits.
     """
 
     urdf: str
@@ -126,6 +147,7 @@ class Scenario:
     gravity: np.ndarray | None = None
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
     objective: str = "sum-of-squares"
+    torque_limits_above_urdf: bool = False
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
@@ -139,7 +161,7 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 
 
 _SECTIONS = {
-    "hand": {"urdf", "joints", "torque_limits"},
+    "hand": {"urdf", "joints", "torque_limits", "torque_limits_above_urdf"},
     "grasp": {"joint_positions", "object_origin", "contacts"},
     "friction": {"mu_tangential", "mu_torsional", "polygon_sides", "min_normal_force",
                  "margin"},
@@ -176,7 +198,7 @@ def _mapping(value: Any, name: str, allowed: set[str]) -> dict:
         raise InputError(name, f"must be a mapping, got {type(value).__name__}")
     for key in value:
         if key not in allowed:
-            raise InputError(f"{name}.{key}" if name else str(key),
+            raise InputError(f"{name}.{cut(key)}" if name else cut(key),
                              f"unknown field (allowed: {', '.join(sorted(allowed))})")
     return value
 
@@ -189,16 +211,19 @@ def _require(section: dict, key: str, name: str) -> Any:
 
 def _number(value: Any, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(name, f"must be a number, got {value!r}")
-    x = float(value)
+        raise InputError(name, f"must be a number, got {quote(value)}")
+    try:
+        x = float(value)
+    except OverflowError:  # an integer of more than 308 digits
+        x = math.inf
     if not math.isfinite(x):
-        raise InputError(name, f"must be finite, got {value!r}")
+        raise InputError(name, f"must be finite, got {quote(value)}")
     return x
 
 
 def _vector(value: Any, name: str, length: int | None = None) -> np.ndarray:
     if not isinstance(value, (list, tuple)):
-        raise InputError(name, f"must be a list of numbers, got {value!r}")
+        raise InputError(name, f"must be a list of numbers, got {quote(value)}")
     if length is not None and len(value) != length:
         raise InputError(name, f"must have {length} entries, got {len(value)}")
     return np.array([_number(v, f"{name}[{i}]") for i, v in enumerate(value)], dtype=float)
@@ -207,7 +232,7 @@ def _vector(value: Any, name: str, length: int | None = None) -> np.ndarray:
 def _positive(value: Any, name: str) -> float:
     x = _number(value, name)
     if x <= 0.0:
-        raise InputError(name, f"must be > 0, got {value!r}")
+        raise InputError(name, f"must be > 0, got {quote(value)}")
     return x
 
 
@@ -222,13 +247,16 @@ def _margin(value: Any, name: str = "friction.margin") -> float:
 def _names(value: Any, name: str) -> list[str]:
     if not isinstance(value, list) or not value:
         raise InputError(name, "must be a non-empty list of names")
-    out = []
+    if len(value) > MAX_JOINTS:
+        raise InputError(name, f"{len(value)} names, more than {MAX_JOINTS}")
+    out, seen = [], set()
     for i, v in enumerate(value):
         if not isinstance(v, str) or not v:
-            raise InputError(f"{name}[{i}]", f"must be a name, got {v!r}")
-        if v in out:
-            raise InputError(f"{name}[{i}]", f"duplicate name '{v}'")
+            raise InputError(f"{name}[{i}]", f"must be a name, got {quote(v)}")
+        if v in seen:
+            raise InputError(f"{name}[{i}]", f"duplicate name '{cut(v)}'")
         out.append(v)
+        seen.add(v)
     return out
 
 
@@ -261,7 +289,7 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
 
     urdf = _require(hand, "urdf", "hand")
     if not isinstance(urdf, str) or not urdf:
-        raise InputError("hand.urdf", f"must be a path, got {urdf!r}")
+        raise InputError("hand.urdf", f"must be a path, got {quote(urdf)}")
     joints = _names(hand["joints"], "hand.joints") if hand.get("joints") is not None else None
 
     limits = hand.get("torque_limits")
@@ -274,11 +302,17 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
                                  f"got {len(limits)}")
         else:
             limits = _positive(limits, "hand.torque_limits")
+    above_urdf = hand.get("torque_limits_above_urdf", False)
+    if not isinstance(above_urdf, bool):
+        raise InputError("hand.torque_limits_above_urdf", "must be true or false")
 
     positions_raw = grasp.get("joint_positions") or {}
     if not isinstance(positions_raw, dict):
         raise InputError("grasp.joint_positions", "must be a mapping joint name -> position")
-    positions = {str(k): _number(v, f"grasp.joint_positions.{k}")
+    if len(positions_raw) > MAX_JOINTS:
+        raise InputError("grasp.joint_positions",
+                         f"{len(positions_raw)} entries, more than {MAX_JOINTS}")
+    positions = {str(k): _number(v, f"grasp.joint_positions.{cut(k)}")
                  for k, v in positions_raw.items()}
 
     origin = _vector(_require(grasp, "object_origin", "grasp"), "grasp.object_origin", 3)
@@ -286,13 +320,16 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
     contacts_raw = _require(grasp, "contacts", "grasp")
     if not isinstance(contacts_raw, list) or not contacts_raw:
         raise InputError("grasp.contacts", "must be a non-empty list of contacts")
+    if len(contacts_raw) > MAX_CONTACTS:
+        raise InputError("grasp.contacts",
+                         f"{len(contacts_raw)} contacts, more than {MAX_CONTACTS}")
     contacts = []
     for i, c in enumerate(contacts_raw):
         name = f"grasp.contacts[{i}]"
         c = _mapping(c, name, _CONTACT_KEYS)
         link = _require(c, "link", name)
         if not isinstance(link, str) or not link:
-            raise InputError(f"{name}.link", f"must be a frame name, got {link!r}")
+            raise InputError(f"{name}.link", f"must be a frame name, got {quote(link)}")
         position = (_vector(c["position"], f"{name}.position", 3)
                     if c.get("position") is not None else np.zeros(3))
         normal = None
@@ -315,9 +352,12 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
 
     sides = _require(friction, "polygon_sides", "friction")
     if isinstance(sides, bool) or not isinstance(sides, int):
-        raise InputError("friction.polygon_sides", f"must be an integer, got {sides!r}")
+        raise InputError("friction.polygon_sides", f"must be an integer, got {quote(sides)}")
     if sides < 3:
         raise InputError("friction.polygon_sides", f"must be >= 3, got {sides}")
+    if sides > MAX_POLYGON_SIDES:
+        raise InputError("friction.polygon_sides",
+                         f"must be at most {MAX_POLYGON_SIDES}, got {quote(sides)}")
     fmin = _number(friction.get("min_normal_force", 0.0), "friction.min_normal_force")
     if fmin < 0.0:
         raise InputError("friction.min_normal_force", f"must be >= 0, got {fmin}")
@@ -349,27 +389,57 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
     if kind not in OBJECTIVES:
         raise InputError("objective.type", f"must be one of {', '.join(OBJECTIVES)}, "
                          f"got {kind!r}")
-
+    if joints is None and (isinstance(limits, list) or weights is not None):
+        per_joint = "hand.torque_limits" if isinstance(limits, list) else "objective.weights"
+        raise InputError("hand.joints", f"required when {per_joint} gives one value per joint "
+                         "(without it the values would follow Pinocchio's joint order, which "
+                         "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
                     joint_positions=positions, object_origin=origin, contacts=contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,
-                    object=obj, gravity=gravity, extra_wrench=extra, objective=kind)
+                    object=obj, gravity=gravity, extra_wrench=extra, objective=kind,
+                    torque_limits_above_urdf=above_urdf)
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """PyYAML's SafeLoader without aliases and with nesting bounded by :data:`MAX_DEPTH`.
+
+    An alias repeats a node by reference, so 2.8 KB of nested aliases expand to
+    billions of values (the "billion laughs"); a scenario never needs one. The
+    composer recurses once per level (5000 levels raised RecursionError).
+    """
+
+    _depth = 0
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            mark = self.peek_event().start_mark
+            raise InputError("scenario", f"YAML aliases are not allowed (line {mark.line + 1})")
+        self._depth += 1
+        try:
+            if self._depth > MAX_DEPTH:
+                mark = self.peek_event().start_mark
+                raise InputError("scenario", f"nested more than {MAX_DEPTH} levels deep "
+                                 f"(line {mark.line + 1})")
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario file.
+    """Read and validate a scenario file, within the bounds of the module's docstring.
 
     Raises:
-        InputError: the file cannot be read or parsed (field ``scenario``), or a
-            field is invalid (named).
+        InputError: the file cannot be read, is not a regular file, too large, not
+            UTF-8, not valid or bounded YAML (field ``scenario``), or a field is
+            invalid (named).
     """
     path = Path(path)
+    text = decode_utf8(read_bounded(path, "scenario", MAX_SCENARIO_BYTES), path, "scenario")
     try:
-        text = path.read_text()
-    except OSError as e:
-        raise InputError("scenario", f"cannot read {path}: {e.strerror}") from e
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        raise InputError("scenario", f"{path} is not valid YAML: {e}".splitlines()[0]) from e
+        data = yaml.load(text, Loader=_BoundedLoader)  # noqa: S506 -- a SafeLoader
+    except (yaml.YAMLError, ValueError) as e:  # ValueError: an integer of 5000 digits
+        first = (str(e).splitlines() or [""])[0]
+        raise InputError("scenario", f"{cut(path, PATH_LENGTH)} is not valid YAML: "
+                         f"{cut(first)}") from e
     return parse_scenario(data, path.resolve().parent, source=str(path))

@@ -188,7 +188,8 @@ class Refiner:
         self.warm_solves = self.warm_fallbacks = 0
 
     def refine(self, setup: GraspSetup, maps: GraspMaps, base: TauQP,
-               tolerance: float = DEFAULT_TOLERANCE) -> Refined:
+               tolerance: float = DEFAULT_TOLERANCE, deadline: float | None = None
+               ) -> Refined:
         """Run round 0 and the refinement rounds on one grasp.
 
         Args:
@@ -197,13 +198,21 @@ class Refiner:
             base: its tau-QP (:func:`~grasp_torque_opt.core.tau_qp.build_tau_qp`),
                 whose decomposition every round reuses.
             tolerance: the certificate's tolerance, SI units.
+            deadline: ``time.perf_counter()`` value by which the rounds stop [s]: each
+                QP's iterations are fitted to the time left, and none starts past it
+                (the rounds end with what they have). None: the caps alone.
         """
-        return _Rounds(self, setup, maps, base, tolerance).run()
+        rounds = _Rounds(self, setup, maps, base, tolerance)
+        rounds.deadline = deadline
+        return rounds.run()
 
 
 class _Rounds:
     """One grasp's rounds (the arrays they share). Each numpy call costs about a
     microsecond here, so the pieces are written in few of them."""
+
+    #: ``time.perf_counter()`` value by which every QP must stop (None: none).
+    deadline: float | None = None
 
     def __init__(self, refiner: Refiner, setup: GraspSetup, maps: GraspMaps, base: TauQP,
                  tolerance: float) -> None:
@@ -248,7 +257,8 @@ class _Rounds:
         what they have; the caller's fallback answers if that is nothing).
         """
         try:
-            raw = self.ws.solve(H, g, self.C.reshape(-1, self.n), self.u.ravel())
+            raw = self.ws.solve(H, g, self.C.reshape(-1, self.n), self.u.ravel(),
+                                deadline=self.deadline)
         except SolverError as e:
             raw = RawResult("error", None, 0, 0.0, str(e))
         self.qp_solves += 1

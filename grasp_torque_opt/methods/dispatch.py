@@ -10,6 +10,7 @@ the load even with the exact cone).
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import time
 
 import numpy as np
@@ -39,6 +40,27 @@ from grasp_torque_opt.reference.feasibility import linearized_feasible
 METHODS = ("tau-qp", "tau-qp-adaptive", "force-qp", "socp", "nlp")
 #: Methods whose feasible set is the linearized (polygon) one.
 LINEARIZED = ("tau-qp", "force-qp")
+#: Under a deadline, the share of the time left that the first backend may use; the
+#: fallback gets the rest (DAQP answered the Allegro's QPs in under 1 ms here).
+PRIMARY_SHARE = 0.8
+
+
+_TAKES_DEADLINE: dict[type, bool] = {}
+
+
+def _timed(solver, qp: TauQP, deadline: float | None, **kwargs) -> RawResult:
+    """``solver.solve(qp)``, with the deadline passed when there is one and the solver
+    takes it (every backend does; a solver of the caller's own that does not runs on
+    its iteration caps alone)."""
+    if deadline is not None:
+        takes = _TAKES_DEADLINE.get(type(solver))
+        if takes is None:
+            params = inspect.signature(solver.solve).parameters
+            takes = _TAKES_DEADLINE[type(solver)] = "deadline" in params or any(
+                p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+        if takes:
+            kwargs["deadline"] = deadline
+    return solver.solve(qp, **kwargs)
 
 
 def qp_answer(qp: TauQP, raw: RawResult
@@ -72,7 +94,8 @@ def planner_metrics(out: Solution, setup: GraspSetup) -> Solution:
 def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None = None,
           solver: TauQPSolver | None = None, backend: str = "proxsuite",
           fallback: TauQPSolver | None = None,
-          tolerance: float = DEFAULT_TOLERANCE, refiner: Refiner | None = None) -> Solution:
+          tolerance: float = DEFAULT_TOLERANCE, refiner: Refiner | None = None,
+          deadline: float | None = None) -> Solution:
     """Solve one grasp with one method and certify the result.
 
     Args:
@@ -90,6 +113,12 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         tolerance: certificate tolerance, SI units.
         refiner: tau-qp-adaptive's rounds (its settings: gap tolerance, rounds),
             reusable across calls; default :class:`Refiner` ().
+        deadline: ``time.perf_counter()`` value by which the tau-QP's solvers must
+            stop [s] (the node's cycle budget; None: only their iteration caps).
+            The first solver may use :data:`PRIMARY_SHARE` of the time left, the
+            fallback the rest; past it, the independent LP that tells an
+            infeasible load from a failed solve is skipped (status ``failed``,
+            "LP skipped").
 
     The setup's friction margin k plans and certifies inside the cone of
     mu/(1+k) (:func:`~grasp_torque_opt.core.margin.planned_friction`); its
@@ -109,7 +138,7 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         # ratio are then measured as for tau-qp.
         planned = dataclasses.replace(setup, friction=planned_friction(setup.friction))
         return planner_metrics(_solve_adaptive(planned, maps, solver, backend, fallback,
-                                               tolerance, refiner), setup)
+                                               tolerance, refiner, deadline), setup)
     timings = {}
     t0 = time.perf_counter()
     if maps is None:
@@ -141,8 +170,10 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
                 # The tightened box leaves a thin feasible set: ProxSuite called 5 of 60
                 # such QPs on random Allegro grasps PRIMAL_INFEASIBLE, DAQP solved all.
                 fallback = make_solver("daqp")
+            first = None if deadline is None else \
+                t2 + PRIMARY_SHARE * max(0.0, deadline - t2)
             try:
-                raw = solver.solve(qp)
+                raw = _timed(solver, qp, first)
             except SolverError as e:
                 if fallback is None:
                     raise
@@ -178,13 +209,13 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
     if method == "tau-qp" and getattr(solver, "last_warm", False) and \
             raw.status == "solved" and cert is not None and not cert.ok:
         # A warm start that lands off the certificate is redone cold in the same call.
-        raw, tau, f = qp_answer(qp, solver.solve(qp, cold=True))
+        raw, tau, f = qp_answer(qp, _timed(solver, qp, first, cold=True))
         cert = certified(tau, f)
     timings["certify"] = time.perf_counter() - t3
     if method == "tau-qp" and fallback is not None and \
             not (raw.status == "solved" and cert is not None and cert.ok):
         t4 = time.perf_counter()
-        raw2, tau2, f2 = qp_answer(qp, fallback.solve(qp))
+        raw2, tau2, f2 = qp_answer(qp, _timed(fallback, qp, deadline))
         if raw2.status == "solved" and f2 is not None:
             cert2 = certified(tau2, f2)
             if cert2.ok:
@@ -204,7 +235,9 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         return planner_metrics(out, setup)
     why = (f"solver: {raw.message}" if cert is None or cert.ok or raw.status != "solved"
            else f"solver: {raw.message}, certificate failed (worst residual {cert.worst:.3g})")
-    if method in LINEARIZED:
+    if method in LINEARIZED and deadline is not None and time.perf_counter() >= deadline:
+        out.message = f"not certified, LP skipped: time budget spent ({why})"
+    elif method in LINEARIZED:
         feasible = linearized_feasible(maps, friction, setup.external_wrench,
                                        tau_min, tau_max)
         if feasible is False:
@@ -221,10 +254,12 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
 
 
 def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: str,
-                    fallback, tolerance: float, refiner: Refiner | None) -> Solution:
+                    fallback, tolerance: float, refiner: Refiner | None,
+                    deadline: float | None = None) -> Solution:
     """tau-qp-adaptive: the rounds of :mod:`~grasp_torque_opt.methods.adaptive`, certified
     bounds attached; the paper's N-gon (the tau-qp path) when no round gave a candidate
-    (or DAQP, which the rounds need, is not installed)."""
+    (or DAQP, which the rounds need, is not installed). Under a deadline the rounds get
+    :data:`PRIMARY_SHARE` of the time left and the polygon the rest."""
     t0 = time.perf_counter()
     if maps is None:
         maps = setup.maps()
@@ -240,7 +275,9 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
         if refiner is None:
             ref, why = None, "the rounds need DAQP, which is not installed (pip install daqp)"
         else:
-            ref = refiner.refine(setup, maps, qp, tolerance)
+            first = None if deadline is None else \
+                t2 + PRIMARY_SHARE * max(0.0, deadline - t2)
+            ref = refiner.refine(setup, maps, qp, tolerance, deadline=first)
             why = ref.message
     except SolverError as e:  # a failed round is answered by the polygon below
         ref, why = None, str(e)
@@ -260,7 +297,7 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
                                 f"{why})", timings=timings, backend="daqp", bounds=bounds)
     # No certified candidate: the paper's N-gon answers (never nothing when it can).
     poly = solve(setup, "tau-qp", maps=maps, solver=solver, backend=backend,
-                 fallback=fallback, tolerance=tolerance)
+                 fallback=fallback, tolerance=tolerance, deadline=deadline)
     timings.update({f"polygon_{k}": v for k, v in poly.timings.items() if k != "maps"})
     upper = None if poly.tau is None else float(poly.tau @ (setup.weights * poly.tau))
     out = dataclasses.replace(poly, method="tau-qp-adaptive", timings=timings,
@@ -268,7 +305,8 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
                                                  qps, "polygon"))
     if poly.optimal:
         out.message = f"{poly.message}; the paper's N-gon, as the rounds gave none ({why})"
-    elif ref is not None and ref.outer_infeasible and linearized_feasible(
+    elif ref is not None and ref.outer_infeasible and \
+            (deadline is None or time.perf_counter() < deadline) and linearized_feasible(
             maps, setup.friction, setup.external_wrench, tau_min, tau_max,
             circumscribed=True) is False:
         out.status = INFEASIBLE

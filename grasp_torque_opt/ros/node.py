@@ -29,12 +29,14 @@ from rcl_interfaces.msg import (
     ParameterDescriptor,
     SetParametersResult,
 )
+from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
 from rclpy.utilities import remove_ros_args
@@ -60,15 +62,21 @@ from grasp_torque_opt.control.controller import (
 )
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import MAX_TORQUE_LIMIT, MAX_URDF_BYTES, Hand
 from grasp_torque_opt.core.report import solution_dict
-from grasp_torque_opt.core.resources import find_config
+from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
 from grasp_torque_opt.core.scenario import OBJECTIVES, load_scenario
 
 NODE_NAME = "grasp_torque_node"
 #: Commands: reliable, only the newest matters.
 COMMAND_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
-#: ~/solve: reliable, up to 100 queued requests (the default 10 dropped a planner's burst).
-SERVICE_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+#: ~/solve: reliable, every request kept until it is taken (keep last 100 dropped 872 to
+#: 900 of 1000 concurrent calls silently); the node answers each, "busy" beyond
+#: MAX_PENDING_SOLVES.
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+#: Solves the service queues for its worker (each a snapshot of the inputs); a request
+#: beyond them is answered "busy" at once.
+MAX_PENDING_SOLVES = 100
 
 
 @dataclass(frozen=True)
@@ -96,9 +104,14 @@ PARAMETERS: dict[str, Spec] = {
     "mu_torsional": Spec("Torsional friction coefficient mu2 [m].", 1e-9, 1.0),
     "polygon_sides": Spec("Sides N of the inscribed friction polygon [-].", 3, 64),
     "min_normal_force": Spec("Minimum normal force per contact [N].", 0.0, 1000.0),
-    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint.",
-                          length="joints"),
-    "weights": Spec("Objective weights W (diagonal), per joint [-].", length="joints"),
+    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint; each at most "
+                          "the joint's URDF effort limit (the scenario's limit if the URDF "
+                          "gives none) unless torque_limits_above_urdf.", length="joints"),
+    "torque_limits_above_urdf": Spec("Allow torque_limits above the URDF's effort limits (up "
+                                     "to 1e4 N m); default: the scenario's "
+                                     "hand.torque_limits_above_urdf.", read_only=True),
+    "weights": Spec("Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the "
+                    "largest at most 1e6 times the smallest [-].", length="joints"),
     "friction_margin": Spec("Friction margin k: plan inside the cone of mu/(1+k), so the "
                             "commanded wrenches hold with up to (1+k) times less friction "
                             "(docs/planner.md) [-].", 0.0, 100.0),
@@ -119,6 +132,9 @@ PARAMETERS: dict[str, Spec] = {
     "fault_policy": Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
                          "controller keeps the last certified command) or 'zero' (publish "
                          "zero torques)."),
+    "max_message_bytes": Spec("A message on joint_states, contacts or external_wrench whose "
+                              "serialized form is longer than this is rejected before it is "
+                              "deserialized [bytes].", 1024, 16777216),
     "max_joint_state_entries": Spec("A joint state with more names or positions than this is "
                                     "rejected unread [-].", 1, 100000),
     "max_wrench_force": Spec("A load whose force norm exceeds this is rejected [N].",
@@ -129,8 +145,9 @@ PARAMETERS: dict[str, Spec] = {
                                  "stops commands [m].", 1e-3, 100.0),
     "stamp_future_tolerance": Spec("A header stamp more than this ahead of the node's clock "
                                    "is rejected [s].", 0.0, 3600.0),
-    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun) [s].",
-                         1e-4, 10.0),
+    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun); its "
+                         "solvers stop by it (or by joint_state_timeout if smaller) [s].",
+                         1e-4, 1.0),
     "solver.method": Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
                           "exact-cone optimum from QPs with a certified gap to it, "
                           "docs/adaptive.md; needs DAQP; about 3 times tau-qp's cycle with "
@@ -148,8 +165,10 @@ PARAMETERS: dict[str, Spec] = {
                               "solver.warm_start_fallbacks). No effect on quadprog."),
     "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
                            "[-].", 1e-12, 1e-4),
-    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 100000),
-    "solver.max_iter_in": Spec("ProxSuite inner iteration cap [-].", 1, 100000),
+    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 10000),
+    "solver.max_iter_in": Spec("ProxSuite inner iteration cap; one outer iteration, up to "
+                               "this many inner ones, is how far a solve can run past its "
+                               "budget [-].", 1, 200),
     "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
                                   1e-12, 1e-2),
     "diagnostics_period": Spec("Period of /diagnostics [s] (1 Hz, as diagnostic_updater).",
@@ -158,11 +177,31 @@ PARAMETERS: dict[str, Spec] = {
                           "so they vanish when the node stops.", 1e-3, 60.0, read_only=True),
     "watchdog_period": Spec("Period of the staleness check between joint states [s].",
                             1e-4, 1.0, read_only=True),
+    "startup_check_time": Spec("At start, how long grasp_torque_node looks for another node "
+                               "of its name on the domain before it takes any input; one "
+                               "found: it exits with an error (code 2). Later, one is "
+                               "reported (diagnostics ERROR) [s].", 0.0, 30.0, read_only=True),
     "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
     "publish_stamped_command": Spec("Also publish each command on ~/effort_commands_stamped "
                                     "(sensor_msgs/JointState: joints, effort, and the stamp of "
                                     "the joint state it was computed from).", read_only=True),
 }
+
+
+def received(info: dict | None) -> float:
+    """When the middleware received a message, on the monotonic clock [s].
+
+    rmw's message info carries ``received_timestamp``: the system clock
+    (``CLOCK_REALTIME``) of this host when the subscription's middleware took the
+    message in, before it waited in the queue for the executor. Its age on the
+    system clock, taken from now on the monotonic clock, is the receipt time
+    (a clock step between the two counts as no wait; a message without it: now).
+    """
+    now = time.monotonic()
+    ns = (info or {}).get("received_timestamp") or 0
+    if ns <= 0:
+        return now
+    return now - max(0.0, (time.time_ns() - ns) * 1e-9)
 
 
 def descriptor(name: str) -> ParameterDescriptor:
@@ -181,6 +220,13 @@ def descriptor(name: str) -> ParameterDescriptor:
 CYCLE_METHODS = ("tau-qp", "tau-qp-adaptive")
 #: Values of ``solver.fallback``.
 FALLBACKS = (*BACKENDS, "none")
+#: Each weight's range, and the largest ratio of two weights: W's condition number
+#: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
+WEIGHT_RANGE = (1e-6, 1e6)
+MAX_WEIGHT_RATIO = 1e6
+#: Longest ProxSuite call of a ``~/solve`` request [s]: the service's worker shares
+#: Python's interpreter lock with the control loop, which ProxSuite holds while it runs.
+SERVICE_SLICE_S = 0.005
 
 
 def _fallback(backend: str, fallback: str) -> str | None:
@@ -189,8 +235,17 @@ def _fallback(backend: str, fallback: str) -> str | None:
     return None if fallback in ("none", backend) or not available(fallback) else fallback
 
 
-def check(name: str, value: Any, m: int) -> str:
-    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too."""
+def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None,
+          joints: list[str] | None = None) -> str:
+    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too.
+
+    Args:
+        name: the parameter.
+        value: its new value.
+        m: number of joints.
+        torque_bounds: the largest value of each torque limit [N m] (None: unchecked).
+        joints: joint names, for messages.
+    """
     spec = PARAMETERS[name]
     if name == "fault_policy":
         return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
@@ -216,6 +271,19 @@ def check(name: str, value: Any, m: int) -> str:
             return f"{name}: must be finite"
         if name in ("torque_limits", "weights") and not all(v > 0 for v in values):
             return f"{name}: every entry must be > 0"
+        if name == "torque_limits" and torque_bounds is not None:
+            try:
+                Hand.check_limits(np.array(values, dtype=float), joints or [], torque_bounds,
+                                  name, "torque_limits_above_urdf (read-only: at start)")
+            except InputError as e:
+                return str(e)
+        if name == "weights":
+            low, high = WEIGHT_RANGE
+            if not all(low <= v <= high for v in values):
+                return f"{name}: every entry must be in [{low:g}, {high:g}]"
+            if max(values) > MAX_WEIGHT_RATIO * min(values):
+                return (f"{name}: the largest entry may be at most {MAX_WEIGHT_RATIO:g} times "
+                        f"the smallest, got {max(values) / min(values):.3g}")
         return ""
     if isinstance(value, float) and not math.isfinite(value):
         return f"{name}: must be finite"
@@ -227,12 +295,20 @@ def check(name: str, value: Any, m: int) -> str:
 class GraspTorqueNode(Node):
     """Publishes certified effort commands on each joint state; answers ``~/solve``."""
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
+        """Args:
+            message_info: age inputs from the middleware's receipt time (rmw message
+                info); False: from the callback's time (rclpy 7.1's EventsExecutor
+                raises SystemError on subscriptions that take message info).
+            kwargs: for rclpy's Node (context, parameter_overrides, ...).
+        """
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.Lock()
+        self._last_stamp = None  # header stamp of the last accepted joint state
         setup = self._load_setup()
         self._m = setup.hand.m
         defaults = {
+            "torque_limits_above_urdf": self._scenario.torque_limits_above_urdf,
             "object_origin": [float(x) for x in setup.object_origin],
             "mu_tangential": setup.friction.mu1,
             "mu_torsional": setup.friction.mu2,
@@ -251,6 +327,7 @@ class GraspTorqueNode(Node):
             "wrench_timeout": 0.5,
             "hold_time": 0.1,
             "fault_policy": "hold",
+            "max_message_bytes": CycleConfig.max_message_bytes,
             "max_joint_state_entries": CycleConfig.max_joint_state_entries,
             "max_wrench_force": CycleConfig.max_wrench_force,
             "max_wrench_torque": CycleConfig.max_wrench_torque,
@@ -268,13 +345,16 @@ class GraspTorqueNode(Node):
             "diagnostics_period": 1.0,
             "marker_period": 0.1,
             "watchdog_period": 0.01,
+            "startup_check_time": 2.0,
             "marker_scale": 0.02,
             "publish_stamped_command": False,
         }
         for name, value in defaults.items():
             self.declare_parameter(name, value, descriptor(name))
+        self._torque_bounds = self._limit_bounds(
+            setup.hand, self.get_parameter("torque_limits_above_urdf").value)
         for name in defaults:
-            reason = check(name, self.get_parameter(name).value, self._m)
+            reason = self._check(name, self.get_parameter(name).value)
             if reason:
                 raise InputError(name, reason.split(": ", 1)[1])
         self._base_setup = setup
@@ -288,15 +368,26 @@ class GraspTorqueNode(Node):
         self._service_controller = TorqueController(*self._configure(
             dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
             backend, False, fallback)
+        self._service_controller.solver = make_solver(
+            backend, self._service_controller.solver.settings, False, SERVICE_SLICE_S)
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
-        self.create_subscription(JointState, "joint_states", self._on_joint_state,
-                                 qos_profile_sensor_data)
-        self.create_subscription(PoseArray, "contacts", self._on_contacts,
-                                 qos_profile_sensor_data)
-        self.create_subscription(WrenchStamped, "external_wrench", self._on_wrench,
-                                 qos_profile_sensor_data)
+        # Serialized (raw): a message is measured before it is deserialized. With message
+        # info, inputs are aged from when the middleware received them.
+        for msg_type, topic, take in ((JointState, "joint_states", self._on_joint_state),
+                                      (PoseArray, "contacts", self._on_contacts),
+                                      (WrenchStamped, "external_wrench", self._on_wrench)):
+            def callback(data, info=None, msg_type=msg_type, topic=topic, take=take):
+                self._on_serialized(topic, msg_type, data, take, info)
+            if message_info:
+                sub_callback = (lambda cb: lambda data, info: cb(data, info))(callback)
+            else:
+                sub_callback = (lambda cb: lambda data: cb(data))(callback)
+            sub = self.create_subscription(msg_type, topic, sub_callback,
+                                           qos_profile_sensor_data, raw=True)
+            if topic == "joint_states":
+                self._joint_states_topic = sub.topic_name  # remapped and resolved
         self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
                                                   COMMAND_QOS)
         self._stamped_pub = None
@@ -307,14 +398,22 @@ class GraspTorqueNode(Node):
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         # The service solves in a worker thread while the executor goes on with the loop.
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
-        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS)
+        self._pending_solves = 0
+        self._busy_answers = 0
+        self._duplicates = 0
+        # A group of its own: in the node's default (mutually exclusive) group, each call
+        # held every callback of the node, the control loop's included, until its solve
+        # was done; reentrant, so that requests are taken (and answered "busy") meanwhile.
+        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS,
+                            callback_group=ReentrantCallbackGroup())
         self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
         self.create_timer(self.get_parameter("diagnostics_period").value,
                           self._on_diagnostics)
         self.create_timer(self.get_parameter("marker_period").value, self._on_markers)
         self.get_logger().info(
-            f"{self._m} joints, {len(setup.contacts)} default contacts; "
-            f"commands on {self._command_pub.topic_name}")
+            f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
+            f"{len(setup.contacts)} default contacts; commands on "
+            f"{self._command_pub.topic_name}")
 
     # -- configuration --------------------------------------------------------------------
 
@@ -325,17 +424,32 @@ class GraspTorqueNode(Node):
         if not name:
             raise InputError("scenario", "parameter not set (a scenario file gives the "
                              "default contacts and load)")
-        scenario = load_scenario(find_config(name))
+        scenario = self._scenario = load_scenario(find_config(name))
         self._scenario_gravity = scenario.gravity
         if urdf and not urdf.lstrip().startswith("<"):
-            urdf = find_config(urdf, "robot_description").read_text()
+            path = find_config(urdf, "robot_description")
+            urdf = decode_utf8(read_bounded(path, "robot_description", MAX_URDF_BYTES), path,
+                               "robot_description")
         setup = GraspSetup.from_scenario(scenario, urdf or None)
         joints = self.declare_parameter("joints", list(setup.hand.joints),
                                         descriptor("joints")).value
         if list(joints) != list(setup.hand.joints):
             setup = GraspSetup.from_scenario(dataclasses.replace(scenario, joints=list(joints)),
                                              urdf or None)
+        self._base_joints = list(setup.hand.joints)
         return setup
+
+    @staticmethod
+    def _limit_bounds(hand: Hand, above_urdf: bool) -> np.ndarray:
+        """The largest torque limit per joint [N m]: the URDF's effort limit, the
+        scenario's limit where the URDF gives none; MAX_TORQUE_LIMIT if allowed above."""
+        if above_urdf:
+            return np.full(hand.m, MAX_TORQUE_LIMIT)
+        effort = hand.effort_limits
+        return np.where(np.isfinite(effort), effort, hand.torque_limits)
+
+    def _check(self, name: str, value: Any) -> str:
+        return check(name, value, self._m, self._torque_bounds, self._base_joints)
 
     def _params(self) -> dict[str, Any]:
         return {name: self.get_parameter(name).value for name in PARAMETERS}
@@ -360,6 +474,7 @@ class GraspTorqueNode(Node):
             gravity_compensation=p["gravity_compensation"], gravity=tuple(p["gravity"]),
             certificate_tolerance=p["certificate_tolerance"],
             max_joint_state_entries=p["max_joint_state_entries"],
+            max_message_bytes=p["max_message_bytes"],
             max_wrench_force=p["max_wrench_force"], max_wrench_torque=p["max_wrench_torque"],
             max_contact_distance=p["max_contact_distance"],
             stamp_future_tolerance=p["stamp_future_tolerance"],
@@ -371,7 +486,7 @@ class GraspTorqueNode(Node):
     def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
         for param in params:
             if param.name in PARAMETERS:
-                reason = check(param.name, param.value, self._m)
+                reason = self._check(param.name, param.value)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
         # min-max is the tau-QP's objective only (docs/planner.md): refuse the pair.
@@ -387,19 +502,25 @@ class GraspTorqueNode(Node):
         p = self._params()
         with self._lock:
             warm_loop = p["solver.warm_start"] and p["solver.backend"] != "quadprog"
-            for ctrl, warm in ((self.controller, warm_loop), (self._service_controller, False)):
+            for ctrl, warm, slice_s in ((self.controller, warm_loop, None),
+                                        (self._service_controller, False, SERVICE_SLICE_S)):
                 setup, config, solver = self._configure(ctrl.setup, p)
                 ctrl.setup, ctrl.config = setup, config
                 if solver != ctrl.solver.settings or \
                         p["solver.backend"] != getattr(ctrl.solver, "name", None) or \
                         warm != getattr(ctrl.solver, "warm_start", False):
-                    ctrl.solver = make_solver(p["solver.backend"], solver, warm)
+                    ctrl.solver = make_solver(p["solver.backend"], solver, warm, slice_s)
                 fallback = _fallback(p["solver.backend"], p["solver.fallback"])
                 if ctrl is self.controller and any(x.name == "solver.fallback" for x in params):
                     self._warn_missing_fallback()
                 if fallback != getattr(ctrl.fallback, "name", None) or \
                         (ctrl.fallback is not None and ctrl.fallback.settings != solver):
                     ctrl.fallback = make_solver(fallback, solver) if fallback else None
+            # The change acts on the command in force at once (a new certified command,
+            # or zeros if the one in force is now over the limits), not at the next cycle.
+            result = self.controller.reconfigured(time.monotonic())
+            if result is not None:
+                self._publish(result, self._last_stamp)
 
     def _warn_missing_fallback(self) -> None:
         name = self.get_parameter("solver.fallback").value
@@ -413,23 +534,40 @@ class GraspTorqueNode(Node):
         """Now on the node's clock (ROS time), the clock of header stamps [s]."""
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _on_joint_state(self, msg: JointState) -> None:
+    def _on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
+                       info: dict | None) -> None:
+        """A message as the middleware delivered it: its length checked, then deserialized
+        and taken (``take(msg, receipt)``)."""
+        receipt = received(info) if info is not None else None
+        with self._lock:
+            try:
+                self.controller.check_bytes(topic, len(data))
+            except InputError as e:
+                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                return
+        take(deserialize_message(data, msg_type), receipt)
+
+    def _on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
+        """A joint state; ``receipt``: when the middleware received it (monotonic [s];
+        None: now)."""
         now = time.monotonic()
+        receipt = now if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
                 # Sizes first: an oversized message is not even copied.
                 self.controller.check_size("joint_states",
                                            max(len(msg.name), len(msg.position)))
-                self.controller.update_joint_state(list(msg.name), list(msg.position), now,
-                                                   stamp, self._clock_now())
+                self.controller.update_joint_state(list(msg.name), list(msg.position),
+                                                   receipt, stamp, self._clock_now())
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
                 return
+            self._last_stamp = msg.header.stamp
             self._publish(self.controller.cycle(now), msg.header.stamp)
 
-    def _on_contacts(self, msg: PoseArray) -> None:
-        now = time.monotonic()
+    def _on_contacts(self, msg: PoseArray, receipt: float | None = None) -> None:
+        now = time.monotonic() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
@@ -442,8 +580,8 @@ class GraspTorqueNode(Node):
             except InputError as e:
                 self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
 
-    def _on_wrench(self, msg: WrenchStamped) -> None:
-        now = time.monotonic()
+    def _on_wrench(self, msg: WrenchStamped, receipt: float | None = None) -> None:
+        now = time.monotonic() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         f, t = msg.wrench.force, msg.wrench.torque
         with self._lock:
@@ -478,6 +616,27 @@ class GraspTorqueNode(Node):
             msg.header.frame_id = self.controller.setup.hand.base_frame
             self._stamped_pub.publish(msg)
 
+    # -- other nodes of this name -------------------------------------------------------
+
+    def duplicates(self) -> int:
+        """How many other nodes of this node's name and namespace the graph shows."""
+        me = (self.get_name(), self.get_namespace())
+        return sum(1 for n in self.get_node_names_and_namespaces() if tuple(n) == me) - 1
+
+    def wait_for_duplicates(self, seconds: float) -> int:
+        """Look for other nodes of this name for up to ``seconds`` (discovery took 0.2 to
+        2.8 s here), without spinning: nothing is taken or published meanwhile.
+
+        Returns:
+            How many were seen (0 after ``seconds``).
+        """
+        end = time.monotonic() + seconds
+        while True:
+            n = self.duplicates()
+            if n > 0 or time.monotonic() >= end:
+                return n
+            time.sleep(0.05)
+
     # -- outputs between cycles -----------------------------------------------------------
 
     def _on_diagnostics(self) -> None:
@@ -485,9 +644,27 @@ class GraspTorqueNode(Node):
             rep = diagnostics.report(self.controller, time.monotonic())
             # The hand's name from its URDF (e.g. allegro_hand_right), as hardware_id asks.
             hand = self.controller.setup.hand.model.name
-        status = DiagnosticStatus(level=bytes([rep.level]), name=f"{self.get_name()}: grasp "
-                                  "torques", message=rep.message, hardware_id=hand,
-                                  values=[KeyValue(key=k, value=v) for k, v in rep.values])
+        # Two sources of joint states are followed as one stream (the stamp rule keeps
+        # either from locking the other out); say so, as the node cannot tell them apart.
+        publishers = self.count_publishers(self._joint_states_topic)
+        if publishers > 1:
+            self.get_logger().warn(f"{publishers} publishers on {self._joint_states_topic}: "
+                                   "their joint states are taken as one stream",
+                                   throttle_duration_sec=10.0)
+        values = [*rep.values, ("joint_states.publishers", str(publishers))]
+        level, message = rep.level, rep.message
+        self._duplicates = self.duplicates()  # about 1 us: rmw's graph cache
+        if self._duplicates > 0:
+            name = self.get_fully_qualified_name()
+            self.get_logger().error(f"another node named {name} is on this domain: both may "
+                                    "drive effort_commands and take parameters",
+                                    throttle_duration_sec=10.0)
+            level = diagnostics.ERROR
+            message = f"another node named {name} is on this domain; {message}"
+        values.append(("duplicate_nodes", str(self._duplicates)))
+        status = DiagnosticStatus(level=bytes([level]), name=f"{self.get_name()}: grasp "
+                                  "torques", message=message, hardware_id=hand,
+                                  values=[KeyValue(key=k, value=v) for k, v in values])
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diag_pub.publish(msg)
@@ -522,12 +699,25 @@ class GraspTorqueNode(Node):
 
     async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
                         ) -> Trigger.Response:
+        """Queue one solve for the worker, or answer "busy" at once when
+        MAX_PENDING_SOLVES are queued: every request gets an answer, in bounded memory.
+        (Runs in the executor's thread only, as does the count.)"""
+        if self._pending_solves >= MAX_PENDING_SOLVES:
+            self._busy_answers += 1
+            response.success = False
+            response.message = (f"busy: {self._pending_solves} solves queued (at most "
+                                f"{MAX_PENDING_SOLVES}); call again later")
+            return response
         with self._lock:
             inputs = self.controller.inputs
-        done = Future(executor=self.executor)
-        done.add_done_callback(lambda _: None)  # completion wakes the executor
-        self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
-        await done
+        self._pending_solves += 1
+        try:
+            done = Future(executor=self.executor)
+            done.add_done_callback(lambda _: None)  # completion wakes the executor
+            self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
+            await done
+        finally:
+            self._pending_solves -= 1
         response.success, response.message = done.result()
         return response
 
@@ -540,7 +730,7 @@ class GraspTorqueNode(Node):
             if stale:
                 done.set_result((False, f"cannot solve: {stale}"))
                 return
-            sol, maps, g = ctrl.solve_inputs(inputs)
+            sol, maps, g = ctrl.solve_inputs(inputs, time.perf_counter() + ctrl.budget())
             cmd, _ = ctrl.gate(sol, g)
             if sol.status == "infeasible":  # what can be held, and what binds (docs/planner.md)
                 from grasp_torque_opt.methods.explain import explain
@@ -625,7 +815,16 @@ def main(args: list[str] | None = None) -> int:
     executor = None
     code = 0
     try:
-        node = GraspTorqueNode()
+        node = GraspTorqueNode(message_info=opts.executor != "events")
+        wait = node.get_parameter("startup_check_time").value
+        if wait > 0.0:
+            node.get_logger().info(f"looking for another {NODE_NAME} on this domain ({wait:g} s)")
+            if node.wait_for_duplicates(wait):
+                raise GraspTorqueError(
+                    f"another node named {node.get_fully_qualified_name()} is on this domain "
+                    f"(ROS_DOMAIN_ID {node.context.get_domain_id()}): refusing to run, as both "
+                    "would drive effort_commands (stop it, or give this one another name with "
+                    "--ros-args -r __node:=NAME)")
         # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()

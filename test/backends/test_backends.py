@@ -2,6 +2,7 @@
 
 import copy
 import dataclasses
+import time
 
 import numpy as np
 import pytest
@@ -288,3 +289,84 @@ def test_proxsuite_kkt_check_sees_a_suboptimal_point(allegro):
     wrong[int(np.argmax(z[:qp.C.shape[0]]))] *= -1.0
     assert kkt_violation(qp, x, y, wrong) > KKT_TOLERANCE
     assert kkt_violation(qp, 0.9 * x, y, z) > KKT_TOLERANCE
+
+
+# -- time budgets ---------------------------------------------------------------------------
+
+
+def hard_qp(allegro, ratio=1e24):
+    """The Allegro's QP with weights 1e-12 and 1e12 alternating: ProxSuite runs to its caps
+    (the issue's freeze: over 11 minutes with caps 100000 x 100000)."""
+    w = np.array([1.0 / np.sqrt(ratio), np.sqrt(ratio)] * (allegro.hand.m // 2))
+    return build_tau_qp(allegro.maps(), allegro.friction, allegro.external_wrench,
+                        *allegro.tau_bounds, w)
+
+
+def test_a_deadline_stops_proxsuite_whatever_its_caps(allegro):
+    from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+
+    solver = TauQPSolver(ProxSuiteSettings(max_iter=100000, max_iter_in=200))
+    t0 = time.perf_counter()
+    raw = solver.solve(hard_qp(allegro), deadline=t0 + 0.05)
+    elapsed = time.perf_counter() - t0
+    assert raw.status == "error" and raw.message.startswith("time budget spent after ")
+    # At most one outer iteration (200 inner ones, well under 0.5 s here) past the deadline.
+    assert elapsed < 0.05 + 0.5 and solver.timeouts == 1
+
+
+def test_a_deadline_leaves_an_ordinary_solve_alone(allegro):
+    """A solve that fits in its budget is one ProxSuite call: bit for bit the same answer.
+    Cut into the shortest slices (continued from each slice's result), it still converges to
+    the same optimum."""
+    qp = build_tau_qp(allegro.maps(), allegro.friction, allegro.external_wrench,
+                      *allegro.tau_bounds, allegro.weights)
+    plain = TauQPSolver().solve(qp)
+    timed = TauQPSolver().solve(qp, deadline=time.perf_counter() + 10.0)
+    assert plain.status == timed.status == "solved"
+    np.testing.assert_array_equal(plain.x, timed.x)
+    sliced = TauQPSolver(max_slice_s=1e-9)
+    sliced._inner_s = 1.0  # every slice as short as allowed (MIN_SLICE_OUTER)
+    got = sliced.solve(qp, deadline=time.perf_counter() + 10.0)
+    assert got.status == "solved"
+    np.testing.assert_allclose(got.x[:allegro.hand.m], plain.x[:allegro.hand.m], atol=1e-7)
+
+
+@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+def test_no_active_set_solve_starts_past_its_deadline(allegro, backend):
+    raw = make_solver(backend).solve(hard_qp(allegro, 1.0), deadline=time.perf_counter() - 1.0)
+    assert raw.status == "error" and "time budget spent" in raw.message and raw.x is None
+
+
+def test_solve_splits_its_deadline_and_skips_the_lp_when_spent(allegro):
+    """dispatch.solve under a deadline: the fallback still answers after a first backend
+    stopped by its share; past the deadline nothing more runs (no LP)."""
+    from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+
+    hard = dataclasses.replace(allegro, weights=np.array([1e-12, 1e12] * 8))
+    slow = TauQPSolver(ProxSuiteSettings(max_iter=100000, max_iter_in=200))
+    t0 = time.perf_counter()
+    sol = solve(hard, solver=slow, fallback=make_solver("daqp"), deadline=t0 + 0.05)
+    assert time.perf_counter() - t0 < 0.05 + 0.5
+    assert slow.timeouts == 1 and "fallback" in sol.timings  # DAQP had its turn
+    spent = solve(allegro, solver=TauQPSolver(), deadline=time.perf_counter() - 1.0)
+    assert spent.status == "failed" and "LP skipped: time budget spent" in spent.message
+
+
+def test_a_deadline_caps_daqps_iterations(allegro):
+    """DAQP cycled for 1677 iterations (146 ms here) on a 32-contact grasp with weights at
+    the ratio bound: under a deadline its cap is the iterations that fit."""
+    from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+    from grasp_torque_opt.core.scenario import ContactSpec
+
+    rng = np.random.default_rng(0)
+    contacts = [ContactSpec(link=c.link, position=c.position + rng.normal(0, 2e-3, 3))
+                for c in allegro.contacts * 8]
+    big = dataclasses.replace(allegro, contacts=contacts)
+    w = np.array([1e-3, 1e3] * 8)
+    qp = build_tau_qp(big.maps(), big.friction, big.external_wrench, *big.tau_bounds, w)
+    solver = make_solver("daqp", ProxSuiteSettings(max_iter=10000))
+    free = solver.solve(qp)
+    t0 = time.perf_counter()
+    capped = solver.solve(qp, deadline=t0 + 0.01)
+    elapsed = time.perf_counter() - t0
+    assert capped.iterations < free.iterations and elapsed < 0.01 + 0.5

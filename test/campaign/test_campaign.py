@@ -33,8 +33,11 @@ from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.core import scenario as schema
 from grasp_torque_opt.ros.node import PARAMETERS, GraspTorqueNode
 
-#: No cycle may take longer than this, whatever the input (the solver is capped).
-STALL = 1.0
+#: No cycle may take longer than this, whatever the input: its solvers stop by its budget
+#: (at most cycle_budget's upper bound, 1 s) and overrun it by one outer iteration at most.
+STALL = 1.5
+#: Between the cycle's last freshness check and the publish call [s].
+PUBLISH_MARGIN = 0.005
 
 
 class Recorder:
@@ -50,7 +53,8 @@ class Recorder:
         ctrl = self.node.controller  # publish follows the cycle at once: same inputs
         # The controller as it is now (a shallow copy keeps this setup and config): a
         # parameter change after the command must not be held against it.
-        self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs, copy.copy(ctrl)))
+        self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs, copy.copy(ctrl),
+                          time.monotonic()))
 
     def __getattr__(self, name: str):
         return getattr(self.real, name)  # e.g. wait_for_all_acked in the safe stop
@@ -100,6 +104,7 @@ class Rig:
 def operations(rig: Rig, size: int) -> st.SearchStrategy:
     """What can happen to a running node: messages, time, parameter changes, solvers."""
     js = mutated(rig.valid_js, rig.names)
+    m = rig.setup.hand.m
     param = st.one_of(
         st.tuples(st.sampled_from(["mu_tangential", "mu_torsional", "min_normal_force",
                                    "hold_time", "joint_state_timeout", "max_wrench_force",
@@ -110,7 +115,15 @@ def operations(rig: Rig, size: int) -> st.SearchStrategy:
         st.tuples(st.sampled_from(["polygon_sides", "solver.max_iter", "solver.max_iter_in",
                                    "max_joint_state_entries"]), st.integers(-5, 300)),
         st.tuples(st.just("fault_policy"), st.sampled_from(["hold", "zero", "", "explode"])),
-        st.tuples(st.just("gravity_compensation"), st.booleans()))
+        st.tuples(st.just("gravity_compensation"), st.booleans()),
+        # The issue's freeze: iteration caps, tolerance and the weights' ratio at their bounds.
+        st.tuples(st.just("solver.max_iter"), st.sampled_from([10000, 10001, 100000])),
+        st.tuples(st.just("solver.max_iter_in"), st.sampled_from([200, 201, 100000])),
+        st.tuples(st.just("solver.eps_abs"), st.just(1e-12)),
+        st.tuples(st.just("weights"), st.sampled_from(
+            [[1e-3, 1e3] * (m // 2) + [1.0] * (m % 2), [1e-6] * (m - 1) + [1.0],
+             [1e-12, 1e12] * (m // 2) + [1.0] * (m % 2)])),
+        st.tuples(st.just("cycle_budget"), st.sampled_from([1e-4, 1.0, 10.0])))
     op = st.one_of(
         st.tuples(st.just("joint_states"), js), st.tuples(st.just("joint_states"), js),
         st.tuples(st.just("joint_states"), st.just(rig.valid_js)),
@@ -119,7 +132,12 @@ def operations(rig: Rig, size: int) -> st.SearchStrategy:
         st.tuples(st.just("sleep"), st.sampled_from([0.005, 0.02, 0.05])),
         st.tuples(st.just("watchdog"), st.none()),
         st.tuples(st.just("solver"), st.sampled_from(FAULT_MODES + ["healthy"] * 4)),
-        st.tuples(st.just("param"), param))
+        st.tuples(st.just("param"), param),
+        # Changes that make the command in force invalid: limits below it.
+        st.tuples(st.just("limits_below"), st.sampled_from([0.01, 0.3, 0.9])),
+        # Two sources: one stamping ahead of (or behind) the clock, one on it.
+        st.tuples(st.just("skewed_joint_state"), st.sampled_from([0.4, 0.49, 0.6, -0.4])),
+        st.tuples(st.just("joint_state_on_clock"), st.none()))
     return st.lists(op, min_size=1, max_size=size)
 
 
@@ -144,6 +162,21 @@ def run(rig: Rig, ops) -> None:
             solver = Injected(arg if arg != "healthy" else FAULT_MODES[0])
             solver.healthy = arg == "healthy"
             node.controller.solver = solver
+        elif kind == "limits_below":
+            seen = rig.recorder.seen  # the command in force: the last one published
+            ref = seen[-1][0] if seen else node.controller.setup.hand.torque_limits
+            limits = np.maximum(arg * np.abs(ref), 1e-3)
+            node.set_parameters([Parameter("torque_limits", value=[float(x) for x in limits])])
+        elif kind in ("skewed_joint_state", "joint_state_on_clock"):
+            msg = copy.deepcopy(rig.valid_js)
+            t = node._clock_now() + (arg or 0.0)
+            msg.header.stamp.sec, msg.header.stamp.nanosec = int(t), int((t % 1.0) * 1e9)
+            before = node.controller.counters.rejected["joint_states"]
+            node._on_joint_state(msg)
+            refused = node.controller.counters.rejected["joint_states"] > before
+            if kind == "joint_state_on_clock" and refused and \
+                    "header.stamp" in node.controller.last_rejection:
+                broken(f"a joint state on the clock refused: {node.controller.last_rejection}")
         else:
             name, value = arg
             if isinstance(value, list) and name in ("torque_limits", "weights"):
@@ -155,8 +188,14 @@ def run(rig: Rig, ops) -> None:
                                             "InvalidParameterValueException"), e
         if kind != "sleep" and time.perf_counter() - t0 > STALL:
             broken(f"{kind} took {time.perf_counter() - t0:.2f} s")
+        # What the effort controller holds is within the limits in force, whatever changed.
+        if rig.recorder.seen:
+            held = rig.recorder.seen[-1][0]
+            limits = node.controller.setup.hand.torque_limits
+            if held.shape == limits.shape and np.any(np.abs(held) > limits):
+                broken(f"the command in force exceeds the limits in force after {kind}")
     ctrl = node.controller
-    for cmd, decision, inputs, then in rig.recorder.seen:
+    for cmd, decision, inputs, then, sent in rig.recorder.seen:
         check_command(cmd, rig.setup.hand.m, then.setup.hand.torque_limits)
         if decision is None or decision.command is None or \
                 not np.array_equal(decision.command, cmd):
@@ -170,6 +209,8 @@ def run(rig: Rig, ops) -> None:
             broken(f"a command from an uncertified solution ({decision.kind})")
         if decision.cycle_time > then.config.cycle_budget:
             broken(f"a command from a cycle over budget ({decision.cycle_time:.4f} s)")
+        if sent - inputs.q_time > then.config.joint_state_timeout + PUBLISH_MARGIN:
+            broken(f"a command sent {sent - inputs.q_time:.4f} s after its joint state")
         # Independently of the package's certificate, at the inputs and parameters it was
         # computed from (its limits are checked on the command above).
         setup, _ = then.grasp_at(inputs)
@@ -310,3 +351,79 @@ def test_campaign_cli(tmp_path, planar_doc):
 
     campaign()
     assert {0, 2} <= set(codes)  # both solved and refused files were generated
+
+
+# -- the CLI on hostile files ----------------------------------------------------------------
+
+#: Longest a hostile file may take through the CLI [s] (the bounds make it well under 1 s).
+FILE_STALL = 10.0
+
+
+@st.composite
+def hostile_texts(draw, text: str) -> bytes:
+    """A valid scenario's text made hostile: YAML aliases nested some levels deep, nesting,
+    bytes that are not UTF-8, many contacts, long strings, long integers, in some field."""
+    lines = text.splitlines()
+    fields = [i for i, line in enumerate(lines) if ": " in line and not line.endswith(":")]
+    i = draw(st.sampled_from(fields))
+    key = lines[i].split(": ", 1)[0]
+    kind = draw(st.sampled_from(["aliases", "nesting", "bytes", "contacts", "string",
+                                 "integer"]))
+    if kind == "aliases":
+        levels = draw(st.integers(1, 7))
+        parts = ['&a0 ["lol", "lol", "lol"]'] + [
+            f"&a{k} [" + ", ".join([f"*a{k - 1}"] * draw(st.integers(2, 9))) + "]"
+            for k in range(1, levels)]
+        lines[i] = f"{key}: [{', '.join(parts)}]"
+    elif kind == "nesting":
+        depth = draw(st.integers(5, 3000))
+        lines[i] = f"{key}: {'[' * depth}1{']' * depth}"
+    elif kind == "string":
+        lines[i] = f"{key}: {'x' * draw(st.integers(100, 200_000))}"
+    elif kind == "integer":
+        lines[i] = f"{key}: {'7' * draw(st.integers(10, 6000))}"
+    elif kind == "contacts":
+        n = draw(st.integers(1, 300))
+        at = next(j for j, line in enumerate(lines) if line.strip() == "contacts:")
+        first = next(j for j in range(at + 1, len(lines)) if lines[j].lstrip().startswith("- "))
+        last = next((j for j in range(first + 1, len(lines))
+                     if lines[j].lstrip().startswith("- ") or not lines[j].startswith("  ")),
+                    len(lines))
+        lines[first:first] = lines[first:last] * n
+    data = "\n".join(lines).encode() + b"\n"
+    if kind == "bytes":
+        at = draw(st.integers(0, len(data)))
+        data = data[:at] + draw(st.binary(min_size=1, max_size=8)) + data[at:]
+    return data
+
+
+def test_campaign_hostile_files(tmp_path, planar_doc):
+    doc = copy.deepcopy(planar_doc)
+    doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
+    path = tmp_path / "hostile.yaml"
+    codes = []
+
+    @settings(CAMPAIGN, max_examples=80)
+    @given(hostile_texts(yaml.safe_dump(doc)))
+    def campaign(data):
+        COUNTS["inputs"] += 1
+        path.write_bytes(data)
+        out, err = io.StringIO(), io.StringIO()
+        t0 = time.perf_counter()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = cli_main(["solve", str(path), "--json"])
+        if time.perf_counter() - t0 > FILE_STALL:
+            broken(f"a hostile file took {time.perf_counter() - t0:.1f} s")
+        codes.append(code)
+        if code == 2:
+            lines = err.getvalue().splitlines()
+            if len(lines) != 1 or not lines[0].startswith(f"grasp-torque-opt: error: {path}: ") \
+                    or len(lines[0]) > 1000:
+                broken(f"bad input without one short line naming it: {err.getvalue()[:300]!r}")
+        elif code in (0, 3, 4):
+            json.loads(out.getvalue())
+        else:
+            broken(f"exit code {code}")
+
+    campaign()
+    assert 2 in codes

@@ -98,16 +98,24 @@ def test_console_script_runs_as_installed():
     assert done.stderr.strip().startswith("grasp-torque-opt: error: /nonexistent.yaml: scenario:")
 
 
-def test_wrong_limit_count_without_joints_exits_2(tmp_path, capsys, planar_doc):
-    """With hand.joints omitted the count is only known from the URDF (4 joints)."""
-    doc = mutated(mutated(planar_doc, ("hand", "joints"), None),
-                  ("hand", "torque_limits"), [10.0, 5.0, 10.0])
+@pytest.mark.parametrize("path,value", [(("hand", "torque_limits"), [10.0, 5.0, 10.0, 5.0]),
+                                        (("objective",), {"weights": [1.0, 2.0, 1.0, 2.0]})])
+def test_per_joint_lists_without_joints_exit_2(tmp_path, capsys, planar_doc, path, value):
+    """Without hand.joints, per-joint values would follow Pinocchio's joint order, not the
+    URDF file's (the Allegro's model order is 0-3, 12-15, 4-7, 8-11): they need the order."""
+    doc = mutated(mutated(planar_doc, ("hand", "joints"), None), path, value)
     doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
     bad = tmp_path / "bad.yaml"
     bad.write_text(yaml.dump(doc))
     code, out, err = run(["solve", str(bad)], capsys)
     assert code == 2 and out == ""
-    assert err.endswith("hand.torque_limits: must have 4 entries (one per joint), got 3\n")
+    assert re.search(r": hand.joints: required when (hand.torque_limits|objective.weights) "
+                     r"gives one value per joint", err), err
+    # A single limit for every joint needs no order.
+    doc["hand"]["torque_limits"] = 5.0
+    doc.pop("objective", None)
+    bad.write_text(yaml.dump(doc))
+    assert run(["solve", str(bad)], capsys)[0] == 0
 
 
 @pytest.mark.parametrize("backend", ["daqp", "quadprog"])

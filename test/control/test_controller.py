@@ -8,9 +8,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import ALLEGRO_URDF
-from cycle_inputs import FAULT_MODES, Injected, base_poses, fresh, joint_state
+from cycle_inputs import FAULT_MODES, Injected, Slow, base_poses, fresh, joint_state
 from independent import assert_holds
 
+from grasp_torque_opt.control.controller import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.methods.dispatch import solve
@@ -237,7 +238,8 @@ def test_long_names_are_cut_in_messages(planar):
 
 def test_stamp_rule(planar):
     """Zero: unstamped, accepted. Ahead of the clock beyond the tolerance: rejected.
-    Backwards: rejected while the last accepted one is fresh, accepted once it is stale."""
+    Backwards from the mark (the last accepted stamp, at most the clock when it was
+    accepted): rejected while that message is fresh, accepted once it is stale."""
     ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
     js = joint_state(planar)
     ctrl.update_joint_state(*js, now=0.0, stamp=0.0, clock=100.0)
@@ -245,11 +247,13 @@ def test_stamp_rule(planar):
     with pytest.raises(InputError, match=r"^joint_states.header.stamp: is 0.600 s ahead of "
                        r"the clock \(stamp_future_tolerance 0.5 s\)$"):
         ctrl.update_joint_state(*js, now=0.02, stamp=100.6, clock=100.0)
-    with pytest.raises(InputError, match="header.stamp: goes backwards by 0.100000 s"):
-        ctrl.update_joint_state(*js, now=0.05, stamp=100.3, clock=100.05)
-    assert ctrl.inputs.q_time == 0.01  # the rejected states were not kept
+    # The mark is 100.0 (the clock when 100.4 was accepted), not 100.4.
+    ctrl.update_joint_state(*js, now=0.03, stamp=100.02, clock=100.03)
+    with pytest.raises(InputError, match="header.stamp: goes backwards by 0.020000 s"):
+        ctrl.update_joint_state(*js, now=0.05, stamp=100.0, clock=100.05)
+    assert ctrl.inputs.q_time == 0.03  # the rejected states were not kept
     ctrl.update_joint_state(*js, now=0.05, stamp=0.0, clock=100.05)  # unstamped: not compared
-    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the last stamp is stale
+    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the mark is stale
     ctrl.update_joint_state(*js, now=0.21, stamp=50.01, clock=100.21)
     with pytest.raises(InputError, match="is negative"):
         ctrl.update_wrench("", [0.0] * 3, [0.0] * 3, 0.3, stamp=-1.0)
@@ -257,17 +261,140 @@ def test_stamp_rule(planar):
     assert ctrl.counters.rejected == {"joint_states": 2, "contacts": 0, "external_wrench": 1}
 
 
+def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
+    """The issue: joint states stamped 0.4 s ahead (within the 0.5 s tolerance) at 25 Hz
+    were followed exclusively, and the real 200 Hz driver rejected as out of order."""
+    ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
+    js = joint_state(planar)
+    accepted = {"driver": 0, "skewed": 0}
+    for k in range(200):  # one second: the driver every 5 ms, the skewed source every 40 ms
+        t = 100.0 + 0.005 * k
+        for source, stamp in (("driver", t - 0.001),) + ((("skewed", t + 0.4),) if k % 8 == 0
+                                                          else ()):
+            try:
+                ctrl.update_joint_state(*js, now=t, stamp=stamp, clock=t)
+                accepted[source] += 1
+            except InputError:
+                pass
+    # Only a driver message sent before the skewed one's arrival can be refused.
+    assert accepted["skewed"] == 25 and accepted["driver"] >= 200 - 25, accepted
+
+
 def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar):
     ctrl = fresh(planar, cycle_budget=1e-4, hold_time=1.0)
     ctrl.update_joint_state(*joint_state(planar), 0.0)
     r = ctrl.cycle(0.0)
-    assert r.command is None and r.fault.startswith("cycle overrun (") and r.cycle_time > 1e-4
+    # The solvers stop by the budget (a failed solve), or the cycle overruns it after a
+    # certified one: either way nothing is published.
+    assert r.command is None and r.cycle_time > 1e-4
+    assert r.fault.startswith("cycle overrun (") or "time budget spent" in r.fault, r.fault
     assert ctrl.counters.overruns == 1 and ctrl.counters.commands == 0
     assert ctrl.last_command is None and ctrl.counters.max_cycle_time == r.cycle_time
     ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=10.0)
     ctrl.update_joint_state(*joint_state(planar), 0.01)
     r = ctrl.cycle(0.01)
     assert r.kind == "solution" and ctrl.counters.recoveries == 1 and ctrl.fault == ""
+
+
+def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
+    """The issue's freeze: caps 100000 x 100000 and weights 1e-12/1e12 kept one ProxSuite
+    solve going for over 11 minutes. The cycle's solvers stop by its budget instead."""
+    from grasp_torque_opt.backends import make_solver
+    from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+
+    hard = dataclasses.replace(allegro, hand=dataclasses.replace(allegro.hand),
+                               weights=np.array([1e-12, 1e12] * 8))
+    ctrl = fresh(hard, cycle_budget=0.05, joint_state_timeout=1.0)
+    settings = ProxSuiteSettings(max_iter=100000, max_iter_in=100)
+    ctrl.solver = make_solver("proxsuite", settings)
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    t0 = time.perf_counter()
+    r = ctrl.cycle(0.0)
+    assert time.perf_counter() - t0 < 0.05 + 0.5
+    assert r.command is None and "time budget spent" in r.fault
+
+
+def test_the_adaptive_method_keeps_the_budget_too(allegro):
+    """tau-qp-adaptive's rounds of DAQP QPs, at the caps' bounds on a 32-contact grasp with
+    the weights' ratio at its bound: over 90 s per cycle without a budget here."""
+    from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+    from grasp_torque_opt.control.controller import TorqueController
+    from grasp_torque_opt.core.scenario import ContactSpec
+
+    rng = np.random.default_rng(0)
+    contacts = [ContactSpec(link=c.link, position=c.position + rng.normal(0, 2e-3, 3))
+                for c in allegro.contacts * 8]
+    big = dataclasses.replace(allegro, hand=dataclasses.replace(allegro.hand),
+                              contacts=contacts, weights=np.array([1e-3, 1e3] * 8))
+    ctrl = TorqueController(big, CycleConfig(cycle_budget=0.05, joint_state_timeout=1.0,
+                                             method="tau-qp-adaptive"),
+                            ProxSuiteSettings(eps_abs=1e-12, max_iter=10000, max_iter_in=200),
+                            "proxsuite", True, "daqp")
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    t0 = time.perf_counter()
+    ctrl.cycle(0.0)
+    assert time.perf_counter() - t0 < 0.05 + 0.5
+
+
+def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar):
+    """Staleness is checked when the command leaves: cycle_budget 10 s but joint states
+    stale after 50 ms (the issue's command 4.2 s late)."""
+    ctrl = fresh(planar, cycle_budget=10.0, joint_state_timeout=0.05, hold_time=1.0)
+    ctrl.solver = Slow(0.08)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    r = ctrl.cycle(0.0)
+    assert r.command is None and r.fault.startswith("inputs went stale during the cycle: "
+                                                     "joint_states stale")
+    assert ctrl.counters.commands == 0 and ctrl.last_command is None
+    ctrl.solver = Slow(0.0)
+    ctrl.update_joint_state(*joint_state(planar), 1.0)
+    assert ctrl.cycle(1.0).kind == "solution"
+
+
+def with_limits(ctrl, limit):
+    """The controller after a torque_limits change (as the node applies one)."""
+    hand = dataclasses.replace(ctrl.setup.hand,
+                               torque_limits=np.full(ctrl.setup.hand.m, float(limit)))
+    ctrl.setup = dataclasses.replace(ctrl.setup, hand=hand)
+
+
+@pytest.mark.parametrize("policy", ["hold", "zero"])
+def test_lowered_limits_act_on_the_command_in_force_at_once(allegro, policy):
+    """The issue: 0.63 N m in force, limits lowered to 0.2 N m (the grasp unholdable), hold
+    policy: nothing new was published and the controller kept 0.63 N m forever."""
+    ctrl = fresh(allegro, fault_policy=policy, hold_time=1.0, joint_state_timeout=1.0)
+    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    w = allegro.external_wrench * 6.2
+    ctrl.update_wrench("", w[:3], w[3:], 0.0)
+    first = ctrl.cycle(0.0)
+    assert first.kind == "solution" and 0.6 < np.abs(first.command).max() < 0.7
+    # Still holdable within 0.65: the new certified command at once.
+    with_limits(ctrl, 0.65)
+    r = ctrl.reconfigured(0.01)
+    assert r.kind == "solution" and np.all(np.abs(r.command) <= 0.65)
+    # Unholdable within 0.2: zeros at once, whatever the policy (within hold_time too).
+    with_limits(ctrl, 0.2)
+    r = ctrl.reconfigured(0.02)
+    assert r.kind == "zero" and np.all(r.command == 0.0)
+    assert r.fault.startswith("the command in force exceeds the new torque_limits")
+    np.testing.assert_array_equal(ctrl.in_force, np.zeros(allegro.hand.m))
+    # Zeros are within any limit: a further change publishes nothing new.
+    with_limits(ctrl, 0.1)
+    assert ctrl.reconfigured(0.03) is None
+    # Raised again: the next cycle recovers.
+    with_limits(ctrl, 0.7)
+    ctrl.update_joint_state(*joint_state(allegro), 0.04)
+    assert ctrl.cycle(0.04).kind == "solution" and ctrl.fault == ""
+
+
+def test_lowered_limits_with_stale_inputs_zero_at_once(planar):
+    ctrl = fresh(planar, fault_policy="hold", joint_state_timeout=0.05, hold_time=10.0)
+    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    cmd = ctrl.cycle(0.0).command
+    assert ctrl.reconfigured(1.0) is None  # stale, but the command in force is within limits
+    with_limits(ctrl, 0.5 * float(np.abs(cmd).max()))
+    r = ctrl.reconfigured(1.0)
+    assert r.kind == "zero" and "joint_states stale" in r.fault
 
 
 # -- fault injection: solvers that fail in every way ----------------------------------------

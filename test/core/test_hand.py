@@ -42,3 +42,24 @@ def test_urdf_string_is_parsed():
     np.testing.assert_array_equal(hand.torque_limits, [10, 5, 10, 5])
     with pytest.raises(InputError, match="robot_description: cannot parse"):
         Hand.from_urdf_string("<robot name='x'><link name='a'/><joint/></robot>")
+
+
+def test_limits_above_the_urdf_effort_are_refused_unless_allowed():
+    urdf = ROOT / "urdf/planar_two_finger.urdf"  # effort limits 10, 5, 10, 5 N m
+    with pytest.raises(InputError, match=r"^hand.torque_limits: 6 N m for joint 'joint2' "
+                       r"exceeds the URDF effort limit \(5 N m\); set "
+                       r"hand.torque_limits_above_urdf: true to allow it$"):
+        Hand.from_urdf(urdf, None, [10.0, 6.0, 10.0, 5.0])
+    hand = Hand.from_urdf(urdf, None, [10.0, 6.0, 10.0, 5.0], above_urdf=True)
+    np.testing.assert_array_equal(hand.torque_limits, [10.0, 6.0, 10.0, 5.0])
+    np.testing.assert_array_equal(hand.effort_limits, [10.0, 5.0, 10.0, 5.0])
+    with pytest.raises(InputError, match=r"exceeds the largest limit accepted \(10000 N m\)"):
+        Hand.from_urdf(urdf, None, 1e300, above_urdf=True)
+
+
+def test_pinocchio_orders_joints_unlike_the_urdf_file():
+    """Why per-joint lists need hand.joints: the Allegro's model order is 0-3, 12-15, 4-7,
+    8-11, not the file's 0-15."""
+    hand = Hand.from_urdf(resolve_urdf(ALLEGRO_URDF, ROOT))
+    assert [int(float(n.split("_")[1])) for n in hand.joints] == \
+        [0, 1, 2, 3, 12, 13, 14, 15, 4, 5, 6, 7, 8, 9, 10, 11]

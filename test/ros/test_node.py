@@ -14,7 +14,8 @@ import pinocchio as pin
 import pytest
 import rclpy
 from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
-from cycle_inputs import base_poses, joint_state
+from cycle_inputs import Slow, base_poses, joint_state
+from geometry_msgs.msg import PoseArray, WrenchStamped
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
@@ -110,6 +111,18 @@ def test_service_says_why_without_inputs(planar_node):
     ("fault_policy", "explode", "fault_policy: must be one of hold, zero"),
     ("mu_tangential", 0.0, "mu_tangential"),
     ("joints", ["joint1"], "read-only parameter: joints"),
+    # The issue's freeze: accepted as in range, they let one solve run for minutes.
+    ("solver.max_iter", 100000, "solver.max_iter"),
+    ("solver.max_iter_in", 100000, "solver.max_iter_in"),
+    ("weights", [1e-12, 1e12, 1e-12, 1e12], "weights: every entry must be in [1e-06, 1e+06]"),
+    ("weights", [1e-4, 1e3, 1.0, 1.0], "weights: the largest entry may be at most 1e+06 times "
+     "the smallest, got 1e+07"),
+    ("cycle_budget", 10.0, "cycle_budget"),
+    # Unbounded limits: 1e6 and 1e300 N m were accepted (URDF effort limits 10, 5, 10, 5).
+    ("torque_limits", [1e6, 1.0, 1.0, 1.0], "torque_limits: 1e+06 N m for joint 'joint1' "
+     "exceeds the URDF effort limit (10 N m); set torque_limits_above_urdf"),
+    ("torque_limits", [1.0, 1.0, 1.0, 1e300], "exceeds the URDF effort limit (5 N m)"),
+    ("torque_limits", [10.0, 5.0, 10.0, 5.1], "joint 'joint4'"),
 ])
 def test_bad_parameter_is_refused_with_its_reason(planar_node, name, value, reason):
     before = planar_node.node.get_parameter(name).value
@@ -388,4 +401,164 @@ def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, ba
         refused = h.node.set_parameters([Parameter("solver.backend", value="osqp")])[0]
         assert not refused.successful and "solver.backend" in refused.reason
     finally:
+        h.close()
+
+
+def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegro):
+    """Hold policy, 0.63 N m in force, torque_limits lowered to 0.2 N m (unholdable): zeros
+    reach the effort controller at once, without another joint state; before, nothing new
+    was published and the controller kept 0.63 N m forever."""
+    h = Harness(ALLEGRO, fault_policy="hold", hold_time=10.0, joint_state_timeout=10.0)
+    try:
+        w = WrenchStamped()
+        w.wrench.force.x = float(allegro.external_wrench[0] * 6.2)
+        h.wrench_pub.publish(w)
+        h.spin_for(0.2)
+        h.send_joint_state(*joint_state(allegro))
+        cmd = h.next_command()
+        assert cmd is not None and np.abs(cmd).max() > 0.6
+        n = len(h.commands)
+        assert h.node.set_parameters([Parameter("torque_limits", value=[0.2] * 16)])[0].successful
+        assert h.spin_until(lambda: len(h.commands) > n, 2.0)
+        assert np.all(h.commands[-1][1] == 0.0) and len(h.commands) == n + 1
+    finally:
+        h.close()
+
+
+def test_limits_above_the_urdf_only_when_allowed_at_start(planar):
+    h = Harness(PLANAR, torque_limits_above_urdf=True)
+    try:
+        node = h.node
+        assert node.set_parameters([Parameter("torque_limits", value=[20.0] * 4)])[0].successful
+        refused = node.set_parameters([Parameter("torque_limits", value=[2e4] * 4)])[0]
+        assert not refused.successful and "exceeds the largest limit accepted (10000 N m)" in \
+            refused.reason
+        h.send_joint_state(*joint_state(planar))
+        assert h.next_command() is not None
+    finally:
+        h.close()
+
+
+def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothing(planar):
+    """Inputs are aged from the middleware's receipt, not from the callback: a joint state
+    that waited 0.3 s for the executor (timeout 0.1 s) is stale when its callback runs. Before,
+    a flood or a slow cycle let commands leave 165 ms after their joint state."""
+    h = Harness(PLANAR, joint_state_timeout=0.1, hold_time=10.0)
+    try:
+        h.send_joint_state(*joint_state(planar))
+        time.sleep(0.3)  # the executor is busy elsewhere: the message waits in the queue
+        h.spin_for(0.3)
+        assert h.commands == []
+        assert h.node.controller.fault.startswith("joint_states stale")
+        h.send_joint_state(*joint_state(planar))
+        assert h.next_command() is not None  # taken at once: fresh
+    finally:
+        h.close()
+
+
+def test_an_oversized_message_is_rejected_before_it_is_deserialized(planar):
+    """20000 poses (1.1 MB) on contacts: refused by its serialized length. Deserializing
+    10^5 poses took 0.8 s here, and a flood of them cut the command rate from 200 to 38 Hz."""
+    from geometry_msgs.msg import Pose
+
+    h = Harness(PLANAR)
+    try:
+        big = PoseArray(poses=[Pose() for _ in range(20000)])
+        h.contacts_pub.publish(big)
+        assert h.spin_until(lambda: h.node.controller.counters.rejected["contacts"] == 1, 5.0)
+        assert h.node.controller.last_rejection == \
+            "contacts: 1120028 bytes serialized, more than max_message_bytes (65536)"
+        h.send_joint_state(*joint_state(planar))  # the loop goes on
+        np.testing.assert_allclose(h.next_command(), solve(planar).tau, atol=1e-9)
+    finally:
+        h.close()
+
+
+def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
+    """300 concurrent ~/solve calls: each answered, solved or "busy" (before, beyond the 100
+    queued requests the rest never were, silently: 872 to 900 of 1000). With solves slower
+    than the calls come, at most MAX_PENDING_SOLVES are queued and the rest are "busy", and
+    the control loop goes on meanwhile."""
+    from rclpy.qos import HistoryPolicy, QoSProfile
+
+    from grasp_torque_opt.ros import node as node_module
+
+    h = Harness(PLANAR, joint_state_timeout=10.0)
+    try:
+        client = h.tester.create_client(Trigger, "grasp_torque_node/solve", qos_profile=QoSProfile(
+            history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
+        assert h.spin_until(client.service_is_ready, 5.0)
+        h.send_joint_state(*joint_state(planar))
+        assert h.next_command() is not None
+
+        def flood(n):
+            futures = [client.call_async(Trigger.Request()) for _ in range(n)]
+            assert h.spin_until(lambda: all(f.done() for f in futures), 30.0), \
+                sum(f.done() for f in futures)
+            answers = [f.result() for f in futures]
+            busy = [a for a in answers if a.message.startswith("busy: ")]
+            assert all(a.success for a in answers if not a.message.startswith("busy: "))
+            assert all(not a.success for a in busy)
+            return len(answers) - len(busy), len(busy)
+
+        solved, _ = flood(300)
+        assert solved >= node_module.MAX_PENDING_SOLVES
+        monkeypatch.setattr(node_module, "MAX_PENDING_SOLVES", 4)
+        h.node._service_controller.solver = Slow(0.05)
+        n = len(h.commands)
+        futures = [client.call_async(Trigger.Request()) for _ in range(20)]
+        for _ in range(10):  # the loop answers joint states while the service solves
+            h.send_joint_state(*joint_state(planar))
+            h.spin_for(0.02)
+        assert len(h.commands) - n >= 5
+        assert h.spin_until(lambda: all(f.done() for f in futures), 30.0)
+        answers = [f.result() for f in futures]
+        busy = [a for a in answers if a.message.startswith("busy: 4 solves queued")]
+        assert busy and all(a.success for a in answers if a not in busy)
+    finally:
+        h.close()
+
+
+def test_a_second_node_of_the_same_name_refuses_to_run(planar):
+    """Two grasp_torque_nodes on one domain both drove effort_commands, and parameter reads
+    and writes went to either. One already running: a second one started exits with code 2
+    and one line naming the other, before it takes any input; the first reports it."""
+    first = Harness(PLANAR)
+    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    second = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--ros-args",
+                               "-p", f"scenario:={PLANAR}", "-p", "startup_check_time:=10.0"],
+                              env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        first.send_joint_state(*joint_state(planar))
+        assert first.next_command() is not None
+        end = time.monotonic() + 15.0
+        while second.poll() is None and time.monotonic() < end:
+            first.spin_for(0.1)
+        assert second.returncode == 2
+        err = second.stderr.read()
+        lines = [line for line in err.splitlines() if "error" in line]
+        assert lines == ["grasp_torque_node: error: another node named /grasp_torque_node is on "
+                         f"this domain (ROS_DOMAIN_ID {DOMAIN}): refusing to run, as both would "
+                         "drive effort_commands (stop it, or give this one another name with "
+                         "--ros-args -r __node:=NAME)"], err
+        first.send_joint_state(*joint_state(planar))  # the first goes on
+        assert first.next_command() is not None
+    finally:
+        if second.poll() is None:
+            second.kill()
+        first.close()
+
+
+def test_a_running_node_reports_another_of_its_name(planar):
+    h = Harness(PLANAR)
+    other = GraspTorqueNode(context=h.context,
+                            parameter_overrides=[Parameter("scenario", value=str(PLANAR))])
+    try:
+        assert h.spin_until(lambda: h.diagnostics and
+                            h.diagnostics[-1].get("duplicate_nodes") == "1", 5.0)
+        d = h.diagnostics[-1]
+        assert d["_level"] == 2 and d["_message"].startswith(
+            "another node named /grasp_torque_node is on this domain; ")
+    finally:
+        other.destroy_node()
         h.close()

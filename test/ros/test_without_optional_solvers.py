@@ -26,7 +26,7 @@ with warnings.catch_warnings(record=True) as caught:
 assert any("threadpoolctl is not installed" in str(w.message) for w in caught), caught
 rclpy.init(domain_id=77)
 node = GraspTorqueNode(parameter_overrides=[Parameter("scenario", value={str(ALLEGRO)!r}),
-                                            Parameter("cycle_budget", value=5.0)])
+                                            Parameter("cycle_budget", value=1.0)])
 assert node.controller.fallback is None, "DAQP absent: no fallback, not a crash"
 refused = node.set_parameters([Parameter("solver.backend", value="daqp")])[0]
 assert not refused.successful and "daqp is not installed" in refused.reason, refused.reason
