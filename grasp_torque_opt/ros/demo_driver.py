@@ -130,6 +130,16 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
         rclpy.try_shutdown()
         return 1
 
+    if not args.watch:
+        # The node takes input only after its start-up check for a namesake on the domain
+        # (startup_check_time): the grasp at rest until its first command, then the play.
+        rest = JointState(name=list(names), position=[float(setup.q[i]) for i in idx_q],
+                          effort=[float("nan")] * len(names))
+        while not received and time.monotonic() < deadline:
+            rest.header.stamp = node.get_clock().now().to_msg()
+            js_pub.publish(rest)
+            rclpy.spin_once(node, timeout_sec=1.0 / args.rate)
+        received.clear()
     period = 1.0 / args.rate
     t0 = time.monotonic()
     next_tick, next_print, next_slow = t0, t0 + 1.0, t0

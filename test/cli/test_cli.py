@@ -151,3 +151,13 @@ def test_line_breaks_in_the_input_stay_escaped_in_the_one_line(tmp_path, capsys,
     assert len(err.splitlines()) == 1 and err.endswith("\n")
     assert err.startswith(f"grasp-torque-opt: error: {bad}: hand.urdf: file not found: ")
     assert urdf.encode("unicode_escape").decode("ascii") in err
+
+
+def test_a_reader_that_goes_away_gets_no_traceback():
+    """`grasp-torque-opt solve ... | head -1`: the pipe closes before the output is written."""
+    child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.cli", "solve", str(ALLEGRO)],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    child.stdout.close()  # the reader is gone before the solve has printed anything
+    err = child.stderr.read().decode()
+    assert child.wait(timeout=120) in (0, 141)
+    assert "Traceback" not in err, err
