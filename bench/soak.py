@@ -33,9 +33,9 @@ DELIVERY_MARGIN_S into an infeasible-load phase and received before a holdable
 load was published again; no command over the lowered limits once the change was
 acknowledged (plus DELIVERY_MARGIN_S); at least one command from the on-clock
 joint states in every skewed-source phase; every service call answered (solved,
-busy or a reason) by the end; no command received later than
-joint_state_timeout + DELIVERY_MARGIN_S after its joint state's stamp. Also
-reported: the node's own
+busy or a reason) by the end. Also reported: commands received later than
+joint_state_timeout + DELIVERY_MARGIN_S after their joint state's stamp (the
+receipt includes delivery and this process's scheduling), the node's own
 counters from /diagnostics (commands, faults, recoveries, rejected.*) and its
 resident memory (VmRSS) at start, end and in between. Not in CI.
 """
@@ -247,6 +247,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     violations: dict[str, int] = {}
     examples: list[str] = []
     stamped_ok = 0
+    late_receipts = {"n": 0}  # commands received later than joint_state_timeout + margin
     zero_policy_commands = 0
     stamped_times: list[tuple[int, int]] = []  # (stamp, receipt) of valid-stamp commands
     diag: dict[str, str] = {}
@@ -286,7 +287,11 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             stamped_ok += 1
             stamped_times.append((s, now))
             if now - s > int(1e9 * (timeout + DELIVERY_MARGIN_S)):
-                broken("late_command", f"received {1e-9 * (now - s):.3f} s after its stamp")
+                # Reported, not an invariant: the receipt time includes the command's
+                # delivery and this process's own scheduling (1400 such on a machine
+                # whose other work took 1.38 of its 2 cores); the node's own bound, from
+                # receipt to publication, is checked by the test suite's campaign.
+                late_receipts["n"] += 1
             phase = state["phase"]
             if phase is not None and phase["kind"] == "skewed_source" and \
                     s not in skewed_stamps:
@@ -656,6 +661,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         "latency_ms": percentiles_ms([1e-9 * (r - s) for s, r in latencies]),
         "latency_ms_per_window": _windows(latencies, start_ns, args.duration),
         "node_counters": node_counters, "service_flood": service,
+        "late_receipts": late_receipts["n"],
         "node_fault_at_end": diag_end.get("fault"),
         "memory_kib": [{"t_s": t, "vm_rss_kib": r} for t, r in memory],
         "memory_growth_kib": (memory[-1][1] - memory[0][1])
@@ -726,6 +732,8 @@ def report(r: dict) -> str:
         f"| overruns / solver failures | {during('overruns')} / {during('solver_failures')} |",
         f"| latency p50 / p99 / max [ms] | {_f(r['latency_ms']['p50_ms'])} / "
         f"{_f(r['latency_ms']['p99_ms'])} / {_f(r['latency_ms']['max_ms'])} |",
+        f"| commands received over joint_state_timeout + {DELIVERY_MARGIN_S:g} s after their "
+        f"stamp | {r['late_receipts']} |",
         f"| node VmRSS start / end [MiB] | {_mib(mem[0]['vm_rss_kib'])} / "
         f"{_mib(mem[-1]['vm_rss_kib'])} |",
         f"| node VmRSS samples [MiB] | "

@@ -155,8 +155,10 @@ def solve(setup: GraspSetup, method: str = "tau-qp", *, maps: GraspMaps | None =
         stage = None
         if setup.objective == "min-max":
             # The LP's t*, then the sum of squares within |tau + offset| <= t* limit / w.
+            t_lp = time.perf_counter()  # the LP first, with the QP's share of the time
             stage = minmax_stage(qp, setup.hand.torque_limits, setup.weights,
-                                 setup.torque_offset)
+                                 setup.torque_offset, None if deadline is None else
+                                 t_lp + PRIMARY_SHARE * max(0.0, deadline - t_lp))
             qp = stage.qp
         t2 = time.perf_counter()
         solver = solver or make_solver(backend)

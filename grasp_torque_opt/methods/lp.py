@@ -23,7 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog
 
-from grasp_torque_opt.backends.daqp import DAQP_INF, KKT_TOLERANCE, kkt_violation
+from grasp_torque_opt.backends.daqp import (
+    DAQP_INF,
+    ITERATION_S,
+    KKT_TOLERANCE,
+    kkt_violation,
+)
 
 #: DAQP's primal tolerance on these LPs (the backends' default eps_abs).
 PRIMAL_TOL = 1e-9
@@ -69,7 +74,8 @@ class DaqpForm:
 
 
 def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-             highs_only: bool = False, form: DaqpForm | None = None) -> LPResult:
+             highs_only: bool = False, form: DaqpForm | None = None,
+             deadline: float | None = None) -> LPResult:
     """Minimize c^T x subject to the bounds and rows of the module docstring.
 
     Args:
@@ -79,21 +85,41 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
         upper: upper bounds, shape (n + r,) (inf allowed); lower == upper: equality.
         highs_only: skip DAQP (the fallback alone; tests and odd problems).
         form: the bounds in DAQP's form if already built (:class:`DaqpForm`).
+        deadline: ``time.perf_counter()`` value by which to stop [s] (the node's cycle
+            budget): DAQP's iterations fitted to the time left at an estimate of its
+            time per iteration, HiGHS's ``time_limit`` the time left, none started
+            past it (``failed``, "time budget spent"). None: the caps alone.
     """
     t0 = time.perf_counter()
     why = ""
     if not highs_only:
-        out = _daqp(c, A, form or DaqpForm(c.size, lower, upper))
+        limit = MAX_ITER
+        if deadline is not None:
+            est = ITERATION_S * max(1.0, c.size * (c.size + A.shape[0]) / (16 * 144))
+            limit = min(MAX_ITER, max(1, int((deadline - t0) / est)))
+        out = _spent(deadline) or _daqp(c, A, form or DaqpForm(c.size, lower, upper), limit)
         if out is not None and out[0] == "optimal":
             return LPResult("optimal", out[1], out[2], "daqp", out[3],
                             time.perf_counter() - t0)
         why = out[3] if out is not None else "DAQP raised"
-    res = _highs(c, A, lower, upper)
+    spent = _spent(deadline)
+    if spent:
+        return LPResult("failed", None, None, "daqp", f"{spent[3]} (after DAQP: {why})",
+                        time.perf_counter() - t0)
+    res = _highs(c, A, lower, upper,
+                 None if deadline is None else deadline - time.perf_counter())
     msg = res.message if not why else f"{res.message} (after DAQP: {why})"
     return LPResult(res.status, res.x, res.lam, "highs", msg, time.perf_counter() - t0)
 
 
-def _daqp(c, A, form: DaqpForm):
+def _spent(deadline: float | None):
+    """The failure of an LP not started past ``deadline`` (None if there is time)."""
+    if deadline is not None and time.perf_counter() >= deadline:
+        return ("failed", None, None, "time budget spent")
+    return None
+
+
+def _daqp(c, A, form: DaqpForm, limit: int | None = None):
     try:
         import daqp  # a selectable backend: a ROS distribution may not have it
     except ImportError:
@@ -103,7 +129,7 @@ def _daqp(c, A, form: DaqpForm):
     try:
         x, _, flag, info = daqp.solve(H, np.ascontiguousarray(c, dtype=float),
                                       np.ascontiguousarray(A, dtype=float), bu, bl, sense,
-                                      primal_tol=PRIMAL_TOL, iter_limit=MAX_ITER,
+                                      primal_tol=PRIMAL_TOL, iter_limit=limit or MAX_ITER,
                                       eps_prox=EPS_PROX)
     except (RuntimeError, ValueError) as e:
         return ("failed", None, None, f"DAQP raised: {e}")
@@ -125,7 +151,7 @@ class _Highs:
     message: str
 
 
-def _highs(c, A, lower, upper) -> _Highs:
+def _highs(c, A, lower, upper, time_limit: float | None = None) -> _Highs:
     n, r = c.size, A.shape[0]
     lo_r, up_r = lower[n:], upper[n:]
     eq = lo_r == up_r
@@ -137,7 +163,9 @@ def _highs(c, A, lower, upper) -> _Highs:
               for lo, up in zip(lower[:n], upper[:n])]
     res = linprog(c, A_ub=A_ub if A_ub.size else None, b_ub=b_ub if b_ub.size else None,
                   A_eq=A[eq] if eq.any() else None, b_eq=up_r[eq] if eq.any() else None,
-                  bounds=bounds, method="highs", options={"maxiter": MAX_ITER})
+                  bounds=bounds, method="highs",
+                  options={"maxiter": MAX_ITER} if time_limit is None else
+                  {"maxiter": MAX_ITER, "time_limit": max(1e-6, time_limit)})
     status = {0: "optimal", 2: "infeasible", 3: "unbounded"}.get(res.status, "failed")
     if status != "optimal":
         return _Highs(status, None, None, f"HiGHS: {res.message}")

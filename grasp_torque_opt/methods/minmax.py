@@ -45,7 +45,7 @@ class MinMax:
 
 
 def minmax_stage(qp: TauQP, limits: np.ndarray, weights: np.ndarray,
-                 offset: np.ndarray | None = None) -> MinMax:
+                 offset: np.ndarray | None = None, deadline: float | None = None) -> MinMax:
     """Solve the min-max LP on a built tau-QP and tighten its torque box to the optimum.
 
     Args:
@@ -53,6 +53,8 @@ def minmax_stage(qp: TauQP, limits: np.ndarray, weights: np.ndarray,
         limits: torque limits, shape (m,) [N m].
         weights: W's diagonal, shape (m,), > 0.
         offset: torque added before commanding (g(q)), shape (m,) [N m], or None.
+        deadline: ``time.perf_counter()`` value by which the LP stops [s]
+            (:func:`~grasp_torque_opt.methods.lp.solve_lp`); None: its caps alone.
     """
     m, n = qp.m, qp.H.shape[0]
     off = np.zeros(m) if offset is None else np.asarray(offset, dtype=float)
@@ -72,7 +74,7 @@ def minmax_stage(qp: TauQP, limits: np.ndarray, weights: np.ndarray,
     upper = np.concatenate((qp.u_box, [inf], qp.b, qp.u, -w * off, w * off))
     c = np.zeros(n + 1)
     c[-1] = 1.0
-    res = solve_lp(c, A, lower, upper)
+    res = solve_lp(c, A, lower, upper, deadline=deadline)
     if res.status != "optimal":
         return MinMax(res.status, None, qp, f"min-max LP {res.status}: {res.message}")
     t = float(res.x[-1])
