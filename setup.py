@@ -4,72 +4,72 @@ from glob import glob
 
 from setuptools import find_packages, setup
 
-package_name = "grasp_torque_opt"
+package_name = 'grasp_torque_opt'
 
 setup(
     name=package_name,
-    version="0.1.0",
-    packages=find_packages(exclude=["test", "bench"]),
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'bench']),
     data_files=[
-        ("share/ament_index/resource_index/packages", ["resource/" + package_name]),
-        ("share/" + package_name, ["package.xml"]),
-        ("share/" + package_name + "/config", glob("config/*.yaml")),
-        ("share/" + package_name + "/urdf", glob("urdf/*.urdf")),
-        ("share/" + package_name + "/launch", glob("launch/*.launch.py")),
-        ("share/" + package_name + "/rviz", glob("rviz/*.rviz")),
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/urdf', glob('urdf/*.urdf')),
+        ('share/' + package_name + '/launch', glob('launch/*.launch.py')),
+        ('share/' + package_name + '/rviz', glob('rviz/*.rviz')),
     ],
-    python_requires=">=3.10",
+    python_requires='>=3.10',
     # In a colcon workspace these come from the distribution (rosdep keys in
     # package.xml); with pip they come from the registry.
     install_requires=[
-        "numpy",
-        "scipy",
-        "pyyaml",
-        "pin",
-        "proxsuite",
-        "clarabel",
-        "example-robot-data",
+        'numpy',
+        'scipy',
+        'pyyaml',
+        'pin',
+        'proxsuite',
+        'clarabel',
+        'example-robot-data',
         # Selectable QP backends (grasp_torque_opt.backends).
-        "daqp",
-        "quadprog",
+        'daqp',
+        'quadprog',
         # One BLAS thread in the node and the CLI (grasp_torque_opt.backends).
-        "threadpoolctl",
+        'threadpoolctl',
     ],
     extras_require={
         # ROS 2 Jazzy from the registry's ros-jazzy-* wheels; optional so that the
         # core installs (and a colcon build works) without them.
-        "ros": [
-            "ros-jazzy-rclpy[fastrtps]",
-            "ros-jazzy-std-msgs",
-            "ros-jazzy-sensor-msgs",
-            "ros-jazzy-geometry-msgs",
-            "ros-jazzy-std-srvs",
-            "ros-jazzy-visualization-msgs",
-            "ros-jazzy-diagnostic-msgs",
+        'ros': [
+            'ros-jazzy-rclpy[fastrtps]',
+            'ros-jazzy-std-msgs',
+            'ros-jazzy-sensor-msgs',
+            'ros-jazzy-geometry-msgs',
+            'ros-jazzy-std-srvs',
+            'ros-jazzy-visualization-msgs',
+            'ros-jazzy-diagnostic-msgs',
         ],
-        "test": ["pytest", "hypothesis"],
+        'test': ['pytest', 'hypothesis'],
         # bench/: the other solvers compared, and process memory.
-        "bench": ["osqp", "psutil"],
+        'bench': ['osqp', 'psutil'],
         # grasp_torque_opt.sim and grasp-torque-sim: the hand in MuJoCo (docs/simulation.md).
-        "sim": ["mujoco>=3.2"],
+        'sim': ['mujoco>=3.2'],
         # grasp-torque-opt score --engine dask: candidate sets that outgrow one machine
         # (docs/planner.md).
-        "distributed": ["dask", "distributed"],
+        'distributed': ['dask', 'distributed'],
     },
     zip_safe=True,
-    maintainer="grasp_torque_opt developers",
-    maintainer_email="dev@grasp-torque-opt.invalid",
-    description="Minimum-effort grasp joint torques with linearized soft-finger cones.",
-    license="BSD-3-Clause",
+    maintainer='grasp_torque_opt developers',
+    maintainer_email='dev@grasp-torque-opt.invalid',
+    description='Minimum-effort grasp joint torques with linearized soft-finger cones.',
+    license='BSD-3-Clause',
     entry_points={
-        "console_scripts": [
-            "grasp-torque-opt = grasp_torque_opt.cli:main",
-            "grasp-torque-demo = grasp_torque_opt.ros.demo_driver:main",
-            "grasp-torque-sim = grasp_torque_opt.ros.sim_driver:main",
+        'console_scripts': [
+            'grasp-torque-opt = grasp_torque_opt.cli:main',
+            'grasp-torque-demo = grasp_torque_opt.ros.demo_driver:main',
+            'grasp-torque-sim = grasp_torque_opt.ros.sim_driver:main',
             # ROS executables (ros2 run grasp_torque_opt ...), installed into lib/<pkg>.
-            "grasp_torque_node = grasp_torque_opt.ros.node:main",
-            "grasp_demo_driver = grasp_torque_opt.ros.demo_driver:main",
-            "grasp_sim_driver = grasp_torque_opt.ros.sim_driver:main",
+            'grasp_torque_node = grasp_torque_opt.ros.node:main',
+            'grasp_demo_driver = grasp_torque_opt.ros.demo_driver:main',
+            'grasp_sim_driver = grasp_torque_opt.ros.sim_driver:main',
         ],
     },
 )

@@ -1,4 +1,5 @@
-"""The control cycle at the edges of the node's parameter ranges: how long can one take?
+"""
+The control cycle at the edges of the node's parameter ranges: how long can one take?
 
 Usage: .venv/bin/python bench/bounds.py [--grasps 40] [--out FILE]
 
@@ -19,18 +20,17 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import time
 from pathlib import Path
+import time
 
-import numpy as np
 from cycle import machine, report
-
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control.controller import CycleConfig, TorqueController
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import MAX_CONTACTS, ContactSpec
+from grasp_torque_opt.core.scenario import ContactSpec, MAX_CONTACTS
 from grasp_torque_opt.core.tau_qp import build_tau_qp
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 BOUNDS = ProxSuiteSettings(eps_abs=1e-12, max_iter=10000, max_iter_in=200)
@@ -42,9 +42,9 @@ UNBUDGETED_CAP_S = 20.0
 
 def weight_patterns(m: int) -> dict[str, np.ndarray]:
     """W at the node's bound: the largest entry 1e6 times the smallest."""
-    return {"alternating": np.array([1e-3, 1e3] * (m // 2) + [1.0] * (m % 2)),
-            "one small": np.r_[1e-3, np.full(m - 1, 1e3)],
-            "one large": np.r_[1e3, np.full(m - 1, 1e-3)]}
+    return {'alternating': np.array([1e-3, 1e3] * (m // 2) + [1.0] * (m % 2)),
+            'one small': np.r_[1e-3, np.full(m - 1, 1e3)],
+            'one large': np.r_[1e3, np.full(m - 1, 1e-3)]}
 
 
 def many_contacts(setup: GraspSetup, p: int) -> GraspSetup:
@@ -60,9 +60,9 @@ def many_contacts(setup: GraspSetup, p: int) -> GraspSetup:
 
 def grasps(n: int) -> list[tuple[str, GraspSetup]]:
     out = []
-    for name in ("planar_two_finger.yaml", "allegro_right.yaml"):
-        out.append((name, GraspSetup.from_file(ROOT / "config" / name)))
-    out.append((f"allegro, {MAX_CONTACTS} contacts", many_contacts(out[1][1], MAX_CONTACTS)))
+    for name in ('planar_two_finger.yaml', 'allegro_right.yaml'):
+        out.append((name, GraspSetup.from_file(ROOT / 'config' / name)))
+    out.append((f'allegro, {MAX_CONTACTS} contacts', many_contacts(out[1][1], MAX_CONTACTS)))
     rng = np.random.default_rng(1)
     cases = []
     for label, setup in out:
@@ -75,62 +75,62 @@ def grasps(n: int) -> list[tuple[str, GraspSetup]]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grasps", type=int, default=40, help="configurations per scenario")
-    parser.add_argument("--out", type=Path,
-                        default=Path(__file__).resolve().parent / "results" / "bounds.json")
+    parser.add_argument('--grasps', type=int, default=40, help='configurations per scenario')
+    parser.add_argument('--out', type=Path,
+                        default=Path(__file__).resolve().parent / 'results' / 'bounds.json')
     args = parser.parse_args()
     single_threaded_math()
     rows = {}
     for label, setup in grasps(args.grasps):
         m = setup.hand.m
-        row = rows.setdefault(label, {"cycles": 0, "unholdable": 0, "commands": 0,
-                                      "unbudgeted_max_s": 0.0,
-                                      **{f"max_cycle_s@{b}": 0.0 for b in BUDGETS},
-                                      **{f"max_overrun_s@{b}": 0.0 for b in BUDGETS}})
+        row = rows.setdefault(label, {'cycles': 0, 'unholdable': 0, 'commands': 0,
+                                      'unbudgeted_max_s': 0.0,
+                                      **{f'max_cycle_s@{b}': 0.0 for b in BUDGETS},
+                                      **{f'max_overrun_s@{b}': 0.0 for b in BUDGETS}})
         for load in LOADS:
-            print(f"{label}, load x{load:g} ...", flush=True)
+            print(f'{label}, load x{load:g} ...', flush=True)
             for weights in weight_patterns(m).values():
                 s = dataclasses.replace(setup, weights=weights,
                                         external_wrench=setup.external_wrench * load)
                 maps = s.maps()
                 qp = build_tau_qp(maps, s.friction, s.external_wrench, *s.tau_bounds, weights)
-                if row["cycles"] < 2 * len(LOADS) * 3:  # the first configuration only
+                if row['cycles'] < 2 * len(LOADS) * 3:  # the first configuration only
                     # Without a budget, up to max_iter x max_iter_in inner iterations: cut at
                     # UNBUDGETED_CAP_S, reported as reached.
                     t0 = time.perf_counter()
-                    make_solver("proxsuite", BOUNDS).solve(qp, deadline=t0 + UNBUDGETED_CAP_S)
-                    row["unbudgeted_max_s"] = max(row["unbudgeted_max_s"],
+                    make_solver('proxsuite', BOUNDS).solve(qp, deadline=t0 + UNBUDGETED_CAP_S)
+                    row['unbudgeted_max_s'] = max(row['unbudgeted_max_s'],
                                                   time.perf_counter() - t0)
                 for budget in BUDGETS:
                     ctrl = TorqueController(
                         dataclasses.replace(s, hand=dataclasses.replace(s.hand)),
                         CycleConfig(cycle_budget=budget, joint_state_timeout=1.0),
-                        BOUNDS, "proxsuite", True, "daqp")
+                        BOUNDS, 'proxsuite', True, 'daqp')
                     names = list(s.hand.joints)
                     ctrl.update_joint_state(names, [float(s.q[i]) for i in s.hand.idx_q], 0.0)
                     r = ctrl.cycle(0.0)
-                    row["cycles"] += 1
-                    row["commands"] += r.kind == "solution"
-                    row["unholdable"] += r.solution is not None and \
-                        r.solution.status == "infeasible"
-                    row[f"max_cycle_s@{budget}"] = max(row[f"max_cycle_s@{budget}"], r.cycle_time)
-                    row[f"max_overrun_s@{budget}"] = max(row[f"max_overrun_s@{budget}"],
+                    row['cycles'] += 1
+                    row['commands'] += r.kind == 'solution'
+                    row['unholdable'] += r.solution is not None and \
+                        r.solution.status == 'infeasible'
+                    row[f'max_cycle_s@{budget}'] = max(row[f'max_cycle_s@{budget}'], r.cycle_time)
+                    row[f'max_overrun_s@{budget}'] = max(row[f'max_overrun_s@{budget}'],
                                                          r.cycle_time - budget)
-    lines = ["| grasp | cycles | commands | unholdable | longest solve, no budget [ms] | "
-             + " | ".join(f"longest cycle, budget {b:g} s [ms] | longest overrun [ms]"
-                          for b in BUDGETS) + " |",
-             "|---|---|---|---|---|" + "---|---|" * len(BUDGETS)]
+    lines = ['| grasp | cycles | commands | unholdable | longest solve, no budget [ms] | '
+             + ' | '.join(f'longest cycle, budget {b:g} s [ms] | longest overrun [ms]'
+                          for b in BUDGETS) + ' |',
+             '|---|---|---|---|---|' + '---|---|' * len(BUDGETS)]
     for label, r in rows.items():
-        unbudgeted = (f"{1e3 * r['unbudgeted_max_s']:.1f}" if r["unbudgeted_max_s"] <
-                      UNBUDGETED_CAP_S else f"over {UNBUDGETED_CAP_S:g} s")
-        budgeted = " | ".join(f"{1e3 * r[f'max_cycle_s@{b}']:.1f} | "
+        unbudgeted = (f"{1e3 * r['unbudgeted_max_s']:.1f}" if r['unbudgeted_max_s'] <
+                      UNBUDGETED_CAP_S else f'over {UNBUDGETED_CAP_S:g} s')
+        budgeted = ' | '.join(f"{1e3 * r[f'max_cycle_s@{b}']:.1f} | "
                               f"{1e3 * max(0.0, r[f'max_overrun_s@{b}']):.1f}" for b in BUDGETS)
         lines.append(f"| {label} | {r['cycles']} | {r['commands']} | {r['unholdable']} | "
                      f"{unbudgeted} | {budgeted} |")
-    report({"machine": machine(), "rows": rows, "settings": dataclasses.asdict(BOUNDS)},
-           "\n".join(lines), args.out, "solver settings at the node's bounds")
+    report({'machine': machine(), 'rows': rows, 'settings': dataclasses.asdict(BOUNDS)},
+           '\n'.join(lines), args.out, "solver settings at the node's bounds")
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     raise SystemExit(main())

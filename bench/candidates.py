@@ -1,4 +1,5 @@
-"""Write a batch of candidate Allegro grasps as JSON Lines, for ``grasp-torque-opt score``.
+"""
+Write a batch of candidate Allegro grasps as JSON Lines, for ``grasp-torque-opt score``.
 
 Usage: .venv/bin/python bench/candidates.py [--count 1000] [--seed 0] [--bad 0]
        [--out candidates.jsonl]
@@ -15,15 +16,14 @@ line by a malformed one (an unknown link), to see the batch go on past it.
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 from itertools import islice
+import json
 from pathlib import Path
+import sys
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from grasps import SCENARIO, draw_candidates  # noqa: E402
-
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
+from grasps import draw_candidates, SCENARIO  # noqa: E402
 
 
 def candidate_lines(count: int = 1000, seed: int = 0, bad: int = 0) -> list[str]:
@@ -32,24 +32,24 @@ def candidate_lines(count: int = 1000, seed: int = 0, bad: int = 0) -> list[str]
     hand = base.hand
     out = []
     for i, (q, w) in enumerate(islice(draw_candidates(base, seed), count)):
-        line = {"id": f"c{i}", "gravity": None,
-                "grasp": {"joint_positions": {j: round(float(x), 6) for j, x in
+        line = {'id': f'c{i}', 'gravity': None,
+                'grasp': {'joint_positions': {j: round(float(x), 6) for j, x in
                                               zip(hand.joints, q[hand.idx_q])}},
-                "load": {"external_wrench": [round(float(x), 6) for x in w]}}
+                'load': {'external_wrench': [round(float(x), 6) for x in w]}}
         if bad and i % bad == bad - 1:
-            line["grasp"]["contacts"] = [{"link": "no_such_link"}]
+            line['grasp']['contacts'] = [{'link': 'no_such_link'}]
         out.append(json.dumps(line))
     return out
 
 
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--count", type=int, default=1000)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--bad", type=int, default=0, help="every K-th line malformed (0: none)")
-    p.add_argument("--out", type=Path, help="file to write (default: stdout)")
+    p.add_argument('--count', type=int, default=1000)
+    p.add_argument('--seed', type=int, default=0)
+    p.add_argument('--bad', type=int, default=0, help='every K-th line malformed (0: none)')
+    p.add_argument('--out', type=Path, help='file to write (default: stdout)')
     a = p.parse_args()
-    text = "\n".join(candidate_lines(a.count, a.seed, a.bad)) + "\n"
+    text = '\n'.join(candidate_lines(a.count, a.seed, a.bad)) + '\n'
     if a.out:
         a.out.write_text(text)
     else:
@@ -57,5 +57,5 @@ def main() -> int:
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -1,4 +1,5 @@
-"""Time the full control cycle on the bundled scenarios, per QP backend.
+"""
+Time the full control cycle on the bundled scenarios, per QP backend.
 
 Usage: .venv/bin/python bench/cycle.py [--repeats 3000]
        [--backends proxsuite,daqp,quadprog,proxsuite+warm,daqp+warm] [--out FILE]
@@ -19,45 +20,44 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
-import os
-import platform
-import time
 from datetime import datetime, timezone
 from importlib import metadata
+import json
+import os
 from pathlib import Path
-
-import numpy as np
+import platform
+import time
 
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.control.controller import CycleConfig, TorqueController
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENARIOS = ["planar_two_finger.yaml", "allegro_right.yaml"]
-STAGES = ["maps", "build", "solve", "certify"]
+SCENARIOS = ['planar_two_finger.yaml', 'allegro_right.yaml']
+STAGES = ['maps', 'build', 'solve', 'certify']
 
 
 def machine() -> dict:
     """What this ran on."""
     cpu = platform.processor() or platform.machine()
     try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
+        for line in Path('/proc/cpuinfo').read_text().splitlines():
+            if line.startswith('model name'):
+                cpu = line.split(':', 1)[1].strip()
                 break
     except OSError:
         pass
     versions = {}
-    for p in ("numpy", "pin", "proxsuite", "daqp", "quadprog", "scipy", "clarabel"):
+    for p in ('numpy', 'pin', 'proxsuite', 'daqp', 'quadprog', 'scipy', 'clarabel'):
         try:
             versions[p] = metadata.version(p)
         except metadata.PackageNotFoundError:
             versions[p] = None
-    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
-            "system": platform.platform(), "versions": versions,
-            "date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")}
+    return {'cpu': cpu, 'cores': os.cpu_count(), 'python': platform.python_version(),
+            'system': platform.platform(), 'versions': versions,
+            'date': datetime.now(timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}
 
 
 def machine_line(m: dict) -> str:
@@ -67,9 +67,9 @@ def machine_line(m: dict) -> str:
             f"Pinocchio {m['versions']['pin']}; {m['date']}")
 
 
-def report(results: dict, table_text: str, out: Path | None, detail: str = "") -> None:
+def report(results: dict, table_text: str, out: Path | None, detail: str = '') -> None:
     """Print the machine line (with ``detail``) and the table; write the JSON to ``out``."""
-    print(machine_line(results["machine"]) + (f"; {detail}" if detail else ""))
+    print(machine_line(results['machine']) + (f'; {detail}' if detail else ''))
     print(table_text)
     if out:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -78,13 +78,13 @@ def report(results: dict, table_text: str, out: Path | None, detail: str = "") -
 
 def summary(samples: list[float]) -> dict:
     """Median and p99 [s]."""
-    return {"median_s": float(np.median(samples)), "p99_s": float(np.percentile(samples, 99))}
+    return {'median_s': float(np.median(samples)), 'p99_s': float(np.percentile(samples, 99))}
 
 
 def solver_of(variant: str):
     """A solver from a variant name: a backend, ``+warm`` for its verified warm start."""
-    backend, _, warm = variant.partition("+")
-    return make_solver(backend, warm_start=warm == "warm")
+    backend, _, warm = variant.partition('+')
+    return make_solver(backend, warm_start=warm == 'warm')
 
 
 def moving(setup: GraspSetup, count: int) -> list[GraspSetup]:
@@ -99,17 +99,18 @@ def moving(setup: GraspSetup, count: int) -> list[GraspSetup]:
 
 
 def bench_core(setup: GraspSetup, variant: str, repeats: int) -> dict:
-    """The core cycle on a moving grasp: maps, build, solve, certify; per stage and in total.
+    """
+    The core cycle on a moving grasp: maps, build, solve, certify; per stage and in total.
 
     As in the node, DAQP is the fallback of the other backends; ``fallbacks``
     counts the cycles it answered, ``failed`` those nobody certified.
     """
     solver = solver_of(variant)
-    fallback = None if variant.startswith("daqp") else make_solver("daqp")
+    fallback = None if variant.startswith('daqp') else make_solver('daqp')
     sol = solve(setup, solver=solver)
     if not sol.optimal:
-        return {"skipped": sol.message}
-    samples = {k: [] for k in STAGES + ["total"]}
+        return {'skipped': sol.message}
+    samples = {k: [] for k in STAGES + ['total']}
     fallbacks = failed = 0
     for i, grasp in enumerate(moving(setup, repeats + 50)):
         t0 = time.perf_counter()
@@ -121,23 +122,23 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int) -> dict:
         if not sol.optimal:
             failed += 1
             continue
-        samples["total"].append(total)
+        samples['total'].append(total)
         for k in STAGES:
             samples[k].append(sol.timings[k])
     out = {k: summary(v) for k, v in samples.items()}
-    total = sum(out[k]["median_s"] for k in STAGES)
+    total = sum(out[k]['median_s'] for k in STAGES)
     for k in STAGES:
-        out[k]["share"] = out[k]["median_s"] / total
-    out["fallbacks"], out["failed"] = int(fallbacks), failed
+        out[k]['share'] = out[k]['median_s'] / total
+    out['fallbacks'], out['failed'] = int(fallbacks), failed
     return out
 
 
 def bench_controller(setup: GraspSetup, variant: str, repeats: int) -> dict:
     """The node's cycle without ROS: take a joint state, then run the cycle."""
-    backend = variant.partition("+")[0]
+    backend = variant.partition('+')[0]
     ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True), backend=backend,
-                            warm_start=variant.endswith("+warm"),
-                            fallback=None if backend == "daqp" else "daqp")
+                            warm_start=variant.endswith('+warm'),
+                            fallback=None if backend == 'daqp' else 'daqp')
     names = list(setup.hand.joints)
     q0 = setup.q[setup.hand.idx_q]
     rng = np.random.default_rng(0)
@@ -151,60 +152,60 @@ def bench_controller(setup: GraspSetup, variant: str, repeats: int) -> dict:
         elapsed = time.perf_counter() - t0
         if i >= 50:
             samples.append(elapsed)
-            published += result.kind == "solution"
-    return {"total": summary(samples), "certified_commands": published, "cycles": repeats}
+            published += result.kind == 'solution'
+    return {'total': summary(samples), 'certified_commands': published, 'cycles': repeats}
 
 
 #: What is timed: each backend, and DAQP with its verified warm start.
-VARIANTS = (*BACKENDS, "proxsuite+warm", "daqp+warm")
+VARIANTS = (*BACKENDS, 'proxsuite+warm', 'daqp+warm')
 
 
 def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS) -> dict:
     """Every scenario and backend, both paths."""
-    out = {"machine": machine(), "repeats": repeats, "scenarios": {}}
+    out = {'machine': machine(), 'repeats': repeats, 'scenarios': {}}
     for name in SCENARIOS:
-        setup = GraspSetup.from_file(ROOT / "config" / name)
-        res = out["scenarios"][name] = {}
+        setup = GraspSetup.from_file(ROOT / 'config' / name)
+        res = out['scenarios'][name] = {}
         for b in backends:
             core = bench_core(setup, b, repeats)
-            res[b] = {"core": core}
-            if "skipped" not in core:
-                res[b]["controller"] = bench_controller(setup, b, repeats)
+            res[b] = {'core': core}
+            if 'skipped' not in core:
+                res[b]['controller'] = bench_controller(setup, b, repeats)
     return out
 
 
 def table(results: dict) -> str:
     """A markdown table: per scenario and backend, stage medians [us] and the totals."""
-    head = ("| scenario | backend | maps | build | solve | certify | core median | core p99 "
-            "| fallbacks / failed | node cycle median | node cycle p99 |")
-    lines = [head, "|" + "---|" * 11]
-    for name, res in results["scenarios"].items():
+    head = ('| scenario | backend | maps | build | solve | certify | core median | core p99 '
+            '| fallbacks / failed | node cycle median | node cycle p99 |')
+    lines = [head, '|' + '---|' * 11]
+    for name, res in results['scenarios'].items():
         for b, r in res.items():
-            core = r["core"]
-            if "skipped" in core:
+            core = r['core']
+            if 'skipped' in core:
                 lines.append(f"| {name} | {b} | - | - | - | - | skipped: {core['skipped']} "
                              "| | | | |")
                 continue
-            stages = " | ".join(f"{1e6 * core[k]['median_s']:.0f} ({100 * core[k]['share']:.0f}%)"
+            stages = ' | '.join(f"{1e6 * core[k]['median_s']:.0f} ({100 * core[k]['share']:.0f}%)"
                                 for k in STAGES)
-            ctl = r["controller"]["total"]
+            ctl = r['controller']['total']
             lines.append(f"| {name} | {b} | {stages} | {1e6 * core['total']['median_s']:.0f} | "
                          f"{1e6 * core['total']['p99_s']:.0f} | {core['fallbacks']} / "
                          f"{core['failed']} | {1e6 * ctl['median_s']:.0f} | "
                          f"{1e6 * ctl['p99_s']:.0f} |")
-    return "\n".join(lines) + "\n\n(times in us; share of the core cycle in parentheses)"
+    return '\n'.join(lines) + '\n\n(times in us; share of the core cycle in parentheses)'
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3000)
-    parser.add_argument("--backends", default=",".join(VARIANTS))
-    parser.add_argument("--out", type=Path, help="also write the results here (JSON)")
+    parser.add_argument('--repeats', type=int, default=3000)
+    parser.add_argument('--backends', default=','.join(VARIANTS))
+    parser.add_argument('--out', type=Path, help='also write the results here (JSON)')
     args = parser.parse_args()
     single_threaded_math()
-    results = run(args.repeats, tuple(args.backends.split(",")))
+    results = run(args.repeats, tuple(args.backends.split(',')))
     report(results, table(results), args.out)
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     main()

@@ -1,4 +1,5 @@
-"""A fixed, seeded set of random feasible Allegro grasps for the benchmarks.
+"""
+A fixed, seeded set of random feasible Allegro grasps for the benchmarks.
 
 Usage: .venv/bin/python bench/grasps.py [--grasps 200] [--seed 0] [--out bench/results/grasps.json]
 
@@ -28,19 +29,18 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import sys
 from pathlib import Path
+import sys
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import ROOT, machine, report  # noqa: E402
-
+from cycle import machine, report, ROOT  # noqa: E402
 from grasp_torque_opt.core.exceptions import GraspTorqueError  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.reference.feasibility import linearized_feasible  # noqa: E402
 
-SCENARIO = ROOT / "config" / "allegro_right.yaml"
+SCENARIO = ROOT / 'config' / 'allegro_right.yaml'
 #: Half-width of the uniform joint-position noise [rad].
 Q_NOISE = 0.08
 #: Cap on candidates per kept grasp, so a bad seed cannot loop forever.
@@ -48,11 +48,12 @@ MAX_DRAWS_PER_GRASP = 50
 
 
 #: Environment variables that set the BLAS/LAPACK thread pools.
-THREAD_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+THREAD_VARS = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')
 
 
 def blas_threads() -> dict:
-    """The thread settings this process runs with (None: the library's default, all cores).
+    """
+    The thread settings this process runs with (None: the library's default, all cores).
 
     Multi-threaded OpenBLAS on the tiny matrices here can cost milliseconds per
     call on a busy machine, so every benchmark records them.
@@ -83,36 +84,37 @@ def allegro_grasps_with_stats(count: int = 200, seed: int = 0,
     base = base or GraspSetup.from_file(SCENARIO)
     tau_min, tau_max = base.tau_bounds
     kept: list[GraspSetup] = []
-    rejected = {"maps": 0, "infeasible": 0, "lp_undecided": 0}
+    rejected = {'maps': 0, 'infeasible': 0, 'lp_undecided': 0}
     drawn = 0
     for q, w in draw_candidates(base, seed):
         if len(kept) == count:
             break
         if drawn >= MAX_DRAWS_PER_GRASP * max(count, 1):
-            raise RuntimeError(f"only {len(kept)} feasible grasps in {drawn} candidates")
+            raise RuntimeError(f'only {len(kept)} feasible grasps in {drawn} candidates')
         drawn += 1
         setup = dataclasses.replace(base, q=q, external_wrench=w)
         try:
             maps = setup.maps()
         except GraspTorqueError:
-            rejected["maps"] += 1
+            rejected['maps'] += 1
             continue
         if not (np.all(np.isfinite(maps.G)) and np.all(np.isfinite(maps.J))):
-            rejected["maps"] += 1
+            rejected['maps'] += 1
             continue
         feasible = linearized_feasible(maps, setup.friction, w, tau_min, tau_max)
         if feasible is None:
-            rejected["lp_undecided"] += 1
+            rejected['lp_undecided'] += 1
         elif not feasible:
-            rejected["infeasible"] += 1
+            rejected['infeasible'] += 1
         else:
             kept.append(setup)
-    return kept, {"count": count, "seed": seed, "drawn": drawn, "rejected": rejected}
+    return kept, {'count': count, 'seed': seed, 'drawn': drawn, 'rejected': rejected}
 
 
 def allegro_grasps(count: int = 200, seed: int = 0,
                    base: GraspSetup | None = None) -> list[GraspSetup]:
-    """``count`` feasible Allegro grasps, deterministic in (count, seed); see the module docstring.
+    """
+    ``count`` feasible Allegro grasps, deterministic in (count, seed); see the module docstring.
 
     Args:
         count: number of grasps kept.
@@ -129,23 +131,23 @@ def run(count: int = 200, seed: int = 0) -> dict:
     dq = np.array([g.q[base.hand.idx_q] - base.q[base.hand.idx_q] for g in grasps])
     force = np.array([np.linalg.norm(g.external_wrench[:3]) for g in grasps])
     moment = np.array([np.linalg.norm(g.external_wrench[3:]) for g in grasps])
-    return {"machine": machine(), "blas_threads": blas_threads(), **stats,
-            "dq_abs_max_rad": float(np.abs(dq).max()),
-            "dq_abs_median_rad": float(np.median(np.abs(dq))),
-            "force_N": {"min": float(force.min()), "median": float(np.median(force)),
-                        "max": float(force.max())},
-            "moment_Nm": {"min": float(moment.min()), "median": float(np.median(moment)),
-                          "max": float(moment.max())}}
+    return {'machine': machine(), 'blas_threads': blas_threads(), **stats,
+            'dq_abs_max_rad': float(np.abs(dq).max()),
+            'dq_abs_median_rad': float(np.median(np.abs(dq))),
+            'force_N': {'min': float(force.min()), 'median': float(np.median(force)),
+                        'max': float(force.max())},
+            'moment_Nm': {'min': float(moment.min()), 'median': float(np.median(moment)),
+                          'max': float(moment.max())}}
 
 
 def table(results: dict) -> str:
     """A short markdown table of the set's make-up."""
     r = results
-    rej = r["rejected"]
-    return "\n".join([
-        "| grasps | seed | drawn | rejected: infeasible | LP undecided | maps | "
-        "max abs dq [rad] | force [N] min / median / max |",
-        "|---:|---:|---:|---:|---:|---:|---:|---|",
+    rej = r['rejected']
+    return '\n'.join([
+        '| grasps | seed | drawn | rejected: infeasible | LP undecided | maps | '
+        'max abs dq [rad] | force [N] min / median / max |',
+        '|---:|---:|---:|---:|---:|---:|---:|---|',
         f"| {r['count']} | {r['seed']} | {r['drawn']} | {rej['infeasible']} | "
         f"{rej['lp_undecided']} | {rej['maps']} | {r['dq_abs_max_rad']:.3f} | "
         f"{r['force_N']['min']:.2f} / {r['force_N']['median']:.2f} / {r['force_N']['max']:.2f} |",
@@ -154,14 +156,14 @@ def table(results: dict) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grasps", type=int, default=200)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, help="write the results as JSON here")
+    parser.add_argument('--grasps', type=int, default=200)
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--out', type=Path, help='write the results as JSON here')
     args = parser.parse_args()
     res = run(args.grasps, args.seed)
     report(res, table(res), args.out,
            f"threads: {res['blas_threads']}")
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     main()

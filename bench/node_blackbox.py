@@ -1,4 +1,5 @@
-"""The node measured as a user measures it: joint states in, effort commands counted, from outside.
+"""
+The node measured as a user measures it: joint states in, effort commands counted, from outside.
 
 Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000] [--runs 1]
 
@@ -22,36 +23,37 @@ matching; it gives no latency. Speed is measured here, never asserted.
 from __future__ import annotations
 
 import argparse
+from datetime import datetime, timezone
 import json
+from pathlib import Path
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
-from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ros_load import (  # noqa: E402
-    CONFIG,
     Child,
+    CONFIG,
     CpuShare,
-    Pacer,
     interrupt_on_signals,
     isolated_env,
+    Pacer,
     private_domains,
 )
 
-PARAMS = CONFIG / "allegro_right_node.yaml"
-SCENARIO = CONFIG / "allegro_right.yaml"
+PARAMS = CONFIG / 'allegro_right_node.yaml'
+SCENARIO = CONFIG / 'allegro_right.yaml'
 #: Answering processes: name -> extra node arguments (None: the echo node).
-TARGETS = {"echo": None, "grasp_torque_node (default)": [],
-           "grasp_torque_node warm_start:=false": ["-p", "solver.warm_start:=false"],
-           "grasp_torque_node backend:=daqp": ["-p", "solver.backend:=daqp"]}
+TARGETS = {'echo': None, 'grasp_torque_node (default)': [],
+           'grasp_torque_node warm_start:=false': ['-p', 'solver.warm_start:=false'],
+           'grasp_torque_node backend:=daqp': ['-p', 'solver.backend:=daqp']}
 DRAIN_S = 0.5
 READY_TIMEOUT_S = 15.0
 
 
 def count_main(args: argparse.Namespace) -> int:
     """The user's process: publish joint states, count the commands, write JSON."""
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
     import numpy as np
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
@@ -59,16 +61,14 @@ def count_main(args: argparse.Namespace) -> int:
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
-
     setup = GraspSetup.from_file(SCENARIO)
     names = list(setup.hand.joints)
     q0 = setup.q[setup.hand.idx_q].astype(float)
     rclpy.init(args=[sys.argv[0]])
-    node = rclpy.create_node("blackbox_user")
-    pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    node = rclpy.create_node('blackbox_user')
+    pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
     received = []
-    node.create_subscription(Float64MultiArray, "effort_commands",
+    node.create_subscription(Float64MultiArray, 'effort_commands',
                              lambda m: received.append(len(m.data)), 10)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
@@ -87,7 +87,7 @@ def count_main(args: argparse.Namespace) -> int:
         k += 1
         pacer.spin_for(0.01)
     if not received:
-        print("user: no effort command came back", file=sys.stderr)
+        print('user: no effort command came back', file=sys.stderr)
         return 1
     pacer.spin_for(0.2)
     received.clear()
@@ -106,8 +106,8 @@ def count_main(args: argparse.Namespace) -> int:
     node.destroy_node()
     rclpy.try_shutdown()
     Path(args.result).write_text(json.dumps({
-        "published": published, "commands": len(received),
-        "wrong_length": sum(n != len(names) for n in received)}))
+        'published': published, 'commands': len(received),
+        'wrong_length': sum(n != len(names) for n in received)}))
     return 0
 
 
@@ -119,18 +119,18 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
         from grasp_torque_opt.core.grasp_setup import GraspSetup
 
         joints = GraspSetup.from_file(SCENARIO).hand.joints
-        cmd = [sys.executable, str(bench / "node_load.py"), "--role", "echo",
-               "--executor", "single", "--joints", ",".join(joints)]
+        cmd = [sys.executable, str(bench / 'node_load.py'), '--role', 'echo',
+               '--executor', 'single', '--joints', ','.join(joints)]
     else:
-        exe = Path(sys.executable).parent / "grasp_torque_node"
-        cmd = [str(exe), "--ros-args", "--params-file", str(PARAMS)] + extra
+        exe = Path(sys.executable).parent / 'grasp_torque_node'
+        cmd = [str(exe), '--ros-args', '--params-file', str(PARAMS)] + extra
     tag = f"{target.split()[0]}-{len(extra or [])}-{extra[-1] if extra else ''}-{rate:g}"
-    tag = "".join(c if c.isalnum() or c in "-." else "_" for c in tag)
-    result = tmp / f"{tag}.json"
-    user = [sys.executable, str(Path(__file__).resolve()), "--role", "user", "--rate",
-            str(rate), "--duration", str(duration), "--result", str(result)]
+    tag = ''.join(c if c.isalnum() or c in '-.' else '_' for c in tag)
+    result = tmp / f'{tag}.json'
+    user = [sys.executable, str(Path(__file__).resolve()), '--role', 'user', '--rate',
+            str(rate), '--duration', str(duration), '--result', str(result)]
     share = CpuShare()
-    with open(tmp / f"{tag}.target.log", "w") as tlog, open(tmp / f"{tag}.user.log", "w") as ulog:
+    with open(tmp / f'{tag}.target.log', 'w') as tlog, open(tmp / f'{tag}.user.log', 'w') as ulog:
         answering = Child(cmd, env, tlog)
         counter = Child(user, env, ulog)
         try:
@@ -138,42 +138,42 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
         finally:
             counter.stop()
             answering.stop()
-    out = {"target": target, "rate_hz": rate, "other_processes_cores": share.others_cores()}
+    out = {'target': target, 'rate_hz': rate, 'other_processes_cores': share.others_cores()}
     if code == 0 and result.exists():
         r = json.loads(result.read_text())
-        out.update(r, answered_pct=100.0 * r["commands"] / r["published"])
+        out.update(r, answered_pct=100.0 * r['commands'] / r['published'])
     else:
-        out["error"] = f"user process exit {code} (logs in {tmp})"
+        out['error'] = f'user process exit {code} (logs in {tmp})'
     return out
 
 
 def table(cases: list[dict]) -> str:
-    lines = ["| rate [Hz] | answering process | run | joint states | commands | answered [%] "
-             "| other work [cores] |", "|---:|---|---:|---:|---:|---:|---:|"]
+    lines = ['| rate [Hz] | answering process | run | joint states | commands | answered [%] '
+             '| other work [cores] |', '|---:|---|---:|---:|---:|---:|---:|']
     for c in cases:
-        if "error" in c:
+        if 'error' in c:
             lines.append(f"| {c['rate_hz']:g} | {c['target']} | {c['run']} | failed: "
                          f"{c['error']} ||||")
             continue
-        other = c["other_processes_cores"]
+        other = c['other_processes_cores']
         lines.append(f"| {c['rate_hz']:g} | {c['target']} | {c['run']} | {c['published']} | "
                      f"{c['commands']} | {c['answered_pct']:.1f} | "
                      f"{'-' if other is None else f'{other:.2f}'} |")
-    return "\n".join(lines)
+    return '\n'.join(lines)
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=8.0, help="seconds published [s]")
-    parser.add_argument("--rates", type=float, nargs="+", default=[500.0, 1000.0])
-    parser.add_argument("--runs", type=int, default=1, help="runs of every case")
-    parser.add_argument("--out", type=Path,
-                        default=Path(__file__).resolve().parent / "results" / "node_blackbox.json")
-    parser.add_argument("--role", choices=["run", "user"], default="run", help=argparse.SUPPRESS)
-    parser.add_argument("--rate", type=float, help=argparse.SUPPRESS)
-    parser.add_argument("--result", help=argparse.SUPPRESS)
+    parser.add_argument('--duration', type=float, default=8.0, help='seconds published [s]')
+    parser.add_argument('--rates', type=float, nargs='+', default=[500.0, 1000.0])
+    parser.add_argument('--runs', type=int, default=1, help='runs of every case')
+    parser.add_argument('--out', type=Path,
+                        default=Path(__file__).resolve().parent / 'results' / 'node_blackbox.json')
+    parser.add_argument('--role', choices=['run', 'user'], default='run', help=argparse.SUPPRESS)
+    parser.add_argument('--rate', type=float, help=argparse.SUPPRESS)
+    parser.add_argument('--result', help=argparse.SUPPRESS)
     args = parser.parse_args()
-    if args.role == "user":
+    if args.role == 'user':
         return count_main(args)
     from cycle import machine
 
@@ -183,24 +183,24 @@ def main() -> int:
           flush=True)
     keys = [(rate, target, run) for run in range(1, args.runs + 1) for rate in args.rates
             for target in TARGETS]
-    tmp = Path(tempfile.mkdtemp(prefix="node_blackbox_"))
+    tmp = Path(tempfile.mkdtemp(prefix='node_blackbox_'))
     cases = []
     for (rate, target, run), domain in zip(keys, private_domains(len(keys))):
         c = run_case(target, rate, args.duration, domain, tmp)
-        c["run"] = run
+        c['run'] = run
         cases.append(c)
-        print(f"  {rate:6g} Hz  {target:38} " + (c.get("error") or
+        print(f'  {rate:6g} Hz  {target:38} ' + (c.get('error') or
               f"answered {c['answered_pct']:5.1f}% ({c['commands']} of {c['published']})"),
               flush=True)
     print()
     print(table(cases))
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps({"machine": m, "date_utc": datetime.now(timezone.utc)
-                                    .isoformat(timespec="seconds"), "duration_s": args.duration,
-                                    "cases": cases}, indent=2))
-    print(f"\nwritten: {args.out}")
-    return 0 if all("error" not in c for c in cases) else 1
+    args.out.write_text(json.dumps({'machine': m, 'date_utc': datetime.now(timezone.utc)
+                                    .isoformat(timespec='seconds'), 'duration_s': args.duration,
+                                    'cases': cases}, indent=2))
+    print(f'\nwritten: {args.out}')
+    return 0 if all('error' not in c for c in cases) else 1
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -1,4 +1,5 @@
-"""The node under load: latency and dropped cycles of grasp_torque_node beside a trivial echo node.
+"""
+The node under load: latency and dropped cycles of grasp_torque_node beside a trivial echo node.
 
 Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
        [--hands allegro planar] [--executors single events] [--out FILE]
@@ -30,39 +31,39 @@ Speed is measured here, never asserted.
 from __future__ import annotations
 
 import argparse
+from datetime import datetime, timezone
 import itertools
 import json
 import math
 import os
+from pathlib import Path
 import subprocess
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
-from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ros_load import (  # noqa: E402
-    CONFIG,
-    RECEIVER_DEPTH,
-    STAMPED_TOPIC,
     Child,
+    CONFIG,
     CpuShare,
-    Pacer,
-    UniqueClock,
     interrupt_on_signals,
     isolated_env,
     node_command,
+    Pacer,
     percentiles_ms,
     private_domains,
+    RECEIVER_DEPTH,
     set_stamp,
     stamp_ns,
+    STAMPED_TOPIC,
+    UniqueClock,
 )
 
-HANDS = {"allegro": ("allegro_right.yaml", "allegro_right_node.yaml"),
-         "planar": ("planar_two_finger.yaml", "planar_two_finger_node.yaml")}
+HANDS = {'allegro': ('allegro_right.yaml', 'allegro_right_node.yaml'),
+         'planar': ('planar_two_finger.yaml', 'planar_two_finger_node.yaml')}
 #: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
-TARGETS = ("echo", "grasp_torque_node", "grasp_torque_node/daqp")
+TARGETS = ('echo', 'grasp_torque_node', 'grasp_torque_node/daqp')
 WARMUP_S = 1.0
 #: After the last joint state, how long commands in flight are still awaited [s].
 DRAIN_S = 0.5
@@ -70,7 +71,7 @@ DRAIN_S = 0.5
 READY_TIMEOUT_S = 10.0
 #: Executors of the answering node. ``events`` is rclpy's EventsExecutor served by a
 #: spin_once loop, as the node's main does (its spin() delivered no callback here).
-EXECUTORS = ("single", "events")
+EXECUTORS = ('single', 'events')
 #: Amplitude of the joint motion around the scenario's grasp [rad].
 AMPLITUDE = 1e-3
 
@@ -78,13 +79,14 @@ AMPLITUDE = 1e-3
 def _executor(name: str):
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.experimental import EventsExecutor
-    return {"single": SingleThreadedExecutor, "events": EventsExecutor}[name]()
+    return {'single': SingleThreadedExecutor, 'events': EventsExecutor}[name]()
 
 
 # -- the echo node ---------------------------------------------------------------------------
 
 def echo_main(args: argparse.Namespace) -> int:
     """A minimal rclpy node: each joint state is answered with zero torques, stamped."""
+    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.node import Node
@@ -92,16 +94,14 @@ def echo_main(args: argparse.Namespace) -> int:
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME
-
-    joints = args.joints.split(",")
+    joints = args.joints.split(',')
     zeros = [0.0] * len(joints)
     rclpy.init()
     node = None
     try:
         node = Node(NODE_NAME)
-        command_pub = node.create_publisher(Float64MultiArray, "effort_commands", COMMAND_QOS)
-        stamped_pub = node.create_publisher(JointState, "~/effort_commands_stamped",
+        command_pub = node.create_publisher(Float64MultiArray, 'effort_commands', COMMAND_QOS)
+        stamped_pub = node.create_publisher(JointState, '~/effort_commands_stamped',
                                             COMMAND_QOS)
 
         def on_joint_state(msg: JointState) -> None:
@@ -110,11 +110,11 @@ def echo_main(args: argparse.Namespace) -> int:
             out.header.stamp = msg.header.stamp
             stamped_pub.publish(out)
 
-        node.create_subscription(JointState, "joint_states", on_joint_state,
+        node.create_subscription(JointState, 'joint_states', on_joint_state,
                                  qos_profile_sensor_data)
         executor = _executor(args.executor)
         executor.add_node(node)
-        if args.executor == "events":  # as grasp_torque_node's main does
+        if args.executor == 'events':  # as grasp_torque_node's main does
             while rclpy.ok():
                 executor.spin_once(timeout_sec=1.0)
         else:
@@ -132,13 +132,12 @@ def echo_main(args: argparse.Namespace) -> int:
 
 def load_main(args: argparse.Namespace) -> int:
     """Publish joint states at a fixed rate, receive the commands, write the figures as JSON."""
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
     import numpy as np
     import rclpy
-    from rclpy.qos import QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
-
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
 
     setup = GraspSetup.from_file(CONFIG / HANDS[args.hand][0])
     names = list(setup.hand.joints)
@@ -146,8 +145,8 @@ def load_main(args: argparse.Namespace) -> int:
     phase = 0.4 * np.arange(len(names))
 
     rclpy.init(args=[sys.argv[0]])
-    node = rclpy.create_node("grasp_load")
-    pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    node = rclpy.create_node('grasp_load')
+    pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
     receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
     command_times: list[float] = []  # perf_counter at receipt of each effort_commands
     bad_length = 0
@@ -169,22 +168,22 @@ def load_main(args: argparse.Namespace) -> int:
         else:
             stamped[s] = now
 
-    node.create_subscription(Float64MultiArray, "effort_commands", on_command, receiver_qos)
+    node.create_subscription(Float64MultiArray, 'effort_commands', on_command, receiver_qos)
     node.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
     executor = _executor(args.load_executor)
     executor.add_node(node)
     pacer = Pacer(executor, args.rate)
 
     def ready() -> bool:
-        return (node.count_subscribers("joint_states") >= 1
+        return (node.count_subscribers('joint_states') >= 1
                 and node.count_publishers(STAMPED_TOPIC) >= 1
-                and node.count_publishers("effort_commands") >= 1)
+                and node.count_publishers('effort_commands') >= 1)
 
     t_ready = time.perf_counter() + READY_TIMEOUT_S
     while not ready() and time.perf_counter() < t_ready:
         pacer.spin_for(0.05)
     if not ready():
-        print("load: nobody answers on joint_states", file=sys.stderr)
+        print('load: nobody answers on joint_states', file=sys.stderr)
         return 1
 
     clock = UniqueClock()
@@ -194,14 +193,14 @@ def load_main(args: argparse.Namespace) -> int:
     t_start = time.perf_counter()
 
     def tick(k: int, now: float) -> bool:
-        if "warm" not in window:
+        if 'warm' not in window:
             if stamped:
-                window["warm"] = now
-                window["start"] = now + WARMUP_S
-                window["end"] = window["start"] + args.duration
+                window['warm'] = now
+                window['start'] = now + WARMUP_S
+                window['end'] = window['start'] + args.duration
             elif now - t_start > READY_TIMEOUT_S:
                 return False
-        if "end" in window and now >= window["end"]:
+        if 'end' in window and now >= window['end']:
             return False
         msg = JointState(name=names,
                          position=(q0 + AMPLITUDE * np.sin(np.pi * k * pacer.period + phase)
@@ -209,41 +208,41 @@ def load_main(args: argparse.Namespace) -> int:
         s = clock()
         set_stamp(msg.header, s)
         pub.publish(msg)
-        if "start" in window and now >= window["start"]:
+        if 'start' in window and now >= window['start']:
             sent.append((s, now))
             lateness.append(pacer.lateness[-1])
         return True
 
     pacer.run(tick)
     pacer.spin_for(DRAIN_S)
-    foreign = {"joint_states_publishers": node.count_publishers("joint_states"),
-               "joint_states_subscribers": node.count_subscribers("joint_states")}
+    foreign = {'joint_states_publishers': node.count_publishers('joint_states'),
+               'joint_states_subscribers': node.count_subscribers('joint_states')}
     node.destroy_node()
     rclpy.try_shutdown()
-    if "start" not in window:
-        print("load: no command came back", file=sys.stderr)
+    if 'start' not in window:
+        print('load: no command came back', file=sys.stderr)
         return 1
 
     n_pub = len(sent)
-    span = sent[-1][1] - sent[0][1] if n_pub > 1 else float("nan")
+    span = sent[-1][1] - sent[0][1] if n_pub > 1 else float('nan')
     latencies = [1e-9 * (stamped[s] - s) for s, _ in sent if s in stamped]
     dropped = n_pub - len(latencies)
-    t0, t1 = window["start"], window["end"]
+    t0, t1 = window['start'], window['end']
     n_cmd = sum(t0 <= t <= t1 for t in command_times)
     result = {
-        "published": n_pub,
-        "publish_rate_hz": (n_pub - 1) / span if n_pub > 1 else None,
-        "publish_lateness": percentiles_ms(lateness),
-        "commands": n_cmd,
-        "command_rate_hz": n_cmd / (t1 - t0),
-        "answered": len(latencies),
-        "dropped": dropped,
-        "dropped_pct": 100.0 * dropped / n_pub if n_pub else None,
-        "latency": percentiles_ms(latencies),
-        "duplicate_stamps": duplicates,
-        "wrong_length_commands": bad_length,
-        "time_to_first_command_s": window["warm"] - t_start,
-        "graph_at_end": foreign,
+        'published': n_pub,
+        'publish_rate_hz': (n_pub - 1) / span if n_pub > 1 else None,
+        'publish_lateness': percentiles_ms(lateness),
+        'commands': n_cmd,
+        'command_rate_hz': n_cmd / (t1 - t0),
+        'answered': len(latencies),
+        'dropped': dropped,
+        'dropped_pct': 100.0 * dropped / n_pub if n_pub else None,
+        'latency': percentiles_ms(latencies),
+        'duplicate_stamps': duplicates,
+        'wrong_length_commands': bad_length,
+        'time_to_first_command_s': window['warm'] - t_start,
+        'graph_at_end': foreign,
     }
     Path(args.result).write_text(json.dumps(result))
     return 0
@@ -259,20 +258,20 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
     env = isolated_env(domain)
     tag = f"{hand}-{target.replace('/', '-')}-{int(rate)}-{executor}"
     me = [sys.executable, str(Path(__file__).resolve())]
-    if target == "echo":
+    if target == 'echo':
         joints = GraspSetup.from_file(CONFIG / HANDS[hand][0]).hand.joints
-        cmd = me + ["--role", "echo", "--executor", executor, "--joints", ",".join(joints)]
+        cmd = me + ['--role', 'echo', '--executor', executor, '--joints', ','.join(joints)]
     else:
-        extra = ["--log-level", "error"]
-        if "/" in target:
-            extra += ["-p", f"solver.backend:={target.split('/', 1)[1]}"]
+        extra = ['--log-level', 'error']
+        if '/' in target:
+            extra += ['-p', f"solver.backend:={target.split('/', 1)[1]}"]
         cmd = node_command(CONFIG / HANDS[hand][1], executor, extra)
-    result_file = tmp / f"{tag}.json"
-    load_cmd = me + ["--role", "load", "--hand", hand, "--rate", str(rate),
-                     "--duration", str(duration), "--load-executor", load_executor,
-                     "--result", str(result_file)]
+    result_file = tmp / f'{tag}.json'
+    load_cmd = me + ['--role', 'load', '--hand', hand, '--rate', str(rate),
+                     '--duration', str(duration), '--load-executor', load_executor,
+                     '--result', str(result_file)]
     children: list[Child] = []
-    with open(tmp / f"{tag}.target.log", "w") as tlog, open(tmp / f"{tag}.load.log", "w") as llog:
+    with open(tmp / f'{tag}.target.log', 'w') as tlog, open(tmp / f'{tag}.load.log', 'w') as llog:
         try:
             load_before = os.getloadavg()[0]
             share = CpuShare()
@@ -289,66 +288,66 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
         finally:
             for c in reversed(children):
                 c.stop()
-    out = {"hand": hand, "target": target, "rate_hz": rate, "executor": executor,
-           "ros_domain_id": domain, "loadavg_1min_before": load_before,
-           "other_processes_cores": share.others_cores(), "target_alive_at_end": target_alive}
+    out = {'hand': hand, 'target': target, 'rate_hz': rate, 'executor': executor,
+           'ros_domain_id': domain, 'loadavg_1min_before': load_before,
+           'other_processes_cores': share.others_cores(), 'target_alive_at_end': target_alive}
     if code == 0 and result_file.exists():
         out.update(json.loads(result_file.read_text()))
     else:
-        tail = " / ".join(line.strip() for line in
-                          (tmp / f"{tag}.load.log").read_text().splitlines()[-3:] if line.strip())
-        out["error"] = f"load process exit {code}: {tail} (logs in {tmp})"
+        tail = ' / '.join(line.strip() for line in
+                          (tmp / f'{tag}.load.log').read_text().splitlines()[-3:] if line.strip())
+        out['error'] = f'load process exit {code}: {tail} (logs in {tmp})'
     return out
 
 
 def _fmt(x: float | None, spec: str) -> str:
-    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
+    return '-' if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
 
 def table(cases: list[dict]) -> str:
     """The markdown tables: every case, then the node against the echo node."""
-    lines = ["| hand | rate [Hz] | executor | answering node | published [Hz] | "
-             "commands [Hz] | dropped | dropped [%] | p50 [ms] | p99 [ms] | max [ms] | "
-             "other work [cores] |",
-             "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = ['| hand | rate [Hz] | executor | answering node | published [Hz] | '
+             'commands [Hz] | dropped | dropped [%] | p50 [ms] | p99 [ms] | max [ms] | '
+             'other work [cores] |',
+             '|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|']
     for c in cases:
-        if "error" in c:
+        if 'error' in c:
             lines.append(f"| {c['hand']} | {c['rate_hz']:g} | {c['executor']} | {c['target']} "
                          f"| failed: {c['error'][:60]} ||||||||")
             continue
-        lat = c["latency"]
+        lat = c['latency']
         lines.append(
             f"| {c['hand']} | {c['rate_hz']:g} | {c['executor']} | {c['target']} | "
             f"{_fmt(c['publish_rate_hz'], '.1f')} | {c['command_rate_hz']:.1f} | "
             f"{c['dropped']} | {_fmt(c['dropped_pct'], '.2f')} | "
             f"{_fmt(lat['p50_ms'], '.3f')} | {_fmt(lat['p99_ms'], '.3f')} | "
             f"{_fmt(lat['max_ms'], '.3f')} | {_fmt(c['other_processes_cores'], '.2f')} |")
-    lines += ["", "| hand | rate [Hz] | executor | node | p99 node / echo | "
-              "dropped node - echo [pp] | p50 node / echo |", "|---|---:|---|---|---:|---:|---:|"]
+    lines += ['', '| hand | rate [Hz] | executor | node | p99 node / echo | '
+              'dropped node - echo [pp] | p50 node / echo |', '|---|---:|---|---|---:|---:|---:|']
     for r in ratios(cases):
         lines.append(f"| {r['hand']} | {r['rate_hz']:g} | {r['executor']} | {r['target']} | "
                      f"{_fmt(r['p99_ratio'], '.2f')} | {_fmt(r['dropped_diff_pp'], '+.2f')} | "
                      f"{_fmt(r['p50_ratio'], '.2f')} |")
-    return "\n".join(lines)
+    return '\n'.join(lines)
 
 
 def ratios(cases: list[dict]) -> list[dict]:
     """The node against the echo node at the same hand, rate and executor."""
-    by_key = {(c["hand"], c["rate_hz"], c["executor"], c["target"]): c for c in cases}
+    by_key = {(c['hand'], c['rate_hz'], c['executor'], c['target']): c for c in cases}
     out = []
     for (hand, rate, executor, target), node in by_key.items():
-        echo = by_key.get((hand, rate, executor, "echo"))
-        if target == "echo" or echo is None:
+        echo = by_key.get((hand, rate, executor, 'echo'))
+        if target == 'echo' or echo is None:
             continue
-        r = {"hand": hand, "rate_hz": rate, "executor": executor, "target": target,
-             "p99_ratio": None,
-             "p50_ratio": None, "dropped_diff_pp": None}
-        if "error" not in node and "error" not in echo:
-            for q in ("p50", "p99"):
-                a, b = node["latency"][f"{q}_ms"], echo["latency"][f"{q}_ms"]
-                r[f"{q}_ratio"] = a / b if a is not None and b else None
-            if node["dropped_pct"] is not None and echo["dropped_pct"] is not None:
-                r["dropped_diff_pp"] = node["dropped_pct"] - echo["dropped_pct"]
+        r = {'hand': hand, 'rate_hz': rate, 'executor': executor, 'target': target,
+             'p99_ratio': None,
+             'p50_ratio': None, 'dropped_diff_pp': None}
+        if 'error' not in node and 'error' not in echo:
+            for q in ('p50', 'p99'):
+                a, b = node['latency'][f'{q}_ms'], echo['latency'][f'{q}_ms']
+                r[f'{q}_ratio'] = a / b if a is not None and b else None
+            if node['dropped_pct'] is not None and echo['dropped_pct'] is not None:
+                r['dropped_diff_pp'] = node['dropped_pct'] - echo['dropped_pct']
         out.append(r)
     return out
 
@@ -361,17 +360,17 @@ def main_run(args: argparse.Namespace) -> int:
     domains = private_domains(len(keys))
     m = machine()
     print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}")
-    print(f"{len(keys)} cases, {args.duration:g} s each after {WARMUP_S:g} s of warm-up; "
-          f"load process executor: {args.load_executor}; receiver depth {RECEIVER_DEPTH}",
+    print(f'{len(keys)} cases, {args.duration:g} s each after {WARMUP_S:g} s of warm-up; '
+          f'load process executor: {args.load_executor}; receiver depth {RECEIVER_DEPTH}',
           flush=True)
     cases = []
-    logs = Path(tempfile.mkdtemp(prefix="node_load_"))
-    print(f"logs of the child processes: {logs}")
+    logs = Path(tempfile.mkdtemp(prefix='node_load_'))
+    print(f'logs of the child processes: {logs}')
     for (hand, rate, executor, target), domain in zip(keys, domains):
         c = run_case(hand, target, rate, executor, args.duration, args.load_executor,
                      domain, logs)
         cases.append(c)
-        if "error" in c:
+        if 'error' in c:
             print(f"  {hand} {target} {rate:g} Hz {executor}: {c['error']}", flush=True)
         else:
             print(f"  {hand:8} {target:18} {rate:6g} Hz {executor:11} "
@@ -382,49 +381,49 @@ def main_run(args: argparse.Namespace) -> int:
                   flush=True)
     print()
     print(table(cases))
-    out = {"machine": m, "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-           "duration_s": args.duration, "warmup_s": WARMUP_S, "drain_s": DRAIN_S,
-           "load_executor": args.load_executor, "receiver_depth": RECEIVER_DEPTH,
-           "cases": cases, "node_vs_echo": ratios(cases)}
+    out = {'machine': m, 'date_utc': datetime.now(timezone.utc).isoformat(timespec='seconds'),
+           'duration_s': args.duration, 'warmup_s': WARMUP_S, 'drain_s': DRAIN_S,
+           'load_executor': args.load_executor, 'receiver_depth': RECEIVER_DEPTH,
+           'cases': cases, 'node_vs_echo': ratios(cases)}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(out, indent=2))
-    print(f"\nwritten: {args.out}")
-    return 0 if all("error" not in c for c in cases) else 1
+    print(f'\nwritten: {args.out}')
+    return 0 if all('error' not in c for c in cases) else 1
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=10.0,
-                        help="measured seconds per case [s]")
-    parser.add_argument("--rates", type=float, nargs="+", default=[500.0, 1000.0],
-                        help="joint-state rates [Hz]")
-    parser.add_argument("--hands", nargs="+", choices=sorted(HANDS), default=list(HANDS))
-    parser.add_argument("--executors", nargs="+", choices=EXECUTORS, default=list(EXECUTORS),
-                        help="executors of the answering nodes")
-    parser.add_argument("--load-executor", choices=["single", "events"], default="events",
-                        help="executor of the load process itself (the same in every case)")
-    parser.add_argument("--out", type=Path,
-                        default=Path(__file__).resolve().parent / "results" / "node_load.json")
+    parser.add_argument('--duration', type=float, default=10.0,
+                        help='measured seconds per case [s]')
+    parser.add_argument('--rates', type=float, nargs='+', default=[500.0, 1000.0],
+                        help='joint-state rates [Hz]')
+    parser.add_argument('--hands', nargs='+', choices=sorted(HANDS), default=list(HANDS))
+    parser.add_argument('--executors', nargs='+', choices=EXECUTORS, default=list(EXECUTORS),
+                        help='executors of the answering nodes')
+    parser.add_argument('--load-executor', choices=['single', 'events'], default='events',
+                        help='executor of the load process itself (the same in every case)')
+    parser.add_argument('--out', type=Path,
+                        default=Path(__file__).resolve().parent / 'results' / 'node_load.json')
     # Roles of the child processes.
-    parser.add_argument("--role", choices=["run", "echo", "load"], default="run",
+    parser.add_argument('--role', choices=['run', 'echo', 'load'], default='run',
                         help=argparse.SUPPRESS)
-    parser.add_argument("--executor", choices=EXECUTORS, default="single",
+    parser.add_argument('--executor', choices=EXECUTORS, default='single',
                         help=argparse.SUPPRESS)
-    parser.add_argument("--joints", help=argparse.SUPPRESS)
-    parser.add_argument("--hand", choices=sorted(HANDS), help=argparse.SUPPRESS)
-    parser.add_argument("--rate", type=float, help=argparse.SUPPRESS)
-    parser.add_argument("--result", help=argparse.SUPPRESS)
+    parser.add_argument('--joints', help=argparse.SUPPRESS)
+    parser.add_argument('--hand', choices=sorted(HANDS), help=argparse.SUPPRESS)
+    parser.add_argument('--rate', type=float, help=argparse.SUPPRESS)
+    parser.add_argument('--result', help=argparse.SUPPRESS)
     args = parser.parse_args()
-    if args.role == "echo":
+    if args.role == 'echo':
         return echo_main(args)
-    if args.role == "load":
+    if args.role == 'load':
         return load_main(args)
     try:
         return main_run(args)
     except KeyboardInterrupt:
-        print("node_load: interrupted, child processes stopped", file=sys.stderr)
+        print('node_load: interrupted, child processes stopped', file=sys.stderr)
         return 130
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -1,4 +1,5 @@
-"""Planner throughput: Allegro grasps scored per second, one core and several.
+"""
+Planner throughput: Allegro grasps scored per second, one core and several.
 
 Usage: .venv/bin/python bench/planner.py [--grasps 200] [--seed 0] [--rounds 5]
        [--workers 2] [--backends proxsuite daqp] [--out bench/results/planner.json]
@@ -34,19 +35,18 @@ import argparse
 import dataclasses
 import multiprocessing as mp
 import os
+from pathlib import Path
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, report  # noqa: E402
-from grasps import SCENARIO, THREAD_VARS, allegro_grasps, blas_threads  # noqa: E402
-
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
+from grasps import allegro_grasps, blas_threads, SCENARIO, THREAD_VARS  # noqa: E402
 
 CHUNK = 25
 TARGET = 5000.0
@@ -56,14 +56,14 @@ _worker: dict = {}
 
 def _init(backend: str, barrier=None) -> None:
     """Per process: the hand and one solver, kept for every chunk."""
-    _worker["barrier"] = barrier
-    _worker["base"] = GraspSetup.from_file(SCENARIO)
-    _worker["solver"] = make_solver(backend)
+    _worker['barrier'] = barrier
+    _worker['base'] = GraspSetup.from_file(SCENARIO)
+    _worker['solver'] = make_solver(backend)
 
 
 def _score(chunk: tuple[np.ndarray, np.ndarray]) -> tuple[int, int]:
     """(scored, certified) of a chunk of candidates (q rows, w_ext rows)."""
-    base, solver = _worker["base"], _worker["solver"]
+    base, solver = _worker['base'], _worker['solver']
     certified = 0
     for q, w in zip(*chunk):
         sol = solve(dataclasses.replace(base, q=q, external_wrench=w), solver=solver)
@@ -74,7 +74,7 @@ def _score(chunk: tuple[np.ndarray, np.ndarray]) -> tuple[int, int]:
 def _warm_up(chunk: tuple[np.ndarray, np.ndarray]) -> int:
     """Score one candidate, then wait for the other workers (so each takes exactly one)."""
     _score((chunk[0][:1], chunk[1][:1]))
-    _worker["barrier"].wait(timeout=60)
+    _worker['barrier'].wait(timeout=60)
     return mp.current_process().pid
 
 
@@ -94,18 +94,18 @@ def sequential(backend: str, work: list) -> dict:
     res = [_score(c) for c in work]
     elapsed = time.perf_counter() - t0
     scored, certified = map(sum, zip(*res))
-    return {"scored": scored, "certified": certified, "seconds": elapsed,
-            "grasps_per_s": scored / elapsed}
+    return {'scored': scored, 'certified': certified, 'seconds': elapsed,
+            'grasps_per_s': scored / elapsed}
 
 
-def pooled(backend: str, work: list, workers: int, worker_threads: str = "1") -> dict:
-    ctx = mp.get_context("spawn")
+def pooled(backend: str, work: list, workers: int, worker_threads: str = '1') -> dict:
+    ctx = mp.get_context('spawn')
     barrier = ctx.Barrier(workers)
     saved = {k: os.environ.get(k) for k in THREAD_VARS}
     t0 = time.perf_counter()
     try:
-        if worker_threads != "default":  # spawned workers read these at import
-            os.environ.update({k: worker_threads for k in THREAD_VARS})
+        if worker_threads != 'default':  # spawned workers read these at import
+            os.environ.update(dict.fromkeys(THREAD_VARS, worker_threads))
         pool = ctx.Pool(workers, initializer=_init, initargs=(backend, barrier))
     finally:
         for k, v in saved.items():
@@ -123,35 +123,35 @@ def pooled(backend: str, work: list, workers: int, worker_threads: str = "1") ->
     # Start-up: the pool's creation, the workers' start (imports, URDF) and
     # one warm-up candidate each (about a millisecond).
     startup = t1 - t0
-    return {"workers": workers, "worker_threads": worker_threads,
-            "workers_that_warmed_up": len(pids), "scored": scored,
-            "certified": certified, "seconds": t2 - t1, "startup_seconds": startup,
-            "grasps_per_s": scored / (t2 - t1),
-            "grasps_per_s_with_startup": scored / (t2 - t1 + startup)}
+    return {'workers': workers, 'worker_threads': worker_threads,
+            'workers_that_warmed_up': len(pids), 'scored': scored,
+            'certified': certified, 'seconds': t2 - t1, 'startup_seconds': startup,
+            'grasps_per_s': scored / (t2 - t1),
+            'grasps_per_s_with_startup': scored / (t2 - t1 + startup)}
 
 
 def run(grasps: int = 200, seed: int = 0, rounds: int = 5, workers: int = 2,
-        backends: tuple[str, ...] = ("proxsuite", "daqp"), worker_threads: str = "1") -> dict:
+        backends: tuple[str, ...] = ('proxsuite', 'daqp'), worker_threads: str = '1') -> dict:
     """Throughput per backend, sequential and pooled (JSON-able)."""
     setups = allegro_grasps(grasps, seed)
     qs = np.array([s.q for s in setups])
     ws = np.array([s.external_wrench for s in setups])
     work = chunks(qs, ws, rounds)
-    out = {"machine": machine(), "blas_threads": blas_threads(), "grasps": grasps,
-           "seed": seed, "rounds": rounds,
-           "target_grasps_per_s": TARGET, "backends": {}}
+    out = {'machine': machine(), 'blas_threads': blas_threads(), 'grasps': grasps,
+           'seed': seed, 'rounds': rounds,
+           'target_grasps_per_s': TARGET, 'backends': {}}
     for b in backends:
-        out["backends"][b] = {"sequential": sequential(b, work),
-                              "pool": pooled(b, work, workers, worker_threads)}
+        out['backends'][b] = {'sequential': sequential(b, work),
+                              'pool': pooled(b, work, workers, worker_threads)}
     return out
 
 
 def table(results: dict) -> str:
     """Markdown table: one row per backend and mode."""
-    lines = ["| backend | mode | scored | certified | grasps/s | "
-             "grasps/s with start-up (start-up s) |", "|---|---|---:|---:|---:|---|"]
-    for b, r in results["backends"].items():
-        s, p = r["sequential"], r["pool"]
+    lines = ['| backend | mode | scored | certified | grasps/s | '
+             'grasps/s with start-up (start-up s) |', '|---|---|---:|---:|---:|---|']
+    for b, r in results['backends'].items():
+        s, p = r['sequential'], r['pool']
         lines.append(f"| {b} | sequential | {s['scored']} | {s['certified']} | "
                      f"{s['grasps_per_s']:.0f} | |")
         lines.append(f"| {b} | pool of {p['workers']} ({p['worker_threads']} thread) | "
@@ -159,19 +159,19 @@ def table(results: dict) -> str:
                      f"{p['grasps_per_s']:.0f} | {p['grasps_per_s_with_startup']:.0f} "
                      f"({p['startup_seconds']:.2f}) |")
     lines.append(f"\ntarget: {results['target_grasps_per_s']:.0f} grasps/s on 2 cores")
-    return "\n".join(lines)
+    return '\n'.join(lines)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grasps", type=int, default=200)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--rounds", type=int, default=5, help="times the batch is scored")
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--backends", nargs="+", default=["proxsuite", "daqp"])
-    parser.add_argument("--worker-threads", default="1",
+    parser.add_argument('--grasps', type=int, default=200)
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--rounds', type=int, default=5, help='times the batch is scored')
+    parser.add_argument('--workers', type=int, default=2)
+    parser.add_argument('--backends', nargs='+', default=['proxsuite', 'daqp'])
+    parser.add_argument('--worker-threads', default='1',
                         help="BLAS/OpenMP threads per pool worker, or 'default'")
-    parser.add_argument("--out", type=Path, help="write the results as JSON here")
+    parser.add_argument('--out', type=Path, help='write the results as JSON here')
     args = parser.parse_args()
     res = run(args.grasps, args.seed, args.rounds, args.workers, tuple(args.backends),
               args.worker_threads)
@@ -179,5 +179,5 @@ def main() -> None:
            f"{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     main()

@@ -1,4 +1,5 @@
-"""Pieces shared by the ROS 2 benchmarks ``node_load.py`` and ``soak.py``.
+"""
+Pieces shared by the ROS 2 benchmarks ``node_load.py`` and ``soak.py``.
 
 Child processes on a private ROS domain (stopped with their whole process
 group, whatever happens), the command line of ``grasp_torque_node``, a pacer
@@ -9,22 +10,22 @@ as integer nanoseconds so that a command can be matched to its joint state.
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import random
 import resource
 import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
-from typing import IO, Callable
+from typing import Callable, IO
 
 import numpy as np
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-CONFIG = ROOT / "config"
+CONFIG = ROOT / 'config'
 #: The node's stamped commands, whatever answers on joint_states (node or echo).
-STAMPED_TOPIC = "/grasp_torque_node/effort_commands_stamped"
+STAMPED_TOPIC = '/grasp_torque_node/effort_commands_stamped'
 #: Depth of the receiver's command queue (reliable). The node publishes with depth 1;
 #: a receiver with depth 1 would lose a command whenever two arrive between two of
 #: its own callbacks, and count the receiver's drops as the node's.
@@ -34,8 +35,8 @@ BUSY_WAIT_S = 300e-6
 
 
 def private_domains(n: int) -> list[int]:
-    """n distinct ROS domain ids in 1..100, none of them the caller's own."""
-    own = os.environ.get("ROS_DOMAIN_ID")
+    """N distinct ROS domain ids in 1..100, none of them the caller's own."""
+    own = os.environ.get('ROS_DOMAIN_ID')
     pool = [d for d in range(1, 101) if str(d) != own]
     return random.sample(pool, n)
 
@@ -43,23 +44,24 @@ def private_domains(n: int) -> list[int]:
 def isolated_env(domain: int) -> dict[str, str]:
     """The environment of every process of a run: a private domain, localhost only."""
     env = dict(os.environ)
-    env["ROS_DOMAIN_ID"] = str(domain)
-    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    env.pop("ROS_STATIC_PEERS", None)
-    env["PYTHONUNBUFFERED"] = "1"
+    env['ROS_DOMAIN_ID'] = str(domain)
+    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    env.pop('ROS_STATIC_PEERS', None)
+    env['PYTHONUNBUFFERED'] = '1'
     return env
 
 
 def node_command(params: Path, executor: str, extra: list[str] | None = None) -> list[str]:
     """Command line of ``grasp_torque_node`` on a params file, stamped commands on."""
-    exe = Path(sys.executable).parent / "grasp_torque_node"
-    head = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasp_torque_opt.ros.node"]
-    return head + ["--executor", executor, "--ros-args", "--params-file", str(params),
-                   "-p", "publish_stamped_command:=true"] + (extra or [])
+    exe = Path(sys.executable).parent / 'grasp_torque_node'
+    head = [str(exe)] if exe.exists() else [sys.executable, '-m', 'grasp_torque_opt.ros.node']
+    return head + ['--executor', executor, '--ros-args', '--params-file', str(params),
+                   '-p', 'publish_stamped_command:=true'] + (extra or [])
 
 
 class Child:
-    """A child process in its own process group; :meth:`stop` ends the whole group.
+    """
+    A child process in its own process group; :meth:`stop` ends the whole group.
 
     Args:
         cmd: command line.
@@ -101,7 +103,8 @@ class Child:
 
 
 def interrupt_on_signals() -> None:
-    """SIGINT and SIGTERM raise KeyboardInterrupt, so that ``finally`` blocks stop the children.
+    """
+    SIGINT and SIGTERM raise KeyboardInterrupt, so that ``finally`` blocks stop the children.
 
     SIGINT too: a process started in the background by a non-interactive shell
     inherits it ignored.
@@ -137,7 +140,8 @@ class UniqueClock:
 
 
 class Pacer:
-    """Calls ``tick`` on absolute deadlines at ``rate`` and spins ``executor`` in between.
+    """
+    Calls ``tick`` on absolute deadlines at ``rate`` and spins ``executor`` in between.
 
     Until ``BUSY_WAIT_S`` before a deadline it serves the receiver's callbacks
     (``spin_once`` with a timeout that ends there); then it busy-waits to the
@@ -179,14 +183,15 @@ class Pacer:
 def percentiles_ms(values_s: list[float] | np.ndarray) -> dict[str, float | None]:
     """p50, p99 and max [ms] of samples in seconds (None when there are none)."""
     if len(values_s) == 0:
-        return {"p50_ms": None, "p99_ms": None, "max_ms": None}
+        return {'p50_ms': None, 'p99_ms': None, 'max_ms': None}
     v = 1e3 * np.asarray(values_s, dtype=float)
-    return {"p50_ms": float(np.percentile(v, 50)), "p99_ms": float(np.percentile(v, 99)),
-            "max_ms": float(v.max())}
+    return {'p50_ms': float(np.percentile(v, 50)), 'p99_ms': float(np.percentile(v, 99)),
+            'max_ms': float(v.max())}
 
 
 class CpuShare:
-    """CPU used by processes other than this one and its reaped children, over an interval.
+    """
+    CPU used by processes other than this one and its reaped children, over an interval.
 
     The machine may be shared: this says how much of it the benchmark had.
     Start it before the children, call :meth:`others_cores` after they were reaped.
@@ -199,9 +204,9 @@ class CpuShare:
 
     @staticmethod
     def _busy_s() -> float:
-        fields = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+        fields = [int(x) for x in Path('/proc/stat').read_text().split('\n', 1)[0].split()[1:]]
         idle = fields[3] + fields[4]  # idle, iowait
-        return (sum(fields[:8]) - idle) / os.sysconf("SC_CLK_TCK")
+        return (sum(fields[:8]) - idle) / os.sysconf('SC_CLK_TCK')
 
     @staticmethod
     def _own_s() -> float:
@@ -221,8 +226,8 @@ class CpuShare:
 def vm_rss_kib(pid: int) -> int | None:
     """Resident set size of a process [KiB], from /proc (None if it is gone)."""
     try:
-        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
+        for line in Path(f'/proc/{pid}/status').read_text().splitlines():
+            if line.startswith('VmRSS:'):
                 return int(line.split()[1])
     except OSError:
         return None

@@ -1,4 +1,5 @@
-"""The whole benchmark suite, one command: results as JSON and one markdown summary.
+"""
+The whole benchmark suite, one command: results as JSON and one markdown summary.
 
 Usage (from a fresh clone):
 
@@ -35,16 +36,17 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import adaptive  # noqa: E402
 import cycle  # noqa: E402
+from grasp_torque_opt.backends import single_threaded_math  # noqa: E402
 import linearization  # noqa: E402
 import node_blackbox  # noqa: E402
 import node_load  # noqa: E402
@@ -52,59 +54,57 @@ import planner  # noqa: E402
 import score  # noqa: E402
 import solvers  # noqa: E402
 
-from grasp_torque_opt.backends import single_threaded_math  # noqa: E402
-
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=HERE / "results")
-    parser.add_argument("--quick", action="store_true", help="small sizes: a smoke test")
-    parser.add_argument("--skip-node", action="store_true", help="skip the node under load")
+    parser.add_argument('--out', type=Path, default=HERE / 'results')
+    parser.add_argument('--quick', action='store_true', help='small sizes: a smoke test')
+    parser.add_argument('--skip-node', action='store_true', help='skip the node under load')
     args = parser.parse_args()
     single_threaded_math()
     args.out.mkdir(parents=True, exist_ok=True)
     grasps = 20 if args.quick else 200
     parts = [
-        ("cycle", lambda: cycle.run(repeats=200 if args.quick else 3000), cycle.table),
-        ("solvers", lambda: solvers.run(grasps=grasps, repeats=3 if args.quick else 5,
+        ('cycle', lambda: cycle.run(repeats=200 if args.quick else 3000), cycle.table),
+        ('solvers', lambda: solvers.run(grasps=grasps, repeats=3 if args.quick else 5,
                                         scenario_repeats=20 if args.quick else 200,
                                         steps=50 if args.quick else 500), solvers.table),
-        ("linearization", lambda: linearization.run(grasps=grasps, backend="daqp"),
+        ('linearization', lambda: linearization.run(grasps=grasps, backend='daqp'),
          linearization.table),
-        ("adaptive", lambda: adaptive.run(grasps=grasps, repeats=3 if args.quick else 7,
+        ('adaptive', lambda: adaptive.run(grasps=grasps, repeats=3 if args.quick else 7,
                                           steps=50 if args.quick else 500),
          adaptive.table),
-        ("planner", lambda: planner.run(grasps=grasps, rounds=1 if args.quick else 5),
+        ('planner', lambda: planner.run(grasps=grasps, rounds=1 if args.quick else 5),
          planner.table),
-        ("score", lambda: score.run(count=400 if args.quick else 4000), score.table),
+        ('score', lambda: score.run(count=400 if args.quick else 4000), score.table),
     ]
     machine = cycle.machine()
-    summary = [f"# Benchmark summary\n\n{cycle.machine_line(machine)}\n"]
+    summary = [f'# Benchmark summary\n\n{cycle.machine_line(machine)}\n']
     for name, run, table in parts:
         t0 = time.monotonic()
-        print(f"== {name}", flush=True)
+        print(f'== {name}', flush=True)
         results = run()
-        (args.out / f"{name}.json").write_text(json.dumps(results, indent=2))
+        (args.out / f'{name}.json').write_text(json.dumps(results, indent=2))
         text = table(results)
         print(text, flush=True)
-        summary.append(f"## {name} ({time.monotonic() - t0:.0f} s)\n\n{text}\n")
+        summary.append(f'## {name} ({time.monotonic() - t0:.0f} s)\n\n{text}\n')
     if not args.skip_node:
-        for name, module, quick in (("node_load", node_load, ["--hands", "allegro"]),
-                                    ("node_blackbox", node_blackbox, [])):
-            print(f"== {name}", flush=True)
-            path = args.out / f"{name}.json"
-            cmd = [sys.executable, str(HERE / f"{name}.py"), "--out", str(path)]
+        for name, module, quick in (('node_load', node_load, ['--hands', 'allegro']),
+                                    ('node_blackbox', node_blackbox, [])):
+            print(f'== {name}', flush=True)
+            path = args.out / f'{name}.json'
+            cmd = [sys.executable, str(HERE / f'{name}.py'), '--out', str(path)]
             if args.quick:
-                cmd += ["--duration", "2"] + quick
+                cmd += ['--duration', '2'] + quick
             t0 = time.monotonic()
             done = subprocess.run(cmd)
-            table = module.table(json.loads(path.read_text())["cases"]) if path.exists() \
-                else f"{name} failed (exit {done.returncode}); see its output above"
-            summary.append(f"## {name} ({time.monotonic() - t0:.0f} s)\n\n{table}\n")
-    (args.out / "summary.md").write_text("\n".join(summary))
+            table = module.table(json.loads(path.read_text())['cases']) if path.exists() \
+                else f'{name} failed (exit {done.returncode}); see its output above'
+            summary.append(f'## {name} ({time.monotonic() - t0:.0f} s)\n\n{table}\n')
+    (args.out / 'summary.md').write_text('\n'.join(summary))
     print(f"written: {args.out}/*.json and {args.out / 'summary.md'}")
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

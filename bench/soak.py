@@ -1,4 +1,5 @@
-"""The soak run: grasp_torque_node at 1 kHz for minutes under valid, invalid and infeasible inputs.
+"""
+The soak run: grasp_torque_node at 1 kHz for minutes under valid, invalid and infeasible inputs.
 
 Usage: .venv/bin/python bench/soak.py [--duration 600] [--rate 1000] [--seed 0] [--out FILE]
 
@@ -43,39 +44,39 @@ resident memory (VmRSS) at start, end and in between. Not in CI.
 from __future__ import annotations
 
 import argparse
+from datetime import datetime, timezone
 import json
 import math
 import os
+from pathlib import Path
 import random
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
-from pathlib import Path
 
 import numpy as np
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ros_load import (  # noqa: E402
-    CONFIG,
-    RECEIVER_DEPTH,
-    STAMPED_TOPIC,
     Child,
+    CONFIG,
     CpuShare,
-    Pacer,
-    UniqueClock,
     interrupt_on_signals,
     isolated_env,
     node_command,
+    Pacer,
     percentiles_ms,
     private_domains,
+    RECEIVER_DEPTH,
     set_stamp,
     stamp_ns,
+    STAMPED_TOPIC,
+    UniqueClock,
     vm_rss_kib,
 )
 
-PARAMS = CONFIG / "allegro_right_node.yaml"
+PARAMS = CONFIG / 'allegro_right_node.yaml'
 #: Time for a joint state to reach the node and for a command computed from a queued
 #: one to come back: the node may hold a backlog of joint states (depth 5) behind a
 #: slow cycle (an infeasible load, up to cycle_budget) [s].
@@ -89,29 +90,29 @@ INFEASIBLE_FORCE_N = 200.0
 MEMORY_SAMPLES = 10
 
 JS_INVALID = {  # kind: relative weight
-    "nan_position": 3, "out_of_range_position": 2, "length_mismatch": 3, "duplicate_name": 2,
-    "empty_name": 2, "missing_joint": 2, "empty_message": 1, "huge_arrays": 1,
-    "future_stamp": 2, "backwards_stamp": 2}
-CONTACT_INVALID = {"non_unit_quaternion": 1, "zero_quaternion": 1, "nan_position": 1,
-                   "wrong_count": 1, "unknown_frame": 1}
-WRENCH_INVALID = {"nan_force": 1, "inf_torque": 1, "unknown_frame": 1, "over_max_force": 1}
+    'nan_position': 3, 'out_of_range_position': 2, 'length_mismatch': 3, 'duplicate_name': 2,
+    'empty_name': 2, 'missing_joint': 2, 'empty_message': 1, 'huge_arrays': 1,
+    'future_stamp': 2, 'backwards_stamp': 2}
+CONTACT_INVALID = {'non_unit_quaternion': 1, 'zero_quaternion': 1, 'nan_position': 1,
+                   'wrong_count': 1, 'unknown_frame': 1}
+WRENCH_INVALID = {'nan_force': 1, 'inf_torque': 1, 'unknown_frame': 1, 'over_max_force': 1}
 P_JS_INVALID = 0.05
 P_SLOW_INVALID = 0.2
 P_SILENCE = 0.25
 P_INFEASIBLE = 0.25
 #: The phases of issue 13's inputs, each in this share of the blocks.
-ISSUE13_PHASES = ("skewed_source", "limits_below", "solver_bounds", "service_flood")
+ISSUE13_PHASES = ('skewed_source', 'limits_below', 'solver_bounds', 'service_flood')
 P_ISSUE13 = 0.1
 SKEW_S = 0.4
 SKEWED_RATE_HZ = 25.0
 LIMITS_FRACTION = 0.2
 FLOOD_CALLS = 200
-BOUNDS = {"solver.max_iter": 10000, "solver.max_iter_in": 200, "solver.eps_abs": 1e-12}
+BOUNDS = {'solver.max_iter': 10000, 'solver.max_iter_in': 200, 'solver.eps_abs': 1e-12}
 
 
 def _node_params() -> dict:
     doc = yaml.safe_load(PARAMS.read_text())
-    return next(iter(doc.values()))["ros__parameters"]
+    return next(iter(doc.values()))['ros__parameters']
 
 
 def _pick(rng: random.Random, weights: dict[str, int]) -> str:
@@ -125,9 +126,9 @@ def schedule(rng: random.Random, duration: float) -> list[tuple[str, float, floa
         u = rng.random()
         start = b * BLOCK_S + rng.uniform(0.2, BLOCK_S - PHASE_S - 0.2)
         if u < P_SILENCE:
-            phases.append(("silence", start, start + PHASE_S))
+            phases.append(('silence', start, start + PHASE_S))
         elif u < P_SILENCE + P_INFEASIBLE:
-            phases.append(("infeasible_load", start, start + PHASE_S))
+            phases.append(('infeasible_load', start, start + PHASE_S))
         else:
             i = int((u - P_SILENCE - P_INFEASIBLE) / P_ISSUE13)
             if i < len(ISSUE13_PHASES):
@@ -137,61 +138,60 @@ def schedule(rng: random.Random, duration: float) -> list[tuple[str, float, floa
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=600.0, help="seconds of the mix [s]")
-    parser.add_argument("--rate", type=float, default=1000.0, help="joint-state rate [Hz]")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--out", type=Path,
-                        default=Path(__file__).resolve().parent / "results" / "soak.json")
+    parser.add_argument('--duration', type=float, default=600.0, help='seconds of the mix [s]')
+    parser.add_argument('--rate', type=float, default=1000.0, help='joint-state rate [Hz]')
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--out', type=Path,
+                        default=Path(__file__).resolve().parent / 'results' / 'soak.json')
     args = parser.parse_args()
     interrupt_on_signals()
-    logs = Path(tempfile.mkdtemp(prefix="soak_"))
+    logs = Path(tempfile.mkdtemp(prefix='soak_'))
     domain = private_domains(1)[0]
     env = isolated_env(domain)
     os.environ.update(env)  # this process drives the node: the same private domain
-    os.environ.pop("ROS_STATIC_PEERS", None)
+    os.environ.pop('ROS_STATIC_PEERS', None)
     node = None
     result = None
-    with open(logs / "node.log", "w") as log:
+    with open(logs / 'node.log', 'w') as log:
         try:
-            node = Child(node_command(PARAMS, "single"), env, log)
+            node = Child(node_command(PARAMS, 'single'), env, log)
             result = drive(args, node, domain, logs)
         except KeyboardInterrupt:
-            print("soak: interrupted, node stopped", file=sys.stderr)
+            print('soak: interrupted, node stopped', file=sys.stderr)
             return 130
         finally:
             if node is not None:
                 node.stop()
-    return 0 if result is not None and result["invariants_broken"] == 0 else 1
+    return 0 if result is not None and result['invariants_broken'] == 0 else 1
 
 
 def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dict | None:
     """Publish the mix at the node, check every command, report."""
-    import pinocchio as pin
-    import rclpy
     from cycle import machine
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
-    from rclpy.experimental import EventsExecutor
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
+    import pinocchio as pin
     from rcl_interfaces.srv import SetParameters
+    import rclpy
+    from rclpy.experimental import EventsExecutor
     from rclpy.parameter import Parameter
-    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
-    from std_srvs.srv import Trigger
+    from rclpy.qos import HistoryPolicy, qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
-
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
+    from std_srvs.srv import Trigger
 
     p = _node_params()
-    setup = GraspSetup.from_file(CONFIG / p["scenario"])
+    setup = GraspSetup.from_file(CONFIG / p['scenario'])
     hand = setup.hand
     names = list(hand.joints)
     m = len(names)
-    limits = np.array(p.get("torque_limits", hand.torque_limits), dtype=float)
+    limits = np.array(p.get('torque_limits', hand.torque_limits), dtype=float)
     q0 = setup.q[hand.idx_q].astype(float)
     base = hand.base_frame
-    timeout = float(p.get("joint_state_timeout", 0.1))
-    hold = float(p.get("hold_time", 0.1))
-    policy = p.get("fault_policy", "hold")
+    timeout = float(p.get('joint_state_timeout', 0.1))
+    hold = float(p.get('hold_time', 0.1))
+    policy = p.get('fault_policy', 'hold')
     stop_bound_s = timeout + hold + DELIVERY_MARGIN_S
     w0 = np.asarray(setup.external_wrench, dtype=float)
     frames = setup.maps().contacts
@@ -203,24 +203,24 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     phases = schedule(rng, args.duration)
     # The warm-up lasts until the node answers: its draws come from a generator of their
     # own, so that the mix depends on the seed only.
-    state = {"last_valid_stamp": 0, "since_silence": 0, "mixing": False, "phase": None,
-             "rng": random.Random(args.seed + 1)}
-    mix = {"joint_states_invalid_fraction": P_JS_INVALID, "joint_states_invalid_kinds": JS_INVALID,
-           "contacts_and_load_rate_hz": SLOW_RATE_HZ, "slow_invalid_fraction": P_SLOW_INVALID,
-           "contacts_invalid_kinds": CONTACT_INVALID, "external_wrench_invalid_kinds":
-           WRENCH_INVALID, "silences": sum(k == "silence" for k, _, _ in phases),
-           "infeasible_load_phases": sum(k == "infeasible_load" for k, _, _ in phases),
-           "phase_s": PHASE_S, "infeasible_force_N": INFEASIBLE_FORCE_N,
-           "holdable_load": "scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis",
-           **{f"{k}_phases": sum(kind == k for kind, _, _ in phases) for k in ISSUE13_PHASES},
-           "skew_s": SKEW_S, "skewed_rate_hz": SKEWED_RATE_HZ,
-           "limits_fraction": LIMITS_FRACTION, "flood_calls": FLOOD_CALLS,
-           "solver_bounds": BOUNDS}
+    state = {'last_valid_stamp': 0, 'since_silence': 0, 'mixing': False, 'phase': None,
+             'rng': random.Random(args.seed + 1)}
+    mix = {'joint_states_invalid_fraction': P_JS_INVALID, 'joint_states_invalid_kinds': JS_INVALID,
+           'contacts_and_load_rate_hz': SLOW_RATE_HZ, 'slow_invalid_fraction': P_SLOW_INVALID,
+           'contacts_invalid_kinds': CONTACT_INVALID, 'external_wrench_invalid_kinds':
+           WRENCH_INVALID, 'silences': sum(k == 'silence' for k, _, _ in phases),
+           'infeasible_load_phases': sum(k == 'infeasible_load' for k, _, _ in phases),
+           'phase_s': PHASE_S, 'infeasible_force_N': INFEASIBLE_FORCE_N,
+           'holdable_load': 'scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis',
+           **{f'{k}_phases': sum(kind == k for kind, _, _ in phases) for k in ISSUE13_PHASES},
+           'skew_s': SKEW_S, 'skewed_rate_hz': SKEWED_RATE_HZ,
+           'limits_fraction': LIMITS_FRACTION, 'flood_calls': FLOOD_CALLS,
+           'solver_bounds': BOUNDS}
     mach = machine()
     print(f"machine: {mach['cpu']}, {mach['cores']} cores, Python {mach['python']}; "
           f"{mach['date']}")
-    print(f"soak: {args.duration:g} s at {args.rate:g} Hz, seed {args.seed}, node pid "
-          f"{node.pid}, ROS_DOMAIN_ID {domain}, logs {logs}")
+    print(f'soak: {args.duration:g} s at {args.rate:g} Hz, seed {args.seed}, node pid '
+          f'{node.pid}, ROS_DOMAIN_ID {domain}, logs {logs}')
     print(f"mix: joint states {100 * (1 - P_JS_INVALID):.0f}% valid, "
           f"{100 * P_JS_INVALID:.0f}% invalid ({', '.join(JS_INVALID)}); contacts and load at "
           f"{SLOW_RATE_HZ:g} Hz, {100 * P_SLOW_INVALID:.0f}% invalid (contacts: "
@@ -230,10 +230,10 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
           f"{timeout:g} + {hold:g} + {DELIVERY_MARGIN_S:g} s", flush=True)
 
     rclpy.init()
-    ros = rclpy.create_node("grasp_soak_driver")
-    js_pub = ros.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
-    contacts_pub = ros.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
-    wrench_pub = ros.create_publisher(WrenchStamped, "external_wrench", qos_profile_sensor_data)
+    ros = rclpy.create_node('grasp_soak_driver')
+    js_pub = ros.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+    contacts_pub = ros.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+    wrench_pub = ros.create_publisher(WrenchStamped, 'external_wrench', qos_profile_sensor_data)
     receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
 
     valid_stamps: set[int] = set()
@@ -247,7 +247,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     violations: dict[str, int] = {}
     examples: list[str] = []
     stamped_ok = 0
-    late_receipts = {"n": 0}  # commands received later than joint_state_timeout + margin
+    late_receipts = {'n': 0}  # commands received later than joint_state_timeout + margin
     zero_policy_commands = 0
     stamped_times: list[tuple[int, int]] = []  # (stamp, receipt) of valid-stamp commands
     diag: dict[str, str] = {}
@@ -255,34 +255,34 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     def broken(kind: str, detail: str) -> None:
         violations[kind] = violations.get(kind, 0) + 1
         if len(examples) < 10:
-            examples.append(f"{kind}: {detail}")
+            examples.append(f'{kind}: {detail}')
 
     def check_values(values, where: str) -> None:
         v = np.asarray(values, dtype=float)
         if v.shape != (m,):
-            broken("wrong_length", f"{where} has {v.size} values for {m} joints")
+            broken('wrong_length', f'{where} has {v.size} values for {m} joints')
         elif not np.all(np.isfinite(v)):
-            broken("not_finite", f"{where} {v.tolist()}")
+            broken('not_finite', f'{where} {v.tolist()}')
         elif np.any(np.abs(v) > limits):
-            broken("over_limit", f"{where} max |value| {np.abs(v).max():.6g}")
+            broken('over_limit', f'{where} max |value| {np.abs(v).max():.6g}')
         else:
             now = time.time_ns()
             in_force = next(lim for t, lim in reversed(limits_in_force) if t <= now)
             if np.any(np.abs(v) > in_force):
-                broken("over_lowered_limit", f"{where} max |value| {np.abs(v).max():.6g} "
-                       f"over the lowered limit {in_force.max():.6g}")
+                broken('over_lowered_limit', f'{where} max |value| {np.abs(v).max():.6g} '
+                       f'over the lowered limit {in_force.max():.6g}')
 
     def on_command(msg: Float64MultiArray) -> None:
         commands.append((time.time_ns(), not any(msg.data)))
-        check_values(msg.data, "effort_commands")
+        check_values(msg.data, 'effort_commands')
 
     def on_stamped(msg: JointState) -> None:
         nonlocal stamped_ok, zero_policy_commands
         now = time.time_ns()
         s = stamp_ns(msg.header.stamp)
-        check_values(msg.effort, "effort_commands_stamped")
+        check_values(msg.effort, 'effort_commands_stamped')
         if list(msg.name) != names:
-            broken("wrong_names", f"stamped command names {list(msg.name)[:3]}...")
+            broken('wrong_names', f'stamped command names {list(msg.name)[:3]}...')
         if s in valid_stamps:
             stamped_ok += 1
             stamped_times.append((s, now))
@@ -291,29 +291,29 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
                 # delivery and this process's own scheduling (1400 such on a machine
                 # whose other work took 1.38 of its 2 cores); the node's own bound, from
                 # receipt to publication, is checked by the test suite's campaign.
-                late_receipts["n"] += 1
-            phase = state["phase"]
-            if phase is not None and phase["kind"] == "skewed_source" and \
+                late_receipts['n'] += 1
+            phase = state['phase']
+            if phase is not None and phase['kind'] == 'skewed_source' and \
                     s not in skewed_stamps:
-                phase["on_clock_commands"] = phase.get("on_clock_commands", 0) + 1
+                phase['on_clock_commands'] = phase.get('on_clock_commands', 0) + 1
         elif s in invalid_stamps:
-            broken("from_invalid_joint_state", f"command stamped {s} answers a rejected state")
-        elif policy == "zero" and not any(msg.effort):
+            broken('from_invalid_joint_state', f'command stamped {s} answers a rejected state')
+        elif policy == 'zero' and not any(msg.effort):
             zero_policy_commands += 1
         else:
-            broken("unknown_stamp", f"command stamped {s} answers no published joint state")
+            broken('unknown_stamp', f'command stamped {s} answers no published joint state')
 
     def on_diag(msg: DiagnosticArray) -> None:
         for status in msg.status:
-            if status.name.startswith("grasp_torque_node"):
+            if status.name.startswith('grasp_torque_node'):
                 diag.clear()
                 diag.update({kv.key: kv.value for kv in status.values})
-                diag["_level"] = str(status.level[0] if isinstance(status.level, bytes)
+                diag['_level'] = str(status.level[0] if isinstance(status.level, bytes)
                                      else status.level)
 
-    ros.create_subscription(Float64MultiArray, "effort_commands", on_command, receiver_qos)
+    ros.create_subscription(Float64MultiArray, 'effort_commands', on_command, receiver_qos)
     ros.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
-    ros.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 10)
+    ros.create_subscription(DiagnosticArray, '/diagnostics', on_diag, 10)
     # Served by spin_once in the pacer (its spin() does not deliver here; see node_load.py).
     executor = EventsExecutor()
     executor.add_node(ros)
@@ -321,14 +321,14 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     clock = UniqueClock()
 
     # -- messages ------------------------------------------------------------------------
-    sent = {"joint_states": {"valid": 0}, "contacts": {"valid": 0},
-            "external_wrench": {"valid": 0, "infeasible": 0}}
+    sent = {'joint_states': {'valid': 0}, 'contacts': {'valid': 0},
+            'external_wrench': {'valid': 0, 'infeasible': 0}}
     for kind in JS_INVALID:
-        sent["joint_states"][kind] = 0
+        sent['joint_states'][kind] = 0
     for kind in CONTACT_INVALID:
-        sent["contacts"][kind] = 0
+        sent['contacts'][kind] = 0
     for kind in WRENCH_INVALID:
-        sent["external_wrench"][kind] = 0
+        sent['external_wrench'][kind] = 0
     huge = JointState(name=names, position=[0.0] * 100000)
 
     def joint_state(k: int, invalid: str | None) -> None:
@@ -340,140 +340,140 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             variant = k % 3
             if variant == 1:  # as joint_state_broadcaster: any order, NaN efforts
                 order = list(range(m))
-                state["rng"].shuffle(order)
+                state['rng'].shuffle(order)
                 n, q = [n[i] for i in order], [q[i] for i in order]
                 msg.effort = [math.nan] * m
             elif variant == 2:  # a joint the model does not know: ignored
-                n, q = n + ["wrist_camera_joint"], q + [0.0]
+                n, q = n + ['wrist_camera_joint'], q + [0.0]
             msg.name, msg.position = n, q
-        elif invalid == "huge_arrays":
+        elif invalid == 'huge_arrays':
             msg = huge
         else:
-            i = state["rng"].randrange(m)
-            if invalid == "nan_position":
+            i = state['rng'].randrange(m)
+            if invalid == 'nan_position':
                 q[i] = math.nan
-            elif invalid == "out_of_range_position":
+            elif invalid == 'out_of_range_position':
                 q[i] = 1e4
-            elif invalid == "length_mismatch":
+            elif invalid == 'length_mismatch':
                 q = q[:-1]
-            elif invalid == "duplicate_name":
+            elif invalid == 'duplicate_name':
                 n[(i + 1) % m] = n[i]
-            elif invalid == "empty_name":
-                n[i] = ""
-            elif invalid == "missing_joint":
+            elif invalid == 'empty_name':
+                n[i] = ''
+            elif invalid == 'missing_joint':
                 del n[i], q[i]
-            elif invalid == "empty_message":
+            elif invalid == 'empty_message':
                 n, q = [], []
-            elif invalid == "future_stamp":
+            elif invalid == 'future_stamp':
                 s += 10_000_000_000
-            elif invalid == "backwards_stamp":
-                s = state["last_valid_stamp"] - 200_000_000
+            elif invalid == 'backwards_stamp':
+                s = state['last_valid_stamp'] - 200_000_000
                 while s in valid_stamps:
                     s -= 1
             msg.name, msg.position = n, q
         set_stamp(msg.header, s)
         if invalid is None:
             valid_stamps.add(s)
-            state["last_valid_stamp"] = s
+            state['last_valid_stamp'] = s
         else:
             invalid_stamps.add(s)
-        if state["mixing"]:
-            sent["joint_states"]["valid" if invalid is None else invalid] += 1
+        if state['mixing']:
+            sent['joint_states']['valid' if invalid is None else invalid] += 1
         js_pub.publish(msg)
 
     def contacts(invalid: str | None) -> None:
         msg = PoseArray()
-        msg.header.frame_id = base if state["rng"].random() < 0.5 else ""
+        msg.header.frame_id = base if state['rng'].random() < 0.5 else ''
         for i, (pos, quat) in enumerate(contact_poses):
             pos, quat = pos.copy(), quat.copy()
-            if invalid == "non_unit_quaternion" and i == 0:
+            if invalid == 'non_unit_quaternion' and i == 0:
                 quat *= 1.1
-            elif invalid == "zero_quaternion" and i == 0:
+            elif invalid == 'zero_quaternion' and i == 0:
                 quat[:] = 0.0
-            elif invalid == "nan_position" and i == 0:
+            elif invalid == 'nan_position' and i == 0:
                 pos[1] = math.nan
-            elif invalid == "wrong_count" and i == len(contact_poses) - 1:
+            elif invalid == 'wrong_count' and i == len(contact_poses) - 1:
                 continue
             pose = Pose()
             pose.position.x, pose.position.y, pose.position.z = map(float, pos)
             (pose.orientation.x, pose.orientation.y, pose.orientation.z,
              pose.orientation.w) = map(float, quat)
             msg.poses.append(pose)
-        if invalid == "unknown_frame":
-            msg.header.frame_id = "no_such_frame"
+        if invalid == 'unknown_frame':
+            msg.header.frame_id = 'no_such_frame'
         set_stamp(msg.header, clock())
-        if state["mixing"]:
-            sent["contacts"]["valid" if invalid is None else invalid] += 1
+        if state['mixing']:
+            sent['contacts']['valid' if invalid is None else invalid] += 1
         contacts_pub.publish(msg)
 
     def wrench(kind: str) -> None:
-        r = state["rng"]
+        r = state['rng']
         msg = WrenchStamped()
-        msg.header.frame_id = base if r.random() < 0.5 else ""
+        msg.header.frame_id = base if r.random() < 0.5 else ''
         w = w0 * r.uniform(0.7, 1.3)
         w[:3] += [r.uniform(-0.2, 0.2) for _ in range(3)]
-        if kind == "infeasible":
+        if kind == 'infeasible':
             w = np.array([INFEASIBLE_FORCE_N, 0.0, 0.0, 0.0, 0.0, 0.0])
-        elif kind == "nan_force":
+        elif kind == 'nan_force':
             w[1] = math.nan
-        elif kind == "inf_torque":
+        elif kind == 'inf_torque':
             w[4] = math.inf
-        elif kind == "over_max_force":
-            w[0] = 10.0 * float(p.get("max_wrench_force", 1000.0))
-        elif kind == "unknown_frame":
-            msg.header.frame_id = "no_such_frame"
+        elif kind == 'over_max_force':
+            w[0] = 10.0 * float(p.get('max_wrench_force', 1000.0))
+        elif kind == 'unknown_frame':
+            msg.header.frame_id = 'no_such_frame'
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = map(float, w)
         s = clock()
         set_stamp(msg.header, s)
-        if state["mixing"]:
-            sent["external_wrench"][kind] += 1
-        if kind == "infeasible" and state["phase"] is not None:
-            state["phase"].setdefault("first_infeasible_ns", s)
-            state["infeasible_span"] = state["phase"]
-        elif kind == "valid" and state.get("infeasible_span") is not None:
-            state["infeasible_span"]["holdable_again_ns"] = s
-            state["infeasible_span"] = None
+        if state['mixing']:
+            sent['external_wrench'][kind] += 1
+        if kind == 'infeasible' and state['phase'] is not None:
+            state['phase'].setdefault('first_infeasible_ns', s)
+            state['infeasible_span'] = state['phase']
+        elif kind == 'valid' and state.get('infeasible_span') is not None:
+            state['infeasible_span']['holdable_again_ns'] = s
+            state['infeasible_span'] = None
         wrench_pub.publish(msg)
 
     # -- issue 13's phases: a skewed second source, parameter changes, a service flood --
-    set_params = ros.create_client(SetParameters, "/grasp_torque_node/set_parameters")
-    flood_client = ros.create_client(Trigger, "/grasp_torque_node/solve", qos_profile=QoSProfile(
+    set_params = ros.create_client(SetParameters, '/grasp_torque_node/set_parameters')
+    flood_client = ros.create_client(Trigger, '/grasp_torque_node/solve', qos_profile=QoSProfile(
         history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
     skewed_every = max(1, round(args.rate / SKEWED_RATE_HZ))
-    defaults = {"torque_limits": [float(x) for x in limits],
-                "weights": [float(x) for x in p.get("weights", setup.weights)],
-                "solver.max_iter": 200, "solver.max_iter_in": 50, "solver.eps_abs": 1e-9}
+    defaults = {'torque_limits': [float(x) for x in limits],
+                'weights': [float(x) for x in p.get('weights', setup.weights)],
+                'solver.max_iter': 200, 'solver.max_iter_in': 50, 'solver.eps_abs': 1e-9}
 
     def set_parameters(values: dict, span: dict | None = None) -> None:
         req = SetParameters.Request(parameters=[Parameter(k, value=v).to_parameter_msg()
                                                 for k, v in values.items()])
         future = set_params.call_async(req)
         param_futures.append(future)
-        if span is not None and "torque_limits" in values:
-            lowered = np.array(values["torque_limits"])
+        if span is not None and 'torque_limits' in values:
+            lowered = np.array(values['torque_limits'])
 
             def acknowledged(_f, lowered=lowered, span=span):
                 # From the answer on (plus delivery), every command meets the new limits.
-                span["limits_acknowledged_ns"] = time.time_ns()
-                if not span.get("ended"):  # not restored already
+                span['limits_acknowledged_ns'] = time.time_ns()
+                if not span.get('ended'):  # not restored already
                     limits_in_force.append((time.time_ns() + int(1e9 * DELIVERY_MARGIN_S),
                                             lowered))
             future.add_done_callback(acknowledged)
 
     def phase_event(kind: str, starting: bool, span: dict) -> None:
-        if kind == "limits_below":
+        if kind == 'limits_below':
             if starting:
-                set_parameters({"torque_limits": [LIMITS_FRACTION * x for x in limits]}, span)
+                set_parameters({'torque_limits': [LIMITS_FRACTION * x for x in limits]}, span)
             else:
-                set_parameters({"torque_limits": defaults["torque_limits"]})
+                set_parameters({'torque_limits': defaults['torque_limits']})
                 limits_in_force.append((time.time_ns(), limits))
-        elif kind == "solver_bounds":
-            m_ = len(defaults["weights"])
-            bounded = {**BOUNDS, "weights": ([1e-3, 1e3] * m_)[:m_]}
+        elif kind == 'solver_bounds':
+            m_ = len(defaults['weights'])
+            bounded = {**BOUNDS, 'weights': ([1e-3, 1e3] * m_)[:m_]}
             set_parameters(bounded if starting else
                            {k: defaults[k] for k in bounded})
-        elif kind == "service_flood" and starting:
+        elif kind == 'service_flood' and starting:
             flood_futures.extend(flood_client.call_async(Trigger.Request())
                                  for _ in range(FLOOD_CALLS))
 
@@ -488,11 +488,11 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     # -- discovery and warm-up -------------------------------------------------------------
     deadline = time.monotonic() + 60.0
     while time.monotonic() < deadline and not (
-            ros.count_subscribers("joint_states") and ros.count_publishers(STAMPED_TOPIC)):
+            ros.count_subscribers('joint_states') and ros.count_publishers(STAMPED_TOPIC)):
         pacer.spin_for(0.05)
         if not node.alive():
             break
-    if not (ros.count_subscribers("joint_states") and ros.count_publishers(STAMPED_TOPIC)):
+    if not (ros.count_subscribers('joint_states') and ros.count_publishers(STAMPED_TOPIC)):
         print(f"soak: the node did not come up (log: {logs / 'node.log'})", file=sys.stderr)
         return None
     slow_every = max(1, round(args.rate / SLOW_RATE_HZ))
@@ -501,14 +501,14 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     def warm_tick(k: int, now: float) -> bool:
         if k % slow_every == 0:
             contacts(None)
-            wrench("valid")
+            wrench('valid')
         joint_state(k, None)
-        if stamped_ok and "t" not in warm:
-            warm["t"] = now
-        return not ("t" in warm and now - warm["t"] >= WARMUP_S) and k < 60 * args.rate
+        if stamped_ok and 't' not in warm:
+            warm['t'] = now
+        return not ('t' in warm and now - warm['t'] >= WARMUP_S) and k < 60 * args.rate
 
     pacer.run(warm_tick)
-    if "t" not in warm:
+    if 't' not in warm:
         print(f"soak: no command came back (log: {logs / 'node.log'})", file=sys.stderr)
         return None
     pacer.spin_for(0.3)  # a fresh /diagnostics
@@ -518,35 +518,35 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     share = CpuShare()
 
     # -- the mix -----------------------------------------------------------------------------
-    state["mixing"] = True
-    state["rng"] = rng
+    state['mixing'] = True
+    state['rng'] = rng
     start_ns = time.time_ns()
     # Phases by tick (deterministic), with the wall-clock times they really had.
-    spans = [{"kind": kind, "k0": round(a * args.rate), "k1": round(b * args.rate)}
+    spans = [{'kind': kind, 'k0': round(a * args.rate), 'k1': round(b * args.rate)}
              for kind, a, b in phases]
     memory_every = max(1, int(args.duration * args.rate / MEMORY_SAMPLES))
     n_ticks = int(args.duration * args.rate)
     period_ns = int(1e9 / args.rate)
-    pi = {"i": 0}
+    pi = {'i': 0}
 
     def current_phase(k: int) -> str:
-        while pi["i"] < len(spans) and spans[pi["i"]]["k1"] <= k:
-            span = spans[pi["i"]]
-            if "start_ns" in span and not span.get("ended"):
-                span["ended"] = True
-                phase_event(span["kind"], False, span)
-            pi["i"] += 1
-        if pi["i"] < len(spans) and spans[pi["i"]]["k0"] <= k:
-            span = spans[pi["i"]]
+        while pi['i'] < len(spans) and spans[pi['i']]['k1'] <= k:
+            span = spans[pi['i']]
+            if 'start_ns' in span and not span.get('ended'):
+                span['ended'] = True
+                phase_event(span['kind'], False, span)
+            pi['i'] += 1
+        if pi['i'] < len(spans) and spans[pi['i']]['k0'] <= k:
+            span = spans[pi['i']]
             t = time.time_ns()
-            if "start_ns" not in span:
-                span["start_ns"] = t
-                phase_event(span["kind"], True, span)
-            span["end_ns"] = t + period_ns
-            state["phase"] = span
-            return span["kind"]
-        state["phase"] = None
-        return ""
+            if 'start_ns' not in span:
+                span['start_ns'] = t
+                phase_event(span['kind'], True, span)
+            span['end_ns'] = t + period_ns
+            state['phase'] = span
+            return span['kind']
+        state['phase'] = None
+        return ''
 
     def mix_tick(k: int, now: float) -> bool:
         if k >= n_ticks:
@@ -554,20 +554,20 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         phase = current_phase(k)
         if k % slow_every == 0:
             contacts(_pick(rng, CONTACT_INVALID) if rng.random() < P_SLOW_INVALID else None)
-            if phase == "infeasible_load":
-                wrench("infeasible")
+            if phase == 'infeasible_load':
+                wrench('infeasible')
             else:
-                wrench(_pick(rng, WRENCH_INVALID) if rng.random() < P_SLOW_INVALID else "valid")
-        if phase == "skewed_source" and k % skewed_every == 0:
+                wrench(_pick(rng, WRENCH_INVALID) if rng.random() < P_SLOW_INVALID else 'valid')
+        if phase == 'skewed_source' and k % skewed_every == 0:
             skewed_joint_state()
-        if phase != "silence":
+        if phase != 'silence':
             invalid = _pick(rng, JS_INVALID) if rng.random() < P_JS_INVALID else None
-            if invalid == "backwards_stamp" and state["since_silence"] < 100:
+            if invalid == 'backwards_stamp' and state['since_silence'] < 100:
                 invalid = None  # right after a silence the node's last stamp may be stale
-            state["since_silence"] += 1
+            state['since_silence'] += 1
             joint_state(k, invalid)
         else:
-            state["since_silence"] = 0
+            state['since_silence'] = 0
         if k and k % memory_every == 0:
             memory.append((k / args.rate, vm_rss_kib(node.pid)))
         return True
@@ -576,9 +576,9 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     pacer.run(mix_tick)
     mix_s = time.perf_counter() - t_mix
     for span in spans:  # a phase that was still on when the mix ended
-        if "start_ns" in span and not span.get("ended"):
-            span["ended"] = True
-            phase_event(span["kind"], False, span)
+        if 'start_ns' in span and not span.get('ended'):
+            span['ended'] = True
+            phase_event(span['kind'], False, span)
     published_rate = n_ticks / mix_s
     end_ns = time.time_ns()
     pacer.spin_for(DRAIN_S)
@@ -588,12 +588,12 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         pacer.spin_for(0.1)
     unanswered = sum(not f.done() for f in flood_futures)
     if unanswered:
-        broken("service_unanswered", f"{unanswered} of {len(flood_futures)} calls")
+        broken('service_unanswered', f'{unanswered} of {len(flood_futures)} calls')
     answers = [f.result() for f in flood_futures if f.done()]
-    service = {"calls": len(flood_futures), "unanswered": unanswered,
-               "solved": sum(a.success for a in answers),
-               "busy": sum(a.message.startswith("busy: ") for a in answers),
-               "cannot_solve": sum(a.message.startswith("cannot solve: ") for a in answers)}
+    service = {'calls': len(flood_futures), 'unanswered': unanswered,
+               'solved': sum(a.success for a in answers),
+               'busy': sum(a.message.startswith('busy: ') for a in answers),
+               'cannot_solve': sum(a.message.startswith('cannot solve: ') for a in answers)}
     pacer.spin_for(0.3)
     diag_end = dict(diag)
     memory.append((args.duration, vm_rss_kib(node.pid)))
@@ -604,33 +604,33 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
 
     # -- after the run: silences and infeasible phases -----------------------------------------
     for span in spans:
-        if "start_ns" not in span:
+        if 'start_ns' not in span:
             continue
-        kind, a, b = span["kind"], span["start_ns"], span["end_ns"]
-        if kind == "skewed_source":
-            if not span.get("on_clock_commands"):
-                broken("driver_locked_out", f"no command from the on-clock joint states in "
-                       f"the skewed-source phase at {1e-9 * (a - start_ns):.1f} s")
+        kind, a, b = span['kind'], span['start_ns'], span['end_ns']
+        if kind == 'skewed_source':
+            if not span.get('on_clock_commands'):
+                broken('driver_locked_out', f'no command from the on-clock joint states in '
+                       f'the skewed-source phase at {1e-9 * (a - start_ns):.1f} s')
             continue
-        if kind == "limits_below" and "limits_acknowledged_ns" not in span:
-            broken("limits_not_acknowledged", f"at {1e-9 * (a - start_ns):.1f} s")
-        if kind in ("limits_below", "solver_bounds", "service_flood"):
+        if kind == 'limits_below' and 'limits_acknowledged_ns' not in span:
+            broken('limits_not_acknowledged', f'at {1e-9 * (a - start_ns):.1f} s')
+        if kind in ('limits_below', 'solver_bounds', 'service_flood'):
             continue
-        if kind == "silence":
+        if kind == 'silence':
             bound = a + int(1e9 * stop_bound_s)
-            late = [t for t, zero in commands if bound < t <= b and not (zero and policy == "zero")]
+            late = [t for t, zero in commands if bound < t <= b and not (zero and policy == 'zero')]
             if late:
-                broken("command_during_silence",
-                       f"{len(late)} command(s) {1e-9 * (late[0] - a):.3f} s into a silence")
+                broken('command_during_silence',
+                       f'{len(late)} command(s) {1e-9 * (late[0] - a):.3f} s into a silence')
         else:
             # A state of the phase may be answered late, once a holdable load is back.
-            bound = span.get("first_infeasible_ns", a) + int(1e9 * DELIVERY_MARGIN_S)
-            back = span.get("holdable_again_ns", end_ns)
+            bound = span.get('first_infeasible_ns', a) + int(1e9 * DELIVERY_MARGIN_S)
+            back = span.get('holdable_again_ns', end_ns)
             under = [s for s, r in stamped_times if bound < s <= b and r < back]
             if under:
-                broken("command_under_infeasible_load",
-                       f"{len(under)} command(s) stamped {1e-9 * (under[0] - a):.3f} s into "
-                       "an infeasible load")
+                broken('command_under_infeasible_load',
+                       f'{len(under)} command(s) stamped {1e-9 * (under[0] - a):.3f} s into '
+                       'an infeasible load')
     mixed_commands = [t for t, _ in commands if start_ns <= t <= end_ns + int(1e9 * DRAIN_S)]
     latencies = [(s, r) for s, r in stamped_times if s >= start_ns]
 
@@ -640,42 +640,42 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         except (KeyError, ValueError):
             return None
 
-    keys = sorted({k for k in diag_end if k in ("cycles", "commands", "zero_commands", "faults",
-                                                "recoveries", "overruns", "solver_failures")
-                   or k.startswith("rejected.")})
-    node_counters = {k: {"start": counter(diag_start, k), "end": counter(diag_end, k)}
+    keys = sorted({k for k in diag_end if k in ('cycles', 'commands', 'zero_commands', 'faults',
+                                                'recoveries', 'overruns', 'solver_failures')
+                   or k.startswith('rejected.')})
+    node_counters = {k: {'start': counter(diag_start, k), 'end': counter(diag_end, k)}
                      for k in keys}
     for v in node_counters.values():
-        v["during"] = (v["end"] - v["start"]) if None not in (v["start"], v["end"]) else None
+        v['during'] = (v['end'] - v['start']) if None not in (v['start'], v['end']) else None
     result = {
-        "machine": mach, "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "duration_s": args.duration, "rate_hz": args.rate, "seed": args.seed,
-        "params_file": PARAMS.name, "fault_policy": policy, "stop_bound_s": stop_bound_s,
-        "delivery_margin_s": DELIVERY_MARGIN_S, "mix": mix, "sent": sent,
-        "published_joint_state_rate_hz": published_rate,
-        "publish_lateness": percentiles_ms(pacer.lateness[-n_ticks:]),
-        "commands_received": len(commands) - commands_before,
-        "commands_received_in_mix": len(mixed_commands),
-        "stamped_commands_matched": stamped_ok - stamped_before,
-        "zero_policy_commands": zero_policy_commands,
-        "latency_ms": percentiles_ms([1e-9 * (r - s) for s, r in latencies]),
-        "latency_ms_per_window": _windows(latencies, start_ns, args.duration),
-        "node_counters": node_counters, "service_flood": service,
-        "late_receipts": late_receipts["n"],
-        "node_fault_at_end": diag_end.get("fault"),
-        "memory_kib": [{"t_s": t, "vm_rss_kib": r} for t, r in memory],
-        "memory_growth_kib": (memory[-1][1] - memory[0][1])
+        'machine': mach, 'date_utc': datetime.now(timezone.utc).isoformat(timespec='seconds'),
+        'duration_s': args.duration, 'rate_hz': args.rate, 'seed': args.seed,
+        'params_file': PARAMS.name, 'fault_policy': policy, 'stop_bound_s': stop_bound_s,
+        'delivery_margin_s': DELIVERY_MARGIN_S, 'mix': mix, 'sent': sent,
+        'published_joint_state_rate_hz': published_rate,
+        'publish_lateness': percentiles_ms(pacer.lateness[-n_ticks:]),
+        'commands_received': len(commands) - commands_before,
+        'commands_received_in_mix': len(mixed_commands),
+        'stamped_commands_matched': stamped_ok - stamped_before,
+        'zero_policy_commands': zero_policy_commands,
+        'latency_ms': percentiles_ms([1e-9 * (r - s) for s, r in latencies]),
+        'latency_ms_per_window': _windows(latencies, start_ns, args.duration),
+        'node_counters': node_counters, 'service_flood': service,
+        'late_receipts': late_receipts['n'],
+        'node_fault_at_end': diag_end.get('fault'),
+        'memory_kib': [{'t_s': t, 'vm_rss_kib': r} for t, r in memory],
+        'memory_growth_kib': (memory[-1][1] - memory[0][1])
         if memory[0][1] is not None and memory[-1][1] is not None else None,
-        "other_processes_cores": others, "node_alive_at_end": alive,
-        "invariants_broken": sum(violations.values()) + (0 if alive else 1),
-        "violations": violations if alive else {**violations, "node_died": 1},
-        "examples": examples,
+        'other_processes_cores': others, 'node_alive_at_end': alive,
+        'invariants_broken': sum(violations.values()) + (0 if alive else 1),
+        'violations': violations if alive else {**violations, 'node_died': 1},
+        'examples': examples,
     }
     print()
     print(report(result))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=2))
-    print(f"\nwritten: {args.out}")
+    print(f'\nwritten: {args.out}')
     return result
 
 
@@ -686,27 +686,27 @@ def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -
     for i in range(MEMORY_SAMPLES):
         a, b = start_ns + int(1e9 * i * width), start_ns + int(1e9 * (i + 1) * width)
         v = [1e-9 * (r - s) for s, r in latencies if a <= s < b]
-        out.append({"t_s": i * width, "n": len(v), **percentiles_ms(v)})
+        out.append({'t_s': i * width, 'n': len(v), **percentiles_ms(v)})
     return out
 
 
 def report(r: dict) -> str:
     """The soak run as a markdown block."""
-    c = r["node_counters"]
+    c = r['node_counters']
 
     def during(key: str) -> str:
-        v = c.get(key, {}).get("during")
-        return "-" if v is None else str(v)
+        v = c.get(key, {}).get('during')
+        return '-' if v is None else str(v)
 
-    js = r["sent"]["joint_states"]
-    ct = r["sent"]["contacts"]
-    wr = r["sent"]["external_wrench"]
-    mem = r["memory_kib"]
+    js = r['sent']['joint_states']
+    ct = r['sent']['contacts']
+    wr = r['sent']['external_wrench']
+    mem = r['memory_kib']
     lines = [
         f"### Soak: {r['duration_s']:g} s at {r['rate_hz']:g} Hz, seed {r['seed']} "
         f"({r['machine']['cpu']}, {r['machine']['cores']} cores; {r['date_utc']})",
-        "",
-        "| figure | value |", "|---|---:|",
+        '',
+        '| figure | value |', '|---|---:|',
         f"| joint states published (valid / invalid) | {js['valid']} / "
         f"{sum(v for k, v in js.items() if k != 'valid')} |",
         f"| joint-state rate achieved [Hz] | {r['published_joint_state_rate_hz']:.1f} |",
@@ -716,8 +716,8 @@ def report(r: dict) -> str:
         f"{sum(v for k, v in wr.items() if k not in ('valid', 'infeasible'))} |",
         f"| silences / infeasible-load phases | {r['mix']['silences']} / "
         f"{r['mix']['infeasible_load_phases']} |",
-        "| skewed-source / limits-below / solver-bounds / service-flood phases | "
-        + " / ".join(str(r["mix"][f"{k}_phases"]) for k in ISSUE13_PHASES) + " |",
+        '| skewed-source / limits-below / solver-bounds / service-flood phases | '
+        + ' / '.join(str(r['mix'][f'{k}_phases']) for k in ISSUE13_PHASES) + ' |',
         f"| service calls (solved / busy / cannot solve / unanswered) | "
         f"{r['service_flood']['calls']} ({r['service_flood']['solved']} / "
         f"{r['service_flood']['busy']} / {r['service_flood']['cannot_solve']} / "
@@ -741,25 +741,25 @@ def report(r: dict) -> str:
         f"| other work on the machine [cores] | {_f(r['other_processes_cores'], '.2f')} |",
         f"| **invariants broken** | **{r['invariants_broken']}** |",
     ]
-    if r["violations"]:
-        lines += ["", "violations: " + ", ".join(f"{k} {v}" for k, v in r["violations"].items())]
-        lines += [f"- {e}" for e in r["examples"]]
-    sent = ", ".join(f"{k} {v}" for k, v in js.items() if k != "valid")
-    lines += ["", f"invalid joint states sent: {sent}",
-              "invalid contacts sent: " + ", ".join(f"{k} {v}" for k, v in ct.items()
-                                                     if k != "valid"),
-              "invalid loads sent: " + ", ".join(f"{k} {v}" for k, v in wr.items()
-                                                 if k not in ("valid", "infeasible"))]
-    return "\n".join(lines)
+    if r['violations']:
+        lines += ['', 'violations: ' + ', '.join(f'{k} {v}' for k, v in r['violations'].items())]
+        lines += [f'- {e}' for e in r['examples']]
+    sent = ', '.join(f'{k} {v}' for k, v in js.items() if k != 'valid')
+    lines += ['', f'invalid joint states sent: {sent}',
+              'invalid contacts sent: ' + ', '.join(f'{k} {v}' for k, v in ct.items()
+                                                     if k != 'valid'),
+              'invalid loads sent: ' + ', '.join(f'{k} {v}' for k, v in wr.items()
+                                                 if k not in ('valid', 'infeasible'))]
+    return '\n'.join(lines)
 
 
-def _f(x: float | None, spec: str = ".3f") -> str:
-    return "-" if x is None else format(x, spec)
+def _f(x: float | None, spec: str = '.3f') -> str:
+    return '-' if x is None else format(x, spec)
 
 
 def _mib(kib: int | None) -> str:
-    return "-" if kib is None else f"{kib / 1024:.1f}"
+    return '-' if kib is None else f'{kib / 1024:.1f}'
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -1,4 +1,5 @@
-"""QP solvers side by side on the tau-QP, the exact-cone references, and warm starts.
+"""
+QP solvers side by side on the tau-QP, the exact-cone references, and warm starts.
 
 Usage: .venv/bin/python bench/solvers.py [--grasps 200] [--seed 0] [--repeats 5]
        [--scenario-repeats 200] [--steps 500] [--out bench/results/solvers.json]
@@ -61,11 +62,11 @@ cold one, or it lands more than 1e-6 (in tau, infinity norm) off the cold optimu
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 import dataclasses
+from pathlib import Path
 import sys
 import time
-from collections.abc import Callable
-from pathlib import Path
 
 import clarabel
 import numpy as np
@@ -74,19 +75,18 @@ import proxsuite
 import scipy.sparse as sp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import ROOT, SCENARIOS, machine, report  # noqa: E402
-from grasps import SCENARIO, allegro_grasps, blas_threads  # noqa: E402
-
+from cycle import machine, report, ROOT, SCENARIOS  # noqa: E402
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings  # noqa: E402
 from grasp_torque_opt.core.certificate import certify  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.core.solution import RawResult  # noqa: E402
-from grasp_torque_opt.core.tau_qp import TauQP, build_tau_qp  # noqa: E402
+from grasp_torque_opt.core.tau_qp import build_tau_qp, TauQP  # noqa: E402
 from grasp_torque_opt.reference.conic import solve_conic  # noqa: E402
 from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp  # noqa: E402
 from grasp_torque_opt.reference.exact_socp import solve_exact_socp  # noqa: E402
 from grasp_torque_opt.reference.force_qp import solve_force_qp  # noqa: E402
+from grasps import allegro_grasps, blas_threads, SCENARIO  # noqa: E402
 
 #: Two optima agree when their torques differ by at most this [N m].
 AGREE_TOL = 1e-6
@@ -94,27 +94,27 @@ AGREE_TOL = 1e-6
 TUNING_GRASPS, TUNING_SEED_OFFSET = 50, 1000
 OSQP_MAX_ITER = 10000
 #: Rows too slow to call more than once per grasp.
-SLOW_ROWS = ("osqp", "slsqp")
+SLOW_ROWS = ('osqp', 'slsqp')
 
 DENSE = proxsuite.proxqp.dense
-QP_ROWS = ["proxsuite", "proxsuite-tuned", "daqp", "quadprog", "osqp", "clarabel-qp"]
-EXACT_ROWS = ["clarabel-socp", "slsqp"]
+QP_ROWS = ['proxsuite', 'proxsuite-tuned', 'daqp', 'quadprog', 'osqp', 'clarabel-qp']
+EXACT_ROWS = ['clarabel-socp', 'slsqp']
 
 
 # ---------------------------------------------------------------- solvers
 
 
 def variant_label(v: ProxSuiteSettings) -> str:
-    return (f"HessianType.{v.hessian_type}, DenseBackend.{v.dense_backend}, eps_abs "
-            f"{v.eps_abs:g}, preconditioner {v.preconditioner}")
+    return (f'HessianType.{v.hessian_type}, DenseBackend.{v.dense_backend}, eps_abs '
+            f'{v.eps_abs:g}, preconditioner {v.preconditioner}')
 
 
 def variant_grid() -> list[ProxSuiteSettings]:
     """ProxSuite dense variants: Hessian type, dense backend, tolerance, preconditioner."""
     return [ProxSuiteSettings(eps_abs=e, hessian_type=h, dense_backend=b, preconditioner=pc)
-            for h in ("Dense", "Diagonal")
-            for b in ("Automatic", "PrimalDualLDLT", "PrimalLDLT")
-            for e in (1e-9, 1e-8, 1e-7) for pc in ("first", "every", "off")]
+            for h in ('Dense', 'Diagonal')
+            for b in ('Automatic', 'PrimalDualLDLT', 'PrimalLDLT')
+            for e in (1e-9, 1e-8, 1e-7) for pc in ('first', 'every', 'off')]
 
 
 def _finite_box(qp: TauQP) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,8 +136,8 @@ def solve_osqp(qp: TauQP) -> RawResult:
     elapsed = time.perf_counter() - t0
     ok = res.info.status_val == osqp.SolverStatus.OSQP_SOLVED
     x = None if res.x is None else np.asarray(res.x, dtype=float)
-    return RawResult("solved" if ok else "error", x, int(res.info.iter), elapsed,
-                     f"{res.info.status} (polish {res.info.status_polish})")
+    return RawResult('solved' if ok else 'error', x, int(res.info.iter), elapsed,
+                     f'{res.info.status} (polish {res.info.status_polish})')
 
 
 def solve_clarabel_qp(qp: TauQP) -> RawResult:
@@ -192,28 +192,28 @@ class Grasp:
 
 def outcome(grasp: Grasp, raw: RawResult, kind: str) -> tuple[bool, np.ndarray | None, str]:
     """(certified, tau, why not) of one call."""
-    tau, f = grasp.from_qp(raw) if kind == "qp" else grasp.from_f(raw)
-    if raw.status != "solved" or tau is None:
-        return False, tau, f"{raw.status}: {raw.message}"
+    tau, f = grasp.from_qp(raw) if kind == 'qp' else grasp.from_f(raw)
+    if raw.status != 'solved' or tau is None:
+        return False, tau, f'{raw.status}: {raw.message}'
     cert = grasp.certify_tau_f(tau, f)
     if not cert.ok:
-        return False, tau, f"certificate failed (worst {cert.worst:.3g}; solver {raw.message})"
-    return True, tau, ""
+        return False, tau, f'certificate failed (worst {cert.worst:.3g}; solver {raw.message})'
+    return True, tau, ''
 
 
 def make_rows(variant: ProxSuiteSettings) -> dict[str, tuple[str, Callable[[Grasp], RawResult]]]:
     """Row name -> (kind, call); each call sees only the grasp."""
-    prox, tuned = make_solver("proxsuite"), make_solver("proxsuite", variant)
-    daqp_, quadprog_ = make_solver("daqp"), make_solver("quadprog")
+    prox, tuned = make_solver('proxsuite'), make_solver('proxsuite', variant)
+    daqp_, quadprog_ = make_solver('daqp'), make_solver('quadprog')
     return {
-        "proxsuite": ("qp", lambda g: prox.solve(g.qp)),
-        "proxsuite-tuned": ("qp", lambda g: tuned.solve(g.qp)),
-        "daqp": ("qp", lambda g: daqp_.solve(g.qp)),
-        "quadprog": ("qp", lambda g: quadprog_.solve(g.qp)),
-        "osqp": ("qp", lambda g: solve_osqp(g.qp)),
-        "clarabel-qp": ("qp", lambda g: solve_clarabel_qp(g.qp)),
-        "clarabel-socp": ("exact", lambda g: solve_exact_socp(*g.args)),
-        "slsqp": ("exact", lambda g: solve_exact_nlp(*g.args)),
+        'proxsuite': ('qp', lambda g: prox.solve(g.qp)),
+        'proxsuite-tuned': ('qp', lambda g: tuned.solve(g.qp)),
+        'daqp': ('qp', lambda g: daqp_.solve(g.qp)),
+        'quadprog': ('qp', lambda g: quadprog_.solve(g.qp)),
+        'osqp': ('qp', lambda g: solve_osqp(g.qp)),
+        'clarabel-qp': ('qp', lambda g: solve_clarabel_qp(g.qp)),
+        'clarabel-socp': ('exact', lambda g: solve_exact_socp(*g.args)),
+        'slsqp': ('exact', lambda g: solve_exact_nlp(*g.args)),
     }
 
 
@@ -229,21 +229,21 @@ def compare(setups: list[GraspSetup], repeats: int, variant: ProxSuiteSettings,
     """Every row on every grasp: failures, agreement, times, ratios (see the module docstring)."""
     table_rows = make_rows(variant)
     names = rows or list(table_rows)
-    per = {r: {"failed": 0, "fail_examples": [], "dev": [], "times": [], "samples": [],
-               "iters": []} for r in names}
+    per = {r: {'failed': 0, 'fail_examples': [], 'dev': [], 'times': [], 'samples': [],
+               'iters': []} for r in names}
     ref_failed, excess = 0, {r: [] for r in EXACT_ROWS}
     single = len(setups) == 1
     for i, setup in enumerate(setups):
         g = Grasp.of(setup)
-        ref_raw = solve_force_qp(*g.args, objective="torque")
-        ok, tau_ref, why = outcome(g, ref_raw, "exact")
+        ref_raw = solve_force_qp(*g.args, objective='torque')
+        ok, tau_ref, why = outcome(g, ref_raw, 'exact')
         if not ok:
             ref_failed += 1
             tau_ref = None
         tau_exact = {}
         for r in names:
             kind, call = table_rows[r]
-            times, good, tau, why = [], True, None, ""
+            times, good, tau, why = [], True, None, ''
             for _ in range(1 if r in SLOW_ROWS and not single else repeats):
                 t0 = time.perf_counter()
                 raw = call(g)
@@ -252,45 +252,45 @@ def compare(setups: list[GraspSetup], repeats: int, variant: ProxSuiteSettings,
                 if not ok and good:
                     good, why = False, why_k
             rec = per[r]
-            rec["times"].append(float(np.median(times)))
-            rec["samples"].extend(times)
-            rec["iters"].append(raw.iterations)
+            rec['times'].append(float(np.median(times)))
+            rec['samples'].extend(times)
+            rec['iters'].append(raw.iterations)
             if not good:
-                rec["failed"] += 1
-                if len(rec["fail_examples"]) < 5:
-                    rec["fail_examples"].append({"grasp": i, "why": why})
+                rec['failed'] += 1
+                if len(rec['fail_examples']) < 5:
+                    rec['fail_examples'].append({'grasp': i, 'why': why})
                 continue
             if r in EXACT_ROWS:
                 tau_exact[r] = tau
-            ref = tau_ref if r in QP_ROWS else tau_exact.get("clarabel-socp") if r == "slsqp" \
+            ref = tau_ref if r in QP_ROWS else tau_exact.get('clarabel-socp') if r == 'slsqp' \
                 else None
             if ref is not None:
-                rec["dev"].append(float(np.max(np.abs(tau - ref))))
+                rec['dev'].append(float(np.max(np.abs(tau - ref))))
         for r, t in tau_exact.items():
             if tau_ref is not None:
                 excess[r].append(float(np.linalg.norm(tau_ref) / np.linalg.norm(t) - 1.0))
-    out = {"grasps": len(setups), "repeats": repeats, "reference_failed": ref_failed,
-           "time_statistic": ("over the calls" if single else
-                              "per grasp the median of the calls; then over the grasps"),
-           "rows": {}}
+    out = {'grasps': len(setups), 'repeats': repeats, 'reference_failed': ref_failed,
+           'time_statistic': ('over the calls' if single else
+                              'per grasp the median of the calls; then over the grasps'),
+           'rows': {}}
     base = None
     for r in names:
         rec = per[r]
-        t = rec["samples"] if single else rec["times"]
-        row = {"failed": rec["failed"], "fail_examples": rec["fail_examples"],
-               "agreement_n": len(rec["dev"]),
-               "max_abs_tau_dev": max(rec["dev"]) if rec["dev"] else None,
-               "median_s": pct(t, 50), "p99_s": pct(t, 99),
-               "iterations_median": float(np.median(rec["iters"]))}
-        if r == "proxsuite":
-            base = row["median_s"]
+        t = rec['samples'] if single else rec['times']
+        row = {'failed': rec['failed'], 'fail_examples': rec['fail_examples'],
+               'agreement_n': len(rec['dev']),
+               'max_abs_tau_dev': max(rec['dev']) if rec['dev'] else None,
+               'median_s': pct(t, 50), 'p99_s': pct(t, 99),
+               'iterations_median': float(np.median(rec['iters']))}
+        if r == 'proxsuite':
+            base = row['median_s']
         if r in EXACT_ROWS and excess[r]:
             e = excess[r]
-            row["excess_polygon_over_exact"] = {"n": len(e), "median": pct(e, 50),
-                                                "p90": pct(e, 90), "max": max(e)}
-        out["rows"][r] = row
-    for r, row in out["rows"].items():
-        row["ratio_to_proxsuite"] = (row["median_s"] / base) if base else None
+            row['excess_polygon_over_exact'] = {'n': len(e), 'median': pct(e, 50),
+                                                'p90': pct(e, 90), 'max': max(e)}
+        out['rows'][r] = row
+    for r, row in out['rows'].items():
+        row['ratio_to_proxsuite'] = (row['median_s'] / base) if base else None
     return out
 
 
@@ -299,11 +299,11 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
     grasps = [Grasp.of(s) for s in setups]
     refs = []
     for g in grasps:
-        ok, tau, _ = outcome(g, solve_force_qp(*g.args, objective="torque"), "exact")
+        ok, tau, _ = outcome(g, solve_force_qp(*g.args, objective='torque'), 'exact')
         refs.append(tau if ok else None)
     tried = []
     for v in variant_grid():
-        solver = make_solver("proxsuite", v)
+        solver = make_solver('proxsuite', v)
         times, failed, dev = [], 0, 0.0
         for g, ref in zip(grasps, refs):
             ts, good = [], True
@@ -311,30 +311,31 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
                 t0 = time.perf_counter()
                 raw = solver.solve(g.qp)
                 ts.append(time.perf_counter() - t0)
-                ok, tau, _ = outcome(g, raw, "qp")
+                ok, tau, _ = outcome(g, raw, 'qp')
                 good = good and ok
                 if ok and ref is not None:
                     dev = max(dev, float(np.max(np.abs(tau - ref))))
             times.append(float(np.median(ts)))
             failed += not good
-        tried.append({"variant": dataclasses.asdict(v), "label": variant_label(v), "failed": failed,
-                      "max_abs_tau_dev": dev, "median_s": float(np.median(times))})
-    good = [t for t in tried if t["failed"] == 0 and t["max_abs_tau_dev"] <= AGREE_TOL]
+        tried.append({'variant': dataclasses.asdict(v), 'label': variant_label(v), 'failed': failed,
+                      'max_abs_tau_dev': dev, 'median_s': float(np.median(times))})
+    good = [t for t in tried if t['failed'] == 0 and t['max_abs_tau_dev'] <= AGREE_TOL]
     best = None
     if good:
         # Times are noisy: among the variants within 10% of the fastest, the
         # tightest eps_abs (the most margin under the certificate), then the fastest.
-        fastest = min(t["median_s"] for t in good)
-        near = [t for t in good if t["median_s"] <= 1.1 * fastest]
-        best = min(near, key=lambda t: (t["variant"]["eps_abs"], t["median_s"]))
-    return {"grasps": len(setups), "tried": tried, "best": best}
+        fastest = min(t['median_s'] for t in good)
+        near = [t for t in good if t['median_s'] <= 1.1 * fastest]
+        best = min(near, key=lambda t: (t['variant']['eps_abs'], t['median_s']))
+    return {'grasps': len(setups), 'tried': tried, 'best': best}
 
 
 # ---------------------------------------------------------------- warm starts
 
 
 def sequence(base: GraspSetup, steps: int, kind: str, seed: int = 0) -> list[GraspSetup]:
-    """A slowly moving sequence: the load's force rotating once around base y.
+    """
+    A slowly moving sequence: the load's force rotating once around base y.
 
     ``kind``: ``load`` only that; ``drift`` every joint also drifting sinusoidally by up
     to 0.05 rad; ``step`` the rotating load 1000 times heavier (infeasible) for 10
@@ -346,17 +347,18 @@ def sequence(base: GraspSetup, steps: int, kind: str, seed: int = 0) -> list[Gra
     for k in range(steps):
         th = 2 * np.pi * k / steps
         w = np.array([scale * np.cos(th), 0.0, scale * np.sin(th), 0.0, 0.0, 0.0])
-        if kind == "step" and k % 50 >= 40:
+        if kind == 'step' and k % 50 >= 40:
             w *= 1e3
         q = base.q.copy()
-        if kind == "drift":
+        if kind == 'drift':
             q[base.hand.idx_q] += 0.05 * np.sin(th + phase)
         out.append(dataclasses.replace(base, q=q, external_wrench=w))
     return out
 
 
 def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) -> dict:
-    """Cold and warm solvers on the same steps, in step order; refs: the force-QP taus.
+    """
+    Cold and warm solvers on the same steps, in step order; refs: the force-QP taus.
 
     ``warm`` is the product's verified warm start (make_solver(..., warm_start=True)):
     a warm answer that is not solved is redone cold inside its call (counted by
@@ -366,7 +368,7 @@ def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) ->
     """
     t_cold, t_warm, it_cold, it_warm = [], [], [], []
     cold_bad, not_solved, cert_failed, off, verdict = 0, 0, 0, 0, 0
-    off_ref = {"cold": 0, "warm": 0}
+    off_ref = {'cold': 0, 'warm': 0}
     worst = 0.0
     for g, ref in zip(grasps, refs):
         t0 = time.perf_counter()
@@ -387,49 +389,49 @@ def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) ->
         t_warm.append(elapsed)
         it_cold.append(rc.iterations)
         it_warm.append(rw.iterations)
-        ok_c, tau_c, _ = outcome(g, rc, "qp")
+        ok_c, tau_c, _ = outcome(g, rc, 'qp')
         if not ok_c:
             cold_bad += 1
         elif ref is not None:
-            off_ref["cold"] += float(np.max(np.abs(tau_c - ref))) > AGREE_TOL
-        ok_w = rw.status == "solved" and tau_w is not None and g.certify_tau_f(tau_w, f_w).ok
+            off_ref['cold'] += float(np.max(np.abs(tau_c - ref))) > AGREE_TOL
+        ok_w = rw.status == 'solved' and tau_w is not None and g.certify_tau_f(tau_w, f_w).ok
         verdict += ok_w != ok_c
         if not ok_w:
             continue
         if ref is not None:
-            off_ref["warm"] += float(np.max(np.abs(tau_w - ref))) > AGREE_TOL
+            off_ref['warm'] += float(np.max(np.abs(tau_w - ref))) > AGREE_TOL
         if ok_c:
             d = float(np.max(np.abs(tau_w - tau_c)))
             worst = max(worst, d)
             off += d > AGREE_TOL
-    return {"steps": len(grasps), "cold_not_certified": cold_bad,
-            "warm_not_solved": not_solved, "warm_certificate_failed": cert_failed,
-            "warm_off_cold_optimum": off, "warm_verdict_differs": verdict,
-            "warm_max_abs_tau_dev_from_cold": worst,
-            "cold_off_reference": off_ref["cold"], "warm_off_reference": off_ref["warm"],
-            "cold_median_s": pct(t_cold, 50), "cold_p99_s": pct(t_cold, 99),
-            "warm_median_s": pct(t_warm, 50), "warm_p99_s": pct(t_warm, 99),
-            "cold_iterations_median": float(np.median(it_cold)),
-            "warm_iterations_median": float(np.median(it_warm))}
+    return {'steps': len(grasps), 'cold_not_certified': cold_bad,
+            'warm_not_solved': not_solved, 'warm_certificate_failed': cert_failed,
+            'warm_off_cold_optimum': off, 'warm_verdict_differs': verdict,
+            'warm_max_abs_tau_dev_from_cold': worst,
+            'cold_off_reference': off_ref['cold'], 'warm_off_reference': off_ref['warm'],
+            'cold_median_s': pct(t_cold, 50), 'cold_p99_s': pct(t_cold, 99),
+            'warm_median_s': pct(t_warm, 50), 'warm_p99_s': pct(t_warm, 99),
+            'cold_iterations_median': float(np.median(it_cold)),
+            'warm_iterations_median': float(np.median(it_warm))}
 
 
 def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
     base = GraspSetup.from_file(SCENARIO)
     out = {}
-    for name in ("load", "drift", "step"):
+    for name in ('load', 'drift', 'step'):
         grasps = [Grasp.of(s) for s in sequence(base, steps, name)]
         refs = []
         for g in grasps:
-            ok, tau, _ = outcome(g, solve_force_qp(*g.args, objective="torque"), "exact")
+            ok, tau, _ = outcome(g, solve_force_qp(*g.args, objective='torque'), 'exact')
             refs.append(tau if ok else None)
         out[name] = {
-            "reference_not_certified": sum(r is None for r in refs),
-            "proxsuite": warm_pair(grasps, refs, make_solver("proxsuite"),
-                                   make_solver("proxsuite", warm_start=True)),
-            "proxsuite-tuned": warm_pair(grasps, refs, make_solver("proxsuite", variant),
-                                         make_solver("proxsuite", variant, warm_start=True)),
-            "daqp": warm_pair(grasps, refs, make_solver("daqp"),
-                              make_solver("daqp", warm_start=True)),
+            'reference_not_certified': sum(r is None for r in refs),
+            'proxsuite': warm_pair(grasps, refs, make_solver('proxsuite'),
+                                   make_solver('proxsuite', warm_start=True)),
+            'proxsuite-tuned': warm_pair(grasps, refs, make_solver('proxsuite', variant),
+                                         make_solver('proxsuite', variant, warm_start=True)),
+            'daqp': warm_pair(grasps, refs, make_solver('daqp'),
+                              make_solver('daqp', warm_start=True)),
         }
     return out
 
@@ -442,60 +444,60 @@ def run(grasps: int = 200, seed: int = 0, repeats: int = 5, scenario_repeats: in
     """The whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
     tuning = tune_proxsuite(allegro_grasps(TUNING_GRASPS, seed + TUNING_SEED_OFFSET),
                             max(1, min(repeats, 3)))
-    variant = ProxSuiteSettings(**tuning["best"]["variant"]) if tuning["best"] else \
+    variant = ProxSuiteSettings(**tuning['best']['variant']) if tuning['best'] else \
         ProxSuiteSettings()
     sets = {}
     for name in SCENARIOS:
-        sets[name] = compare([GraspSetup.from_file(ROOT / "config" / name)], scenario_repeats,
+        sets[name] = compare([GraspSetup.from_file(ROOT / 'config' / name)], scenario_repeats,
                              variant)
-    sets[f"allegro grasp set ({grasps}, seed {seed})"] = compare(
+    sets[f'allegro grasp set ({grasps}, seed {seed})'] = compare(
         allegro_grasps(grasps, seed), repeats, variant)
-    return {"machine": machine(), "osqp": osqp.__version__, "blas_threads": blas_threads(),
-            "grasps": grasps, "seed": seed, "repeats": repeats,
-            "tuning": tuning, "tuned_variant": variant_label(variant), "sets": sets,
-            "warm_starts": warm_starts(steps, variant)}
+    return {'machine': machine(), 'osqp': osqp.__version__, 'blas_threads': blas_threads(),
+            'grasps': grasps, 'seed': seed, 'repeats': repeats,
+            'tuning': tuning, 'tuned_variant': variant_label(variant), 'sets': sets,
+            'warm_starts': warm_starts(steps, variant)}
 
 
 def _us(x: float | None) -> str:
-    return "-" if x is None else f"{1e6 * x:.0f}"
+    return '-' if x is None else f'{1e6 * x:.0f}'
 
 
 def table(results: dict) -> str:
     """Markdown tables: one per problem set, then the warm starts."""
-    lines = [f"ProxSuite tuned: {results['tuned_variant']}", ""]
-    for name, res in results["sets"].items():
+    lines = [f"ProxSuite tuned: {results['tuned_variant']}", '']
+    for name, res in results['sets'].items():
         lines += [f"**{name}** ({res['grasps']} grasp(s), {res['time_statistic']}; "
-                  f"reference not certified: {res['reference_failed']})", "",
-                  "| solver | failed | max abs tau - ref [N m] | median [us] | p99 [us] | "
-                  "ratio to proxsuite | polygon excess over exact (median / max) |",
-                  "|---|---:|---:|---:|---:|---:|---|"]
-        for r, row in res["rows"].items():
-            dev = "-" if row["max_abs_tau_dev"] is None else f"{row['max_abs_tau_dev']:.1e}"
-            ratio = "-" if row["ratio_to_proxsuite"] is None else f"{row['ratio_to_proxsuite']:.2f}"
-            ex = row.get("excess_polygon_over_exact")
-            ex = "" if not ex else f"{100 * ex['median']:.2f}% / {100 * ex['max']:.2f}%"
+                  f"reference not certified: {res['reference_failed']})", '',
+                  '| solver | failed | max abs tau - ref [N m] | median [us] | p99 [us] | '
+                  'ratio to proxsuite | polygon excess over exact (median / max) |',
+                  '|---|---:|---:|---:|---:|---:|---|']
+        for r, row in res['rows'].items():
+            dev = '-' if row['max_abs_tau_dev'] is None else f"{row['max_abs_tau_dev']:.1e}"
+            ratio = '-' if row['ratio_to_proxsuite'] is None else f"{row['ratio_to_proxsuite']:.2f}"
+            ex = row.get('excess_polygon_over_exact')
+            ex = '' if not ex else f"{100 * ex['median']:.2f}% / {100 * ex['max']:.2f}%"
             lines.append(f"| {r} | {row['failed']} | {dev} | {_us(row['median_s'])} | "
                          f"{_us(row['p99_s'])} | {ratio} | {ex} |")
-        rows = res["rows"]
-        slsqp = rows.get("slsqp", {})
-        if slsqp.get("median_s") and slsqp.get("excess_polygon_over_exact"):
-            ex = slsqp["excess_polygon_over_exact"]
-            speed = ", ".join(f"{r} {slsqp['median_s'] / rows[r]['median_s']:.0f}x"
-                              for r in ("proxsuite", "proxsuite-tuned", "daqp", "quadprog")
-                              if rows.get(r, {}).get("median_s"))
-            lines += ["", f"Faster than SLSQP on the exact cone (median over median; target "
+        rows = res['rows']
+        slsqp = rows.get('slsqp', {})
+        if slsqp.get('median_s') and slsqp.get('excess_polygon_over_exact'):
+            ex = slsqp['excess_polygon_over_exact']
+            speed = ', '.join(f"{r} {slsqp['median_s'] / rows[r]['median_s']:.0f}x"
+                              for r in ('proxsuite', 'proxsuite-tuned', 'daqp', 'quadprog')
+                              if rows.get(r, {}).get('median_s'))
+            lines += ['', f"Faster than SLSQP on the exact cone (median over median; target "
                       f"1000x): {speed}; torque-norm excess of the polygon optimum over the "
                       f"exact one: median {100 * ex['median']:.2f}%, p90 {100 * ex['p90']:.2f}%,"
                       f" max {100 * ex['max']:.2f}%."]
-        lines.append("")
-    lines += ["**warm starts** (cold bad: not certified; warm redone cold: not solved / "
-              "certificate failed; warm bad: verdict differs from the cold one / off the cold "
-              "optimum by > 1e-6; off ref: > 1e-6 from the force QP)",
-              "", "| sequence | solver | cold median / p99 [us] | warm median / p99 [us] | "
-              "iterations cold / warm | cold bad | warm redone cold | warm bad | "
-              "max abs warm - cold [N m] | off ref cold / warm |",
-              "|---|---|---|---|---|---:|---|---|---:|---|"]
-    for seq, res in results["warm_starts"].items():
+        lines.append('')
+    lines += ['**warm starts** (cold bad: not certified; warm redone cold: not solved / '
+              'certificate failed; warm bad: verdict differs from the cold one / off the cold '
+              'optimum by > 1e-6; off ref: > 1e-6 from the force QP)',
+              '', '| sequence | solver | cold median / p99 [us] | warm median / p99 [us] | '
+              'iterations cold / warm | cold bad | warm redone cold | warm bad | '
+              'max abs warm - cold [N m] | off ref cold / warm |',
+              '|---|---|---|---|---|---:|---|---|---:|---|']
+    for seq, res in results['warm_starts'].items():
         for solver, w in res.items():
             if not isinstance(w, dict):
                 continue
@@ -508,22 +510,22 @@ def table(results: dict) -> str:
                 f"{w['warm_off_cold_optimum']} | "
                 f"{w['warm_max_abs_tau_dev_from_cold']:.1e} | {w['cold_off_reference']} / "
                 f"{w['warm_off_reference']} |")
-    return "\n".join(lines)
+    return '\n'.join(lines)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--grasps", type=int, default=200)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--repeats", type=int, default=5, help="calls per grasp (median taken)")
-    parser.add_argument("--scenario-repeats", type=int, default=200)
-    parser.add_argument("--steps", type=int, default=500, help="warm-start sequence length")
-    parser.add_argument("--out", type=Path, help="write the results as JSON here")
+    parser.add_argument('--grasps', type=int, default=200)
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--repeats', type=int, default=5, help='calls per grasp (median taken)')
+    parser.add_argument('--scenario-repeats', type=int, default=200)
+    parser.add_argument('--steps', type=int, default=500, help='warm-start sequence length')
+    parser.add_argument('--out', type=Path, help='write the results as JSON here')
     args = parser.parse_args()
     res = run(args.grasps, args.seed, args.repeats, args.scenario_repeats, args.steps)
     report(res, table(res), args.out,
            f"{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp; threads: {res['blas_threads']}")
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     main()

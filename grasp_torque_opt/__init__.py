@@ -1,4 +1,5 @@
-"""Minimum-effort grasp joint torques with linearized soft-finger friction cones.
+"""
+Minimum-effort grasp joint torques with linearized soft-finger friction cones.
 
 The package is layered (docs/architecture.md); each family imports only the ones
 below it:
@@ -24,32 +25,32 @@ import importlib
 
 #: Public name -> module that defines it.
 _EXPORTS = {
-    "GraspSetup": "grasp_torque_opt.core.grasp_setup",
-    "load_scenario": "grasp_torque_opt.core.scenario",
-    "parse_scenario": "grasp_torque_opt.core.scenario",
-    "Scenario": "grasp_torque_opt.core.scenario",
-    "Solution": "grasp_torque_opt.core.solution",
-    "solution_dict": "grasp_torque_opt.core.report",
-    "GraspTorqueError": "grasp_torque_opt.core.exceptions",
-    "InputError": "grasp_torque_opt.core.exceptions",
-    "SolverError": "grasp_torque_opt.core.exceptions",
-    "BACKENDS": "grasp_torque_opt.backends",
-    "make_solver": "grasp_torque_opt.backends",
-    "ProxSuiteSettings": "grasp_torque_opt.backends.proxsuite",
-    "METHODS": "grasp_torque_opt.methods.dispatch",
-    "Refiner": "grasp_torque_opt.methods.adaptive",
-    "AdaptiveSettings": "grasp_torque_opt.methods.adaptive",
-    "Bounds": "grasp_torque_opt.core.bounds",
-    "solve": "grasp_torque_opt.methods.dispatch",
-    "compare": "grasp_torque_opt.methods.compare",
+    'GraspSetup': 'grasp_torque_opt.core.grasp_setup',
+    'load_scenario': 'grasp_torque_opt.core.scenario',
+    'parse_scenario': 'grasp_torque_opt.core.scenario',
+    'Scenario': 'grasp_torque_opt.core.scenario',
+    'Solution': 'grasp_torque_opt.core.solution',
+    'solution_dict': 'grasp_torque_opt.core.report',
+    'GraspTorqueError': 'grasp_torque_opt.core.exceptions',
+    'InputError': 'grasp_torque_opt.core.exceptions',
+    'SolverError': 'grasp_torque_opt.core.exceptions',
+    'BACKENDS': 'grasp_torque_opt.backends',
+    'make_solver': 'grasp_torque_opt.backends',
+    'ProxSuiteSettings': 'grasp_torque_opt.backends.proxsuite',
+    'METHODS': 'grasp_torque_opt.methods.dispatch',
+    'Refiner': 'grasp_torque_opt.methods.adaptive',
+    'AdaptiveSettings': 'grasp_torque_opt.methods.adaptive',
+    'Bounds': 'grasp_torque_opt.core.bounds',
+    'solve': 'grasp_torque_opt.methods.dispatch',
+    'compare': 'grasp_torque_opt.methods.compare',
     # The planner's numbers (docs/planner.md).
-    "load_capacity": "grasp_torque_opt.methods.capacity",
-    "direction_capacities": "grasp_torque_opt.methods.capacity",
-    "Capacity": "grasp_torque_opt.methods.capacity",
-    "explain": "grasp_torque_opt.methods.explain",
-    "ScoreJob": "grasp_torque_opt.methods.score",
-    "score_batch": "grasp_torque_opt.methods.score",
-    "read_candidates": "grasp_torque_opt.methods.score",
+    'load_capacity': 'grasp_torque_opt.methods.capacity',
+    'direction_capacities': 'grasp_torque_opt.methods.capacity',
+    'Capacity': 'grasp_torque_opt.methods.capacity',
+    'explain': 'grasp_torque_opt.methods.explain',
+    'ScoreJob': 'grasp_torque_opt.methods.score',
+    'score_batch': 'grasp_torque_opt.methods.score',
+    'read_candidates': 'grasp_torque_opt.methods.score',
 }
 
 __all__ = sorted(_EXPORTS)

@@ -1,6 +1,7 @@
 # Copyright 2026 grasp_torque_opt developers
 # SPDX-License-Identifier: BSD-3-Clause
-"""Start grasp_torque_node beside a ros2_control effort controller.
+"""
+Start grasp_torque_node beside a ros2_control effort controller.
 
     ros2 launch grasp_torque_opt grasp_torque.launch.py \
         params_file:=/path/to/my_hand_node.yaml controller:=effort_controller \
@@ -18,10 +19,11 @@ parameter; otherwise the scenario's ``hand.urdf`` is used.
 import os
 
 from ament_index_python.packages import get_package_share_directory
-from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
+
+from launch import LaunchDescription
 
 PACKAGE = 'grasp_torque_opt'
 

@@ -1,4 +1,5 @@
-"""The adversarial campaign's tools: messages generated from their definitions, the
+"""
+The adversarial campaign's tools: messages generated from their definitions, the
 invariants every published command must meet, and the counts printed after the run.
 
 Strategies start from a valid message and overwrite some of its fields, each chosen
@@ -13,12 +14,12 @@ from __future__ import annotations
 import copy
 import importlib
 
-import numpy as np
 from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
+import numpy as np
 
 #: Counts of the whole run, printed by conftest's terminal summary.
-COUNTS = {"inputs": 0, "commands": 0, "broken": 0}
+COUNTS = {'inputs': 0, 'commands': 0, 'broken': 0}
 
 #: Reproducible and bounded: CI sees the same examples every run.
 CAMPAIGN = settings(deadline=None, derandomize=True, database=None,
@@ -36,18 +37,20 @@ FLOATS = st.one_of(
 
 def message_class(type_name: str):
     """The Python class of a ROS type such as ``geometry_msgs/Pose``."""
-    package, name = type_name.split("/")
-    return getattr(importlib.import_module(f"{package}.msg"), name)
+    package, name = type_name.split('/')
+    return getattr(importlib.import_module(f'{package}.msg'), name)
 
 
-def leaf_fields(cls, prefix: str = "") -> list[tuple[str, str]]:
-    """(dotted path, type) of every leaf field of a message class, from its definition.
-    Sequences of messages are leaves (their length and content are generated whole)."""
+def leaf_fields(cls, prefix: str = '') -> list[tuple[str, str]]:
+    """
+    (dotted path, type) of every leaf field of a message class, from its definition.
+    Sequences of messages are leaves (their length and content are generated whole).
+    """
     out = []
     for name, typ in cls.get_fields_and_field_types().items():
-        path = f"{prefix}{name}"
-        if "/" in typ and not typ.startswith("sequence<"):
-            out += leaf_fields(message_class(typ), path + ".")
+        path = f'{prefix}{name}'
+        if '/' in typ and not typ.startswith('sequence<'):
+            out += leaf_fields(message_class(typ), path + '.')
         else:
             out.append((path, typ))
     return out
@@ -55,18 +58,18 @@ def leaf_fields(cls, prefix: str = "") -> list[tuple[str, str]]:
 
 def value_of(typ: str, names: list[str], max_len: int = 12) -> st.SearchStrategy:
     """Values of a ROS field type, valid and invalid."""
-    if typ in ("double", "float"):
+    if typ in ('double', 'float'):
         return FLOATS
-    if typ == "int32":
+    if typ == 'int32':
         return st.one_of(st.integers(-2**31, 2**31 - 1), st.sampled_from([0, -1, 2**31 - 1]))
-    if typ == "uint32":
+    if typ == 'uint32':
         return st.one_of(st.integers(0, 2**32 - 1), st.just(0))
-    if typ == "string":
-        return st.one_of(st.sampled_from(names + ["", "no_such_frame", "x" * 5000]),
+    if typ == 'string':
+        return st.one_of(st.sampled_from(names + ['', 'no_such_frame', 'x' * 5000]),
                          st.text(max_size=12))
-    if typ.startswith("sequence<"):
-        inner = typ[len("sequence<"):-1]
-        item = messages_of(message_class(inner), names) if "/" in inner else \
+    if typ.startswith('sequence<'):
+        inner = typ[len('sequence<'):-1]
+        item = messages_of(message_class(inner), names) if '/' in inner else \
             value_of(inner, names)
         return st.one_of(st.lists(item, max_size=max_len), st.just(OVERSIZED))
     raise NotImplementedError(typ)
@@ -87,7 +90,7 @@ def messages_of(cls, names: list[str]) -> st.SearchStrategy:
 
 def set_field(msg, path: str, value) -> None:
     """Set a dotted field; :data:`OVERSIZED` fills a sequence with 100000 default items."""
-    *parents, last = path.split(".")
+    *parents, last = path.split('.')
     target = msg
     for p in parents:
         target = getattr(target, p)
@@ -107,8 +110,8 @@ def mutated(draw, valid, names: list[str], max_mutations: int = 3):
     leaves = leaf_fields(type(valid))
     for _ in range(draw(st.integers(0, max_mutations))):
         path, typ = draw(st.sampled_from(leaves))
-        items = getattr(msg, path) if "." not in path else None
-        if typ.startswith("sequence<") and "/" in typ and items and draw(st.booleans()):
+        items = getattr(msg, path) if '.' not in path else None
+        if typ.startswith('sequence<') and '/' in typ and items and draw(st.booleans()):
             # One field of one item, e.g. poses[1].orientation.w.
             item = items[draw(st.integers(0, len(items) - 1))]
             sub, sub_typ = draw(st.sampled_from(leaf_fields(type(item))))
@@ -120,16 +123,16 @@ def mutated(draw, valid, names: list[str], max_mutations: int = 3):
 
 def check_command(cmd, m: int, limits: np.ndarray) -> None:
     """The invariant on what reaches the motors: len(joints) finite values within limits."""
-    COUNTS["commands"] += 1
+    COUNTS['commands'] += 1
     cmd = np.asarray(cmd, dtype=float)
     ok = cmd.shape == (m,) and bool(np.all(np.isfinite(cmd))) and \
         bool(np.all(np.abs(cmd) <= limits))
     if not ok:
-        COUNTS["broken"] += 1
-    assert ok, f"command broke the invariant: {cmd!r}"
+        COUNTS['broken'] += 1
+    assert ok, f'command broke the invariant: {cmd!r}'
 
 
 def broken(why: str) -> None:
     """Count a broken invariant and fail."""
-    COUNTS["broken"] += 1
+    COUNTS['broken'] += 1
     raise AssertionError(why)

@@ -5,18 +5,17 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import parse_scenario
 import pytest
 import yaml
 
-from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import parse_scenario
-
 ROOT = Path(__file__).resolve().parent.parent
-CONFIG = ROOT / "config"
-PLANAR = CONFIG / "planar_two_finger.yaml"
-ALLEGRO = CONFIG / "allegro_right.yaml"
+CONFIG = ROOT / 'config'
+PLANAR = CONFIG / 'planar_two_finger.yaml'
+ALLEGRO = CONFIG / 'allegro_right.yaml'
 #: The Allegro right hand that example-robot-data ships.
-ALLEGRO_URDF = "example-robot-data:allegro_hand_description/urdf/allegro_right_hand.urdf"
+ALLEGRO_URDF = 'example-robot-data:allegro_hand_description/urdf/allegro_right_hand.urdf'
 
 
 def scenario_doc(path: Path) -> dict:
@@ -29,22 +28,22 @@ def setup_from_doc(doc: dict, base: Path = CONFIG) -> GraspSetup:
     return GraspSetup.from_scenario(parse_scenario(copy.deepcopy(doc), base))
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope='session')
 def planar_doc() -> dict:
     return scenario_doc(PLANAR)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope='session')
 def allegro_doc() -> dict:
     return scenario_doc(ALLEGRO)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope='session')
 def planar(planar_doc) -> GraspSetup:
     return setup_from_doc(planar_doc)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope='session')
 def allegro(allegro_doc) -> GraspSetup:
     return setup_from_doc(allegro_doc)
 
@@ -52,15 +51,15 @@ def allegro(allegro_doc) -> GraspSetup:
 def with_contacts(doc: dict, contacts: list[dict]) -> dict:
     """A copy of a scenario document with other contacts."""
     out = copy.deepcopy(doc)
-    out["grasp"]["contacts"] = contacts
+    out['grasp']['contacts'] = contacts
     return out
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope='session')
 def hyperstatic(planar_doc) -> GraspSetup:
     """The planar hand with two contacts on finger 1 (distal link and tip) and one on finger 2."""
-    contacts = copy.deepcopy(planar_doc["grasp"]["contacts"])
-    contacts.insert(1, {"link": "finger1_distal", "position": [0.0, 0.03, 0.0]})
+    contacts = copy.deepcopy(planar_doc['grasp']['contacts'])
+    contacts.insert(1, {'link': 'finger1_distal', 'position': [0.0, 0.03, 0.0]})
     return setup_from_doc(with_contacts(planar_doc, contacts))
 
 
@@ -68,7 +67,7 @@ def pytest_terminal_summary(terminalreporter):
     """The adversarial campaign's counts (test_campaign*.py), printed even without -s."""
     from campaign import COUNTS
 
-    if COUNTS["inputs"]:
+    if COUNTS['inputs']:
         terminalreporter.write_line(
             f"campaign: {COUNTS['inputs']} inputs tried, {COUNTS['commands']} commands "
             f"published, {COUNTS['broken']} invariants broken")

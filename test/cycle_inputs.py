@@ -1,4 +1,5 @@
-"""Inputs for the control cycle shared by the controller, node and campaign tests.
+"""
+Inputs for the control cycle shared by the controller, node and campaign tests.
 
 Joint states and contact poses of a scenario's grasp, a controller on fresh
 inputs, and :class:`Injected`, a solver that fails on purpose in every way a
@@ -8,13 +9,12 @@ real one can (for the fault paths; the healthy path is the real ProxSuite).
 import dataclasses
 import time
 
-import numpy as np
-import pinocchio as pin
-
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.control.controller import CycleConfig, TorqueController
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
+import numpy as np
+import pinocchio as pin
 
 
 def joint_state(setup, q=None, names=None):
@@ -25,9 +25,11 @@ def joint_state(setup, q=None, names=None):
 
 
 def fresh(setup, **config):
-    """A controller of its own; the cycle budget is generous unless a test is about it
-    (other processes may load this machine)."""
-    config.setdefault("cycle_budget", 10.0)
+    """
+    A controller of its own; the cycle budget is generous unless a test is about it
+    (other processes may load this machine).
+    """
+    config.setdefault('cycle_budget', 10.0)
     return TorqueController(dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)),
                             CycleConfig(**config))
 
@@ -41,8 +43,10 @@ def base_poses(setup, q=None):
 
 
 class Injected:
-    """A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose:
-    ``mode`` says how; ``healthy`` makes it the real one again."""
+    """
+    A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose:
+    ``mode`` says how; ``healthy`` makes it the real one again.
+    """
 
     def __init__(self, mode: str):
         self.inner = TauQPSolver()
@@ -53,30 +57,32 @@ class Injected:
     def solve(self, qp):
         if self.healthy:
             return self.inner.solve(qp)
-        if self.mode == "raise-solver":
-            raise SolverError("injected: ProxSuite failed")
-        if self.mode == "raise-other":
-            raise ZeroDivisionError("injected")
-        if self.mode == "nan-data":  # the real solver must refuse it at once
+        if self.mode == 'raise-solver':
+            raise SolverError('injected: ProxSuite failed')
+        if self.mode == 'raise-other':
+            raise ZeroDivisionError('injected')
+        if self.mode == 'nan-data':  # the real solver must refuse it at once
             return self.inner.solve(dataclasses.replace(qp, H=qp.H * np.nan))
-        if self.mode == "inverted-bounds":
+        if self.mode == 'inverted-bounds':
             return self.inner.solve(dataclasses.replace(qp, l_box=qp.u_box + 1.0))
         good = self.inner.solve(qp)
-        if self.mode == "max-iter":
-            return RawResult("error", good.x, 1000, 0.01, "PROXQP_MAX_ITER_REACHED")
-        if self.mode == "wrong-x":  # finite, claimed solved, but not a solution
-            return RawResult("solved", good.x + 0.05, good.iterations, good.solve_time_s,
-                             "PROXQP_SOLVED")
-        if self.mode == "nan-x":
-            return RawResult("solved", good.x * np.nan, 1, 0.0, "PROXQP_SOLVED")
-        if self.mode == "wrong-size-x":
-            return RawResult("solved", good.x[:-1], 1, 0.0, "PROXQP_SOLVED")
+        if self.mode == 'max-iter':
+            return RawResult('error', good.x, 1000, 0.01, 'PROXQP_MAX_ITER_REACHED')
+        if self.mode == 'wrong-x':  # finite, claimed solved, but not a solution
+            return RawResult('solved', good.x + 0.05, good.iterations, good.solve_time_s,
+                             'PROXQP_SOLVED')
+        if self.mode == 'nan-x':
+            return RawResult('solved', good.x * np.nan, 1, 0.0, 'PROXQP_SOLVED')
+        if self.mode == 'wrong-size-x':
+            return RawResult('solved', good.x[:-1], 1, 0.0, 'PROXQP_SOLVED')
         raise AssertionError(self.mode)
 
 
 class Slow:
-    """A solver that answers correctly, late (it takes no deadline): a cycle or a service
-    call that outlasts its budget or its inputs."""
+    """
+    A solver that answers correctly, late (it takes no deadline): a cycle or a service
+    call that outlasts its budget or its inputs.
+    """
 
     def __init__(self, delay: float):
         self.inner, self.delay = TauQPSolver(), delay
@@ -87,5 +93,5 @@ class Slow:
         return self.inner.solve(qp)
 
 
-FAULT_MODES = ["raise-solver", "raise-other", "nan-data", "inverted-bounds", "max-iter",
-               "wrong-x", "nan-x", "wrong-size-x"]
+FAULT_MODES = ['raise-solver', 'raise-other', 'nan-data', 'inverted-bounds', 'max-iter',
+               'wrong-x', 'nan-x', 'wrong-size-x']

@@ -27,7 +27,7 @@ def lp_feasible(setup, maps) -> bool:
     off = np.zeros(setup.hand.m) if setup.torque_offset is None else setup.torque_offset
     res = linprog(np.zeros(4 * p), A_ub=np.vstack((S, maps.J.T, -maps.J.T)),
                   b_ub=np.concatenate((np.tile(b_i, p), lim - off, lim + off)), A_eq=maps.G,
-                  b_eq=-setup.external_wrench, bounds=(None, None), method="highs")
+                  b_eq=-setup.external_wrench, bounds=(None, None), method='highs')
     assert res.status in (0, 2), res.message
     return res.status == 0
 
@@ -53,7 +53,7 @@ def assert_holds(setup, maps, tau, wrenches, tol=1e-6):
 
 def _planned_mu(fr):
     """mu1, mu2 of the cone planned with the friction margin k: mu / (1 + k) (docs/planner.md)."""
-    k = getattr(fr, "margin", 0.0)
+    k = getattr(fr, 'margin', 0.0)
     return fr.mu1 / (1.0 + k), fr.mu2 / (1.0 + k)
 
 
@@ -70,8 +70,10 @@ def _f_space(setup, maps):
 
 
 def lp_capacity(setup, maps, load):
-    """HiGHS in contact-force space: max alpha with G f + alpha load = 0, the planned
-    polygons and |J^T f + offset| <= limits. Returns (alpha, f) or (None, None)."""
+    """
+    HiGHS in contact-force space: max alpha with G f + alpha load = 0, the planned
+    polygons and |J^T f + offset| <= limits. Returns (alpha, f) or (None, None).
+    """
     S, b, lim, off = _f_space(setup, maps)
     nf = 4 * maps.p
     c = np.zeros(nf + 1)
@@ -82,15 +84,17 @@ def lp_capacity(setup, maps, load):
     b_ub = np.concatenate((b, lim - off, lim + off))
     A_eq = np.hstack((maps.G, np.asarray(load, float)[:, None]))
     res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=np.zeros(6),
-                  bounds=[(None, None)] * nf + [(0, None)], method="highs")
+                  bounds=[(None, None)] * nf + [(0, None)], method='highs')
     if res.status != 0:
         return None, None
     return float(res.x[-1]), res.x[:nf]
 
 
 def lp_minmax(setup, maps, weights=None):
-    """HiGHS in contact-force space: min t with G f + w_ext = 0, the planned polygons,
-    w_i |(J^T f)_i + offset_i| <= t limit_i and |J^T f + offset| <= limits. Returns t or None."""
+    """
+    HiGHS in contact-force space: min t with G f + w_ext = 0, the planned polygons,
+    w_i |(J^T f)_i + offset_i| <= t limit_i and |J^T f + offset| <= limits. Returns t or None.
+    """
     S, b, lim, off = _f_space(setup, maps)
     m = setup.hand.m
     w = np.ones(m) if weights is None else np.asarray(weights, float)
@@ -106,7 +110,7 @@ def lp_minmax(setup, maps, weights=None):
     b_ub = np.concatenate((b, lim - off, lim + off, -w * off, w * off))
     res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=np.hstack((maps.G, np.zeros((6, 1)))),
                   b_eq=-setup.external_wrench, bounds=[(None, None)] * nf + [(0, None)],
-                  method="highs")
+                  method='highs')
     return float(res.x[-1]) if res.status == 0 else None
 
 

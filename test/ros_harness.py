@@ -1,13 +1,14 @@
 """The node under test beside a tester node, on a ROS domain of this test run's own."""
 
 import os
-import time
 from pathlib import Path
+import time
 
-import numpy as np
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode, SERVICE_QOS
+import numpy as np
+import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
@@ -16,10 +17,8 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import MarkerArray
 
-from grasp_torque_opt.ros.node import COMMAND_QOS, SERVICE_QOS, GraspTorqueNode
-
 # Each run on its own domain, heard only on this machine.
-os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 DOMAIN = 1 + os.getpid() % 100
 
 
@@ -31,31 +30,31 @@ class Harness:
         rclpy.init(context=self.context, domain_id=DOMAIN)
         # The most generous cycle budget unless a test is about it: other processes may
         # load this machine, and an overrun drops the command by design.
-        params.setdefault("cycle_budget", 1.0)
+        params.setdefault('cycle_budget', 1.0)
         # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
-        params.setdefault("diagnostics_period", 0.1)
-        overrides = [Parameter("scenario", value=str(scenario))]
-        overrides += [Parameter(k.replace("__", "."), value=v) for k, v in params.items()]
+        params.setdefault('diagnostics_period', 0.1)
+        overrides = [Parameter('scenario', value=str(scenario))]
+        overrides += [Parameter(k.replace('__', '.'), value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
-        self.tester = rclpy.create_node("tester", context=self.context)
+        self.tester = rclpy.create_node('tester', context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.executor.add_node(self.tester)
         t = self.tester
-        self.js_pub = t.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
-        self.contacts_pub = t.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
-        self.wrench_pub = t.create_publisher(WrenchStamped, "external_wrench",
+        self.js_pub = t.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+        self.contacts_pub = t.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+        self.wrench_pub = t.create_publisher(WrenchStamped, 'external_wrench',
                                              qos_profile_sensor_data)
         self.commands: list[tuple[float, np.ndarray]] = []
         self.diagnostics: list[dict] = []
         self.markers: list[MarkerArray] = []
-        t.create_subscription(Float64MultiArray, "effort_commands",
+        t.create_subscription(Float64MultiArray, 'effort_commands',
                               lambda m: self.commands.append((time.monotonic(),
                                                               np.array(m.data))), COMMAND_QOS)
-        t.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 10)
-        t.create_subscription(MarkerArray, "grasp_torque_node/contact_wrenches",
+        t.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 10)
+        t.create_subscription(MarkerArray, 'grasp_torque_node/contact_wrenches',
                               self.markers.append, 1)
-        self.solve_client = t.create_client(Trigger, "grasp_torque_node/solve",
+        self.solve_client = t.create_client(Trigger, 'grasp_torque_node/solve',
                                             qos_profile=SERVICE_QOS)
         assert self.spin_until(lambda: self.js_pub.get_subscription_count() > 0
                                and self.contacts_pub.get_subscription_count() > 0
@@ -63,10 +62,10 @@ class Harness:
 
     def _on_diag(self, msg):
         for s in msg.status:
-            if s.name.startswith("grasp_torque_node"):
+            if s.name.startswith('grasp_torque_node'):
                 self.diagnostics.append({**{kv.key: kv.value for kv in s.values},
-                                         "_level": s.level[0], "_message": s.message,
-                                         "_hardware_id": s.hardware_id})
+                                         '_level': s.level[0], '_message': s.message,
+                                         '_hardware_id': s.hardware_id})
 
     def spin_until(self, predicate, timeout: float) -> bool:
         end = time.monotonic() + timeout
@@ -79,7 +78,7 @@ class Harness:
 
     def send_joint_state(self, names, positions) -> None:
         self.js_pub.publish(JointState(name=list(names), position=[float(x) for x in positions],
-                                       effort=[float("nan")] * len(names)))
+                                       effort=[float('nan')] * len(names)))
 
     def next_command(self, timeout: float = 2.0) -> np.ndarray | None:
         n = len(self.commands)

@@ -5,15 +5,15 @@ from pathlib import Path
 
 from conftest import ROOT
 
-PACKAGE = ROOT / "grasp_torque_opt"
+PACKAGE = ROOT / 'grasp_torque_opt'
 #: Family -> rank; a module may import its own family and families of a lower rank.
-RANKS = {"core": 0, "backends": 1, "reference": 1, "methods": 2, "control": 3, "sim": 3,
-         "ros": 4, "cli": 4}
+RANKS = {'core': 0, 'backends': 1, 'reference': 1, 'methods': 2, 'control': 3, 'sim': 3,
+         'ros': 4, 'cli': 4}
 
 
 def family(module: str) -> str:
     """``grasp_torque_opt.core.hand`` -> ``core``; ``grasp_torque_opt.cli`` -> ``cli``."""
-    return module.split(".")[1]
+    return module.split('.')[1]
 
 
 def imports(path: Path) -> set[str]:
@@ -21,31 +21,31 @@ def imports(path: Path) -> set[str]:
     found = set()
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            names = [node.module] + [f'{node.module}.{a.name}' for a in node.names]
         elif isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         else:
             continue
-        found.update(n for n in names[:1] if n.startswith("grasp_torque_opt."))
-        if isinstance(node, ast.ImportFrom) and node.module == "grasp_torque_opt":
-            found.update(f"grasp_torque_opt.{a.name}" for a in node.names)
+        found.update(n for n in names[:1] if n.startswith('grasp_torque_opt.'))
+        if isinstance(node, ast.ImportFrom) and node.module == 'grasp_torque_opt':
+            found.update(f'grasp_torque_opt.{a.name}' for a in node.names)
     return found
 
 
 def modules() -> dict[str, Path]:
     out = {}
-    for path in PACKAGE.rglob("*.py"):
-        parts = path.relative_to(ROOT).with_suffix("").parts
-        if parts[-1] == "__init__":
+    for path in PACKAGE.rglob('*.py'):
+        parts = path.relative_to(ROOT).with_suffix('').parts
+        if parts[-1] == '__init__':
             parts = parts[:-1]
         if len(parts) > 1:  # the package's own __init__ only maps public names lazily
-            out[".".join(parts)] = path
+            out['.'.join(parts)] = path
     return out
 
 
 def test_every_module_belongs_to_a_known_family():
     unknown = {m for m in modules() if family(m) not in RANKS}
-    assert not unknown, f"modules outside the families of docs/architecture.md: {unknown}"
+    assert not unknown, f'modules outside the families of docs/architecture.md: {unknown}'
 
 
 def test_no_module_imports_a_family_above_its_own():
@@ -55,13 +55,13 @@ def test_no_module_imports_a_family_above_its_own():
         for other in imports(path):
             theirs = family(other)
             if theirs != mine and RANKS[theirs] >= RANKS[mine]:
-                wrong.append(f"{module} imports {other}")
-    assert not wrong, "\n".join(wrong)
+                wrong.append(f'{module} imports {other}')
+    assert not wrong, '\n'.join(wrong)
 
 
 def test_the_parser_sees_imports_at_module_and_function_level():
     """The parser finds imports inside functions too (e.g. a lazy import of the node)."""
-    code = PACKAGE / "core" / "grasp_maps.py"
-    assert "grasp_torque_opt.core.hand" in imports(code)
-    sample = ROOT / "test" / "ros_harness.py"
-    assert "grasp_torque_opt.ros.node" in imports(sample)
+    code = PACKAGE / 'core' / 'grasp_maps.py'
+    assert 'grasp_torque_opt.core.hand' in imports(code)
+    sample = ROOT / 'test' / 'ros_harness.py'
+    assert 'grasp_torque_opt.ros.node' in imports(sample)

@@ -1,4 +1,5 @@
-"""QP backends for the tau-QP: ProxSuite (the default), DAQP and quadprog.
+"""
+QP backends for the tau-QP: ProxSuite (the default), DAQP and quadprog.
 
 Every backend takes a built :class:`~grasp_torque_opt.core.tau_qp.TauQP` and returns
 a :class:`~grasp_torque_opt.core.solution.RawResult`; none is trusted: the caller
@@ -26,11 +27,12 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings, TauQPSolver
 from grasp_torque_opt.backends.quadprog import QuadprogSolver
 
 #: Selectable backends; the first is the default.
-BACKENDS = ("proxsuite", "daqp", "quadprog")
+BACKENDS = ('proxsuite', 'daqp', 'quadprog')
 
 
 def available(backend: str) -> bool:
-    """Whether the Python module of a backend can be imported here.
+    """
+    Whether the Python module of a backend can be imported here.
 
     ProxSuite is a dependency; DAQP and quadprog are optional (pip installs them, a
     ROS distribution may not have them).
@@ -42,7 +44,8 @@ def available(backend: str) -> bool:
 
 
 def single_threaded_math() -> None:
-    """Limit BLAS and OpenMP to one thread in this process (the node's and CLI's mains call it).
+    """
+    Limit BLAS and OpenMP to one thread in this process (the node's and CLI's mains call it).
 
     The matrices of one grasp are tiny; with OpenBLAS's default threads, a
     triangular solve in the QP build took 8 to 16 ms instead of tens of
@@ -53,15 +56,16 @@ def single_threaded_math() -> None:
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # optional: a ROS distribution may not have it
-        warnings.warn("threadpoolctl is not installed: BLAS keeps its own thread count "
-                      "(pip install threadpoolctl, or set OPENBLAS_NUM_THREADS=1)", stacklevel=2)
+        warnings.warn('threadpoolctl is not installed: BLAS keeps its own thread count '
+                      '(pip install threadpoolctl, or set OPENBLAS_NUM_THREADS=1)', stacklevel=2)
         return
     threadpool_limits(1)
 
 
-def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None = None,
+def make_solver(backend: str = 'proxsuite', settings: ProxSuiteSettings | None = None,
                 warm_start: bool = False, max_slice_s: float | None = None):
-    """A tau-QP solver by backend name (one of :data:`BACKENDS`).
+    """
+    A tau-QP solver by backend name (one of :data:`BACKENDS`).
 
     ``warm_start`` applies to ProxSuite and DAQP (each verifies its warm answers
     and redoes a bad one cold); quadprog has none. ``max_slice_s`` bounds each
@@ -72,11 +76,11 @@ def make_solver(backend: str = "proxsuite", settings: ProxSuiteSettings | None =
             module is not installed, saying how to install it.
     """
     if backend in BACKENDS and not available(backend):
-        raise ValueError(f"backend {backend!r} is not installed (pip install {backend})")
-    if backend == "proxsuite":
+        raise ValueError(f'backend {backend!r} is not installed (pip install {backend})')
+    if backend == 'proxsuite':
         return TauQPSolver(settings, warm_start, max_slice_s)
-    if backend == "daqp":
+    if backend == 'daqp':
         return DaqpSolver(settings, warm_start)
-    if backend == "quadprog":
+    if backend == 'quadprog':
         return QuadprogSolver(settings)
     raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")

@@ -1,4 +1,5 @@
-"""DAQP (a dual active-set method) on the tau-QP, every answer KKT-checked.
+"""
+DAQP (a dual active-set method) on the tau-QP, every answer KKT-checked.
 
 DAQP is exact to its tolerances on small dense QPs. A positive semidefinite
 Hessian (the internal-force variables z carry no cost) is handled by DAQP's
@@ -10,12 +11,11 @@ from __future__ import annotations
 import math
 import time
 
-import numpy as np
-
 from grasp_torque_opt.backends.proxsuite import ESTIMATE_DECAY, ProxSuiteSettings, size_factor
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
-from grasp_torque_opt.core.tau_qp import TauQP, check_data
+from grasp_torque_opt.core.tau_qp import check_data, TauQP
+import numpy as np
 
 #: DAQP's "infinite" bound.
 DAQP_INF = 1e30
@@ -30,7 +30,8 @@ KKT_TOLERANCE = 1e-6
 
 def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray,
                   upper: np.ndarray, x: np.ndarray, lam: np.ndarray) -> float:
-    """How far (x, lam) is from a KKT point of min 1/2 x'Hx + g'x, lower <= [x; A x] <= upper.
+    """
+    How far (x, lam) is from a KKT point of min 1/2 x'Hx + g'x, lower <= [x; A x] <= upper.
 
     Sign convention (DAQP's, bounds on x first): H x + g + [I A'] lam = 0,
     lam > 0 on an active upper bound, lam < 0 on an active lower one. An
@@ -59,7 +60,8 @@ def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray
 
 
 class DaqpSolver:
-    """DAQP on the tau-QP: bounds on x, then the equalities, then the cone rows.
+    """
+    DAQP on the tau-QP: bounds on x, then the equalities, then the cone rows.
 
     One DAQP workspace is kept per problem size. Every answer is checked for
     optimality (:func:`kkt_violation` with DAQP's multipliers, to
@@ -79,7 +81,7 @@ class DaqpSolver:
         warm_start: start from the previous active set.
     """
 
-    name = "daqp"
+    name = 'daqp'
 
     def __init__(self, settings: ProxSuiteSettings | None = None,
                  warm_start: bool = False) -> None:
@@ -100,7 +102,8 @@ class DaqpSolver:
 
     def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
               ) -> RawResult:
-        """Solve a built tau-QP (warm if enabled and verified, else cold).
+        """
+        Solve a built tau-QP (warm if enabled and verified, else cold).
 
         Args:
             qp: the QP.
@@ -116,10 +119,10 @@ class DaqpSolver:
             self.fallbacks += 1
         self.last_warm = False
         if deadline is not None and time.perf_counter() >= deadline:
-            return RawResult("error", None, 0, 0.0, "time budget spent before DAQP started")
+            return RawResult('error', None, 0, 0.0, 'time budget spent before DAQP started')
         why = check_data(qp)
         if why:
-            return RawResult("error", None, 0, 0.0, why)
+            return RawResult('error', None, 0, 0.0, why)
         n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
         A = np.vstack((qp.A, qp.C))
         upper = np.concatenate((np.minimum(qp.u_box, DAQP_INF), qp.b, qp.u))
@@ -138,26 +141,27 @@ class DaqpSolver:
                                                   sense, cold, limit)
         except RuntimeError as e:  # e.g. a failed setup: the next call starts anew
             self._dims = None
-            raise SolverError(f"DAQP failed: {e}") from e
+            raise SolverError(f'DAQP failed: {e}') from e
         if iterations:
             self._iter_s = max((time.perf_counter() - t0) / iterations,
                                ESTIMATE_DECAY * self._iter_s)
         if x is None:
             self._dims = None
-            return RawResult("error", None, 0, time.perf_counter() - t0,
-                             f"DAQP setup or update failed (exit flag {flag})")
-        kkt = info["kkt"]
+            return RawResult('error', None, 0, time.perf_counter() - t0,
+                             f'DAQP setup or update failed (exit flag {flag})')
+        kkt = info['kkt']
         elapsed = time.perf_counter() - t0
-        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
-        message = f"DAQP exit flag {int(flag)}"
-        if status == "solved" and not kkt <= KKT_TOLERANCE:
-            status, message = "error", f"{message}, but KKT violated by {kkt:.3g}"
+        status = {1: 'solved', -1: 'infeasible'}.get(int(flag), 'error')
+        message = f'DAQP exit flag {int(flag)}'
+        if status == 'solved' and not kkt <= KKT_TOLERANCE:
+            status, message = 'error', f'{message}, but KKT violated by {kkt:.3g}'
         return RawResult(status, np.asarray(x, dtype=float), iterations, elapsed, message)
 
     def _run(self, qp: TauQP, n: int, dims: tuple[int, int, int], H: np.ndarray,
              A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray,
              cold: bool, limit: int):
-        """Set up or update the workspace and solve (warm if enabled and not ``cold``, verified),
+        """
+        Set up or update the workspace and solve (warm if enabled and not ``cold``, verified),
         with at most ``limit`` iterations per DAQP solve.
 
         Returns:
@@ -189,7 +193,7 @@ class DaqpSolver:
             self._limit = limit
         self._keep = (H, qp.g, A, upper, lower, sense)  # buffers DAQP may point to
         x, _, flag, info = self._model.solve()
-        iterations = int(info["iterations"])
+        iterations = int(info['iterations'])
         kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
         if warm:
             self.warm_solves += 1
@@ -205,20 +209,21 @@ class DaqpSolver:
                     self._limit = rest
                 self._model.update(sense=sense)  # the same data, cold
                 x, _, flag, info = self._model.solve()
-                iterations += int(info["iterations"])
+                iterations += int(info['iterations'])
                 kkt = self._kkt(flag, H, qp.g, A, lower, upper, x, info)
-        return x, flag, {**info, "kkt": kkt}, iterations
+        return x, flag, {**info, 'kkt': kkt}, iterations
 
     @staticmethod
     def _kkt(flag, H, g, A, lower, upper, x, info) -> float:
         """KKT violation of a DAQP answer that says optimal (inf otherwise)."""
         if int(flag) != 1:
-            return float("inf")
-        return kkt_violation(H, g, A, lower, upper, np.asarray(x), info["lam"])
+            return float('inf')
+        return kkt_violation(H, g, A, lower, upper, np.asarray(x), info['lam'])
 
 
 class DaqpWorkspace:
-    """One DAQP workspace for a sequence of QPs of one size, each started from the last.
+    """
+    One DAQP workspace for a sequence of QPs of one size, each started from the last.
 
     The QP: minimize 1/2 x'Hx + g'x subject to A_eq x = b_eq, C x <= u and
     l_box <= x <= u_box. :meth:`load` sets every datum (a new workspace when
@@ -235,7 +240,7 @@ class DaqpWorkspace:
         max_iter: DAQP's iteration cap (one QP can never stall).
     """
 
-    name = "daqp"
+    name = 'daqp'
 
     def __init__(self, eps_abs: float = ProxSuiteSettings.eps_abs,
                  max_iter: int = ProxSuiteSettings.max_iter) -> None:
@@ -254,7 +259,8 @@ class DaqpWorkspace:
     def load(self, H: np.ndarray, g: np.ndarray, A_eq: np.ndarray, b_eq: np.ndarray,
              C: np.ndarray, u: np.ndarray, l_box: np.ndarray, u_box: np.ndarray,
              semidefinite: bool, warm: bool = False) -> None:
-        """Set every datum of the QP; the next solve starts cold unless ``warm``.
+        """
+        Set every datum of the QP; the next solve starts cold unless ``warm``.
 
         Args:
             semidefinite: H may be singular (DAQP's proximal-point iterations on).
@@ -282,7 +288,8 @@ class DaqpWorkspace:
     def solve(self, H: np.ndarray | None = None, g: np.ndarray | None = None,
               C: np.ndarray | None = None, u: np.ndarray | None = None,
               cold: bool = False, deadline: float | None = None) -> RawResult:
-        """Solve with the given H, g, C, u (None: keep the last), warm unless ``cold``.
+        """
+        Solve with the given H, g, C, u (None: keep the last), warm unless ``cold``.
 
         Args:
             deadline: ``time.perf_counter()`` value [s]: past it no solve starts, and
@@ -300,7 +307,7 @@ class DaqpWorkspace:
         if deadline is not None:
             left = deadline - time.perf_counter()
             if left <= 0.0:
-                return RawResult("error", None, 0, 0.0, "time budget spent before DAQP started")
+                return RawResult('error', None, 0, 0.0, 'time budget spent before DAQP started')
             limit = min(limit, max(1, int(left / self._iter_s)))
         n_eq = self._n_eq
         n = self._H.shape[0]
@@ -314,7 +321,7 @@ class DaqpWorkspace:
         # One sum per array: NaN or Inf anywhere makes it non-finite.
         if not math.isfinite(self._H.sum() + self._g.sum() + self._A.sum()
                              + self._upper[n:].sum()):
-            return RawResult("error", None, 0, 0.0, "QP data not finite")
+            return RawResult('error', None, 0, 0.0, 'QP data not finite')
         t0 = time.perf_counter()
         try:
             if self._model is None:
@@ -323,8 +330,8 @@ class DaqpWorkspace:
                                             self._lower, self._sense)
                 if flag < 0:
                     self._model = None
-                    return RawResult("error", None, 0, time.perf_counter() - t0,
-                                     f"DAQP setup failed (exit flag {flag})")
+                    return RawResult('error', None, 0, time.perf_counter() - t0,
+                                     f'DAQP setup failed (exit flag {flag})')
                 s = self._model.settings
                 s.update(primal_tol=self.eps_abs, iter_limit=limit,
                          eps_prox=-1e-6 if self._dims[3] else 0.0)
@@ -337,8 +344,8 @@ class DaqpWorkspace:
                                           sense=self._sense if cold or self._cold else None)
                 if flag is not None and flag < 0:
                     self._model = None
-                    return RawResult("error", None, 0, time.perf_counter() - t0,
-                                     f"DAQP update failed (exit flag {flag})")
+                    return RawResult('error', None, 0, time.perf_counter() - t0,
+                                     f'DAQP update failed (exit flag {flag})')
                 if limit != self._limit:  # a budget's cap, or back to max_iter
                     s = self._model.settings
                     s.update(iter_limit=limit)
@@ -347,13 +354,13 @@ class DaqpWorkspace:
             x, _, flag, info = self._model.solve()
         except RuntimeError as e:
             self._model = None
-            raise SolverError(f"DAQP failed: {e}") from e
+            raise SolverError(f'DAQP failed: {e}') from e
         self._cold = False
         elapsed = time.perf_counter() - t0
-        if int(info["iterations"]):
-            self._iter_s = max(elapsed / int(info["iterations"]), ESTIMATE_DECAY * self._iter_s)
-        status = {1: "solved", -1: "infeasible"}.get(int(flag), "error")
-        if status == "solved":
-            self.multipliers = np.asarray(info["lam"], dtype=float)
-        return RawResult(status, np.asarray(x, dtype=float), int(info["iterations"]), elapsed,
-                         f"DAQP exit flag {int(flag)}")
+        if int(info['iterations']):
+            self._iter_s = max(elapsed / int(info['iterations']), ESTIMATE_DECAY * self._iter_s)
+        status = {1: 'solved', -1: 'infeasible'}.get(int(flag), 'error')
+        if status == 'solved':
+            self.multipliers = np.asarray(info['lam'], dtype=float)
+        return RawResult(status, np.asarray(x, dtype=float), int(info['iterations']), elapsed,
+                         f'DAQP exit flag {int(flag)}')

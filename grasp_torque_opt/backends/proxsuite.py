@@ -2,22 +2,22 @@
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
-
-import numpy as np
-import proxsuite
+import time
 
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
-from grasp_torque_opt.core.tau_qp import TauQP, check_data
+from grasp_torque_opt.core.tau_qp import check_data, TauQP
+import numpy as np
+import proxsuite
 
 #: Largest KKT violation (:func:`kkt_violation`) of a warm answer taken as optimal.
 KKT_TOLERANCE = 1e-6
 
 
 def kkt_violation(qp: TauQP, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> float:
-    """How far ProxSuite's (x, y, z) is from a KKT point of the tau-QP.
+    """
+    How far ProxSuite's (x, y, z) is from a KKT point of the tau-QP.
 
     ProxSuite's convention: H x + g + A'y + C'z_C + z_box = 0, z = [z_C; z_box],
     z_i > 0 on an active upper bound, < 0 on an active lower one. The cone rows
@@ -59,8 +59,10 @@ INNER_ITERATION_S = 25e-6
 
 
 def size_factor(qp: TauQP) -> float:
-    """How much more one iteration of a dense solver costs on ``qp`` than on the Allegro's
-    four-fingertip tau-QP (16 variables, 144 rows), as n (n + rows), at least 1."""
+    """
+    How much more one iteration of a dense solver costs on ``qp`` than on the Allegro's
+    four-fingertip tau-QP (16 variables, 144 rows), as n (n + rows), at least 1.
+    """
     n = qp.H.shape[0]
     return max(1.0, n * (n + qp.A.shape[0] + qp.C.shape[0]) / (16 * 144))
 #: Each solve's measured time per inner iteration replaces the estimate if larger; a
@@ -74,7 +76,8 @@ MIN_SLICE_OUTER = 20
 
 @dataclass(frozen=True)
 class ProxSuiteSettings:
-    """ProxSuite dense settings used for the tau-QP.
+    """
+    ProxSuite dense settings used for the tau-QP.
 
     Attributes:
         eps_abs: absolute stopping tolerance.
@@ -115,14 +118,15 @@ class ProxSuiteSettings:
     max_iter: int = 200
     max_iter_in: int = 50
     eps_primal_inf: float = 1e-12
-    hessian_type: str = "Diagonal"
-    dense_backend: str = "PrimalDualLDLT"
-    preconditioner: str = "first"
+    hessian_type: str = 'Diagonal'
+    dense_backend: str = 'PrimalDualLDLT'
+    preconditioner: str = 'first'
 
 
 
 class TauQPSolver:
-    """ProxSuite dense solver for tau-QPs, allocated once per problem size.
+    """
+    ProxSuite dense solver for tau-QPs, allocated once per problem size.
 
     A time budget (``deadline`` of :meth:`solve`) is kept by ProxSuite's own
     iteration cap: ProxSuite has no wall-clock limit, so the solve runs in
@@ -154,7 +158,7 @@ class TauQPSolver:
             so that the control loop's thread gets the lock between them.
     """
 
-    name = "proxsuite"
+    name = 'proxsuite'
 
     def __init__(self, settings: ProxSuiteSettings | None = None,
                  warm_start: bool = False, max_slice_s: float | None = None) -> None:
@@ -173,14 +177,15 @@ class TauQPSolver:
 
     def _hessian_type(self, H: np.ndarray) -> str:
         """The settings' Hessian type, unless H is not diagonal (then ``Dense``)."""
-        if self.settings.hessian_type == "Diagonal" and \
+        if self.settings.hessian_type == 'Diagonal' and \
                 np.count_nonzero(H) != np.count_nonzero(np.diagonal(H)):
-            return "Dense"
+            return 'Dense'
         return self.settings.hessian_type
 
     def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
               ) -> RawResult:
-        """Solve a built tau-QP (warm if enabled and the size is unchanged, else cold).
+        """
+        Solve a built tau-QP (warm if enabled and the size is unchanged, else cold).
 
         Args:
             qp: the QP.
@@ -201,10 +206,10 @@ class TauQPSolver:
         self.last_warm = False
         why = check_data(qp)
         if why:
-            return RawResult("error", None, 0, 0.0, why)
+            return RawResult('error', None, 0, 0.0, why)
         n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
-        data = dict(H=qp.H, g=qp.g, A=qp.A if n_eq else None, b=qp.b if n_eq else None,
-                    C=qp.C, l=np.full(n_in, -np.inf), u=qp.u, l_box=qp.l_box, u_box=qp.u_box)
+        data = {'H': qp.H, 'g': qp.g, 'A': qp.A if n_eq else None, 'b': qp.b if n_eq else None,
+                    'C': qp.C, 'l': np.full(n_in, -np.inf), 'u': qp.u, 'l_box': qp.l_box, 'u_box': qp.u_box}
         dims = (n, n_eq, n_in, self._hessian_type(qp.H))
         guess = proxsuite.proxqp.InitialGuess
         t0 = time.perf_counter()
@@ -218,7 +223,7 @@ class TauQPSolver:
                 self._qp.settings.initial_guess = (guess.WARM_START_WITH_PREVIOUS_RESULT if warm
                                                    else guess.NO_INITIAL_GUESS)
                 self._qp.update(**data,
-                                update_preconditioner=self.settings.preconditioner == "every")
+                                update_preconditioner=self.settings.preconditioner == 'every')
             iterations, stopped = self._solve_until(deadline)
             if warm:
                 self.warm_solves += 1
@@ -232,23 +237,24 @@ class TauQPSolver:
                     iterations += more
         except (RuntimeError, ValueError, TypeError) as e:
             self._dims = None
-            raise SolverError(f"ProxSuite failed: {e}") from e
+            raise SolverError(f'ProxSuite failed: {e}') from e
         elapsed = time.perf_counter() - t0
         info = self._qp.results.info
         if stopped:
             self.timeouts += 1
             x = np.array(self._qp.results.x) if iterations else None  # else the last QP's
-            return RawResult("error", x, iterations, elapsed,
-                             f"time budget spent after {iterations} iterations "
-                             f"({1e3 * elapsed:.1f} ms)")
+            return RawResult('error', x, iterations, elapsed,
+                             f'time budget spent after {iterations} iterations '
+                             f'({1e3 * elapsed:.1f} ms)')
         out = proxsuite.proxqp.QPSolverOutput
-        status = {out.PROXQP_SOLVED: "solved",
-                  out.PROXQP_PRIMAL_INFEASIBLE: "infeasible"}.get(info.status, "error")
+        status = {out.PROXQP_SOLVED: 'solved',
+                  out.PROXQP_PRIMAL_INFEASIBLE: 'infeasible'}.get(info.status, 'error')
         return RawResult(status, np.array(self._qp.results.x), iterations, elapsed,
-                         str(info.status).rsplit(".", 1)[-1])
+                         str(info.status).rsplit('.', 1)[-1])
 
     def _solve_until(self, deadline: float | None) -> tuple[int, bool]:
-        """ProxSuite's solve from the initial guess set, within ``deadline`` if given.
+        """
+        ProxSuite's solve from the initial guess set, within ``deadline`` if given.
 
         Returns:
             (inner iterations, whether the deadline stopped it before ProxSuite did).
@@ -308,5 +314,5 @@ class TauQPSolver:
         s.eps_duality_gap_abs = self.settings.eps_abs
         s.eps_duality_gap_rel = 0.0
         s.initial_guess = proxsuite.proxqp.InitialGuess.NO_INITIAL_GUESS
-        self._qp.init(**data, compute_preconditioner=self.settings.preconditioner != "off")
+        self._qp.init(**data, compute_preconditioner=self.settings.preconditioner != 'off')
         self._dims = dims

@@ -1,4 +1,5 @@
-"""quadprog (Goldfarb-Idnani) on the tau-QP.
+"""
+quadprog (Goldfarb-Idnani) on the tau-QP.
 
 It needs a positive definite Hessian, so only grasps without internal-force
 variables (k = 0, e.g. the Allegro's four fingertips); otherwise it returns an
@@ -9,22 +10,22 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
-
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.core.solution import RawResult
-from grasp_torque_opt.core.tau_qp import TauQP, check_data
+from grasp_torque_opt.core.tau_qp import check_data, TauQP
+import numpy as np
 
 
 class QuadprogSolver:
-    """quadprog (Goldfarb-Idnani) on the tau-QP; grasps with k = 0 only.
+    """
+    quadprog (Goldfarb-Idnani) on the tau-QP; grasps with k = 0 only.
 
     Args:
         settings: unused (quadprog has no tolerances; its active-set method
             ends after finitely many steps).
     """
 
-    name = "quadprog"
+    name = 'quadprog'
 
     def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
         import quadprog
@@ -33,17 +34,19 @@ class QuadprogSolver:
         self.settings = settings or ProxSuiteSettings()
 
     def solve(self, qp: TauQP, deadline: float | None = None) -> RawResult:
-        """Solve a built tau-QP (none starts past ``deadline``, a ``time.perf_counter()``
-        value [s]; a quadprog solve ends after finitely many active-set steps)."""
+        """
+        Solve a built tau-QP (none starts past ``deadline``, a ``time.perf_counter()``
+        value [s]; a quadprog solve ends after finitely many active-set steps).
+        """
         if deadline is not None and time.perf_counter() >= deadline:
-            return RawResult("error", None, 0, 0.0, "time budget spent before quadprog started")
+            return RawResult('error', None, 0, 0.0, 'time budget spent before quadprog started')
         why = check_data(qp)
         if why:
-            return RawResult("error", None, 0, 0.0, why)
+            return RawResult('error', None, 0, 0.0, why)
         if qp.H.shape[0] != qp.m:
-            return RawResult("error", None, 0, 0.0, "quadprog needs a positive definite "
-                             f"Hessian; this grasp has {qp.H.shape[0] - qp.m} internal-force "
-                             "variables")
+            return RawResult('error', None, 0, 0.0, 'quadprog needs a positive definite '
+                             f'Hessian; this grasp has {qp.H.shape[0] - qp.m} internal-force '
+                             'variables')
         n = qp.m
         lo, hi = np.isfinite(qp.l_box), np.isfinite(qp.u_box)
         eye = np.eye(n)
@@ -56,8 +59,8 @@ class QuadprogSolver:
                                                                 meq=qp.A.shape[0])
         except ValueError as e:
             elapsed = time.perf_counter() - t0
-            status = "infeasible" if "inconsistent" in str(e) else "error"
-            return RawResult(status, None, 0, elapsed, f"quadprog: {e}")
+            status = 'infeasible' if 'inconsistent' in str(e) else 'error'
+            return RawResult(status, None, 0, elapsed, f'quadprog: {e}')
         elapsed = time.perf_counter() - t0
-        return RawResult("solved", np.asarray(x, dtype=float), int(iterations[0]), elapsed,
-                         "quadprog solved")
+        return RawResult('solved', np.asarray(x, dtype=float), int(iterations[0]), elapsed,
+                         'quadprog solved')

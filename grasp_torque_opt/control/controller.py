@@ -1,4 +1,5 @@
-"""The control cycle, free of ROS: inputs checked and timed, solve, certify, gate, fault policy.
+"""
+The control cycle, free of ROS: inputs checked and timed, solve, certify, gate, fault policy.
 
 The node (:mod:`grasp_torque_opt.ros.node`) only converts messages to the plain
 arrays taken here and publishes what :meth:`TorqueController.cycle` and
@@ -28,14 +29,11 @@ frames, magnitudes, header stamps); a rejected message changes nothing.
 
 from __future__ import annotations
 
+from collections import Counter
 import dataclasses
+from dataclasses import dataclass, field
 import math
 import time
-from collections import Counter
-from dataclasses import dataclass, field
-
-import numpy as np
-import pinocchio as pin
 
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
@@ -47,8 +45,10 @@ from grasp_torque_opt.core.scenario import ContactSpec
 from grasp_torque_opt.core.solution import Solution
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
+import pinocchio as pin
 
-POLICIES = ("hold", "zero")
+POLICIES = ('hold', 'zero')
 #: A quaternion is accepted when | ||q|| - 1 | is at most this, then normalized.
 QUATERNION_TOLERANCE = 1e-3
 #: |joint position| above this [rad or m] is a corrupted message, not a hand.
@@ -56,12 +56,13 @@ MAX_ABS_JOINT_POSITION = 1e3
 #: Names and frames in error messages are cut to this many characters.
 SHOWN_NAME_LENGTH = 64
 #: The input topics, as named in counters, stamps and messages.
-SOURCES = ("joint_states", "contacts", "external_wrench")
+SOURCES = ('joint_states', 'contacts', 'external_wrench')
 
 
 @dataclass(frozen=True)
 class CycleConfig:
-    """Timing and safety settings of the cycle.
+    """
+    Timing and safety settings of the cycle.
 
     Attributes:
         joint_state_timeout: joint states older than this stop commands [s] (> 0).
@@ -94,7 +95,7 @@ class CycleConfig:
     contacts_timeout: float = 0.5
     wrench_timeout: float = 0.5
     hold_time: float = 0.1
-    fault_policy: str = "hold"
+    fault_policy: str = 'hold'
     gravity_compensation: bool = False
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     certificate_tolerance: float = DEFAULT_TOLERANCE
@@ -105,12 +106,13 @@ class CycleConfig:
     max_contact_distance: float = 1.0
     stamp_future_tolerance: float = 0.5
     cycle_budget: float = 0.05
-    method: str = "tau-qp"
+    method: str = 'tau-qp'
 
 
 @dataclass(frozen=True)
 class ContactPoses:
-    """Contact frames as estimated: pose i is contact i's frame in frame ``frame``.
+    """
+    Contact frames as estimated: pose i is contact i's frame in frame ``frame``.
 
     Attributes:
         frame: model frame the poses are expressed in ('' = the base frame).
@@ -125,7 +127,8 @@ class ContactPoses:
 
 @dataclass(frozen=True)
 class Inputs:
-    """A snapshot of the latest valid inputs and their monotonic receipt times [s].
+    """
+    A snapshot of the latest valid inputs and their monotonic receipt times [s].
 
     ``contacts`` and ``wrench`` are None until one arrives (then the scenario's
     defaults are used); ``q`` is None until the first joint state. ``wrench`` is
@@ -142,7 +145,8 @@ class Inputs:
 
 @dataclass
 class CycleResult:
-    """What one cycle decided.
+    """
+    What one cycle decided.
 
     Attributes:
         command: effort command to publish now, in ``joints`` order [N m], or None.
@@ -160,13 +164,14 @@ class CycleResult:
     solution: Solution | None = None
     maps: GraspMaps | None = None
     gravity_torque: np.ndarray | None = None
-    fault: str = ""
+    fault: str = ''
     cycle_time: float = 0.0
 
 
 @dataclass
 class Counters:
-    """Running totals, for diagnostics.
+    """
+    Running totals, for diagnostics.
 
     ``solver_failures`` counts solves that raised or gave nothing certifiable
     (not the confirmed infeasible ones); ``fallback_solves`` certified
@@ -189,7 +194,7 @@ class Counters:
 
 def show(name: str) -> str:
     """A name as quoted in messages, cut to :data:`SHOWN_NAME_LENGTH` characters."""
-    return name if len(name) <= SHOWN_NAME_LENGTH else name[:SHOWN_NAME_LENGTH] + "..."
+    return name if len(name) <= SHOWN_NAME_LENGTH else name[:SHOWN_NAME_LENGTH] + '...'
 
 
 def stamp_seconds(sec: int, nanosec: int) -> float:
@@ -200,12 +205,13 @@ def stamp_seconds(sec: int, nanosec: int) -> float:
 def _finite(a: np.ndarray, name: str) -> np.ndarray:
     a = np.asarray(a, dtype=float)
     if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite (NaN or Inf found)")
+        raise InputError(name, 'must be finite (NaN or Inf found)')
     return a
 
 
 def quaternion_matrix(xyzw: np.ndarray, name: str) -> np.ndarray:
-    """Rotation matrix of a unit quaternion (x, y, z, w).
+    """
+    Rotation matrix of a unit quaternion (x, y, z, w).
 
     Raises:
         InputError: not finite, or its norm is off 1 by more than
@@ -214,13 +220,14 @@ def quaternion_matrix(xyzw: np.ndarray, name: str) -> np.ndarray:
     q = _finite(xyzw, name)
     norm = float(np.linalg.norm(q))
     if abs(norm - 1.0) > QUATERNION_TOLERANCE:
-        raise InputError(name, f"is not a unit quaternion (norm {norm:.6g})")
+        raise InputError(name, f'is not a unit quaternion (norm {norm:.6g})')
     x, y, z, w = q / norm
     return pin.Quaternion(w, x, y, z).toRotationMatrix()
 
 
 class TorqueController:
-    """The cycle of the node, on plain arrays.
+    """
+    The cycle of the node, on plain arrays.
 
     Args:
         setup: the grasp of the scenario: hand, default contacts and load,
@@ -236,7 +243,7 @@ class TorqueController:
 
     def __init__(self, setup: GraspSetup, config: CycleConfig | None = None,
                  solver_settings: ProxSuiteSettings | None = None,
-                 backend: str = "proxsuite", warm_start: bool = False,
+                 backend: str = 'proxsuite', warm_start: bool = False,
                  fallback: str | None = None) -> None:
         self.setup = setup
         self.config = config or CycleConfig()
@@ -251,8 +258,8 @@ class TorqueController:
         #: the effort controller holds (it has no timeout) [N m].
         self.in_force: np.ndarray | None = None
         self.last: CycleResult | None = None
-        self.fault = ""
-        self.last_rejection = ""
+        self.fault = ''
+        self.last_rejection = ''
         self._stamps: dict[str, tuple[float, float]] = {}  # source -> (stamp, receipt time)
         model = self.setup.hand.model
         self._model_joints = {model.names[j]: model.joints[j].idx_q
@@ -261,7 +268,8 @@ class TorqueController:
     # -- inputs ---------------------------------------------------------------------------
 
     def check_bytes(self, source: str, n: int) -> None:
-        """Reject a message by the length of its serialized form, before it is deserialized
+        """
+        Reject a message by the length of its serialized form, before it is deserialized
         (5.6 MB of poses took 0.8 s to deserialize here, holding up the loop).
 
         Raises:
@@ -269,12 +277,13 @@ class TorqueController:
         """
         limit = self.config.max_message_bytes
         if n > limit:
-            e = InputError(source, f"{n} bytes serialized, more than max_message_bytes ({limit})")
+            e = InputError(source, f'{n} bytes serialized, more than max_message_bytes ({limit})')
             self._reject(source, e)
             raise e
 
     def check_size(self, source: str, n: int) -> None:
-        """Reject a message by its size alone, before it is read.
+        """
+        Reject a message by its size alone, before it is read.
 
         Args:
             source: ``joint_states`` (``n`` names or positions, at most
@@ -285,18 +294,19 @@ class TorqueController:
             InputError: the size is out of bounds (counted as a rejection).
         """
         try:
-            if source == "joint_states" and n > self.config.max_joint_state_entries:
-                raise InputError("joint_states", f"{n} entries, more than "
-                                 f"max_joint_state_entries ({self.config.max_joint_state_entries})")
+            if source == 'joint_states' and n > self.config.max_joint_state_entries:
+                raise InputError('joint_states', f'{n} entries, more than '
+                                 f'max_joint_state_entries ({self.config.max_joint_state_entries})')
             p = len(self.setup.contacts)
-            if source == "contacts" and n != p:
-                raise InputError("contacts", f"{n} poses for {p} contacts")
+            if source == 'contacts' and n != p:
+                raise InputError('contacts', f'{n} poses for {p} contacts')
         except InputError as e:
             self._reject(source, e)
             raise
 
     def _check_stamp(self, source: str, stamp: float, clock: float | None, now: float) -> None:
-        """The header stamp rule (docs/node.md, "Input checks").
+        """
+        The header stamp rule (docs/node.md, "Input checks").
 
         0 is an unstamped message: accepted, not compared. A stamp more than
         ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)
@@ -311,20 +321,20 @@ class TorqueController:
         if stamp == 0.0:
             return
         if not math.isfinite(stamp) or stamp < 0.0:
-            raise InputError(f"{source}.header.stamp", f"is negative ({stamp:.9g} s)")
+            raise InputError(f'{source}.header.stamp', f'is negative ({stamp:.9g} s)')
         tol = self.config.stamp_future_tolerance
         if clock is not None and clock > 0.0 and stamp > clock + tol:
-            raise InputError(f"{source}.header.stamp", f"is {stamp - clock:.3f} s ahead of the "
-                             f"clock (stamp_future_tolerance {tol} s)")
+            raise InputError(f'{source}.header.stamp', f'is {stamp - clock:.3f} s ahead of the '
+                             f'clock (stamp_future_tolerance {tol} s)')
         last = self._stamps.get(source)
         if last is not None and stamp < last[0] and now - last[1] <= self._timeout(source):
-            raise InputError(f"{source}.header.stamp", f"goes backwards by "
-                             f"{last[0] - stamp:.6f} s (out of order)")
+            raise InputError(f'{source}.header.stamp', f'goes backwards by '
+                             f'{last[0] - stamp:.6f} s (out of order)')
 
     def _timeout(self, source: str) -> float:
         c = self.config
-        t = {"joint_states": c.joint_state_timeout, "contacts": c.contacts_timeout,
-             "external_wrench": c.wrench_timeout}[source]
+        t = {'joint_states': c.joint_state_timeout, 'contacts': c.contacts_timeout,
+             'external_wrench': c.wrench_timeout}[source]
         return t if t > 0 else c.joint_state_timeout
 
     def _keep_stamp(self, source: str, stamp: float, now: float, clock: float | None) -> None:
@@ -334,7 +344,8 @@ class TorqueController:
 
     def update_joint_state(self, names: list[str], positions: list[float], now: float,
                            stamp: float = 0.0, clock: float | None = None) -> None:
-        """Take a joint state: names and positions, any order, extra joints ignored.
+        """
+        Take a joint state: names and positions, any order, extra joints ignored.
 
         Only the positions of model joints are used, so NaN elsewhere (velocity,
         effort, unknown joints) is accepted. Names that are not model joints are
@@ -353,20 +364,20 @@ class TorqueController:
                 used position not finite or beyond :data:`MAX_ABS_JOINT_POSITION`,
                 a bad stamp. The state is not kept.
         """
-        self.check_size("joint_states", max(len(names), len(positions)))
+        self.check_size('joint_states', max(len(names), len(positions)))
         try:
             if len(names) != len(positions):
-                raise InputError("joint_states", f"{len(names)} names but "
-                                 f"{len(positions)} positions")
+                raise InputError('joint_states', f'{len(names)} names but '
+                                 f'{len(positions)} positions')
             if len(set(names)) != len(names):
                 dup = next(n for n, k in Counter(names).items() if k > 1)
-                raise InputError("joint_states", f"duplicate joint name '{show(dup)}'")
+                raise InputError('joint_states', f"duplicate joint name '{show(dup)}'")
             if any(not n for n in names):
-                raise InputError("joint_states", "empty joint name")
+                raise InputError('joint_states', 'empty joint name')
             given = set(names)
             missing = [n for n in self.setup.hand.joints if n not in given]
             if missing:
-                raise InputError("joint_states", f"missing commanded joint(s) "
+                raise InputError('joint_states', f"missing commanded joint(s) "
                                  f"{', '.join(missing[:4])}")
             q = (self.setup.q if self.inputs.q is None else self.inputs.q).copy()
             for name, value in zip(names, positions):
@@ -374,21 +385,22 @@ class TorqueController:
                 if iq is None:
                     continue
                 if not math.isfinite(value):
-                    raise InputError("joint_states", f"position of '{name}' is not finite")
+                    raise InputError('joint_states', f"position of '{name}' is not finite")
                 if abs(value) > MAX_ABS_JOINT_POSITION:
-                    raise InputError("joint_states", f"position of '{name}' is {value:.6g}, "
+                    raise InputError('joint_states', f"position of '{name}' is {value:.6g}, "
                                      f"beyond +-{MAX_ABS_JOINT_POSITION:g}")
                 q[iq] = value
-            self._check_stamp("joint_states", stamp, clock, now)
+            self._check_stamp('joint_states', stamp, clock, now)
         except InputError as e:
-            self._reject("joint_states", e)
+            self._reject('joint_states', e)
             raise
-        self._keep_stamp("joint_states", stamp, now, clock)
+        self._keep_stamp('joint_states', stamp, now, clock)
         self.inputs = dataclasses.replace(self.inputs, q=q, q_time=now)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
                         now: float, stamp: float = 0.0, clock: float | None = None) -> None:
-        """Take contact frames: one pose per scenario contact, in model frame ``frame``.
+        """
+        Take contact frames: one pose per scenario contact, in model frame ``frame``.
 
         Args:
             frame: model frame of the poses ('' = the base frame).
@@ -406,32 +418,33 @@ class TorqueController:
         """
         positions = np.asarray(positions, dtype=float)
         quaternions = np.asarray(quaternions, dtype=float)
-        self.check_size("contacts", len(positions))
+        self.check_size('contacts', len(positions))
         try:
             p = len(self.setup.contacts)
             if positions.shape != (p, 3) or quaternions.shape != (p, 4):
-                raise InputError("contacts", f"positions of shape {positions.shape} and "
-                                 f"quaternions of shape {quaternions.shape}, expected "
-                                 f"({p}, 3) and ({p}, 4)")
+                raise InputError('contacts', f'positions of shape {positions.shape} and '
+                                 f'quaternions of shape {quaternions.shape}, expected '
+                                 f'({p}, 3) and ({p}, 4)')
             model = self.setup.hand.model
             if frame and not model.existFrame(frame):
-                raise FrameNotFound("contacts.header.frame_id", show(frame),
+                raise FrameNotFound('contacts.header.frame_id', show(frame),
                                     {f.name for f in model.frames})
-            _finite(positions, "contacts.poses.position")
+            _finite(positions, 'contacts.poses.position')
             rotations = np.array([quaternion_matrix(quaternions[i],
-                                                    f"contacts.poses[{i}].orientation")
+                                                    f'contacts.poses[{i}].orientation')
                                   for i in range(p)])
-            self._check_stamp("contacts", stamp, clock, now)
+            self._check_stamp('contacts', stamp, clock, now)
         except InputError as e:
-            self._reject("contacts", e)
+            self._reject('contacts', e)
             raise
-        self._keep_stamp("contacts", stamp, now, clock)
+        self._keep_stamp('contacts', stamp, now, clock)
         self.inputs = dataclasses.replace(
             self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
 
     def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
                       now: float, stamp: float = 0.0, clock: float | None = None) -> None:
-        """Take the load on the object (about its origin), axes of model frame ``frame``.
+        """
+        Take the load on the object (about its origin), axes of model frame ``frame``.
 
         Args:
             frame: model frame of the axes ('' = the base frame).
@@ -449,27 +462,27 @@ class TorqueController:
         try:
             model = self.setup.hand.model
             if frame and not model.existFrame(frame):
-                raise FrameNotFound("external_wrench.header.frame_id", show(frame),
+                raise FrameNotFound('external_wrench.header.frame_id', show(frame),
                                     {f.name for f in model.frames})
-            w = np.concatenate((_finite(force, "external_wrench.wrench.force"),
-                                _finite(torque, "external_wrench.wrench.torque")))
+            w = np.concatenate((_finite(force, 'external_wrench.wrench.force'),
+                                _finite(torque, 'external_wrench.wrench.torque')))
             if w.shape != (6,):
-                raise InputError("external_wrench.wrench", f"{w.size} values, expected 6")
+                raise InputError('external_wrench.wrench', f'{w.size} values, expected 6')
             c = self.config
             for part, v, bound, key, unit in ((
-                    "force", w[:3], c.max_wrench_force, "max_wrench_force", "N"), (
-                    "torque", w[3:], c.max_wrench_torque, "max_wrench_torque", "N m")):
-                with np.errstate(over="ignore"):  # 1e308 entries: an infinite norm
+                    'force', w[:3], c.max_wrench_force, 'max_wrench_force', 'N'), (
+                    'torque', w[3:], c.max_wrench_torque, 'max_wrench_torque', 'N m')):
+                with np.errstate(over='ignore'):  # 1e308 entries: an infinite norm
                     norm = float(np.linalg.norm(v))
                 if norm > bound:
-                    raise InputError(f"external_wrench.wrench.{part}",
-                                     f"norm {norm:.6g} {unit} exceeds {key} "
-                                     f"({bound} {unit})")
-            self._check_stamp("external_wrench", stamp, clock, now)
+                    raise InputError(f'external_wrench.wrench.{part}',
+                                     f'norm {norm:.6g} {unit} exceeds {key} '
+                                     f'({bound} {unit})')
+            self._check_stamp('external_wrench', stamp, clock, now)
         except InputError as e:
-            self._reject("external_wrench", e)
+            self._reject('external_wrench', e)
             raise
-        self._keep_stamp("external_wrench", stamp, now, clock)
+        self._keep_stamp('external_wrench', stamp, now, clock)
         # Kept in the given axes; turned into base axes at the cycle's configuration.
         self.inputs = dataclasses.replace(self.inputs, wrench=(frame, w), wrench_time=now)
 
@@ -484,19 +497,20 @@ class TorqueController:
         i = inputs or self.inputs
         c = self.config
         if i.q is None:
-            return "no joint state yet"
+            return 'no joint state yet'
         if now - i.q_time > c.joint_state_timeout:
-            return f"joint_states stale ({now - i.q_time:.3f} s > {c.joint_state_timeout} s)"
+            return f'joint_states stale ({now - i.q_time:.3f} s > {c.joint_state_timeout} s)'
         if i.contacts_time is not None and c.contacts_timeout > 0 and \
                 now - i.contacts_time > c.contacts_timeout:
-            return f"contacts stale ({now - i.contacts_time:.3f} s > {c.contacts_timeout} s)"
+            return f'contacts stale ({now - i.contacts_time:.3f} s > {c.contacts_timeout} s)'
         if i.wrench_time is not None and c.wrench_timeout > 0 and \
                 now - i.wrench_time > c.wrench_timeout:
-            return f"external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)"
-        return ""
+            return f'external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)'
+        return ''
 
     def grasp_at(self, inputs: Inputs) -> tuple[GraspSetup, np.ndarray | None]:
-        """The grasp of a snapshot of inputs, and g(q) if compensated.
+        """
+        The grasp of a snapshot of inputs, and g(q) if compensated.
 
         Raises:
             InputError: a contact point beyond ``max_contact_distance``, or the
@@ -516,9 +530,9 @@ class TorqueController:
             for i, (spec, p, R) in enumerate(zip(setup.contacts, cp.positions, cp.rotations)):
                 distance = float(np.linalg.norm(oMF.act(p)))
                 if distance > limit:
-                    raise InputError(f"contacts.poses[{i}].position",
-                                     f"is {distance:.6g} m from the base origin, beyond "
-                                     f"max_contact_distance ({limit} m)")
+                    raise InputError(f'contacts.poses[{i}].position',
+                                     f'is {distance:.6g} m from the base origin, beyond '
+                                     f'max_contact_distance ({limit} m)')
                 R_base = oMF.rotation @ R
                 oMl = data.oMf[model.getFrameId(spec.link)]
                 contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(oMF.act(p)),
@@ -536,14 +550,17 @@ class TorqueController:
                                    torque_offset=g), g
 
     def budget(self) -> float:
-        """The time a cycle's solvers may take [s]: ``cycle_budget``, or
+        """
+        The time a cycle's solvers may take [s]: ``cycle_budget``, or
         ``joint_state_timeout`` if smaller (a command later than that would answer a
-        stale joint state)."""
+        stale joint state).
+        """
         return min(self.config.cycle_budget, self.config.joint_state_timeout)
 
     def solve_inputs(self, inputs: Inputs, deadline: float | None = None
                      ) -> tuple[Solution, GraspMaps, np.ndarray | None]:
-        """Solve the grasp of a snapshot of inputs with the tau-QP (certified).
+        """
+        Solve the grasp of a snapshot of inputs with the tau-QP (certified).
 
         Args:
             inputs: the snapshot.
@@ -563,13 +580,13 @@ class TorqueController:
 
     def _refiner(self) -> Refiner | None:
         """tau-qp-adaptive's rounds (kept across cycles, warm as the solver is), else None."""
-        if self.config.method != "tau-qp-adaptive":
+        if self.config.method != 'tau-qp-adaptive':
             return None
-        warm = getattr(self.solver, "warm_start", False)
-        settings = getattr(self.solver, "settings", None)
+        warm = getattr(self.solver, 'warm_start', False)
+        settings = getattr(self.solver, 'settings', None)
         wanted = AdaptiveSettings(warm_start=warm,
-                                  eps_abs=getattr(settings, "eps_abs", AdaptiveSettings.eps_abs),
-                                  max_iter=getattr(settings, "max_iter",
+                                  eps_abs=getattr(settings, 'eps_abs', AdaptiveSettings.eps_abs),
+                                  max_iter=getattr(settings, 'max_iter',
                                                    AdaptiveSettings.max_iter))
         if self.refiner is None or self.refiner.settings != wanted:
             self.refiner = Refiner(wanted)
@@ -578,20 +595,21 @@ class TorqueController:
     def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
         """The last check before a command leaves: certified, finite, sized, within limits."""
         if not solution.optimal:
-            return None, f"no certified solution ({solution.status}: {solution.message})"
+            return None, f'no certified solution ({solution.status}: {solution.message})'
         cmd = solution.tau + (0.0 if g is None else g)
         lim = self.setup.hand.torque_limits
         if cmd.shape != lim.shape:
-            return None, f"command has {cmd.size} values for {lim.size} joints"
+            return None, f'command has {cmd.size} values for {lim.size} joints'
         if not np.all(np.isfinite(cmd)):
-            return None, "command not finite"
+            return None, 'command not finite'
         if np.any(np.abs(cmd) > lim):
             k = int(np.argmax(np.abs(cmd) - lim))
-            return None, f"command over the limit at {self.setup.hand.joints[k]}"
-        return cmd, ""
+            return None, f'command over the limit at {self.setup.hand.joints[k]}'
+        return cmd, ''
 
     def cycle(self, now: float) -> CycleResult:
-        """One cycle on the latest inputs (run it on each new joint state).
+        """
+        One cycle on the latest inputs (run it on each new joint state).
 
         Never raises: every failure is a fault, handled by the policy. The
         solvers stop by :meth:`budget`. A certified command from a cycle that
@@ -606,18 +624,18 @@ class TorqueController:
         self.counters.max_cycle_time = max(self.counters.max_cycle_time, elapsed)
         if elapsed > self.config.cycle_budget:
             self.counters.overruns += 1
-            if result.kind == "solution":
-                result = self._faulted(now, f"cycle overrun ({1e3 * elapsed:.1f} ms > "
-                                       f"cycle_budget {1e3 * self.config.cycle_budget:.1f} ms)",
+            if result.kind == 'solution':
+                result = self._faulted(now, f'cycle overrun ({1e3 * elapsed:.1f} ms > '
+                                       f'cycle_budget {1e3 * self.config.cycle_budget:.1f} ms)',
                                        result.solution, result.maps, result.gravity_torque)
-        late = self.stale(now + elapsed) if result.kind == "solution" else ""
+        late = self.stale(now + elapsed) if result.kind == 'solution' else ''
         if late:
-            result = self._faulted(now + elapsed, f"inputs went stale during the cycle: {late}",
+            result = self._faulted(now + elapsed, f'inputs went stale during the cycle: {late}',
                                    result.solution, result.maps, result.gravity_torque)
-        if result.kind == "solution":
+        if result.kind == 'solution':
             if self.fault:
                 self.counters.recoveries += 1
-            self.fault = ""
+            self.fault = ''
             self.last_command, self.last_command_time = result.command, now
             self.in_force = result.command
             self.counters.commands += 1
@@ -635,22 +653,23 @@ class TorqueController:
         try:
             sol, maps, g = self.solve_inputs(self.inputs, deadline)
         except InputError as e:
-            return self._faulted(now, f"inputs do not make a grasp: {e}")
+            return self._faulted(now, f'inputs do not make a grasp: {e}')
         except GraspTorqueError as e:
             self.counters.solver_failures += 1
-            return self._faulted(now, f"solver failed: {e}")
+            return self._faulted(now, f'solver failed: {e}')
         except Exception as e:  # noqa: BLE001 -- a control loop fails safe, it does not die
             self.counters.solver_failures += 1
-            return self._faulted(now, f"cycle failed: {type(e).__name__}: {e}")
-        if sol.status == "failed":
+            return self._faulted(now, f'cycle failed: {type(e).__name__}: {e}')
+        if sol.status == 'failed':
             self.counters.solver_failures += 1
         cmd, why = self.gate(sol, g)
         if cmd is None:
             return self._faulted(now, why, sol, maps, g)
-        return CycleResult(cmd, "solution", sol, maps, g)
+        return CycleResult(cmd, 'solution', sol, maps, g)
 
     def watchdog(self, now: float) -> CycleResult | None:
-        """Between cycles: notice stale joint states and apply the policy.
+        """
+        Between cycles: notice stale joint states and apply the policy.
 
         Returns:
             A result when there is a fault (its command may be the zero policy's),
@@ -668,10 +687,10 @@ class TorqueController:
         self.fault = reason
         held = (self.last_command_time is not None
                 and now - self.last_command_time <= self.config.hold_time)
-        if not held and self.config.fault_policy == "zero":
+        if not held and self.config.fault_policy == 'zero':
             result = self._zero(reason, sol, maps, g)
         else:
-            result = CycleResult(None, "none", sol, maps, g, reason)
+            result = CycleResult(None, 'none', sol, maps, g, reason)
         self.last = result
         return result
 
@@ -680,10 +699,11 @@ class TorqueController:
         cmd = np.zeros(self.setup.hand.m)
         self.counters.zero_commands += 1
         self.in_force = cmd
-        return CycleResult(cmd, "zero", sol, maps, g, reason)
+        return CycleResult(cmd, 'zero', sol, maps, g, reason)
 
     def reconfigured(self, now: float) -> CycleResult | None:
-        """After a parameter change: make the command in force valid at once.
+        """
+        After a parameter change: make the command in force valid at once.
 
         The rule (docs/node.md, "Faults"): the cycle runs again at once on the
         latest inputs with the new parameters, and a certified command is
@@ -703,13 +723,13 @@ class TorqueController:
         result = None
         if self.inputs.q is not None and not self.stale(now):
             result = self.cycle(now)
-            if result.kind == "solution":
+            if result.kind == 'solution':
                 return result
         lim = self.setup.hand.torque_limits
         if self.in_force.shape == lim.shape and np.all(np.abs(self.in_force) <= lim):
             return result if result is not None and result.command is not None else None
         why = result.fault if result is not None else self.stale(now)
-        reason = "the command in force exceeds the new torque_limits" + (f" ({why})" if why else "")
+        reason = 'the command in force exceeds the new torque_limits' + (f' ({why})' if why else '')
         if not self.fault:
             self.counters.faults += 1
         self.fault = reason

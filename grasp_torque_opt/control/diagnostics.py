@@ -21,11 +21,12 @@ class Report:
 
 
 def _ago(now: float, t: float | None) -> str:
-    return "never" if t is None else f"{now - t:.4f}"
+    return 'never' if t is None else f'{now - t:.4f}'
 
 
 def report(controller: TorqueController, now: float) -> Report:
-    """The controller's state as a diagnostic status.
+    """
+    The controller's state as a diagnostic status.
 
     Level: STALE before the first joint state, OK while certified commands flow,
     WARN during a fault while the last certified command is held (within
@@ -37,61 +38,61 @@ def report(controller: TorqueController, now: float) -> Report:
     last = c.last
     sol = last.solution if last is not None else None
     if c.inputs.q is None:
-        level, message = STALE, "waiting for joint_states"
+        level, message = STALE, 'waiting for joint_states'
     elif not c.fault:
-        level, message = OK, "certified torques published"
+        level, message = OK, 'certified torques published'
     else:
         held = (c.last_command_time is not None
                 and now - c.last_command_time <= cfg.hold_time)
         if held:
-            level, message = WARN, f"holding last certified command: {c.fault}"
-        elif cfg.fault_policy == "zero":
-            level, message = ERROR, f"zero torques published: {c.fault}"
+            level, message = WARN, f'holding last certified command: {c.fault}'
+        elif cfg.fault_policy == 'zero':
+            level, message = ERROR, f'zero torques published: {c.fault}'
         else:
-            level, message = ERROR, f"hold policy, last certified command kept: {c.fault}"
-    values.append(("fault", c.fault or "none"))
-    values.append(("fault_policy", cfg.fault_policy))
+            level, message = ERROR, f'hold policy, last certified command kept: {c.fault}'
+    values.append(('fault', c.fault or 'none'))
+    values.append(('fault_policy', cfg.fault_policy))
     if sol is not None:
-        values += [("status", sol.status), ("solver_message", sol.message),
-                   ("solve_time_s", f"{sol.solve_time_s:.6f}"),
-                   ("cycle_time_s", f"{last.cycle_time or sum(sol.timings.values()):.6f}"),
-                   ("iterations", str(sol.iterations))]
+        values += [('status', sol.status), ('solver_message', sol.message),
+                   ('solve_time_s', f'{sol.solve_time_s:.6f}'),
+                   ('cycle_time_s', f'{last.cycle_time or sum(sol.timings.values()):.6f}'),
+                   ('iterations', str(sol.iterations))]
         if sol.certificate is not None:
             cert = sol.certificate.as_dict()
-            values += [(f"certificate.{k}", f"{cert[k]:.3e}")
-                       for k in ("equilibrium", "torque", "cone", "normal_force",
-                                 "torque_limit")]
-            values.append(("certificate.ok", str(sol.certificate.ok).lower()))
+            values += [(f'certificate.{k}', f'{cert[k]:.3e}')
+                       for k in ('equilibrium', 'torque', 'cone', 'normal_force',
+                                 'torque_limit')]
+            values.append(('certificate.ok', str(sol.certificate.ok).lower()))
         if sol.optimal and last.maps is not None:
-            values.append(("torque_norm", f"{sol.torque_norm:.6f}"))
-            values += [("objective", sol.objective),
-                       ("friction_margin", f"{sol.friction_margin:g}"),
-                       ("max_torque_ratio", f"{sol.max_torque_ratio:.4f}"),
-                       ("friction_usage_max", f"{float(sol.friction_usage.max()):.4f}")]
+            values.append(('torque_norm', f'{sol.torque_norm:.6f}'))
+            values += [('objective', sol.objective),
+                       ('friction_margin', f'{sol.friction_margin:g}'),
+                       ('max_torque_ratio', f'{sol.max_torque_ratio:.4f}'),
+                       ('friction_usage_max', f'{float(sol.friction_usage.max()):.4f}')]
             usage = friction_usage(sol.wrenches, c.setup.friction.mu1, c.setup.friction.mu2)
             for i, (frame, (ut, ur)) in enumerate(zip(last.maps.contacts, usage)):
-                key = f"contact{i}.{frame.link}"
-                values += [(f"{key}.normal_force_N", f"{sol.wrenches[i, 2]:.4f}"),
-                           (f"{key}.friction_usage", f"{sol.friction_usage[i]:.4f}"),
-                           (f"{key}.tangential_usage", f"{ut:.4f}"),
-                           (f"{key}.torsional_usage", f"{ur:.4f}")]
+                key = f'contact{i}.{frame.link}'
+                values += [(f'{key}.normal_force_N', f'{sol.wrenches[i, 2]:.4f}'),
+                           (f'{key}.friction_usage', f'{sol.friction_usage[i]:.4f}'),
+                           (f'{key}.tangential_usage', f'{ut:.4f}'),
+                           (f'{key}.torsional_usage', f'{ur:.4f}')]
     if last is not None and last.gravity_torque is not None:
-        values.append(("gravity_torque_norm",
-                       f"{float((last.gravity_torque ** 2).sum() ** 0.5):.6f}"))
+        values.append(('gravity_torque_norm',
+                       f'{float((last.gravity_torque ** 2).sum() ** 0.5):.6f}'))
     n = c.counters
-    values += [("cycles", str(n.cycles)), ("commands", str(n.commands)),
-               ("zero_commands", str(n.zero_commands)), ("faults", str(n.faults)),
-               ("recoveries", str(n.recoveries)), ("solver_failures", str(n.solver_failures)),
-               ("overruns", str(n.overruns)), ("max_cycle_time_s", f"{n.max_cycle_time:.6f}"),
-               ("cycle_budget_s", f"{cfg.cycle_budget:.6f}")]
+    values += [('cycles', str(n.cycles)), ('commands', str(n.commands)),
+               ('zero_commands', str(n.zero_commands)), ('faults', str(n.faults)),
+               ('recoveries', str(n.recoveries)), ('solver_failures', str(n.solver_failures)),
+               ('overruns', str(n.overruns)), ('max_cycle_time_s', f'{n.max_cycle_time:.6f}'),
+               ('cycle_budget_s', f'{cfg.cycle_budget:.6f}')]
     solver = c.solver
-    values += [("solver.backend", getattr(solver, "name", type(solver).__name__)),
-               ("solver.warm_solves", str(getattr(solver, "warm_solves", 0))),
-               ("solver.warm_start_fallbacks", str(getattr(solver, "fallbacks", 0))),
-               ("solver.fallback_solves", str(n.fallback_solves))]
-    values += [(f"rejected.{k}", str(v)) for k, v in n.rejected.items()]
-    values.append(("last_rejection", c.last_rejection or "none"))
-    values += [("age.joint_states_s", _ago(now, c.inputs.q_time)),
-               ("age.contacts_s", _ago(now, c.inputs.contacts_time)),
-               ("age.external_wrench_s", _ago(now, c.inputs.wrench_time))]
+    values += [('solver.backend', getattr(solver, 'name', type(solver).__name__)),
+               ('solver.warm_solves', str(getattr(solver, 'warm_solves', 0))),
+               ('solver.warm_start_fallbacks', str(getattr(solver, 'fallbacks', 0))),
+               ('solver.fallback_solves', str(n.fallback_solves))]
+    values += [(f'rejected.{k}', str(v)) for k, v in n.rejected.items()]
+    values.append(('last_rejection', c.last_rejection or 'none'))
+    values += [('age.joint_states_s', _ago(now, c.inputs.q_time)),
+               ('age.contacts_s', _ago(now, c.inputs.contacts_time)),
+               ('age.external_wrench_s', _ago(now, c.inputs.wrench_time))]
     return Report(level, message, values)

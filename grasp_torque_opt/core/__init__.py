@@ -1,4 +1,5 @@
-"""The numerical core: no ROS, no solver (numpy, SciPy's linear algebra and Pinocchio only).
+"""
+The numerical core: no ROS, no solver (numpy, SciPy's linear algebra and Pinocchio only).
 
 Scenario files, the hand model, contact frames, the grasp matrix G and hand
 Jacobian J, the friction polygons, the tau-QP's data (a plain dataclass), the

@@ -1,4 +1,5 @@
-"""Certified bounds on the exact-cone optimum (docs/adaptive.md).
+"""
+Certified bounds on the exact-cone optimum (docs/adaptive.md).
 
 The exact problem (the SOCP of :mod:`grasp_torque_opt.reference.exact_socp`):
 
@@ -28,14 +29,13 @@ that relaxation's optimum; the fmin part can lift it above.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
-
-import numpy as np
+import math
 
 from grasp_torque_opt.core.friction import dual_cone_margin
 from grasp_torque_opt.core.scenario import Friction
 from grasp_torque_opt.core.tau_qp import TauQP
+import numpy as np
 
 #: A dual-cone margin down to -ROUNDING * max(1, max |sigma|) is rounding: a contact
 #: whose rows are all slack has sigma = 0 up to 1e-16 on either side.
@@ -44,7 +44,8 @@ ROUNDING = 1e-12
 
 @dataclass(frozen=True)
 class Bounds:
-    """Where the returned torque stands against the exact-cone optimum.
+    """
+    Where the returned torque stands against the exact-cone optimum.
 
     Every figure is the weighted torque norm sqrt(tau^T W tau) [N m] (||tau||_2
     for W = I), the square root of the objective that every method minimizes.
@@ -78,12 +79,13 @@ class Bounds:
 
     def as_dict(self) -> dict:
         """Plain-data form (JSON), with ``converged``."""
-        return {**asdict(self), "converged": self.converged}
+        return {**asdict(self), 'converged': self.converged}
 
 
 def make_bounds(lower_objective: float, upper_objective: float | None, tolerance: float,
                 rounds: int, qp_solves: int, source: str) -> Bounds:
-    """Bounds from objective values (tau^T W tau): their square roots and the gap.
+    """
+    Bounds from objective values (tau^T W tau): their square roots and the gap.
 
     Args:
         lower_objective: the best lower bound on tau^T W tau (-inf or <= 0: none).
@@ -97,7 +99,8 @@ def make_bounds(lower_objective: float, upper_objective: float | None, tolerance
 
 def relaxation_duals(qp: TauQP, rows: np.ndarray, row_multipliers: np.ndarray,
                      compat_multipliers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(eta, v) from the multipliers of a tau-QP whose cone rows are ``rows``.
+    """
+    (eta, v) from the multipliers of a tau-QP whose cone rows are ``rows``.
 
     With rows a_r f_i <= b_r (f = M1 w + M2 tau + N z) and multipliers lam_r >= 0,
     the QP's stationarity in tau reads 2 W tau + mu_box + eta = 0 with
@@ -121,7 +124,8 @@ def dual_bound(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, fricti
                weights: np.ndarray, tau_min: np.ndarray, tau_max: np.ndarray,
                eta: np.ndarray, v: np.ndarray,
                gt_pinv: np.ndarray | None = None) -> float | None:
-    """A checked lower bound on the exact optimum of tau^T W tau (module docstring).
+    """
+    A checked lower bound on the exact optimum of tau^T W tau (module docstring).
 
     y is the least-squares solution of G^T y = J eta - v, so that sigma is -v
     where the relaxation's stationarity holds exactly; the bound's validity does

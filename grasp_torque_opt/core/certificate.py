@@ -1,4 +1,5 @@
-"""The certificate every result must pass before anyone sees it.
+"""
+The certificate every result must pass before anyone sees it.
 
 Checks the recomputed contact wrenches f against the exact problem, not the
 solver's view of it: equilibrium G f + w_ext = 0, tau = J^T f, the exact
@@ -7,20 +8,20 @@ solver's view of it: equilibrium G f + w_ext = 0, tau = J^T f, the exact
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
-
-import numpy as np
+import math
 
 from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.scenario import Friction
+import numpy as np
 
 DEFAULT_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
 class Certificate:
-    """Residuals of a candidate solution; all are >= 0 and 0 is exact.
+    """
+    Residuals of a candidate solution; all are >= 0 and 0 is exact.
 
     Attributes:
         equilibrium: ||G f + w_ext||_inf [N, N m].
@@ -53,13 +54,14 @@ class Certificate:
 
     def as_dict(self) -> dict:
         """Plain-data form (JSON), with ``ok``."""
-        return {**asdict(self), "ok": self.ok}
+        return {**asdict(self), 'ok': self.ok}
 
 
 def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction: Friction,
             tau_min: np.ndarray, tau_max: np.ndarray, tau: np.ndarray, f: np.ndarray,
             tolerance: float = DEFAULT_TOLERANCE) -> Certificate:
-    """Check a candidate (tau, f) against the exact problem.
+    """
+    Check a candidate (tau, f) against the exact problem.
 
     Args:
         G: grasp matrix, shape (6, 4p).
@@ -76,7 +78,7 @@ def certify(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, friction:
     f = np.asarray(f, dtype=float)
     # One sum per array: NaN or Inf anywhere makes it non-finite.
     if not math.isfinite(tau.sum() + f.sum()):
-        inf = float("inf")
+        inf = float('inf')
         return Certificate(inf, inf, inf, inf, inf, False, tolerance)
     w = f.reshape(-1, 4)
     margin = cone_margin(w, friction.mu1, friction.mu2)

@@ -1,4 +1,5 @@
-"""Contact frames by the pinned rule (docs/design.md section 1).
+"""
+Contact frames by the pinned rule (docs/design.md section 1).
 
 Contact frame i: origin at the contact point p_i, z_i the inward unit normal
 (from the finger into the object), x_i = normalize(a x z_i) with a the base
@@ -10,14 +11,14 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from grasp_torque_opt.core.exceptions import InputError
+import numpy as np
 
 
 def contact_rotation(normal: np.ndarray, tangent: np.ndarray | None = None,
-                     field: str = "normal") -> np.ndarray:
-    """Rotation of a contact frame in base axes.
+                     field: str = 'normal') -> np.ndarray:
+    """
+    Rotation of a contact frame in base axes.
 
     Args:
         normal: inward normal in base axes, shape (3,); normalized here.
@@ -36,7 +37,8 @@ def contact_rotation(normal: np.ndarray, tangent: np.ndarray | None = None,
 
 def contact_rotations(normals: np.ndarray, tangents: list[np.ndarray | None],
                       fields: list[str]) -> np.ndarray:
-    """Rotations of p contact frames at once (the rule of :func:`contact_rotation`).
+    """
+    Rotations of p contact frames at once (the rule of :func:`contact_rotation`).
 
     Plain float arithmetic per contact: for a handful of contacts it costs a
     sixth of the same rule written with numpy array operations.
@@ -58,7 +60,7 @@ def contact_rotations(normals: np.ndarray, tangents: list[np.ndarray | None],
                                       fields):
         norm = math.sqrt(nx * nx + ny * ny + nz * nz)
         if not math.isfinite(norm) or norm < 1e-9:
-            raise InputError(f"{field}.normal", "must be finite and not zero")
+            raise InputError(f'{field}.normal', 'must be finite and not zero')
         zx, zy, zz = nx / norm, ny / norm, nz / norm
         if t is None:
             # x = a x z, a the base axis least aligned with z (the first on a tie).
@@ -73,12 +75,12 @@ def contact_rotations(normals: np.ndarray, tangents: list[np.ndarray | None],
             tx, ty, tz = (float(v) for v in np.asarray(t, dtype=float).reshape(3))
             tn = math.sqrt(tx * tx + ty * ty + tz * tz)
             if not math.isfinite(tn) or tn < 1e-9:
-                raise InputError(f"{field}.tangent", "must be finite and not zero")
+                raise InputError(f'{field}.tangent', 'must be finite and not zero')
             tx, ty, tz = tx / tn, ty / tn, tz / tn
             d = tx * zx + ty * zy + tz * zz
             xx, xy, xz = tx - d * zx, ty - d * zy, tz - d * zz
             if math.sqrt(xx * xx + xy * xy + xz * xz) < 1e-6:
-                raise InputError(f"{field}.tangent", "is parallel to the normal")
+                raise InputError(f'{field}.tangent', 'is parallel to the normal')
         k = 1.0 / math.sqrt(xx * xx + xy * xy + xz * xz)
         xx, xy, xz = xx * k, xy * k, xz * k
         yx, yy, yz = zy * xz - zz * xy, zz * xx - zx * xz, zx * xy - zy * xx

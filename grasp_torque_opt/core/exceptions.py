@@ -1,7 +1,7 @@
 """Exceptions of grasp_torque_opt: one base class, subclasses that name the bad input."""
 
-import reprlib
 from collections.abc import Iterable
+import reprlib
 
 #: Longest quotation of the user's input in an error message [characters].
 QUOTE_LENGTH = 80
@@ -12,10 +12,12 @@ _REPR.maxstring = _REPR.maxother = QUOTE_LENGTH
 
 
 def quote(value: object) -> str:
-    """``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time whatever
-    its size (a value quoted whole once printed a 4.3 MB "one line")."""
+    """
+    ``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time whatever
+    its size (a value quoted whole once printed a 4.3 MB "one line").
+    """
     text = _REPR.repr(value)
-    return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + "..."
+    return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + '...'
 
 
 #: Longest quotation of a path in an error message [characters].
@@ -23,10 +25,12 @@ PATH_LENGTH = 240
 
 
 def cut(name: object, limit: int = QUOTE_LENGTH) -> str:
-    """A name from the input as quoted in messages: ``str(name)`` cut to ``limit``
-    characters (:data:`PATH_LENGTH` for paths)."""
+    """
+    A name from the input as quoted in messages: ``str(name)`` cut to ``limit``
+    characters (:data:`PATH_LENGTH` for paths).
+    """
     text = str(name) if not isinstance(name, str) else name
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+    return text if len(text) <= limit else text[:limit - 3] + '...'
 
 
 class GraspTorqueError(Exception):
@@ -34,7 +38,8 @@ class GraspTorqueError(Exception):
 
 
 class InputError(GraspTorqueError):
-    """An input value is invalid.
+    """
+    An input value is invalid.
 
     Attributes:
         field: dotted path of the offending input, e.g. ``grasp.contacts[1].normal``.
@@ -44,13 +49,13 @@ class InputError(GraspTorqueError):
     def __init__(self, field: str, problem: str) -> None:
         self.field = field
         self.problem = problem
-        super().__init__(f"{field}: {problem}")
+        super().__init__(f'{field}: {problem}')
 
 
 def _choices(available: Iterable[str], limit: int = 12) -> str:
     names = sorted(available)
-    shown = ", ".join(cut(n) for n in names[:limit])
-    return shown + (f", ... ({len(names)} in all)" if len(names) > limit else "")
+    shown = ', '.join(cut(n) for n in names[:limit])
+    return shown + (f', ... ({len(names)} in all)' if len(names) > limit else '')
 
 
 class FrameNotFound(InputError):

@@ -1,4 +1,5 @@
-"""Grasp matrix G and hand Jacobian J from the kinematics (Pinocchio).
+"""
+Grasp matrix G and hand Jacobian J from the kinematics (Pinocchio).
 
 Each contact contributes its own blocks, written in its contact frame; the
 functions here only stack them.
@@ -16,18 +17,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
-import numpy as np
-import pinocchio as pin
-
 from grasp_torque_opt.core.contact_frame import contact_rotations
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.scenario import ContactSpec
+import numpy as np
+import pinocchio as pin
 
 
 @dataclass(frozen=True)
 class ContactFrame:
-    """A contact frame in the base frame.
+    """
+    A contact frame in the base frame.
 
     Attributes:
         link: model frame that touches.
@@ -54,7 +55,8 @@ class ContactFrame:
 
 @dataclass(frozen=True)
 class GraspMaps:
-    """Kinematic maps of one grasp at one configuration.
+    """
+    Kinematic maps of one grasp at one configuration.
 
     Attributes:
         G: grasp matrix, shape (6, 4p), about the object origin, base axes.
@@ -99,7 +101,8 @@ def _skews(v: np.ndarray) -> np.ndarray:
 
 def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
                        object_origin: np.ndarray) -> GraspMaps:
-    """Contact frames, G and J at configuration q.
+    """
+    Contact frames, G and J at configuration q.
 
     All contacts at once (batched numpy, no per-element Python loops):
 
@@ -124,7 +127,7 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
     pin.updateFramePlacements(model, data)
     c = np.asarray(object_origin, dtype=float)
     p = len(contacts)
-    fids = tuple(hand.frame_index(spec.link, f"grasp.contacts[{i}].link")
+    fids = tuple(hand.frame_index(spec.link, f'grasp.contacts[{i}].link')
                  for i, spec in enumerate(contacts))
     po = np.empty((2 * p, 3))  # contact points p_i, then link origins o_i
     for i, (spec, fid) in enumerate(zip(contacts, fids)):
@@ -137,11 +140,11 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
         if n is None:
             towards = c - points[i]
             if towards @ towards < 1e-18:
-                raise InputError(f"grasp.contacts[{i}].normal", "cannot default: the "
-                                 "contact point coincides with grasp.object_origin")
+                raise InputError(f'grasp.contacts[{i}].normal', 'cannot default: the '
+                                 'contact point coincides with grasp.object_origin')
             normals[i] = towards
     R = contact_rotations(normals, [spec.tangent for spec in contacts],
-                          [f"grasp.contacts[{i}]" for i in range(p)])
+                          [f'grasp.contacts[{i}]' for i in range(p)])
     # skew(v) rows for r_i = p_i - c (moments) and d_i = p_i - o_i (point velocity).
     arms = np.empty((2 * p, 3))
     np.subtract(points, c, out=arms[:p])

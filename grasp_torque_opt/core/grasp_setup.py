@@ -5,22 +5,22 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from grasp_torque_opt.core.exceptions import InputError
-from grasp_torque_opt.core.grasp_maps import GraspMaps, compute_grasp_maps
+from grasp_torque_opt.core.grasp_maps import compute_grasp_maps, GraspMaps
 from grasp_torque_opt.core.hand import Hand, resolve_urdf
 from grasp_torque_opt.core.scenario import (
     ContactSpec,
     Friction,
-    Scenario,
     load_scenario,
+    Scenario,
 )
+import numpy as np
 
 
 @dataclass(frozen=True)
 class GraspSetup:
-    """Everything one solve needs.
+    """
+    Everything one solve needs.
 
     Attributes:
         hand: the hand (model, actuated joints, torque limits).
@@ -45,7 +45,7 @@ class GraspSetup:
     external_wrench: np.ndarray
     weights: np.ndarray
     torque_offset: np.ndarray | None = None
-    objective: str = "sum-of-squares"
+    objective: str = 'sum-of-squares'
 
     @property
     def tau_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -56,7 +56,8 @@ class GraspSetup:
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, urdf_xml: str | None = None) -> GraspSetup:
-        """Load the hand of a scenario and bind the scenario to it.
+        """
+        Load the hand of a scenario and bind the scenario to it.
 
         Args:
             scenario: the validated scenario.
@@ -75,8 +76,8 @@ class GraspSetup:
                                   scenario.joints, scenario.torque_limits, above)
         weights = np.ones(hand.m) if scenario.weights is None else np.asarray(scenario.weights)
         if weights.shape != (hand.m,):
-            raise InputError("objective.weights",
-                             f"must have {hand.m} entries (one per joint), got {weights.size}")
+            raise InputError('objective.weights',
+                             f'must have {hand.m} entries (one per joint), got {weights.size}')
         setup = cls(hand=hand, q=hand.configuration(scenario.joint_positions),
                     contacts=scenario.contacts, object_origin=scenario.object_origin,
                     friction=scenario.friction, external_wrench=scenario.external_wrench,

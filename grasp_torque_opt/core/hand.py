@@ -1,4 +1,5 @@
-"""The hand: a Pinocchio model loaded from URDF, its actuated joints and torque limits.
+"""
+The hand: a Pinocchio model loaded from URDF, its actuated joints and torque limits.
 
 A URDF is read within bounds (docs/design.md section 4.1): a regular file of at most
 :data:`MAX_URDF_BYTES`, UTF-8, at most :data:`MAX_URDF_ELEMENTS` ``<joint>`` and
@@ -9,26 +10,25 @@ Pinocchio's workspace grows as nv^3 on a chain (23 MB at 64, 142 MB at 128, 1.1 
 
 from __future__ import annotations
 
-import os
-import re
 from dataclasses import dataclass, field
 from functools import cached_property
 from importlib import metadata
+import os
 from pathlib import Path
-
-import numpy as np
-import pinocchio as pin
+import re
 
 from grasp_torque_opt.core.exceptions import (
-    PATH_LENGTH,
+    cut,
     FrameNotFound,
     InputError,
     JointNotFound,
-    cut,
+    PATH_LENGTH,
 )
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
+import numpy as np
+import pinocchio as pin
 
-ERD_PREFIX = "example-robot-data:"
+ERD_PREFIX = 'example-robot-data:'
 #: Largest torque limit accepted at all [N m], also when a limit above the URDF's effort
 #: limit is allowed: a bound on what any command can be (1e300 was accepted once).
 MAX_TORQUE_LIMIT = 1e4
@@ -39,11 +39,12 @@ MAX_URDF_BYTES = 2 * 1024 * 1024
 MAX_URDF_ELEMENTS = 512
 #: Most degrees of freedom (nv) of a model: its workspace is allocated next.
 MAX_MODEL_DOF = 64
-_ELEMENT = {tag: re.compile(rf"<{tag}[\s/>]") for tag in ("joint", "link")}
+_ELEMENT = {tag: re.compile(rf'<{tag}[\s/>]') for tag in ('joint', 'link')}
 
 
 def example_robot_data_dir() -> Path:
-    """Folder ``robots/`` of example-robot-data.
+    """
+    Folder ``robots/`` of example-robot-data.
 
     Looked up in this order: the pip distribution ``example-robot-data`` (its
     cmeel prefix), then ``share/example-robot-data/robots`` under each entry
@@ -54,22 +55,23 @@ def example_robot_data_dir() -> Path:
     """
     candidates = []
     try:
-        dist = metadata.distribution("example-robot-data")
-        candidates.append(Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots")))
+        dist = metadata.distribution('example-robot-data')
+        candidates.append(Path(dist.locate_file('cmeel.prefix/share/example-robot-data/robots')))
     except metadata.PackageNotFoundError:
         pass
-    for prefix in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep):
+    for prefix in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep):
         if prefix:
-            candidates.append(Path(prefix) / "share" / "example-robot-data" / "robots")
+            candidates.append(Path(prefix) / 'share' / 'example-robot-data' / 'robots')
     for c in candidates:
         if c.is_dir():
             return c
-    raise InputError("hand.urdf", "example-robot-data is not installed "
-                     "(pip install example-robot-data, or source a ROS installation that has it)")
+    raise InputError('hand.urdf', 'example-robot-data is not installed '
+                     '(pip install example-robot-data, or source a ROS installation that has it)')
 
 
 def resolve_urdf(spec: str, base_dir: Path) -> Path:
-    """Resolve a URDF reference of a scenario to a file.
+    """
+    Resolve a URDF reference of a scenario to a file.
 
     Args:
         spec: ``example-robot-data:<path under robots/>``, an absolute path, or a
@@ -87,29 +89,31 @@ def resolve_urdf(spec: str, base_dir: Path) -> Path:
         if not path.is_absolute():
             path = base_dir / path
     if not os.path.exists(path):  # False on any OSError, e.g. a name too long
-        raise InputError("hand.urdf", f"file not found: {cut(path, PATH_LENGTH)}")
+        raise InputError('hand.urdf', f'file not found: {cut(path, PATH_LENGTH)}')
     return path
 
 
 def bounded_urdf(xml: str, field_name: str) -> str:
-    """A URDF document within :data:`MAX_URDF_BYTES` and :data:`MAX_URDF_ELEMENTS`.
+    """
+    A URDF document within :data:`MAX_URDF_BYTES` and :data:`MAX_URDF_ELEMENTS`.
 
     Raises:
         InputError: naming ``field_name``.
     """
     if len(xml) > MAX_URDF_BYTES:
-        raise InputError(field_name, f"the URDF is larger than {MAX_URDF_BYTES} bytes")
+        raise InputError(field_name, f'the URDF is larger than {MAX_URDF_BYTES} bytes')
     for tag, pattern in _ELEMENT.items():
         n = len(pattern.findall(xml))
         if n > MAX_URDF_ELEMENTS:
-            raise InputError(field_name, f"the URDF has {n} <{tag}> elements, more than "
-                             f"{MAX_URDF_ELEMENTS}")
+            raise InputError(field_name, f'the URDF has {n} <{tag}> elements, more than '
+                             f'{MAX_URDF_ELEMENTS}')
     return xml
 
 
 @dataclass(frozen=True)
 class Hand:
-    """A hand model with its actuated joints in command order.
+    """
+    A hand model with its actuated joints in command order.
 
     Attributes:
         model: Pinocchio model; its world frame is the base frame.
@@ -130,11 +134,12 @@ class Hand:
 
     def __post_init__(self) -> None:
         # Kinematics workspace, allocated once; a Hand is not shared across threads.
-        object.__setattr__(self, "data", self.model.createData())
-        object.__setattr__(self, "_frame_ids", {})
+        object.__setattr__(self, 'data', self.model.createData())
+        object.__setattr__(self, '_frame_ids', {})
 
     def frame_index(self, name: str, field_name: str) -> int:
-        """Index of a model frame by name, looked up once per name.
+        """
+        Index of a model frame by name, looked up once per name.
 
         Raises:
             FrameNotFound: naming ``field_name`` and listing close matches.
@@ -153,8 +158,10 @@ class Hand:
 
     @cached_property
     def base_frame(self) -> str:
-        """Name of the root link: the base frame (looked up once: the node stamps every
-        command with it)."""
+        """
+        Name of the root link: the base frame (looked up once: the node stamps every
+        command with it).
+        """
         return next(f.name for f in self.model.frames
                     if f.type == pin.FrameType.BODY and f.parentJoint == 0)
 
@@ -173,29 +180,31 @@ class Hand:
     @staticmethod
     def check_limits(limits: np.ndarray, joints: list[str], bounds: np.ndarray,
                      field: str, override: str) -> None:
-        """Each limit finite, > 0 and at most its bound (the URDF's effort limit).
+        """
+        Each limit finite, > 0 and at most its bound (the URDF's effort limit).
 
         Raises:
             InputError: naming ``field`` and the first joint over its bound, and the
                 setting ``override`` that allows more.
         """
         if not np.all(np.isfinite(limits) & (limits > 0.0)):
-            raise InputError(field, "must be finite and > 0")
+            raise InputError(field, 'must be finite and > 0')
         over = np.flatnonzero(limits > bounds)
         if over.size:
             i = int(over[0])
-            what = ("the URDF effort limit" if bounds[i] < MAX_TORQUE_LIMIT
-                    else "the largest limit accepted")
+            what = ('the URDF effort limit' if bounds[i] < MAX_TORQUE_LIMIT
+                    else 'the largest limit accepted')
             raise InputError(field, f"{limits[i]:g} N m for joint '{joints[i]}' exceeds "
                              f"{what} ({bounds[i]:g} N m)" + (
-                                 f"; set {override}: true to allow it"
-                                 if bounds[i] < MAX_TORQUE_LIMIT else ""))
+                                 f'; set {override}: true to allow it'
+                                 if bounds[i] < MAX_TORQUE_LIMIT else ''))
 
     @classmethod
     def from_model(cls, model: pin.Model, joints: list[str] | None = None,
                    torque_limits: float | list[float] | np.ndarray | None = None,
                    above_urdf: bool = False) -> Hand:
-        """Bind actuated joints and limits to a model.
+        """
+        Bind actuated joints and limits to a model.
 
         Args:
             model: the Pinocchio model.
@@ -211,14 +220,14 @@ class Hand:
                 effort limit without ``above_urdf`` (``hand.torque_limits``).
         """
         if model.nv > MAX_MODEL_DOF:
-            raise InputError("hand.urdf", f"the model has {model.nv} degrees of freedom, more "
-                             f"than {MAX_MODEL_DOF}")
+            raise InputError('hand.urdf', f'the model has {model.nv} degrees of freedom, more '
+                             f'than {MAX_MODEL_DOF}')
         available = cls.one_dof_joints(model)
         if joints is None:
             joints = available
         for i, name in enumerate(joints):
             if name not in available:
-                raise JointNotFound(f"hand.joints[{i}]", name, available)
+                raise JointNotFound(f'hand.joints[{i}]', name, available)
         ids = [model.getJointId(n) for n in joints]
         idx_q = np.array([model.joints[j].idx_q for j in ids], dtype=int)
         idx_v = np.array([model.joints[j].idx_v for j in ids], dtype=int)
@@ -226,23 +235,23 @@ class Hand:
             limits = np.asarray(model.effortLimit, dtype=float)[idx_v]
             for name, lim in zip(joints, limits):
                 if not (np.isfinite(lim) and lim > 0.0):
-                    raise InputError("hand.torque_limits",
+                    raise InputError('hand.torque_limits',
                                      f"the URDF gives no effort limit for joint '{name}'; "
                                      "set hand.torque_limits")
         else:
             limits = np.asarray(torque_limits, dtype=float)
             if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):
-                raise InputError("hand.torque_limits",
-                                 f"must have {len(joints)} entries (one per joint), "
-                                 f"got {limits.size}")
+                raise InputError('hand.torque_limits',
+                                 f'must have {len(joints)} entries (one per joint), '
+                                 f'got {limits.size}')
             limits = np.broadcast_to(limits, (len(joints),))
             effort = np.asarray(model.effortLimit, dtype=float)[idx_v]
             bounds = np.full(len(joints), MAX_TORQUE_LIMIT)
             if not above_urdf:
                 known = np.isfinite(effort) & (effort > 0.0)
                 bounds[known] = np.minimum(effort[known], MAX_TORQUE_LIMIT)
-            cls.check_limits(limits, list(joints), bounds, "hand.torque_limits",
-                             "hand.torque_limits_above_urdf")
+            cls.check_limits(limits, list(joints), bounds, 'hand.torque_limits',
+                             'hand.torque_limits_above_urdf')
         return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
                    torque_limits=np.array(limits, dtype=float))
 
@@ -250,32 +259,37 @@ class Hand:
     def from_urdf(cls, path: str | Path, joints: list[str] | None = None,
                   torque_limits: float | list[float] | np.ndarray | None = None,
                   above_urdf: bool = False) -> Hand:
-        """Load a hand from a URDF file (fixed base; meshes are not needed), within the
-        module's bounds."""
+        """
+        Load a hand from a URDF file (fixed base; meshes are not needed), within the
+        module's bounds.
+        """
         path = Path(path)
-        xml = decode_utf8(read_bounded(path, "hand.urdf", MAX_URDF_BYTES), path, "hand.urdf")
+        xml = decode_utf8(read_bounded(path, 'hand.urdf', MAX_URDF_BYTES), path, 'hand.urdf')
         try:
-            model = pin.buildModelFromXML(bounded_urdf(xml, "hand.urdf"))
+            model = pin.buildModelFromXML(bounded_urdf(xml, 'hand.urdf'))
         except (RuntimeError, ValueError) as e:
-            raise InputError("hand.urdf",
-                             f"cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}") from e
+            raise InputError('hand.urdf',
+                             f'cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}') from e
         return cls.from_model(model, joints, torque_limits, above_urdf)
 
     @classmethod
     def from_urdf_string(cls, xml: str, joints: list[str] | None = None,
                          torque_limits: float | list[float] | np.ndarray | None = None,
                          above_urdf: bool = False) -> Hand:
-        """Load a hand from a URDF document (e.g. the ``robot_description`` parameter),
-        within the module's bounds."""
+        """
+        Load a hand from a URDF document (e.g. the ``robot_description`` parameter),
+        within the module's bounds.
+        """
         try:
-            model = pin.buildModelFromXML(bounded_urdf(xml, "robot_description"))
+            model = pin.buildModelFromXML(bounded_urdf(xml, 'robot_description'))
         except (RuntimeError, ValueError) as e:
-            raise InputError("robot_description", f"cannot parse the URDF: {cut(e, 400)}") from e
+            raise InputError('robot_description', f'cannot parse the URDF: {cut(e, 400)}') from e
         return cls.from_model(model, joints, torque_limits, above_urdf)
 
     def configuration(self, positions: dict[str, float],
-                      field: str = "grasp.joint_positions") -> np.ndarray:
-        """Full configuration q from joint positions by name; others stay at 0.
+                      field: str = 'grasp.joint_positions') -> np.ndarray:
+        """
+        Full configuration q from joint positions by name; others stay at 0.
 
         Raises:
             JointNotFound: a name is not a 1-DoF joint of the model.
@@ -284,6 +298,6 @@ class Hand:
         available = self.one_dof_joints(self.model)
         for name, value in positions.items():
             if name not in available:
-                raise JointNotFound(f"{field}.{name}", name, available)
+                raise JointNotFound(f'{field}.{name}', name, available)
             q[self.model.joints[self.model.getJointId(name)].idx_q] = value
         return q

@@ -1,4 +1,5 @@
-"""Friction margin and the numbers a planner reads off a solution (docs/planner.md).
+"""
+Friction margin and the numbers a planner reads off a solution (docs/planner.md).
 
 A friction margin k >= 0 plans inside the soft-finger cone of mu1/(1+k) and
 mu2/(1+k): every wrench planned (and certified) in that reduced cone uses at
@@ -20,13 +21,13 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
-
 from grasp_torque_opt.core.scenario import Friction
+import numpy as np
 
 
 def planned_friction(friction: Friction) -> Friction:
-    """The friction the optimization and the certificate use: the cone reduced by the margin.
+    """
+    The friction the optimization and the certificate use: the cone reduced by the margin.
 
     Returns:
         ``friction`` itself when its margin is 0, else a copy with mu1/(1+k),
@@ -40,7 +41,8 @@ def planned_friction(friction: Friction) -> Friction:
 
 
 def cone_usage(wrenches: np.ndarray, mu1: float, mu2: float) -> np.ndarray:
-    """Friction usage per contact, (||f_t||/mu1 + |m_z|/mu2) / f_z [-].
+    """
+    Friction usage per contact, (||f_t||/mu1 + |m_z|/mu2) / f_z [-].
 
     Args:
         wrenches: shape (p, 4), [fx, fy, fz, mz] per contact, contact frames [N, N m].
@@ -52,13 +54,14 @@ def cone_usage(wrenches: np.ndarray, mu1: float, mu2: float) -> np.ndarray:
     """
     w = np.atleast_2d(np.asarray(wrenches, dtype=float))
     demand = np.hypot(w[:, 0], w[:, 1]) / mu1 + np.abs(w[:, 3]) / mu2
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide='ignore', invalid='ignore'):
         return np.where(w[:, 2] > 0.0, demand / np.where(w[:, 2] > 0.0, w[:, 2], 1.0), np.inf)
 
 
 def torque_ratio(tau: np.ndarray, limits: np.ndarray, offset: np.ndarray | None = None,
                  weights: np.ndarray | None = None) -> float:
-    """max_i w_i |tau_i + offset_i| / limit_i: how close the commanded torques come to a limit [-].
+    """
+    max_i w_i |tau_i + offset_i| / limit_i: how close the commanded torques come to a limit [-].
 
     Args:
         tau: optimized joint torques, shape (m,) [N m].

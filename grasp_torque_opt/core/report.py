@@ -13,7 +13,8 @@ def _floats(a) -> list[float] | None:
 
 
 def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
-    """Plain data for JSON.
+    """
+    Plain data for JSON.
 
     Pinned keys: ``status``, ``method``, ``joints``, ``tau`` [N m],
     ``torque_norm`` [N m], ``solve_time_s``, ``certificate``, ``contacts`` (per
@@ -32,29 +33,29 @@ def solution_dict(solution: Solution, maps: GraspMaps) -> dict[str, Any]:
     contacts = []
     for i, frame in enumerate(maps.contacts):
         contacts.append({
-            "link": frame.link,
-            "position": _floats(frame.position),
-            "normal": _floats(frame.normal),
-            "tangent": _floats(frame.tangent),
-            "wrench": None if solution.wrenches is None else _floats(solution.wrenches[i]),
-            "friction_usage": None if usage is None else float(usage[i]),
+            'link': frame.link,
+            'position': _floats(frame.position),
+            'normal': _floats(frame.normal),
+            'tangent': _floats(frame.tangent),
+            'wrench': None if solution.wrenches is None else _floats(solution.wrenches[i]),
+            'friction_usage': None if usage is None else float(usage[i]),
         })
     return {
-        "status": solution.status,
-        "method": solution.method,
-        "joints": list(solution.joints),
-        "tau": _floats(solution.tau),
-        "torque_norm": solution.torque_norm,
-        "solve_time_s": solution.solve_time_s,
-        "certificate": None if solution.certificate is None else solution.certificate.as_dict(),
-        "contacts": contacts,
-        "message": solution.message,
-        "iterations": solution.iterations,
-        "timings_s": dict(solution.timings),
-        "bounds": None if solution.bounds is None else solution.bounds.as_dict(),
-        "objective": solution.objective,
-        "friction_margin": solution.friction_margin,
-        "max_torque_ratio": solution.max_torque_ratio,
-        "friction_usage_max": None if usage is None else float(max(usage)),
-        "infeasibility": solution.infeasibility,
+        'status': solution.status,
+        'method': solution.method,
+        'joints': list(solution.joints),
+        'tau': _floats(solution.tau),
+        'torque_norm': solution.torque_norm,
+        'solve_time_s': solution.solve_time_s,
+        'certificate': None if solution.certificate is None else solution.certificate.as_dict(),
+        'contacts': contacts,
+        'message': solution.message,
+        'iterations': solution.iterations,
+        'timings_s': dict(solution.timings),
+        'bounds': None if solution.bounds is None else solution.bounds.as_dict(),
+        'objective': solution.objective,
+        'friction_margin': solution.friction_margin,
+        'max_torque_ratio': solution.max_torque_ratio,
+        'friction_usage_max': None if usage is None else float(max(usage)),
+        'infeasibility': solution.infeasibility,
     }

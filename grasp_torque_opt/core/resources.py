@@ -1,28 +1,31 @@
-"""Where the package's bundled files (config/, urdf/) are, installed or in the source tree,
-and how any input file is read: a regular file, within a size bound."""
+"""
+Where the package's bundled files (config/, urdf/) are, installed or in the source tree,
+and how any input file is read: a regular file, within a size bound.
+"""
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import stat
 import sys
-from pathlib import Path
 
-from grasp_torque_opt.core.exceptions import PATH_LENGTH, InputError, cut
+from grasp_torque_opt.core.exceptions import cut, InputError, PATH_LENGTH
 
-PACKAGE = "grasp_torque_opt"
+PACKAGE = 'grasp_torque_opt'
 
 
 def config_dirs() -> list[Path]:
     """Candidate config/ folders: installed shares (ROS prefixes, this Python), then the source."""
-    prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
-    dirs = [Path(p) / "share" / PACKAGE / "config" for p in prefixes + [sys.prefix]]
-    dirs.append(Path(__file__).resolve().parents[2] / "config")  # grasp_torque_opt/core/ -> root
+    prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    dirs = [Path(p) / 'share' / PACKAGE / 'config' for p in prefixes + [sys.prefix]]
+    dirs.append(Path(__file__).resolve().parents[2] / 'config')  # grasp_torque_opt/core/ -> root
     return [d for d in dirs if d.is_dir()]
 
 
-def find_config(name: str, field: str = "scenario") -> Path:
-    """A file given as a path, or by name among the bundled config files.
+def find_config(name: str, field: str = 'scenario') -> Path:
+    """
+    A file given as a path, or by name among the bundled config files.
 
     Raises:
         InputError: naming ``field``, when neither exists.
@@ -39,7 +42,8 @@ def find_config(name: str, field: str = "scenario") -> Path:
 
 
 def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
-    """The bytes of a regular file of at most ``limit`` bytes.
+    """
+    The bytes of a regular file of at most ``limit`` bytes.
 
     Opened without blocking and checked on the open descriptor, so a device, a
     pipe or a symlink to one is refused before anything is read (``/dev/zero``
@@ -54,14 +58,14 @@ def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except OSError as e:
-        raise InputError(field_name, f"cannot read {shown}: {e.strerror}") from e
+        raise InputError(field_name, f'cannot read {shown}: {e.strerror}') from e
     try:
         mode = os.fstat(fd).st_mode
         if stat.S_ISDIR(mode):
-            raise InputError(field_name, f"{shown} is a directory, not a file")
+            raise InputError(field_name, f'{shown} is a directory, not a file')
         if not stat.S_ISREG(mode):
-            raise InputError(field_name, f"{shown} is not a regular file (a device, pipe or "
-                             "socket)")
+            raise InputError(field_name, f'{shown} is not a regular file (a device, pipe or '
+                             'socket)')
         chunks, left = [], limit + 1
         while left > 0:
             chunk = os.read(fd, left)
@@ -69,13 +73,13 @@ def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
                 break
             chunks.append(chunk)
             left -= len(chunk)
-        data = b"".join(chunks)
+        data = b''.join(chunks)
     except OSError as e:
-        raise InputError(field_name, f"cannot read {shown}: {e.strerror}") from e
+        raise InputError(field_name, f'cannot read {shown}: {e.strerror}') from e
     finally:
         os.close(fd)
     if len(data) > limit:
-        raise InputError(field_name, f"{shown} is larger than {limit} bytes")
+        raise InputError(field_name, f'{shown} is larger than {limit} bytes')
     return data
 
 
@@ -83,7 +87,7 @@ def decode_utf8(data: bytes, path: Path, field_name: str) -> str:
     """UTF-8 text, or an error that says where the first bad byte is."""
     shown = cut(path, PATH_LENGTH)
     try:
-        return data.decode("utf-8")
+        return data.decode('utf-8')
     except UnicodeDecodeError as e:
-        raise InputError(field_name, f"{shown} is not UTF-8 text (byte 0x{data[e.start]:02x} "
-                         f"at offset {e.start})") from e
+        raise InputError(field_name, f'{shown} is not UTF-8 text (byte 0x{data[e.start]:02x} '
+                         f'at offset {e.start})') from e

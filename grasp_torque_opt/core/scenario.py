@@ -1,4 +1,5 @@
-"""Scenario files (YAML, schema in docs/design.md section 4): load and validate.
+"""
+Scenario files (YAML, schema in docs/design.md section 4): load and validate.
 
 Validation here is structural (types, lengths, finiteness, ranges); what needs
 the model (joint and frame names, URDF limits) is checked when the scenario is
@@ -15,16 +16,15 @@ most :data:`MAX_SCENARIO_BYTES`, UTF-8, YAML without aliases and nested at most
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
+import math
 from pathlib import Path
 from typing import Any
 
+from grasp_torque_opt.core.exceptions import cut, InputError, PATH_LENGTH, quote
+from grasp_torque_opt.core.resources import decode_utf8, read_bounded
 import numpy as np
 import yaml
-
-from grasp_torque_opt.core.exceptions import PATH_LENGTH, InputError, cut, quote
-from grasp_torque_opt.core.resources import decode_utf8, read_bounded
 
 #: Largest scenario file read [bytes] (the bundled ones are about 2 KB).
 MAX_SCENARIO_BYTES = 256 * 1024
@@ -41,7 +41,8 @@ MAX_POLYGON_SIDES = 64
 
 @dataclass(frozen=True)
 class ContactSpec:
-    """One contact as the scenario states it.
+    """
+    One contact as the scenario states it.
 
     Attributes:
         link: model frame that touches the object.
@@ -60,7 +61,8 @@ class ContactSpec:
 
 @dataclass(frozen=True)
 class Friction:
-    """Soft-finger friction and its linearization.
+    """
+    Soft-finger friction and its linearization.
 
     Attributes:
         mu1: tangential friction coefficient [-].
@@ -80,15 +82,16 @@ class Friction:
 
 #: Objectives of the tau-QP (docs/planner.md): the paper's sum of squared torques, and
 #: the min-max of |tau_i| / limit_i (an LP, then the sum of squares among its optima).
-OBJECTIVES = ("sum-of-squares", "min-max")
+OBJECTIVES = ('sum-of-squares', 'min-max')
 
 #: Object shapes and the entries of their ``size`` [m].
-SHAPES = {"sphere": ("radius",), "box": ("x", "y", "z"), "cylinder": ("radius", "length")}
+SHAPES = {'sphere': ('radius',), 'box': ('x', 'y', 'z'), 'cylinder': ('radius', 'length')}
 
 
 @dataclass(frozen=True)
 class ObjectSpec:
-    """The grasped object: what a simulation holds, and whose weight can be the load.
+    """
+    The grasped object: what a simulation holds, and whose weight can be the load.
 
     Attributes:
         shape: ``sphere``, ``box`` or ``cylinder`` (axis along the object's z).
@@ -110,7 +113,8 @@ class ObjectSpec:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario.
+    """
+    A validated scenario.
 
     Attributes:
         urdf: the hand's URDF path as written (see :func:`resolve_urdf`).
@@ -142,18 +146,20 @@ class Scenario:
     friction: Friction
     external_wrench: np.ndarray
     weights: list[float] | None = None
-    source: str = field(default="<memory>")
+    source: str = field(default='<memory>')
     object: ObjectSpec | None = None
     gravity: np.ndarray | None = None
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    objective: str = "sum-of-squares"
+    objective: str = 'sum-of-squares'
     torque_limits_above_urdf: bool = False
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
                   origin: np.ndarray) -> np.ndarray:
-    """The object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,);
-    zero without an object or without gravity."""
+    """
+    The object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,);
+    zero without an object or without gravity.
+    """
     if obj is None or gravity is None:
         return np.zeros(6)
     force = obj.mass * np.asarray(gravity, dtype=float)
@@ -161,107 +167,108 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 
 
 _SECTIONS = {
-    "hand": {"urdf", "joints", "torque_limits", "torque_limits_above_urdf"},
-    "grasp": {"joint_positions", "object_origin", "contacts"},
-    "friction": {"mu_tangential", "mu_torsional", "polygon_sides", "min_normal_force",
-                 "margin"},
-    "load": {"external_wrench"},
-    "objective": {"weights", "type"},
+    'hand': {'urdf', 'joints', 'torque_limits', 'torque_limits_above_urdf'},
+    'grasp': {'joint_positions', 'object_origin', 'contacts'},
+    'friction': {'mu_tangential', 'mu_torsional', 'polygon_sides', 'min_normal_force',
+                 'margin'},
+    'load': {'external_wrench'},
+    'objective': {'weights', 'type'},
 }
-_CONTACT_KEYS = {"link", "position", "normal", "tangent"}
-_OBJECT_KEYS = {"shape", "size", "mass", "position", "rpy"}
+_CONTACT_KEYS = {'link', 'position', 'normal', 'tangent'}
+_OBJECT_KEYS = {'shape', 'size', 'mass', 'position', 'rpy'}
 
 
 def _object(value: Any, origin: np.ndarray) -> ObjectSpec:
-    section = _mapping(value, "object", _OBJECT_KEYS)
-    shape = _require(section, "shape", "object")
+    section = _mapping(value, 'object', _OBJECT_KEYS)
+    shape = _require(section, 'shape', 'object')
     if shape not in SHAPES:
-        raise InputError("object.shape", f"must be one of {', '.join(SHAPES)}, got {shape!r}")
+        raise InputError('object.shape', f"must be one of {', '.join(SHAPES)}, got {shape!r}")
     entries = SHAPES[shape]
-    size = _vector(_require(section, "size", "object"), "object.size")
+    size = _vector(_require(section, 'size', 'object'), 'object.size')
     if len(size) != len(entries):
-        raise InputError("object.size", f"must have {len(entries)} entries for a {shape} "
+        raise InputError('object.size', f"must have {len(entries)} entries for a {shape} "
                          f"({', '.join(entries)}), got {len(size)}")
     for i, x in enumerate(size):
         if x <= 0.0:
-            raise InputError(f"object.size[{i}]", f"must be > 0, got {x}")
-    mass = _positive(_require(section, "mass", "object"), "object.mass")
-    position = (_vector(section["position"], "object.position", 3)
-                if section.get("position") is not None else origin.copy())
-    rpy = (_vector(section["rpy"], "object.rpy", 3) if section.get("rpy") is not None
+            raise InputError(f'object.size[{i}]', f'must be > 0, got {x}')
+    mass = _positive(_require(section, 'mass', 'object'), 'object.mass')
+    position = (_vector(section['position'], 'object.position', 3)
+                if section.get('position') is not None else origin.copy())
+    rpy = (_vector(section['rpy'], 'object.rpy', 3) if section.get('rpy') is not None
            else np.zeros(3))
     return ObjectSpec(shape=shape, size=size, mass=mass, position=position, rpy=rpy)
 
 
 def _mapping(value: Any, name: str, allowed: set[str]) -> dict:
     if not isinstance(value, dict):
-        raise InputError(name, f"must be a mapping, got {type(value).__name__}")
+        raise InputError(name, f'must be a mapping, got {type(value).__name__}')
     for key in value:
         if key not in allowed:
-            raise InputError(f"{name}.{cut(key)}" if name else cut(key),
+            raise InputError(f'{name}.{cut(key)}' if name else cut(key),
                              f"unknown field (allowed: {', '.join(sorted(allowed))})")
     return value
 
 
 def _require(section: dict, key: str, name: str) -> Any:
     if key not in section or section[key] is None:
-        raise InputError(f"{name}.{key}" if name else key, "missing required field")
+        raise InputError(f'{name}.{key}' if name else key, 'missing required field')
     return section[key]
 
 
 def _number(value: Any, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(name, f"must be a number, got {quote(value)}")
+        raise InputError(name, f'must be a number, got {quote(value)}')
     try:
         x = float(value)
     except OverflowError:  # an integer of more than 308 digits
         x = math.inf
     if not math.isfinite(x):
-        raise InputError(name, f"must be finite, got {quote(value)}")
+        raise InputError(name, f'must be finite, got {quote(value)}')
     return x
 
 
 def _vector(value: Any, name: str, length: int | None = None) -> np.ndarray:
     if not isinstance(value, (list, tuple)):
-        raise InputError(name, f"must be a list of numbers, got {quote(value)}")
+        raise InputError(name, f'must be a list of numbers, got {quote(value)}')
     if length is not None and len(value) != length:
-        raise InputError(name, f"must have {length} entries, got {len(value)}")
-    return np.array([_number(v, f"{name}[{i}]") for i, v in enumerate(value)], dtype=float)
+        raise InputError(name, f'must have {length} entries, got {len(value)}')
+    return np.array([_number(v, f'{name}[{i}]') for i, v in enumerate(value)], dtype=float)
 
 
 def _positive(value: Any, name: str) -> float:
     x = _number(value, name)
     if x <= 0.0:
-        raise InputError(name, f"must be > 0, got {quote(value)}")
+        raise InputError(name, f'must be > 0, got {quote(value)}')
     return x
 
 
-def _margin(value: Any, name: str = "friction.margin") -> float:
+def _margin(value: Any, name: str = 'friction.margin') -> float:
     """A friction margin k: finite and >= 0 [-]."""
     k = _number(value, name)
     if k < 0.0:
-        raise InputError(name, f"must be >= 0, got {value!r}")
+        raise InputError(name, f'must be >= 0, got {value!r}')
     return k
 
 
 def _names(value: Any, name: str) -> list[str]:
     if not isinstance(value, list) or not value:
-        raise InputError(name, "must be a non-empty list of names")
+        raise InputError(name, 'must be a non-empty list of names')
     if len(value) > MAX_JOINTS:
-        raise InputError(name, f"{len(value)} names, more than {MAX_JOINTS}")
+        raise InputError(name, f'{len(value)} names, more than {MAX_JOINTS}')
     out, seen = [], set()
     for i, v in enumerate(value):
         if not isinstance(v, str) or not v:
-            raise InputError(f"{name}[{i}]", f"must be a name, got {quote(v)}")
+            raise InputError(f'{name}[{i}]', f'must be a name, got {quote(v)}')
         if v in seen:
-            raise InputError(f"{name}[{i}]", f"duplicate name '{cut(v)}'")
+            raise InputError(f'{name}[{i}]', f"duplicate name '{cut(v)}'")
         out.append(v)
         seen.add(v)
     return out
 
 
-def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scenario:
-    """Validate a scenario given as plain data (as parsed from YAML).
+def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scenario:
+    """
+    Validate a scenario given as plain data (as parsed from YAML).
 
     Args:
         data: the parsed document.
@@ -274,124 +281,124 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
     Raises:
         InputError: naming the first invalid field.
     """
-    top = _mapping(data, "", set(_SECTIONS) | {"object", "gravity"})
-    hand = _mapping(_require(top, "hand", ""), "hand", _SECTIONS["hand"])
-    grasp = _mapping(_require(top, "grasp", ""), "grasp",
-                     _SECTIONS["grasp"])
-    friction = _mapping(_require(top, "friction", ""), "friction",
-                        _SECTIONS["friction"])
-    gravity = _vector(top["gravity"], "gravity", 3) if top.get("gravity") is not None else None
+    top = _mapping(data, '', set(_SECTIONS) | {'object', 'gravity'})
+    hand = _mapping(_require(top, 'hand', ''), 'hand', _SECTIONS['hand'])
+    grasp = _mapping(_require(top, 'grasp', ''), 'grasp',
+                     _SECTIONS['grasp'])
+    friction = _mapping(_require(top, 'friction', ''), 'friction',
+                        _SECTIONS['friction'])
+    gravity = _vector(top['gravity'], 'gravity', 3) if top.get('gravity') is not None else None
     # With an object and gravity the load is the object's weight; load is then optional.
-    weighed = gravity is not None and top.get("object") is not None
-    load = _mapping(top.get("load") or {} if weighed else _require(top, "load", ""), "load",
-                    _SECTIONS["load"])
-    objective = _mapping(top.get("objective") or {}, "objective", _SECTIONS["objective"])
+    weighed = gravity is not None and top.get('object') is not None
+    load = _mapping(top.get('load') or {} if weighed else _require(top, 'load', ''), 'load',
+                    _SECTIONS['load'])
+    objective = _mapping(top.get('objective') or {}, 'objective', _SECTIONS['objective'])
 
-    urdf = _require(hand, "urdf", "hand")
+    urdf = _require(hand, 'urdf', 'hand')
     if not isinstance(urdf, str) or not urdf:
-        raise InputError("hand.urdf", f"must be a path, got {quote(urdf)}")
-    joints = _names(hand["joints"], "hand.joints") if hand.get("joints") is not None else None
+        raise InputError('hand.urdf', f'must be a path, got {quote(urdf)}')
+    joints = _names(hand['joints'], 'hand.joints') if hand.get('joints') is not None else None
 
-    limits = hand.get("torque_limits")
+    limits = hand.get('torque_limits')
     if limits is not None:
         if isinstance(limits, (list, tuple)):
-            limits = [_positive(v, f"hand.torque_limits[{i}]") for i, v in enumerate(limits)]
+            limits = [_positive(v, f'hand.torque_limits[{i}]') for i, v in enumerate(limits)]
             if joints is not None and len(limits) != len(joints):
-                raise InputError("hand.torque_limits",
-                                 f"must have {len(joints)} entries (one per joint), "
-                                 f"got {len(limits)}")
+                raise InputError('hand.torque_limits',
+                                 f'must have {len(joints)} entries (one per joint), '
+                                 f'got {len(limits)}')
         else:
-            limits = _positive(limits, "hand.torque_limits")
-    above_urdf = hand.get("torque_limits_above_urdf", False)
+            limits = _positive(limits, 'hand.torque_limits')
+    above_urdf = hand.get('torque_limits_above_urdf', False)
     if not isinstance(above_urdf, bool):
-        raise InputError("hand.torque_limits_above_urdf", "must be true or false")
+        raise InputError('hand.torque_limits_above_urdf', 'must be true or false')
 
-    positions_raw = grasp.get("joint_positions") or {}
+    positions_raw = grasp.get('joint_positions') or {}
     if not isinstance(positions_raw, dict):
-        raise InputError("grasp.joint_positions", "must be a mapping joint name -> position")
+        raise InputError('grasp.joint_positions', 'must be a mapping joint name -> position')
     if len(positions_raw) > MAX_JOINTS:
-        raise InputError("grasp.joint_positions",
-                         f"{len(positions_raw)} entries, more than {MAX_JOINTS}")
-    positions = {str(k): _number(v, f"grasp.joint_positions.{cut(k)}")
+        raise InputError('grasp.joint_positions',
+                         f'{len(positions_raw)} entries, more than {MAX_JOINTS}')
+    positions = {str(k): _number(v, f'grasp.joint_positions.{cut(k)}')
                  for k, v in positions_raw.items()}
 
-    origin = _vector(_require(grasp, "object_origin", "grasp"), "grasp.object_origin", 3)
+    origin = _vector(_require(grasp, 'object_origin', 'grasp'), 'grasp.object_origin', 3)
 
-    contacts_raw = _require(grasp, "contacts", "grasp")
+    contacts_raw = _require(grasp, 'contacts', 'grasp')
     if not isinstance(contacts_raw, list) or not contacts_raw:
-        raise InputError("grasp.contacts", "must be a non-empty list of contacts")
+        raise InputError('grasp.contacts', 'must be a non-empty list of contacts')
     if len(contacts_raw) > MAX_CONTACTS:
-        raise InputError("grasp.contacts",
-                         f"{len(contacts_raw)} contacts, more than {MAX_CONTACTS}")
+        raise InputError('grasp.contacts',
+                         f'{len(contacts_raw)} contacts, more than {MAX_CONTACTS}')
     contacts = []
     for i, c in enumerate(contacts_raw):
-        name = f"grasp.contacts[{i}]"
+        name = f'grasp.contacts[{i}]'
         c = _mapping(c, name, _CONTACT_KEYS)
-        link = _require(c, "link", name)
+        link = _require(c, 'link', name)
         if not isinstance(link, str) or not link:
-            raise InputError(f"{name}.link", f"must be a frame name, got {quote(link)}")
-        position = (_vector(c["position"], f"{name}.position", 3)
-                    if c.get("position") is not None else np.zeros(3))
+            raise InputError(f'{name}.link', f'must be a frame name, got {quote(link)}')
+        position = (_vector(c['position'], f'{name}.position', 3)
+                    if c.get('position') is not None else np.zeros(3))
         normal = None
-        if c.get("normal") is not None:
-            normal = _vector(c["normal"], f"{name}.normal", 3)
+        if c.get('normal') is not None:
+            normal = _vector(c['normal'], f'{name}.normal', 3)
             norm = np.linalg.norm(normal)
             if norm < 1e-9:
-                raise InputError(f"{name}.normal", "must not be zero")
+                raise InputError(f'{name}.normal', 'must not be zero')
             normal = normal / norm
         tangent = None
-        if c.get("tangent") is not None:
-            tangent = _vector(c["tangent"], f"{name}.tangent", 3)
+        if c.get('tangent') is not None:
+            tangent = _vector(c['tangent'], f'{name}.tangent', 3)
             if np.linalg.norm(tangent) < 1e-9:
-                raise InputError(f"{name}.tangent", "must not be zero")
+                raise InputError(f'{name}.tangent', 'must not be zero')
             if normal is not None:
                 t = tangent / np.linalg.norm(tangent)
                 if np.linalg.norm(t - (t @ normal) * normal) < 1e-6:
-                    raise InputError(f"{name}.tangent", "is parallel to the normal")
+                    raise InputError(f'{name}.tangent', 'is parallel to the normal')
         contacts.append(ContactSpec(link=link, position=position, normal=normal, tangent=tangent))
 
-    sides = _require(friction, "polygon_sides", "friction")
+    sides = _require(friction, 'polygon_sides', 'friction')
     if isinstance(sides, bool) or not isinstance(sides, int):
-        raise InputError("friction.polygon_sides", f"must be an integer, got {quote(sides)}")
+        raise InputError('friction.polygon_sides', f'must be an integer, got {quote(sides)}')
     if sides < 3:
-        raise InputError("friction.polygon_sides", f"must be >= 3, got {sides}")
+        raise InputError('friction.polygon_sides', f'must be >= 3, got {sides}')
     if sides > MAX_POLYGON_SIDES:
-        raise InputError("friction.polygon_sides",
-                         f"must be at most {MAX_POLYGON_SIDES}, got {quote(sides)}")
-    fmin = _number(friction.get("min_normal_force", 0.0), "friction.min_normal_force")
+        raise InputError('friction.polygon_sides',
+                         f'must be at most {MAX_POLYGON_SIDES}, got {quote(sides)}')
+    fmin = _number(friction.get('min_normal_force', 0.0), 'friction.min_normal_force')
     if fmin < 0.0:
-        raise InputError("friction.min_normal_force", f"must be >= 0, got {fmin}")
+        raise InputError('friction.min_normal_force', f'must be >= 0, got {fmin}')
     fric = Friction(
-        mu1=_positive(_require(friction, "mu_tangential", "friction"), "friction.mu_tangential"),
-        mu2=_positive(_require(friction, "mu_torsional", "friction"), "friction.mu_torsional"),
+        mu1=_positive(_require(friction, 'mu_tangential', 'friction'), 'friction.mu_tangential'),
+        mu2=_positive(_require(friction, 'mu_torsional', 'friction'), 'friction.mu_torsional'),
         sides=sides,
         min_normal_force=fmin,
-        margin=_margin(friction.get("margin", 0.0)),
+        margin=_margin(friction.get('margin', 0.0)),
     )
 
-    if weighed and load.get("external_wrench") is None:
+    if weighed and load.get('external_wrench') is None:
         extra = np.zeros(6)
     else:
-        extra = _vector(_require(load, "external_wrench", "load"), "load.external_wrench", 6)
-    obj = _object(top["object"], origin) if top.get("object") is not None else None
+        extra = _vector(_require(load, 'external_wrench', 'load'), 'load.external_wrench', 6)
+    obj = _object(top['object'], origin) if top.get('object') is not None else None
     wrench = extra + weight_wrench(obj, gravity, origin)
 
     weights = None
-    if objective.get("weights") is not None:
-        weights = [_positive(v, f"objective.weights[{i}]")
-                   for i, v in enumerate(_vector(objective["weights"], "objective.weights"))]
+    if objective.get('weights') is not None:
+        weights = [_positive(v, f'objective.weights[{i}]')
+                   for i, v in enumerate(_vector(objective['weights'], 'objective.weights'))]
         if joints is not None and len(weights) != len(joints):
-            raise InputError("objective.weights",
-                             f"must have {len(joints)} entries (one per joint), "
-                             f"got {len(weights)}")
+            raise InputError('objective.weights',
+                             f'must have {len(joints)} entries (one per joint), '
+                             f'got {len(weights)}')
 
-    kind = objective.get("type", OBJECTIVES[0])
+    kind = objective.get('type', OBJECTIVES[0])
     if kind not in OBJECTIVES:
-        raise InputError("objective.type", f"must be one of {', '.join(OBJECTIVES)}, "
+        raise InputError('objective.type', f"must be one of {', '.join(OBJECTIVES)}, "
                          f"got {kind!r}")
     if joints is None and (isinstance(limits, list) or weights is not None):
-        per_joint = "hand.torque_limits" if isinstance(limits, list) else "objective.weights"
-        raise InputError("hand.joints", f"required when {per_joint} gives one value per joint "
+        per_joint = 'hand.torque_limits' if isinstance(limits, list) else 'objective.weights'
+        raise InputError('hand.joints', f"required when {per_joint} gives one value per joint "
                          "(without it the values would follow Pinocchio's joint order, which "
                          "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
@@ -402,7 +409,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = "<memory>") -> Scena
 
 
 class _BoundedLoader(yaml.SafeLoader):
-    """PyYAML's SafeLoader without aliases and with nesting bounded by :data:`MAX_DEPTH`.
+    """
+    PyYAML's SafeLoader without aliases and with nesting bounded by :data:`MAX_DEPTH`.
 
     An alias repeats a node by reference, so 2.8 KB of nested aliases expand to
     billions of values (the "billion laughs"); a scenario never needs one. The
@@ -414,20 +422,21 @@ class _BoundedLoader(yaml.SafeLoader):
     def compose_node(self, parent, index):
         if self.check_event(yaml.AliasEvent):
             mark = self.peek_event().start_mark
-            raise InputError("scenario", f"YAML aliases are not allowed (line {mark.line + 1})")
+            raise InputError('scenario', f'YAML aliases are not allowed (line {mark.line + 1})')
         self._depth += 1
         try:
             if self._depth > MAX_DEPTH:
                 mark = self.peek_event().start_mark
-                raise InputError("scenario", f"nested more than {MAX_DEPTH} levels deep "
-                                 f"(line {mark.line + 1})")
+                raise InputError('scenario', f'nested more than {MAX_DEPTH} levels deep '
+                                 f'(line {mark.line + 1})')
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario file, within the bounds of the module's docstring.
+    """
+    Read and validate a scenario file, within the bounds of the module's docstring.
 
     Raises:
         InputError: the file cannot be read, is not a regular file, too large, not
@@ -435,11 +444,11 @@ def load_scenario(path: str | Path) -> Scenario:
             invalid (named).
     """
     path = Path(path)
-    text = decode_utf8(read_bounded(path, "scenario", MAX_SCENARIO_BYTES), path, "scenario")
+    text = decode_utf8(read_bounded(path, 'scenario', MAX_SCENARIO_BYTES), path, 'scenario')
     try:
         data = yaml.load(text, Loader=_BoundedLoader)  # noqa: S506 -- a SafeLoader
     except (yaml.YAMLError, ValueError) as e:  # ValueError: an integer of 5000 digits
-        first = (str(e).splitlines() or [""])[0]
-        raise InputError("scenario", f"{cut(path, PATH_LENGTH)} is not valid YAML: "
-                         f"{cut(first)}") from e
+        first = (str(e).splitlines() or [''])[0]
+        raise InputError('scenario', f'{cut(path, PATH_LENGTH)} is not valid YAML: '
+                         f'{cut(first)}') from e
     return parse_scenario(data, path.resolve().parent, source=str(path))

@@ -4,19 +4,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from grasp_torque_opt.core.bounds import Bounds
 from grasp_torque_opt.core.certificate import Certificate
+import numpy as np
 
-OPTIMAL = "optimal"
-INFEASIBLE = "infeasible"
-FAILED = "failed"
+OPTIMAL = 'optimal'
+INFEASIBLE = 'infeasible'
+FAILED = 'failed'
 
 
 @dataclass
 class Solution:
-    """Outcome of one method on one grasp.
+    """
+    Outcome of one method on one grasp.
 
     ``status`` is ``optimal`` only when the certificate passed; ``infeasible``
     only when no torque can hold the load (confirmed independently for the
@@ -55,11 +55,11 @@ class Solution:
     iterations: int = 0
     solve_time_s: float = 0.0
     certificate: Certificate | None = None
-    message: str = ""
+    message: str = ''
     timings: dict[str, float] = field(default_factory=dict)
-    backend: str = ""
+    backend: str = ''
     bounds: Bounds | None = None
-    objective: str = "sum-of-squares"
+    objective: str = 'sum-of-squares'
     friction_margin: float = 0.0
     friction_usage: np.ndarray | None = None
     max_torque_ratio: float | None = None
@@ -78,7 +78,8 @@ class Solution:
 
 @dataclass(frozen=True)
 class RawResult:
-    """What a solver said, before certification.
+    """
+    What a solver said, before certification.
 
     Attributes:
         status: ``solved``, ``infeasible`` or ``error``.

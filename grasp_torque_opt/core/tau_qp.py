@@ -1,4 +1,5 @@
-"""The tau-space QP (docs/design.md section 2): build it as a plain dataclass.
+"""
+The tau-space QP (docs/design.md section 2): build it as a plain dataclass.
 
 With A = [G; J^T] (shape (6 + m) x 4p), every wrench that balances the load and
 produces tau is
@@ -23,16 +24,15 @@ solve in 10 to 70 iterations.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import lru_cache
-
-import numpy as np
-from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
+import math
 
 from grasp_torque_opt.core.friction import friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
+import numpy as np
+from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
 
 #: Relative singular-value threshold for the rank of A.
 RANK_RTOL = 1e-10
@@ -44,7 +44,8 @@ BOX_MARGIN = 1e-8
 
 @dataclass(frozen=True)
 class TauQP:
-    """A built tau-space QP: 1/2 x^T H x + g^T x, A x = b, C x <= u, box on x.
+    """
+    A built tau-space QP: 1/2 x^T H x + g^T x, A x = b, C x <= u, box on x.
 
     Attributes:
         H: Hessian, shape (n, n), n = m + k.
@@ -90,7 +91,8 @@ class TauQP:
 
 
 def decompose(A_full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """pinv(A), an orthonormal basis of null(A), and one of A's left null space.
+    """
+    pinv(A), an orthonormal basis of null(A), and one of A's left null space.
 
     A full-column-rank A with at least as many rows as columns (the Allegro's
     four fingertips: 22 x 16) takes a Householder QR, A = [Q1 Q2] [R; 0]:
@@ -129,7 +131,8 @@ def _hessian(weights: tuple[float, ...], k: int) -> np.ndarray:
 
 def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
                  tau_min: np.ndarray, tau_max: np.ndarray, weights: np.ndarray) -> TauQP:
-    """Build the tau-space QP of one grasp.
+    """
+    Build the tau-space QP of one grasp.
 
     What does not change between cycles (S for the friction and contact count,
     H for the weights) is cached; the rest is a few array operations.
@@ -166,7 +169,8 @@ def build_tau_qp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarra
 
 
 def check_data(qp: TauQP) -> str:
-    """Why a QP must not reach a solver ('' if it may): non-finite data, NaN or inverted bounds.
+    """
+    Why a QP must not reach a solver ('' if it may): non-finite data, NaN or inverted bounds.
 
     One NaN in its data made ProxSuite run for 84 s uncapped and return NaN.
     """
@@ -174,7 +178,7 @@ def check_data(qp: TauQP) -> str:
     # overflow of huge finite entries, which is refused as well).
     total = qp.H.sum() + qp.g.sum() + qp.A.sum() + qp.b.sum() + qp.C.sum() + qp.u.sum()
     if not math.isfinite(total):
-        return "QP data not finite"
+        return 'QP data not finite'
     if not (qp.l_box <= qp.u_box).all():  # False for NaN as well
-        return "QP bounds NaN or inverted (lower > upper)"
-    return ""
+        return 'QP bounds NaN or inverted (lower > upper)'
+    return ''

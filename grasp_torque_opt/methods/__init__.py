@@ -1,4 +1,5 @@
-"""Every method behind one entry point, and their comparison (the paper's Table 2).
+"""
+Every method behind one entry point, and their comparison (the paper's Table 2).
 
 :func:`solve` runs the kinematics, builds the problem, solves it with a backend
 or a reference method, certifies the answer and decides the status.
@@ -6,4 +7,4 @@ or a reference method, certifies the answer and decides the status.
 
 from grasp_torque_opt.methods.dispatch import METHODS, solve
 
-__all__ = ["METHODS", "solve"]
+__all__ = ['METHODS', 'solve']

@@ -1,4 +1,5 @@
-"""Method ``tau-qp-adaptive``: the exact-cone optimum from QPs, with a certified gap.
+"""
+Method ``tau-qp-adaptive``: the exact-cone optimum from QPs, with a certified gap.
 
 docs/adaptive.md has the derivation and the measurements. All rounds of one
 grasp share one DAQP workspace of fixed size, so each starts from the previous
@@ -37,23 +38,22 @@ paper's N-gon when no round gave a certified candidate.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import lru_cache
-
-import numpy as np
-from scipy.linalg.lapack import dposv
+import math
 
 from grasp_torque_opt.backends.daqp import DaqpWorkspace
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.core.bounds import dual_bound, relaxation_duals
-from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE, Certificate, certify
+from grasp_torque_opt.core.certificate import Certificate, certify, DEFAULT_TOLERANCE
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.friction import circumscribed_rows
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.solution import RawResult
 from grasp_torque_opt.core.tau_qp import TauQP
+import numpy as np
+from scipy.linalg.lapack import dposv
 
 #: Relative inflation of every facet (core.friction.circumscribed_rows): the rows'
 #: dual vectors then lie strictly inside the exact dual cone, so rounding cannot
@@ -80,7 +80,8 @@ FIRST_SIDES = 16
 
 @dataclass(frozen=True)
 class AdaptiveSettings:
-    """Settings of ``tau-qp-adaptive``.
+    """
+    Settings of ``tau-qp-adaptive``.
 
     Attributes:
         gap_tolerance: stop when sqrt(upper/lower) - 1 is at most this [-].
@@ -108,7 +109,8 @@ class AdaptiveSettings:
 
 @dataclass
 class Refined:
-    """What the rounds found for one grasp.
+    """
+    What the rounds found for one grasp.
 
     Attributes:
         tau: the best certified candidate's torques [N m], or None.
@@ -142,7 +144,8 @@ class Refined:
 @lru_cache(maxsize=32)
 def _template(mu1: float, mu2: float, sides: int
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One contact's rows in round 0, the spare tangent slots, and the rows' pieces.
+    """
+    One contact's rows in round 0, the spare tangent slots, and the rows' pieces.
 
     Rows: two tangent slots (here two of the polygon's rows again), the inflated
     circumscribed polygon's 2 N rows, -fz <= -f_min. Pieces, shape (R, 2): 1
@@ -168,7 +171,8 @@ def _torque_rows(n: int, m: int) -> np.ndarray:
 
 
 class Refiner:
-    """Runs the rounds; reusable across grasps (one DAQP workspace, reset per grasp).
+    """
+    Runs the rounds; reusable across grasps (one DAQP workspace, reset per grasp).
 
     Args:
         settings: the method's settings.
@@ -190,7 +194,8 @@ class Refiner:
     def refine(self, setup: GraspSetup, maps: GraspMaps, base: TauQP,
                tolerance: float = DEFAULT_TOLERANCE, deadline: float | None = None
                ) -> Refined:
-        """Run round 0 and the refinement rounds on one grasp.
+        """
+        Run round 0 and the refinement rounds on one grasp.
 
         Args:
             setup: the grasp.
@@ -208,8 +213,10 @@ class Refiner:
 
 
 class _Rounds:
-    """One grasp's rounds (the arrays they share). Each numpy call costs about a
-    microsecond here, so the pieces are written in few of them."""
+    """
+    One grasp's rounds (the arrays they share). Each numpy call costs about a
+    microsecond here, so the pieces are written in few of them.
+    """
 
     #: ``time.perf_counter()`` value by which every QP must stop (None: none).
     deadline: float | None = None
@@ -251,7 +258,8 @@ class _Rounds:
     # -- pieces -----------------------------------------------------------------------
 
     def _qp(self, H: np.ndarray | None = None, g: np.ndarray | None = None):
-        """Solve with the current rows (and H, g): (raw, x, row multipliers, compat ones).
+        """
+        Solve with the current rows (and H, g): (raw, x, row multipliers, compat ones).
 
         A solver that raises is a failed round like any other (the rounds end with
         what they have; the caller's fallback answers if that is nothing).
@@ -260,11 +268,11 @@ class _Rounds:
             raw = self.ws.solve(H, g, self.C.reshape(-1, self.n), self.u.ravel(),
                                 deadline=self.deadline)
         except SolverError as e:
-            raw = RawResult("error", None, 0, 0.0, str(e))
+            raw = RawResult('error', None, 0, 0.0, str(e))
         self.qp_solves += 1
         self.iterations += raw.iterations
         self.solve_time += raw.solve_time_s
-        if raw.status != "solved" or raw.x is None or raw.x.shape != (self.n,):
+        if raw.status != 'solved' or raw.x is None or raw.x.shape != (self.n,):
             return raw, None, None, None
         lam = self.ws.multipliers
         n, n_eq = self.n, self.n_eq
@@ -278,8 +286,10 @@ class _Rounds:
         return f, f[:, :2] / np.where(ok, nt, 1.0)[:, None], nt, ok
 
     def _turn(self, u: np.ndarray, ok: np.ndarray) -> None:
-        """Tangent slots at the directions u (core.friction.tangent_rows; the spare rows
-        where no direction is defined)."""
+        """
+        Tangent slots at the directions u (core.friction.tangent_rows; the spare rows
+        where no direction is defined).
+        """
         slots = self.slots
         slots[:, :, :2] = self.a * u[:, None, :]
         if not ok.all():
@@ -290,7 +300,8 @@ class _Rounds:
 
     def _curvature(self, u: np.ndarray, nt: np.ndarray, ok: np.ndarray,
                    nu: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """H and g with 1/2 sum_i w_i (u_i_perp . f_t,i(x))^2, w_i = nu_i / (mu1 ||f_t,i||).
+        """
+        H and g with 1/2 sum_i w_i (u_i_perp . f_t,i(x))^2, w_i = nu_i / (mu1 ||f_t,i||).
 
         That is the second-order term of ||f_t,i||/mu1 at the point (its Hessian
         there is (I - u u^T) / (mu1 ||f_t||)), nu_i >= 0 contact i's cone
@@ -298,8 +309,8 @@ class _Rounds:
         """
         w = np.where(ok, nu / (self.fr.mu1 * np.where(ok, nt, 1.0)), 0.0)
         perp = np.column_stack((-u[:, 1], u[:, 0]))
-        Bp = np.einsum("pj,pjn->pn", perp, self.MN[:, :2, :])
-        c = np.einsum("pj,pj->p", perp, self.f0[:, :2])
+        Bp = np.einsum('pj,pjn->pn', perp, self.MN[:, :2, :])
+        c = np.einsum('pj,pj->p', perp, self.f0[:, :2])
         return self.base.H + (Bp.T * w) @ Bp, Bp.T @ (w * c)
 
     def _bound(self, lam: np.ndarray, y: np.ndarray) -> float:
@@ -310,7 +321,8 @@ class _Rounds:
         return -math.inf if d is None else d
 
     def _restore(self, x: np.ndarray, lam: np.ndarray, box: np.ndarray):
-        """Gauss-Newton steps (min-norm) onto the active or violated exact-cone pieces.
+        """
+        Gauss-Newton steps (min-norm) onto the active or violated exact-cone pieces.
 
         Kept: the compatibility rows, the active torque bounds and f_min rows. A
         contact whose tangential force is below :data:`APEX` of its normal one is
@@ -370,10 +382,11 @@ class _Rounds:
                 sol = np.linalg.lstsq(Jc @ Jc.T, rhs, rcond=None)[0]
             x = x + Jc.T @ sol[:, 0]
             duals = (rows, owner, sol[:, 1], at_fmin, apex, (n_eq, k_f, n_fix, k_a))
-        raise AssertionError("unreachable")
+        raise AssertionError('unreachable')
 
     def _kkt_bound(self, duals) -> float:
-        """The dual bound from the multipliers that make the restored point a KKT point.
+        """
+        The dual bound from the multipliers that make the restored point a KKT point.
 
         Near the optimum they are the exact problem's own multipliers (the
         rows are the exact cone's gradients there), so no QP is needed for a
@@ -429,7 +442,7 @@ class _Rounds:
         if s.warm_start and last is not None and last[0] == self._key():
             self.refiner.warm_solves += 1
             self._load(warm=True)
-            out = self._rounds(-math.inf, None, "refined", (None,) + last[1:4], last[4], 1)
+            out = self._rounds(-math.inf, None, 'refined', (None,) + last[1:4], last[4], 1)
             if out.tau is not None:
                 return out
             self.refiner.warm_fallbacks += 1
@@ -439,8 +452,8 @@ class _Rounds:
         self._load(warm=False)
         raw, x, lam, y = self._qp()
         if x is None:
-            return self._done(None, -math.inf, 0, "circumscribed", f"round 0: {raw.message}",
-                              raw.status == "infeasible")
+            return self._done(None, -math.inf, 0, 'circumscribed', f'round 0: {raw.message}',
+                              raw.status == 'infeasible')
         point = self._point(x)
         best = self._candidate(x, point)
         lower = -math.inf
@@ -448,7 +461,7 @@ class _Rounds:
         first = (self.rows.copy(), lam.copy(), y.copy())
         if best is not None or s.max_rounds == 0:
             lower = self._bound(lam, y)
-        out = self._rounds(lower, best, "circumscribed" if best is not None else "refined",
+        out = self._rounds(lower, best, 'circumscribed' if best is not None else 'refined',
                            point, np.maximum(lam[:, :-1], 0.0).sum(axis=1), 0, first)
         return out
 
@@ -459,7 +472,8 @@ class _Rounds:
 
     def _rounds(self, lower: float, best, source: str, point, nu: np.ndarray, start: int,
                 first=None) -> Refined:
-        """The refinement rounds from a point's directions and multipliers nu.
+        """
+        The refinement rounds from a point's directions and multipliers nu.
 
         Args:
             start: 0 after round 0 (a gap check first), 1 for a warm start (a step
@@ -472,17 +486,17 @@ class _Rounds:
             return math.sqrt(best[0] / lower) - 1.0 if best is not None and lower > 0 \
                 else math.inf
 
-        message, rounds, last_nu = "max rounds", 0, None
+        message, rounds, last_nu = 'max rounds', 0, None
         for rounds in range(1, max(s.max_rounds, start) + 1):
             if gap() <= s.gap_tolerance:
                 rounds -= 1
-                message = "gap within tolerance"
+                message = 'gap within tolerance'
                 break
             _, u, nt, ok = point
             self._turn(u, ok)
             raw, xs, lam_s, y_s = self._qp(*self._curvature(u, nt, ok, nu))
             if xs is None:
-                message = f"round {rounds} step: {raw.message}"
+                message = f'round {rounds} step: {raw.message}'
                 break
             last_nu = np.maximum(lam_s[:, :-1], 0.0).sum(axis=1)
             xh, point, duals = self._restore(xs, lam_s, self.ws.multipliers[:self.n])
@@ -490,12 +504,12 @@ class _Rounds:
                 xh, point, duals = xs, self._point(xs), None
             cand = self._candidate(xh, point)
             if cand is not None and (best is None or cand[0] < best[0]):
-                best, source = cand, "refined"
+                best, source = cand, 'refined'
                 self.refiner.last = (self._key(), point[1], point[2], point[3], last_nu)
             if best is not None:  # without a candidate no bound closes the gap
                 lower = max(lower, self._kkt_bound(duals))
                 if gap() <= s.gap_tolerance:
-                    message = "gap within tolerance"
+                    message = 'gap within tolerance'
                     break
             # The restored point's own multipliers bound loosely while it is still a
             # step away (10 to 100 times its excess, measured): the relaxation with
@@ -503,13 +517,13 @@ class _Rounds:
             self._turn(point[1], point[3])
             raw, xl, lam_l, y_l = self._qp(base.H, base.g)
             if xl is None:
-                message = f"round {rounds} relaxation: {raw.message}"
+                message = f'round {rounds} relaxation: {raw.message}'
                 break
             lower = max(lower, self._bound(lam_l, y_l))
             nu = np.maximum(lam_l[:, :-1], 0.0).sum(axis=1)
         else:
             if gap() <= s.gap_tolerance:
-                message = "gap within tolerance"
+                message = 'gap within tolerance'
         if lower == -math.inf and first is not None:
             self.rows = first[0]
             lower = self._bound(first[1], first[2])

@@ -1,4 +1,5 @@
-"""Load capacity: how many times over a grasp holds its load, and how much along each axis.
+"""
+Load capacity: how many times over a grasp holds its load, and how much along each axis.
 
 The capacity of a grasp for a load w_ext is the largest factor alpha such that
 alpha w_ext is holdable within the torque limits and the (margined) linearized
@@ -28,28 +29,28 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
-from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE, Certificate, certify
+from grasp_torque_opt.core.certificate import Certificate, certify, DEFAULT_TOLERANCE
 from grasp_torque_opt.core.friction import friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.methods.lp import DaqpForm, LPResult, solve_lp
 from grasp_torque_opt.reference.feasibility import linearized_feasible
+import numpy as np
 
 #: Cap on alpha, so that the LP stays bounded; reaching it reports ``unbounded``.
 ALPHA_MAX = 1e6
 #: The 12 axis directions: name -> (wrench index, sign); F in N, M in N m.
-DIRECTIONS = {f"{s}{a}": (i, 1.0 if s == "+" else -1.0)
-              for i, a in enumerate(("Fx", "Fy", "Fz", "Mx", "My", "Mz")) for s in "+-"}
+DIRECTIONS = {f'{s}{a}': (i, 1.0 if s == '+' else -1.0)
+              for i, a in enumerate(('Fx', 'Fy', 'Fz', 'Mx', 'My', 'Mz')) for s in '+-'}
 #: A multiplier counts as binding above this share of the largest one.
 BINDING_RTOL = 1e-6
 
 
 @dataclass(frozen=True)
 class Binding:
-    """What limits a capacity: the constraints with a nonzero multiplier at the LP optimum.
+    """
+    What limits a capacity: the constraints with a nonzero multiplier at the LP optimum.
 
     Every one of them is active at every optimal point (complementary slackness).
 
@@ -63,27 +64,28 @@ class Binding:
 
     def as_dict(self) -> dict:
         """Plain data (JSON)."""
-        return {"joints": [{"joint": j, "limit": s} for j, s in self.joints],
-                "contacts": [{"link": c, "constraint": s} for c, s in self.contacts]}
+        return {'joints': [{'joint': j, 'limit': s} for j, s in self.joints],
+                'contacts': [{'link': c, 'constraint': s} for c, s in self.contacts]}
 
     def text(self) -> str:
         """One sentence: joints at their limit and contacts on their cone, by name."""
         parts = []
         if self.joints:
-            parts.append("joints at their torque limit: " + ", ".join(
-                f"{j} ({s})" for j, s in self.joints))
-        cones = [c for c, s in self.contacts if s == "friction cone"]
-        normals = [c for c, s in self.contacts if s != "friction cone"]
+            parts.append('joints at their torque limit: ' + ', '.join(
+                f'{j} ({s})' for j, s in self.joints))
+        cones = [c for c, s in self.contacts if s == 'friction cone']
+        normals = [c for c, s in self.contacts if s != 'friction cone']
         if cones:
-            parts.append("contacts on their friction cone: " + ", ".join(cones))
+            parts.append('contacts on their friction cone: ' + ', '.join(cones))
         if normals:
-            parts.append("contacts at the minimum normal force: " + ", ".join(normals))
-        return "; ".join(parts) if parts else "nothing identified"
+            parts.append('contacts at the minimum normal force: ' + ', '.join(normals))
+        return '; '.join(parts) if parts else 'nothing identified'
 
 
 @dataclass(frozen=True)
 class Capacity:
-    """One capacity.
+    """
+    One capacity.
 
     Attributes:
         status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds: the
@@ -108,18 +110,19 @@ class Capacity:
     wrenches: np.ndarray | None = None
     certificate: Certificate | None = None
     binding: Binding | None = None
-    solver: str = ""
-    message: str = ""
+    solver: str = ''
+    message: str = ''
 
     def as_dict(self) -> dict:
         """Plain data (JSON): ``status``, ``value``, ``unit``, ``binding``, ``certified``."""
-        return {"status": self.status, "value": self.value, "unit": self.unit,
-                "certified": self.certificate is not None and self.certificate.ok,
-                "binding": None if self.binding is None else self.binding.as_dict()}
+        return {'status': self.status, 'value': self.value, 'unit': self.unit,
+                'certified': self.certificate is not None and self.certificate.ok,
+                'binding': None if self.binding is None else self.binding.as_dict()}
 
 
 class CapacityLP:
-    """The capacity LP of one grasp, built once and solved for any load direction.
+    """
+    The capacity LP of one grasp, built once and solved for any load direction.
 
     Variables x = [f (4p); alpha]; rows: G f + alpha d = 0 (6), J^T f in the torque
     bounds (m), S f <= b (the planned polygons and f_min).
@@ -148,9 +151,10 @@ class CapacityLP:
         self.c[-1] = -1.0
         self.form = DaqpForm(n, self.lower, self.upper)
 
-    def solve(self, load: np.ndarray, unit: str = "-", highs_only: bool = False,
+    def solve(self, load: np.ndarray, unit: str = '-', highs_only: bool = False,
               binding: bool = True) -> Capacity:
-        """The largest alpha with alpha * load holdable, certified.
+        """
+        The largest alpha with alpha * load holdable, certified.
 
         Args:
             load: the load direction w_ext, shape (6,) [N, N m] (about the object
@@ -163,53 +167,53 @@ class CapacityLP:
         load = np.asarray(load, dtype=float)
         scale = float(np.abs(load).max())  # the max norm: no overflow at 1e300
         if not np.isfinite(scale):
-            return Capacity("failed", None, unit, message="load not finite")
+            return Capacity('failed', None, unit, message='load not finite')
         if scale == 0.0:
-            return Capacity("unbounded", None, unit, message=(
-                "zero load: any multiple of it is the same load"))
+            return Capacity('unbounded', None, unit, message=(
+                'zero load: any multiple of it is the same load'))
         # The LP on the unit direction, alpha rescaled after: a load of 1e-6 or 1e6 N
         # gives the LP the same numbers.
         self.A[:6, -1] = load / scale
         res = solve_lp(self.c, self.A, self.lower, self.upper, highs_only=highs_only,
                        form=self.form)
         out = self._capacity(res, load, scale, unit, binding)
-        if out.status == "failed" and res.solver == "daqp" and not highs_only:
+        if out.status == 'failed' and res.solver == 'daqp' and not highs_only:
             out = self._capacity(solve_lp(self.c, self.A, self.lower, self.upper,
                                           highs_only=True), load, scale, unit, binding)
         return out
 
     def _capacity(self, res: LPResult, load: np.ndarray, scale: float, unit: str,
                   binding: bool = True) -> Capacity:
-        if res.status == "infeasible":
+        if res.status == 'infeasible':
             # Said only when the independent feasibility LP agrees that zero load cannot
             # be held either (else the capacity LP's verdict is numerics, not the grasp).
             if linearized_feasible(self.maps, self.friction, np.zeros(6), self.tau_min,
                                    self.tau_max) is False:
-                return Capacity("infeasible", None, unit, solver=res.solver, message=(
-                    "not even zero load can be held: the minimum normal force cannot be "
-                    f"produced within the torque limits ({res.message})"))
-            return Capacity("failed", None, unit, solver=res.solver, message=(
-                f"{res.message}, but the feasibility LP does not confirm that zero load "
-                "cannot be held"))
-        if res.status != "optimal":
-            return Capacity("failed", None, unit, solver=res.solver, message=res.message)
+                return Capacity('infeasible', None, unit, solver=res.solver, message=(
+                    'not even zero load can be held: the minimum normal force cannot be '
+                    f'produced within the torque limits ({res.message})'))
+            return Capacity('failed', None, unit, solver=res.solver, message=(
+                f'{res.message}, but the feasibility LP does not confirm that zero load '
+                'cannot be held'))
+        if res.status != 'optimal':
+            return Capacity('failed', None, unit, solver=res.solver, message=res.message)
         f, alpha = res.x[:self.nf], float(res.x[-1])
         if alpha >= (1.0 - 1e-9) * ALPHA_MAX:
-            return Capacity("unbounded", None, unit, solver=res.solver, message=(
-                f"alpha reached its cap {ALPHA_MAX:g}: the grasp holds this load "
-                "direction without bound"))
+            return Capacity('unbounded', None, unit, solver=res.solver, message=(
+                f'alpha reached its cap {ALPHA_MAX:g}: the grasp holds this load '
+                'direction without bound'))
         alpha /= scale
         tau = self.maps.J.T @ f
         cert = certify(self.maps.G, self.maps.J, alpha * load, self.friction, self.tau_min,
                        self.tau_max, tau, f, self.tolerance)
         if not cert.ok:
-            return Capacity("failed", None, unit, certificate=cert, solver=res.solver,
-                            message=f"{res.message}, certificate failed (worst residual "
-                                    f"{cert.worst:.3g})")
-        return Capacity("optimal", alpha, unit, tau=tau, wrenches=f.reshape(-1, 4),
+            return Capacity('failed', None, unit, certificate=cert, solver=res.solver,
+                            message=f'{res.message}, certificate failed (worst residual '
+                                    f'{cert.worst:.3g})')
+        return Capacity('optimal', alpha, unit, tau=tau, wrenches=f.reshape(-1, 4),
                         certificate=cert, binding=self._binding(res, f) if binding else None,
                         solver=res.solver,
-                        message=f"certified ({res.message})")
+                        message=f'certified ({res.message})')
 
     def _binding(self, res: LPResult, f: np.ndarray) -> Binding:
         n = self.nf + 1
@@ -220,13 +224,13 @@ class CapacityLP:
         thresh = BINDING_RTOL * scale
         m = self.m
         lam_tau, lam_S = lam[:m], lam[m:]
-        joints = [(self.setup.hand.joints[j], "upper" if lam_tau[j] > 0 else "lower")
+        joints = [(self.setup.hand.joints[j], 'upper' if lam_tau[j] > 0 else 'lower')
                   for j in np.argsort(-np.abs(lam_tau)) if abs(lam_tau[j]) > thresh]
         rows = self.S.shape[0] // self.maps.p
         per_contact: dict[tuple[int, str], float] = {}
         for r in np.flatnonzero(np.abs(lam_S) > thresh):
             i, kind = divmod(int(r), rows)
-            key = (i, "min normal force" if kind == rows - 1 else "friction cone")
+            key = (i, 'min normal force' if kind == rows - 1 else 'friction cone')
             per_contact[key] = per_contact.get(key, 0.0) + abs(float(lam_S[r]))
         contacts = [(self.maps.links[i], kind) for (i, kind), _ in
                     sorted(per_contact.items(), key=lambda kv: -kv[1])]
@@ -235,7 +239,8 @@ class CapacityLP:
 
 def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
                   load: np.ndarray | None = None, highs_only: bool = False) -> Capacity:
-    """How many times over the grasp holds its load (alpha [-], certified).
+    """
+    How many times over the grasp holds its load (alpha [-], certified).
 
     Args:
         setup: the grasp (its friction margin and torque offset apply).
@@ -244,13 +249,14 @@ def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
         highs_only: HiGHS alone, no DAQP.
     """
     lp = CapacityLP(setup, maps if maps is not None else setup.maps())
-    return lp.solve(setup.external_wrench if load is None else load, "-", highs_only)
+    return lp.solve(setup.external_wrench if load is None else load, '-', highs_only)
 
 
 def direction_capacities(setup: GraspSetup, maps: GraspMaps | None = None,
                          lp: CapacityLP | None = None, binding: bool = True
                          ) -> dict[str, Capacity]:
-    """The largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
+    """
+    The largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
 
     Args:
         setup: the grasp.
@@ -266,5 +272,5 @@ def direction_capacities(setup: GraspSetup, maps: GraspMaps | None = None,
     for name, (i, sign) in DIRECTIONS.items():
         d = np.zeros(6)
         d[i] = sign
-        out[name] = lp.solve(d, "N" if i < 3 else "N m", binding=binding)
+        out[name] = lp.solve(d, 'N' if i < 3 else 'N m', binding=binding)
     return out

@@ -1,4 +1,5 @@
-"""Why a load is infeasible: the largest holdable fraction of it, and what binds there.
+"""
+Why a load is infeasible: the largest holdable fraction of it, and what binds there.
 
 When no torque within the limits holds a load, the capacity LP of
 :mod:`.capacity` still answers: alpha < 1 is the largest fraction of the load
@@ -21,7 +22,8 @@ from grasp_torque_opt.methods.capacity import Capacity, load_capacity
 
 @dataclass(frozen=True)
 class Explanation:
-    """What can be held of a load.
+    """
+    What can be held of a load.
 
     Attributes:
         capacity: the capacity LP's answer for the load (``value`` is the fraction).
@@ -39,22 +41,24 @@ class Explanation:
     def text(self) -> str:
         """One line: the fraction and what binds, by name."""
         c = self.capacity
-        if c.status == "infeasible":
+        if c.status == 'infeasible':
             return c.message
-        if c.status != "optimal":
-            return f"no explanation: the capacity LP {c.status} ({c.message})"
+        if c.status != 'optimal':
+            return f'no explanation: the capacity LP {c.status} ({c.message})'
         if c.value >= 1.0:
             return (f"the capacity LP finds the whole load holdable ({c.value:.4g} times over): "
                     "the solver's verdict and the LP disagree")
-        return (f"at most {100 * c.value:.1f}% of this load can be held; there, "
-                f"{c.binding.text()}")
+        return (f'at most {100 * c.value:.1f}% of this load can be held; there, '
+                f'{c.binding.text()}')
 
     def as_dict(self) -> dict:
-        """Plain data (JSON): ``holdable_fraction``, ``binding``, ``status``, ``certified``,
-        ``text``."""
+        """
+        Plain data (JSON): ``holdable_fraction``, ``binding``, ``status``, ``certified``,
+        ``text``.
+        """
         d = self.capacity.as_dict()
-        return {"holdable_fraction": d["value"], "status": d["status"],
-                "certified": d["certified"], "binding": d["binding"], "text": self.text}
+        return {'holdable_fraction': d['value'], 'status': d['status'],
+                'certified': d['certified'], 'binding': d['binding'], 'text': self.text}
 
 
 def explain(setup: GraspSetup, maps: GraspMaps | None = None) -> Explanation:

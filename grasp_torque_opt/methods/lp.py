@@ -1,4 +1,5 @@
-"""Small dense LPs for the planner's metrics: DAQP, KKT-checked, with SciPy HiGHS behind it.
+"""
+Small dense LPs for the planner's metrics: DAQP, KKT-checked, with SciPy HiGHS behind it.
 
 The capacity and min-max LPs (docs/planner.md) have a few dozen variables and
 about a hundred rows. DAQP solves them in tens of microseconds (SciPy's HiGHS:
@@ -17,11 +18,8 @@ with lower == upper is an equality. Infinite bounds are allowed.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
-
-import numpy as np
-from scipy.optimize import linprog
+import time
 
 from grasp_torque_opt.backends.daqp import (
     DAQP_INF,
@@ -29,6 +27,8 @@ from grasp_torque_opt.backends.daqp import (
     KKT_TOLERANCE,
     kkt_violation,
 )
+import numpy as np
+from scipy.optimize import linprog
 
 #: DAQP's primal tolerance on these LPs (the backends' default eps_abs).
 PRIMAL_TOL = 1e-9
@@ -40,7 +40,8 @@ EPS_PROX = 1e-2
 
 @dataclass(frozen=True)
 class LPResult:
-    """An LP's answer.
+    """
+    An LP's answer.
 
     Attributes:
         status: ``optimal``, ``infeasible``, ``unbounded`` or ``failed``.
@@ -62,8 +63,10 @@ class LPResult:
 
 
 class DaqpForm:
-    """DAQP's view of the bounds (clipped to its infinity, equality flags, zero Hessian),
-    built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp)."""
+    """
+    DAQP's view of the bounds (clipped to its infinity, equality flags, zero Hessian),
+    built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp).
+    """
 
     def __init__(self, n: int, lower: np.ndarray, upper: np.ndarray) -> None:
         self.sense = np.zeros(lower.size, dtype=np.int32)
@@ -76,7 +79,8 @@ class DaqpForm:
 def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
              highs_only: bool = False, form: DaqpForm | None = None,
              deadline: float | None = None) -> LPResult:
-    """Minimize c^T x subject to the bounds and rows of the module docstring.
+    """
+    Minimize c^T x subject to the bounds and rows of the module docstring.
 
     Args:
         c: cost, shape (n,).
@@ -91,31 +95,31 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
             past it (``failed``, "time budget spent"). None: the caps alone.
     """
     t0 = time.perf_counter()
-    why = ""
+    why = ''
     if not highs_only:
         limit = MAX_ITER
         if deadline is not None:
             est = ITERATION_S * max(1.0, c.size * (c.size + A.shape[0]) / (16 * 144))
             limit = min(MAX_ITER, max(1, int((deadline - t0) / est)))
         out = _spent(deadline) or _daqp(c, A, form or DaqpForm(c.size, lower, upper), limit)
-        if out is not None and out[0] == "optimal":
-            return LPResult("optimal", out[1], out[2], "daqp", out[3],
+        if out is not None and out[0] == 'optimal':
+            return LPResult('optimal', out[1], out[2], 'daqp', out[3],
                             time.perf_counter() - t0)
-        why = out[3] if out is not None else "DAQP raised"
+        why = out[3] if out is not None else 'DAQP raised'
     spent = _spent(deadline)
     if spent:
-        return LPResult("failed", None, None, "daqp", f"{spent[3]} (after DAQP: {why})",
+        return LPResult('failed', None, None, 'daqp', f'{spent[3]} (after DAQP: {why})',
                         time.perf_counter() - t0)
     res = _highs(c, A, lower, upper,
                  None if deadline is None else deadline - time.perf_counter())
-    msg = res.message if not why else f"{res.message} (after DAQP: {why})"
-    return LPResult(res.status, res.x, res.lam, "highs", msg, time.perf_counter() - t0)
+    msg = res.message if not why else f'{res.message} (after DAQP: {why})'
+    return LPResult(res.status, res.x, res.lam, 'highs', msg, time.perf_counter() - t0)
 
 
 def _spent(deadline: float | None):
     """The failure of an LP not started past ``deadline`` (None if there is time)."""
     if deadline is not None and time.perf_counter() >= deadline:
-        return ("failed", None, None, "time budget spent")
+        return ('failed', None, None, 'time budget spent')
     return None
 
 
@@ -123,7 +127,7 @@ def _daqp(c, A, form: DaqpForm, limit: int | None = None):
     try:
         import daqp  # a selectable backend: a ROS distribution may not have it
     except ImportError:
-        return ("failed", None, None, "DAQP is not installed")
+        return ('failed', None, None, 'DAQP is not installed')
 
     H, bu, bl, sense = form.H, form.bu, form.bl, form.sense
     try:
@@ -132,14 +136,14 @@ def _daqp(c, A, form: DaqpForm, limit: int | None = None):
                                       primal_tol=PRIMAL_TOL, iter_limit=limit or MAX_ITER,
                                       eps_prox=EPS_PROX)
     except (RuntimeError, ValueError) as e:
-        return ("failed", None, None, f"DAQP raised: {e}")
+        return ('failed', None, None, f'DAQP raised: {e}')
     if flag not in (1, 2) or x is None or not np.isfinite(x).all():
-        return ("failed", None, None, f"DAQP exit flag {flag}")
-    lam = np.asarray(info["lam"], dtype=float)
+        return ('failed', None, None, f'DAQP exit flag {flag}')
+    lam = np.asarray(info['lam'], dtype=float)
     violation = kkt_violation(H, c, A, bl, bu, x, lam)
     if not violation <= KKT_TOLERANCE:
-        return ("failed", None, None, f"DAQP answer off the KKT conditions by {violation:.2g}")
-    return ("optimal", np.asarray(x, dtype=float), lam,
+        return ('failed', None, None, f'DAQP answer off the KKT conditions by {violation:.2g}')
+    return ('optimal', np.asarray(x, dtype=float), lam,
             f"DAQP optimal, KKT-checked ({info['iterations']} iterations)")
 
 
@@ -163,12 +167,12 @@ def _highs(c, A, lower, upper, time_limit: float | None = None) -> _Highs:
               for lo, up in zip(lower[:n], upper[:n])]
     res = linprog(c, A_ub=A_ub if A_ub.size else None, b_ub=b_ub if b_ub.size else None,
                   A_eq=A[eq] if eq.any() else None, b_eq=up_r[eq] if eq.any() else None,
-                  bounds=bounds, method="highs",
-                  options={"maxiter": MAX_ITER} if time_limit is None else
-                  {"maxiter": MAX_ITER, "time_limit": max(1e-6, time_limit)})
-    status = {0: "optimal", 2: "infeasible", 3: "unbounded"}.get(res.status, "failed")
-    if status != "optimal":
-        return _Highs(status, None, None, f"HiGHS: {res.message}")
+                  bounds=bounds, method='highs',
+                  options={'maxiter': MAX_ITER} if time_limit is None else
+                  {'maxiter': MAX_ITER, 'time_limit': max(1e-6, time_limit)})
+    status = {0: 'optimal', 2: 'infeasible', 3: 'unbounded'}.get(res.status, 'failed')
+    if status != 'optimal':
+        return _Highs(status, None, None, f'HiGHS: {res.message}')
     # HiGHS's marginals are d(objective)/d(bound), <= 0 on a binding upper bound of a
     # minimization: DAQP's lam is their negative.
     lam = np.zeros(n + r)
@@ -181,4 +185,4 @@ def _highs(c, A, lower, upper, time_limit: float | None = None) -> _Highs:
     if eq.any():
         row[eq] = -res.eqlin.marginals
     lam[n:] = row
-    return _Highs("optimal", np.asarray(res.x, dtype=float), lam, "HiGHS optimal")
+    return _Highs('optimal', np.asarray(res.x, dtype=float), lam, 'HiGHS optimal')

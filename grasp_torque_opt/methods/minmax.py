@@ -1,4 +1,5 @@
-"""The min-max torque objective (the paper's future work): an LP, then the sum of squares.
+"""
+The min-max torque objective (the paper's future work): an LP, then the sum of squares.
 
     minimize    t = max_i w_i |tau_i + offset_i| / limit_i
     subject to  the tau-QP's constraints (cones, compatibility, torque box)
@@ -18,10 +19,9 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-import numpy as np
-
 from grasp_torque_opt.core.tau_qp import TauQP
 from grasp_torque_opt.methods.lp import solve_lp
+import numpy as np
 
 #: Relative room on t* for the second stage (the LP is solved to 1e-9).
 SLACK = 1e-7
@@ -29,7 +29,8 @@ SLACK = 1e-7
 
 @dataclass(frozen=True)
 class MinMax:
-    """The LP stage.
+    """
+    The LP stage.
 
     Attributes:
         status: the LP's status (``optimal``, ``infeasible``, ``unbounded``, ``failed``).
@@ -46,7 +47,8 @@ class MinMax:
 
 def minmax_stage(qp: TauQP, limits: np.ndarray, weights: np.ndarray,
                  offset: np.ndarray | None = None, deadline: float | None = None) -> MinMax:
-    """Solve the min-max LP on a built tau-QP and tighten its torque box to the optimum.
+    """
+    Solve the min-max LP on a built tau-QP and tighten its torque box to the optimum.
 
     Args:
         qp: the tau-QP (sum-of-squares objective; only its constraints are used here).
@@ -75,12 +77,12 @@ def minmax_stage(qp: TauQP, limits: np.ndarray, weights: np.ndarray,
     c = np.zeros(n + 1)
     c[-1] = 1.0
     res = solve_lp(c, A, lower, upper, deadline=deadline)
-    if res.status != "optimal":
-        return MinMax(res.status, None, qp, f"min-max LP {res.status}: {res.message}")
+    if res.status != 'optimal':
+        return MinMax(res.status, None, qp, f'min-max LP {res.status}: {res.message}')
     t = float(res.x[-1])
     reach = (t * (1.0 + SLACK) + 1e-12) * lim / w
     l_box, u_box = qp.l_box.copy(), qp.u_box.copy()
     l_box[:m] = np.maximum(l_box[:m], -reach - off)
     u_box[:m] = np.minimum(u_box[:m], reach - off)
-    return MinMax("optimal", t, dataclasses.replace(qp, l_box=l_box, u_box=u_box),
-                  f"min-max LP t* = {t:.6g} ({res.message})")
+    return MinMax('optimal', t, dataclasses.replace(qp, l_box=l_box, u_box=u_box),
+                  f'min-max LP t* = {t:.6g} ({res.message})')

@@ -1,4 +1,5 @@
-"""Batch scoring for grasp planners: many candidate grasps of one hand, in parallel.
+"""
+Batch scoring for grasp planners: many candidate grasps of one hand, in parallel.
 
 A batch is a base scenario (the hand, and every default) and candidates, one
 JSON object per line (JSON Lines, docs/planner.md). Each line is a partial
@@ -31,18 +32,15 @@ chunk function; each worker binds the base scenario once and reuses one solver.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
 import hashlib
 import json
 import math
 import os
-import time
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
+import time
 from typing import Any
-
-import numpy as np
-import yaml
 
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
@@ -50,25 +48,28 @@ from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
 from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
+import yaml
 
 #: Metrics: ``basic`` (solve: status, norms, ratio, usage) or ``full`` (plus capacities).
-METRICS = ("basic", "full")
+METRICS = ('basic', 'full')
 #: Engines: this process, a multiprocessing pool, or a Dask distributed cluster.
-ENGINES = ("serial", "processes", "dask")
+ENGINES = ('serial', 'processes', 'dask')
 #: Keys a candidate line may hold: ``id`` and the scenario's sections except ``hand``.
-CANDIDATE_KEYS = ("id", "grasp", "friction", "load", "gravity", "object", "objective")
+CANDIDATE_KEYS = ('id', 'grasp', 'friction', 'load', 'gravity', 'object', 'objective')
 #: A longer line is refused unread (bounded memory per candidate) [characters].
 MAX_LINE = 1_000_000
 #: Candidates per task sent to a worker.
 CHUNK = 64
 #: What a rank key sorts by: True for "larger is better".
-RANK_KEYS = {"capacity": True, "torque_norm": False, "max_torque_ratio": False,
-             "friction_usage_max": False}
+RANK_KEYS = {'capacity': True, 'torque_norm': False, 'max_torque_ratio': False,
+             'friction_usage_max': False}
 
 
 @dataclass(frozen=True)
 class ScoreJob:
-    """What every worker needs: the base scenario's text and the batch's options.
+    """
+    What every worker needs: the base scenario's text and the batch's options.
 
     Attributes:
         scenario_text: the base scenario file's contents (YAML).
@@ -82,15 +83,16 @@ class ScoreJob:
 
     scenario_text: str
     base_dir: str
-    source: str = "<scenario>"
-    metrics: str = "full"
-    backend: str = "daqp"
-    fallback: str | None = "proxsuite"
+    source: str = '<scenario>'
+    metrics: str = 'full'
+    backend: str = 'daqp'
+    fallback: str | None = 'proxsuite'
     objective: str | None = None
 
     @classmethod
     def from_file(cls, path: str | Path, **options: Any) -> ScoreJob:
-        """The job of a base scenario file.
+        """
+        The job of a base scenario file.
 
         Raises:
             InputError: the file cannot be read (field ``scenario``).
@@ -99,7 +101,7 @@ class ScoreJob:
         try:
             text = path.read_text()
         except OSError as e:
-            raise InputError("scenario", f"cannot read {path}: {e.strerror}") from e
+            raise InputError('scenario', f'cannot read {path}: {e.strerror}') from e
         return cls(scenario_text=text, base_dir=str(path.resolve().parent), source=str(path),
                    **options)
 
@@ -110,7 +112,8 @@ class ScoreJob:
 
 
 def merge(base: Any, override: Any) -> Any:
-    """A candidate merged into the base document: mappings key by key, ``None`` removes.
+    """
+    A candidate merged into the base document: mappings key by key, ``None`` removes.
 
     Copies only what changes; the base is never modified.
     """
@@ -132,13 +135,13 @@ class Scorer:
         if job.metrics not in METRICS:
             raise ValueError(f"metrics must be one of {', '.join(METRICS)}, got {job.metrics!r}")
         if job.objective is not None and job.objective not in OBJECTIVES:
-            raise InputError("objective", f"must be one of {', '.join(OBJECTIVES)}, "
+            raise InputError('objective', f"must be one of {', '.join(OBJECTIVES)}, "
                              f"got {job.objective!r}")
         self.job = job
         try:
             doc = yaml.safe_load(job.scenario_text)
         except yaml.YAMLError as e:
-            raise InputError("scenario", f"{job.source} is not valid YAML: {e}"
+            raise InputError('scenario', f'{job.source} is not valid YAML: {e}'
                              .splitlines()[0]) from e
         self.base_dir = Path(job.base_dir)
         self.doc = doc
@@ -148,69 +151,70 @@ class Scorer:
                          else None)
 
     def candidate(self, lineno: int, text: str) -> tuple[Any, GraspSetup]:
-        """The candidate of one line, bound to the base hand.
+        """
+        The candidate of one line, bound to the base hand.
 
         Raises:
             InputError: naming the line and the field.
         """
         if len(text) > MAX_LINE:
-            raise InputError(f"line {lineno}", f"longer than {MAX_LINE} characters")
+            raise InputError(f'line {lineno}', f'longer than {MAX_LINE} characters')
         try:
             data = json.loads(text)
         except json.JSONDecodeError as e:
-            raise InputError(f"line {lineno}", f"not valid JSON: {e}") from e
+            raise InputError(f'line {lineno}', f'not valid JSON: {e}') from e
         except RecursionError as e:  # '[[[[...' nested beyond Python's stack
-            raise InputError(f"line {lineno}", "nested too deeply") from e
+            raise InputError(f'line {lineno}', 'nested too deeply') from e
         if not isinstance(data, dict):
-            raise InputError(f"line {lineno}", f"must be a JSON object, got "
-                             f"{type(data).__name__}")
+            raise InputError(f'line {lineno}', f'must be a JSON object, got '
+                             f'{type(data).__name__}')
         for key in data:
             if key not in CANDIDATE_KEYS:
-                raise InputError(f"line {lineno}: {key}", "unknown or fixed field (allowed: "
+                raise InputError(f'line {lineno}: {key}', "unknown or fixed field (allowed: "
                                  f"{', '.join(CANDIDATE_KEYS)}; the hand is the base "
                                  "scenario's)")
-        ident = data.pop("id", lineno)
+        ident = data.pop('id', lineno)
         try:
-            scenario = parse_scenario(merge(self.doc, data), self.base_dir, f"line {lineno}")
+            scenario = parse_scenario(merge(self.doc, data), self.base_dir, f'line {lineno}')
             base = self.base
             hand = base.hand
             weights = (np.ones(hand.m) if scenario.weights is None
                        else np.asarray(scenario.weights, dtype=float))
             if weights.shape != (hand.m,):
-                raise InputError("objective.weights", f"must have {hand.m} entries (one per "
-                                 f"joint), got {weights.size}")
+                raise InputError('objective.weights', f'must have {hand.m} entries (one per '
+                                 f'joint), got {weights.size}')
             setup = GraspSetup(
                 hand=hand, q=hand.configuration(scenario.joint_positions),
                 contacts=scenario.contacts, object_origin=scenario.object_origin,
                 friction=scenario.friction, external_wrench=scenario.external_wrench,
                 weights=weights, objective=self.job.objective or scenario.objective)
         except InputError as e:
-            raise InputError(f"line {lineno}: {e.field}", e.problem) from e
+            raise InputError(f'line {lineno}: {e.field}', e.problem) from e
         return ident, setup
 
     def score_line(self, lineno: int, text: str) -> dict[str, Any]:
         """The record of one line (a bad line gives status ``error``; never raises)."""
         t0 = time.perf_counter()
-        record: dict[str, Any] = {"line": lineno, "id": None}
+        record: dict[str, Any] = {'line': lineno, 'id': None}
         try:
-            record["id"], setup = self.candidate(lineno, text)
+            record['id'], setup = self.candidate(lineno, text)
             maps = setup.maps()
         except InputError as e:
             msg = str(e)
-            if not msg.startswith(f"line {lineno}"):
-                msg = f"line {lineno}: {msg}"
-            return {**record, "status": "error", "error": msg,
-                    "time_s": time.perf_counter() - t0}
+            if not msg.startswith(f'line {lineno}'):
+                msg = f'line {lineno}: {msg}'
+            return {**record, 'status': 'error', 'error': msg,
+                    'time_s': time.perf_counter() - t0}
         except GraspTorqueError as e:
-            return {**record, "status": "error", "error": f"line {lineno}: {e}",
-                    "time_s": time.perf_counter() - t0}
+            return {**record, 'status': 'error', 'error': f'line {lineno}: {e}',
+                    'time_s': time.perf_counter() - t0}
         try:
             record.update(self.score(setup, maps))
         except GraspTorqueError as e:
-            record.update(status="failed", error=f"line {lineno}: {e}")
+            record.update(status='failed', error=f'line {lineno}: {e}')
         except Exception as e:  # noqa: BLE001 -- one candidate never stops the batch
-            record.update(status="failed", error=f"line {lineno}: {type(e).__name__}: {e}")
-        record["time_s"] = time.perf_counter() - t0
+            record.update(status='failed', error=f'line {lineno}: {type(e).__name__}: {e}')
+        record['time_s'] = time.perf_counter() - t0
         return record
 
     def score(self, setup: GraspSetup, maps) -> dict[str, Any]:
@@ -218,19 +222,19 @@ class Scorer:
         sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback)
         usage = sol.friction_usage
         out: dict[str, Any] = {
-            "status": sol.status, "error": None, "torque_norm": sol.torque_norm,
-            "max_torque_ratio": sol.max_torque_ratio,
-            "friction_usage_max": None if usage is None else float(usage.max()),
-            "friction_usage": None if usage is None else [float(u) for u in usage],
-            "backend": sol.backend, "solve_time_s": sol.solve_time_s,
+            'status': sol.status, 'error': None, 'torque_norm': sol.torque_norm,
+            'max_torque_ratio': sol.max_torque_ratio,
+            'friction_usage_max': None if usage is None else float(usage.max()),
+            'friction_usage': None if usage is None else [float(u) for u in usage],
+            'backend': sol.backend, 'solve_time_s': sol.solve_time_s,
         }
-        if self.job.metrics == "full":
+        if self.job.metrics == 'full':
             lp = CapacityLP(setup, maps)
             cap = lp.solve(setup.external_wrench, binding=False)
-            out["capacity"] = cap.value
-            out["capacity_status"] = cap.status
-            out["holdable_fraction"] = (cap.value if sol.status == "infeasible" else None)
-            out["capacities"] = {k: c.value for k, c in
+            out['capacity'] = cap.value
+            out['capacity_status'] = cap.status
+            out['holdable_fraction'] = (cap.value if sol.status == 'infeasible' else None)
+            out['capacities'] = {k: c.value for k, c in
                                  direction_capacities(setup, maps, lp, binding=False).items()}
         return out
 
@@ -252,17 +256,18 @@ def score_chunk(job: ScoreJob, chunk: Sequence[tuple[int, str]]) -> list[dict[st
 
 
 def read_candidates(path: str | Path) -> list[tuple[int, str]]:
-    """(line number, text) of every non-blank line of a JSON Lines file (1-based).
+    """
+    (line number, text) of every non-blank line of a JSON Lines file (1-based).
 
     Raises:
         InputError: the file cannot be read (field ``candidates``).
     """
     path = Path(path)
     try:
-        with path.open(encoding="utf-8", errors="replace") as fh:
+        with path.open(encoding='utf-8', errors='replace') as fh:
             return [(i, line) for i, line in enumerate(fh, 1) if line.strip()]
     except OSError as e:
-        raise InputError("candidates", f"cannot read {path}: {e.strerror}") from e
+        raise InputError('candidates', f'cannot read {path}: {e.strerror}') from e
 
 
 def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tuple[int, str]]]:
@@ -272,14 +277,15 @@ def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tup
 
 #: Thread variables set to 1 in spawned workers (two workers with a multi-threaded
 #: BLAS each oversubscribe two cores).
-THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+THREAD_VARS = ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS')
 
 
 def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int | None = None,
-                engine: str = "processes", scheduler: str | None = None,
+                engine: str = 'processes', scheduler: str | None = None,
                 progress: Callable[[int, int], None] | None = None,
                 chunk: int = CHUNK) -> list[dict[str, Any]]:
-    """Score every candidate line, in parallel; records in input order.
+    """
+    Score every candidate line, in parallel; records in input order.
 
     Args:
         job: the base scenario and options.
@@ -312,10 +318,10 @@ def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int
         if progress is not None:
             progress(done, total)
 
-    if engine == "serial" or (engine == "processes" and (workers == 1 or len(tasks) <= 1)):
+    if engine == 'serial' or (engine == 'processes' and (workers == 1 or len(tasks) <= 1)):
         for i, t in enumerate(tasks):
             finished(i, score_chunk(job, t))
-    elif engine == "processes":
+    elif engine == 'processes':
         _pool_map(job, tasks, workers, finished)
     else:
         _dask_map(job, tasks, workers, scheduler, finished)
@@ -325,9 +331,9 @@ def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int
 def _pool_map(job: ScoreJob, tasks: list, workers: int, finished) -> None:
     import multiprocessing as mp
 
-    ctx = mp.get_context("spawn")  # fork after Pinocchio and BLAS threads is not safe
+    ctx = mp.get_context('spawn')  # fork after Pinocchio and BLAS threads is not safe
     saved = {k: os.environ.get(k) for k in THREAD_VARS}
-    os.environ.update({k: "1" for k in THREAD_VARS})  # spawned workers read these at import
+    os.environ.update(dict.fromkeys(THREAD_VARS, '1'))  # spawned workers read these at import
     try:
         pool = ctx.Pool(min(workers, len(tasks)))
     finally:
@@ -345,15 +351,15 @@ def _pool_map(job: ScoreJob, tasks: list, workers: int, finished) -> None:
 def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
               finished) -> None:
     try:
-        from dask.distributed import Client, LocalCluster, as_completed
+        from dask.distributed import as_completed, Client, LocalCluster
     except ImportError as e:
-        raise InputError("engine", "dask needs the optional extra 'distributed' "
+        raise InputError('engine', "dask needs the optional extra 'distributed' "
                          "(pip install 'grasp_torque_opt[distributed]')") from e
     cluster = None
     if scheduler is None:
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                dashboard_address=None,
-                               env={k: "1" for k in THREAD_VARS})
+                               env=dict.fromkeys(THREAD_VARS, '1'))
     try:
         with Client(scheduler or cluster) as client:
             job_ref = client.scatter(job, broadcast=True)
@@ -366,22 +372,23 @@ def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
             cluster.close()
 
 
-def rank(records: Sequence[dict[str, Any]], by: str = "capacity") -> list[dict[str, Any]]:
-    """Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
+def rank(records: Sequence[dict[str, Any]], by: str = 'capacity') -> list[dict[str, Any]]:
+    """
+    Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
 
     Without capacities (``metrics="basic"``) ``capacity`` falls back to ``torque_norm``.
     """
     if by not in RANK_KEYS:
         raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
-    if by == "capacity" and not any("capacity" in r for r in records):
-        by = "torque_norm"
+    if by == 'capacity' and not any('capacity' in r for r in records):
+        by = 'torque_norm'
     larger = RANK_KEYS[by]
 
     def key(r: dict) -> tuple:
         v = r.get(by)
-        ok = r.get("status") == "optimal" and v is not None and math.isfinite(v)
-        order = {"optimal": 0, "infeasible": 1, "failed": 2}.get(r.get("status"), 3)
-        return (not ok, order, (-v if larger else v) if ok else 0.0, r["line"])
+        ok = r.get('status') == 'optimal' and v is not None and math.isfinite(v)
+        order = {'optimal': 0, 'infeasible': 1, 'failed': 2}.get(r.get('status'), 3)
+        return (not ok, order, (-v if larger else v) if ok else 0.0, r['line'])
 
     return sorted(records, key=key)
 
@@ -390,19 +397,19 @@ def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
     """One line: how many of each status, and the rate."""
     counts: dict[str, int] = {}
     for r in records:
-        counts[r["status"]] = counts.get(r["status"], 0) + 1
-    parts = ", ".join(f"{counts.get(s, 0)} {s}" for s in ("optimal", "infeasible", "failed",
-                                                           "error"))
-    rate = len(records) / seconds if seconds > 0 else float("inf")
-    return f"scored {len(records)} candidates in {seconds:.2f} s ({rate:.0f}/s): {parts}"
+        counts[r['status']] = counts.get(r['status'], 0) + 1
+    parts = ', '.join(f'{counts.get(s, 0)} {s}' for s in ('optimal', 'infeasible', 'failed',
+                                                           'error'))
+    rate = len(records) / seconds if seconds > 0 else float('inf')
+    return f'scored {len(records)} candidates in {seconds:.2f} s ({rate:.0f}/s): {parts}'
 
 
 def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
     """The ranked table (text, not a contract)."""
     def num(v, fmt):
-        return format(v, fmt) if v is not None else "-".rjust(int(fmt.split(".")[0]))
+        return format(v, fmt) if v is not None else '-'.rjust(int(fmt.split('.')[0]))
 
-    full = any("capacity" in r for r in ranked)
+    full = any('capacity' in r for r in ranked)
     head = f"{'rank':>4}  {'line':>6}  {'id':<12} {'status':<10} {'|tau| N m':>9} " \
            f"{'max tau/lim':>11} {'friction':>8}"
     if full:
@@ -413,13 +420,13 @@ def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
                f"{num(r.get('torque_norm'), '9.4f')} {num(r.get('max_torque_ratio'), '11.3f')} "
                f"{num(r.get('friction_usage_max'), '8.3f')}")
         if full:
-            caps = {k: v for k, v in (r.get("capacities") or {}).items() if v is not None}
+            caps = {k: v for k, v in (r.get('capacities') or {}).items() if v is not None}
             worst = min(caps, key=caps.get) if caps else None
-            unit = "N m" if worst and worst[1] == "M" else "N"
+            unit = 'N m' if worst and worst[1] == 'M' else 'N'
             row += (f" {num(r.get('capacity'), '8.3f')} "
                     f"{(f'{worst} {caps[worst]:.3g} {unit}' if worst else '-'):>18}")
         lines.append(row)
-    return "\n".join(lines)
+    return '\n'.join(lines)
 
 
 def record_json(record: dict[str, Any]) -> str:

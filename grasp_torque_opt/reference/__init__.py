@@ -1,4 +1,5 @@
-"""Reference methods and independent checks, beside the product's tau-QP.
+"""
+Reference methods and independent checks, beside the product's tau-QP.
 
 The contact-force QP, the exact cone as an SOCP and as an NLP (Clarabel, SciPy
 SLSQP), and the HiGHS LP that confirms an infeasible verdict. They build on the

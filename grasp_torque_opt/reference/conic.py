@@ -5,11 +5,10 @@ from __future__ import annotations
 import time
 
 import clarabel
-import numpy as np
-import scipy.sparse as sp
-
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
+import numpy as np
+import scipy.sparse as sp
 
 #: Clarabel's feasibility and gap tolerances (tighter than its defaults, so that
 #: its optima pass the 1e-6 certificate with room to spare).
@@ -18,7 +17,8 @@ TOLERANCE = 1e-10
 
 def solve_conic(P: np.ndarray, q: np.ndarray, A: np.ndarray, b: np.ndarray,
                 cones: list) -> RawResult:
-    """Minimize 1/2 x^T P x + q^T x subject to A x + s = b, s in the given cones.
+    """
+    Minimize 1/2 x^T P x + q^T x subject to A x + s = b, s in the given cones.
 
     Args:
         P: PSD Hessian, shape (n, n) (its upper triangle is used).
@@ -43,9 +43,9 @@ def solve_conic(P: np.ndarray, q: np.ndarray, A: np.ndarray, b: np.ndarray,
     except (KeyboardInterrupt, SystemExit):
         raise
     except BaseException as e:  # noqa: B036 -- a Rust panic arrives as pyo3's PanicException
-        raise SolverError(f"Clarabel failed: {e}") from e
+        raise SolverError(f'Clarabel failed: {e}') from e
     elapsed = time.perf_counter() - t0
     name = str(sol.status)
-    status = ("solved" if name in ("Solved", "AlmostSolved")
-              else "infeasible" if name == "PrimalInfeasible" else "error")
+    status = ('solved' if name in ('Solved', 'AlmostSolved')
+              else 'infeasible' if name == 'PrimalInfeasible' else 'error')
     return RawResult(status, np.array(sol.x), int(sol.iterations), elapsed, name)

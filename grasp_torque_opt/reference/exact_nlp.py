@@ -1,4 +1,5 @@
-"""Reference method (c): an iterative nonlinear solve of the exact cone (SciPy SLSQP).
+"""
+Reference method (c): an iterative nonlinear solve of the exact cone (SciPy SLSQP).
 
 A stand-in for the paper's reference [6]. Over x = [f; s], with the smooth
 form of the exact cone:
@@ -17,12 +18,11 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
-from scipy.optimize import minimize
-
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
 from grasp_torque_opt.core.solution import RawResult
+import numpy as np
+from scipy.optimize import minimize
 
 #: Smoothing of ||(fx, fy)|| at 0 [N]; the smoothed cone is inside the exact one.
 EPS = 1e-9
@@ -69,11 +69,11 @@ def solve_exact_nlp(maps: GraspMaps, friction: Friction, external_wrench: np.nda
     f0[iz] = np.maximum(f0[iz], friction.min_normal_force + 1.0)
     x0 = np.concatenate((f0, 0.5 * f0[iz]))
     t0 = time.perf_counter()
-    res = minimize(objective, x0, jac=True, method="SLSQP",
-                   constraints=[{"type": "eq", "fun": lambda x: Gx @ x + external_wrench,
-                                 "jac": lambda x: Gx},
-                                {"type": "ineq", "fun": ineq, "jac": ineq_jac}],
-                   options={"ftol": 1e-10, "maxiter": max_iter})
+    res = minimize(objective, x0, jac=True, method='SLSQP',
+                   constraints=[{'type': 'eq', 'fun': lambda x: Gx @ x + external_wrench,
+                                 'jac': lambda x: Gx},
+                                {'type': 'ineq', 'fun': ineq, 'jac': ineq_jac}],
+                   options={'ftol': 1e-10, 'maxiter': max_iter})
     elapsed = time.perf_counter() - t0
-    return RawResult("solved" if res.success else "error", np.array(res.x), int(res.nit),
+    return RawResult('solved' if res.success else 'error', np.array(res.x), int(res.nit),
                      elapsed, str(res.message))

@@ -1,4 +1,5 @@
-"""Reference method (b): the exact soft-finger cone as an SOCP (Clarabel).
+"""
+Reference method (b): the exact soft-finger cone as an SOCP (Clarabel).
 
 sqrt(fx^2 + fy^2)/mu1 + |mz|/mu2 <= fz holds iff some s_i satisfies
 ||(fx, fy)|| <= mu1 s_i and |mz| <= mu2 (fz - s_i). Over x = [f; s]:
@@ -16,12 +17,11 @@ is an inner approximation of the cone).
 from __future__ import annotations
 
 import clarabel
-import numpy as np
-
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
 from grasp_torque_opt.core.solution import RawResult
 from grasp_torque_opt.reference.conic import solve_conic
+import numpy as np
 
 
 def solve_exact_socp(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,

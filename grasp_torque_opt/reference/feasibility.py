@@ -1,4 +1,5 @@
-"""Independent feasibility check of the linearized problem: an LP (SciPy HiGHS).
+"""
+Independent feasibility check of the linearized problem: an LP (SciPy HiGHS).
 
 A solver's "infeasible" is never trusted alone: before a polygon method
 reports ``infeasible``, this LP must agree that no f satisfies
@@ -9,18 +10,18 @@ exact cone too (``tau-qp-adaptive``'s infeasible verdict).
 
 from __future__ import annotations
 
-import numpy as np
-from scipy.optimize import linprog
-
 from grasp_torque_opt.core.friction import circumscribed_rows, friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
+import numpy as np
+from scipy.optimize import linprog
 
 
 def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
                         tau_min: np.ndarray, tau_max: np.ndarray,
                         circumscribed: bool = False) -> bool | None:
-    """Whether some contact wrench holds the load within the polygon and the limits.
+    """
+    Whether some contact wrench holds the load within the polygon and the limits.
 
     Args:
         circumscribed: the N-gon scaled by 1/cos(pi/N) (it contains the exact
@@ -38,5 +39,5 @@ def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np
         S = np.kron(np.eye(maps.p), block)
     res = linprog(np.zeros(G.shape[1]), A_ub=np.vstack((S, J.T, -J.T)),
                   b_ub=np.concatenate((b_S, tau_max, -tau_min)),
-                  A_eq=G, b_eq=-external_wrench, bounds=(None, None), method="highs")
+                  A_eq=G, b_eq=-external_wrench, bounds=(None, None), method='highs')
     return {0: True, 2: False}.get(res.status)

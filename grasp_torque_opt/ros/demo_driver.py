@@ -1,4 +1,5 @@
-"""A demo driver that needs no robot: it plays a scenario as a hand would.
+"""
+A demo driver that needs no robot: it plays a scenario as a hand would.
 
 It publishes joint states (the scenario's grasp with a small sinusoidal motion,
 NaN efforts as joint_state_broadcaster sends them), the contact frames at the
@@ -16,27 +17,26 @@ from __future__ import annotations
 
 import argparse
 import os
+from pathlib import Path
 import sys
 import time
-from pathlib import Path
-
-import numpy as np
 
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
+import numpy as np
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="grasp-torque-demo", description=__doc__.splitlines()[0])
-    p.add_argument("--params", default="allegro_right_node.yaml",
-                   help="node params file (bundled name or path); its scenario is played")
-    p.add_argument("--duration", type=float, default=5.0, help="seconds to play [s]")
-    p.add_argument("--rate", type=float, default=200.0, help="joint state rate [Hz]")
-    p.add_argument("--amplitude", type=float, default=0.01, help="joint motion [rad]")
-    p.add_argument("--with-node", action="store_true",
-                   help="start grasp_torque_node in a child process")
-    p.add_argument("--watch", action="store_true",
-                   help="publish nothing: only print what a running node does "
-                        "(on the current ROS_DOMAIN_ID)")
+    p = argparse.ArgumentParser(prog='grasp-torque-demo', description=__doc__.splitlines()[0])
+    p.add_argument('--params', default='allegro_right_node.yaml',
+                   help='node params file (bundled name or path); its scenario is played')
+    p.add_argument('--duration', type=float, default=5.0, help='seconds to play [s]')
+    p.add_argument('--rate', type=float, default=200.0, help='joint state rate [Hz]')
+    p.add_argument('--amplitude', type=float, default=0.01, help='joint motion [rad]')
+    p.add_argument('--with-node', action='store_true',
+                   help='start grasp_torque_node in a child process')
+    p.add_argument('--watch', action='store_true',
+                   help='publish nothing: only print what a running node does '
+                        '(on the current ROS_DOMAIN_ID)')
     return p
 
 
@@ -44,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the demo; exit code 0 when certified commands flowed and all were well-formed."""
     args = _parser().parse_args(argv)
     if args.with_node and args.watch:
-        print("grasp-torque-demo: error: --watch and --with-node exclude each other",
+        print('grasp-torque-demo: error: --watch and --with-node exclude each other',
               file=sys.stderr)
         return 2
     if not args.watch:
@@ -53,27 +53,26 @@ def main(argv: list[str] | None = None) -> int:
     from grasp_torque_opt.core.resources import find_config
 
     try:
-        params = find_config(args.params, "--params")
+        params = find_config(args.params, '--params')
         scenario = find_config(scenario_of(params))
     except InputError as e:
-        print(f"grasp-torque-demo: error: {e}", file=sys.stderr)
+        print(f'grasp-torque-demo: error: {e}', file=sys.stderr)
         return 2
     with node_process(params, args.with_node):
         return _play(args, scenario)
 
 
 def _play(args: argparse.Namespace, scenario: Path) -> int:
-    import pinocchio as pin
-    import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
-    from rclpy.qos import qos_profile_sensor_data
-    from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float64MultiArray
-
     from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
     from grasp_torque_opt.core.grasp_setup import GraspSetup
     from grasp_torque_opt.ros.node import COMMAND_QOS
+    import pinocchio as pin
+    import rclpy
+    from rclpy.qos import qos_profile_sensor_data
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
 
     setup = GraspSetup.from_file(scenario)
     hand = setup.hand
@@ -83,10 +82,10 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     limits = hand.torque_limits
 
     rclpy.init()
-    node = rclpy.create_node("grasp_demo_driver")
-    js_pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
-    contacts_pub = node.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
-    wrench_pub = node.create_publisher(WrenchStamped, "external_wrench",
+    node = rclpy.create_node('grasp_demo_driver')
+    js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+    contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+    wrench_pub = node.create_publisher(WrenchStamped, 'external_wrench',
                                        qos_profile_sensor_data)
     received: list[tuple[float, np.ndarray]] = []
     diag: dict[str, str] = {}
@@ -103,28 +102,28 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
 
     def on_diagnostics(msg: DiagnosticArray) -> None:
         for status in msg.status:
-            if status.name.startswith("grasp_torque_node"):
+            if status.name.startswith('grasp_torque_node'):
                 diag.clear()
                 diag.update({kv.key: kv.value for kv in status.values})
-                diag["message"] = status.message
-                if "solve_time_s" in diag:
-                    solve_times.append(float(diag["solve_time_s"]))
+                diag['message'] = status.message
+                if 'solve_time_s' in diag:
+                    solve_times.append(float(diag['solve_time_s']))
 
-    node.create_subscription(Float64MultiArray, "effort_commands", on_command, COMMAND_QOS)
-    node.create_subscription(DiagnosticArray, "/diagnostics", on_diagnostics, 10)
+    node.create_subscription(Float64MultiArray, 'effort_commands', on_command, COMMAND_QOS)
+    node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
 
-    domain = os.environ.get("ROS_DOMAIN_ID", "0")
+    domain = os.environ.get('ROS_DOMAIN_ID', '0')
     if args.watch:
-        print(f"grasp-torque-demo: watching effort_commands and /diagnostics for "
-              f"{args.duration:g} s (ROS_DOMAIN_ID {domain})")
+        print(f'grasp-torque-demo: watching effort_commands and /diagnostics for '
+              f'{args.duration:g} s (ROS_DOMAIN_ID {domain})')
     else:
-        print(f"grasp-torque-demo: {scenario.name}, {hand.m} joints, joint states at "
-              f"{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID {domain})")
+        print(f'grasp-torque-demo: {scenario.name}, {hand.m} joints, joint states at '
+              f'{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID {domain})')
     deadline = time.monotonic() + 30.0
-    while node.count_subscribers("joint_states") == 0 and time.monotonic() < deadline:
+    while node.count_subscribers('joint_states') == 0 and time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.1)
-    if node.count_subscribers("joint_states") == 0 and not args.watch:
-        print("grasp-torque-demo: no grasp_torque_node is listening on joint_states",
+    if node.count_subscribers('joint_states') == 0 and not args.watch:
+        print('grasp-torque-demo: no grasp_torque_node is listening on joint_states',
               file=sys.stderr)
         node.destroy_node()
         rclpy.try_shutdown()
@@ -134,7 +133,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
         # The node takes input only after its start-up check for a namesake on the domain
         # (startup_check_time): the grasp at rest until its first command, then the play.
         rest = JointState(name=list(names), position=[float(setup.q[i]) for i in idx_q],
-                          effort=[float("nan")] * len(names))
+                          effort=[float('nan')] * len(names))
         while not received and time.monotonic() < deadline:
             rest.header.stamp = node.get_clock().now().to_msg()
             js_pub.publish(rest)
@@ -152,7 +151,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
             for k, iq in enumerate(idx_q):
                 q[iq] = setup.q[iq] + args.amplitude * np.sin(2 * np.pi * 0.5 * t + 0.4 * k)
             js = JointState(name=list(names), position=[float(q[i]) for i in idx_q],
-                            effort=[float("nan")] * len(names))
+                            effort=[float('nan')] * len(names))
             js.header.stamp = node.get_clock().now().to_msg()
             js_pub.publish(js)
             if now >= next_slow:  # contacts and load at 50 Hz
@@ -179,8 +178,8 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
             next_print += 1.0
             n = len(received) - last_count
             last_count = len(received)
-            norm = np.linalg.norm(received[-1][1]) if received else float("nan")
-            solve_ms = 1e3 * float(diag.get("solve_time_s", "nan"))
+            norm = np.linalg.norm(received[-1][1]) if received else float('nan')
+            solve_ms = 1e3 * float(diag.get('solve_time_s', 'nan'))
             if args.watch:
                 next_tick = next_print
             print(f"t={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  "
@@ -193,13 +192,13 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     while time.monotonic() < end:
         rclpy.spin_once(node, timeout_sec=0.02)
 
-    sent = "" if args.watch else f" for about {int(args.duration * args.rate)} joint states"
+    sent = '' if args.watch else f' for about {int(args.duration * args.rate)} joint states'
     norms = [np.linalg.norm(c) for _, c in received]
-    print(f"summary: {len(received)} commands{sent} "
-          f"({len(received) / args.duration:.1f}/s); malformed {bad}; "
-          + (f"|command| {min(norms):.4f} to {max(norms):.4f} N m; " if norms else "")
-          + (f"solve time median {1e3 * np.median(solve_times):.3f} ms (diagnostics); "
-             if solve_times else "")
+    print(f'summary: {len(received)} commands{sent} '
+          f'({len(received) / args.duration:.1f}/s); malformed {bad}; '
+          + (f'|command| {min(norms):.4f} to {max(norms):.4f} N m; ' if norms else '')
+          + (f'solve time median {1e3 * np.median(solve_times):.3f} ms (diagnostics); '
+             if solve_times else '')
           + f"node cycles {played.get('cycles', '-')}, faults {played.get('faults', '-')}, "
           f"rejected joint states {played.get('rejected.joint_states', '-')}, "
           f"last status {played.get('status', '-')}")
@@ -208,5 +207,5 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     return 0 if (received or args.watch) and bad == 0 else 1
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

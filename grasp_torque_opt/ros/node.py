@@ -1,4 +1,5 @@
-"""ROS 2 node ``grasp_torque_node``: certified grasp torques every cycle, and a solve service.
+"""
+ROS 2 node ``grasp_torque_node``: certified grasp torques every cycle, and a solve service.
 
 A thin adapter over :class:`grasp_torque_opt.control.controller.TorqueController`:
 messages in, plain arrays to the controller, its decisions out. Interface
@@ -8,34 +9,55 @@ pinned in docs/design.md section 4; parameters, units and defaults in docs/desig
 from __future__ import annotations
 
 import argparse
+from concurrent.futures import ThreadPoolExecutor
 import dataclasses
+from dataclasses import dataclass
 import json
 import math
 import signal
 import sys
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, PoseArray, WrenchStamped
+from grasp_torque_opt.backends import (
+    available,
+    BACKENDS,
+    make_solver,
+    single_threaded_math,
+)
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.control import diagnostics
+from grasp_torque_opt.control.controller import (
+    CycleConfig,
+    CycleResult,
+    POLICIES,
+    stamp_seconds,
+    TorqueController,
+)
+from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import Hand, MAX_TORQUE_LIMIT, MAX_URDF_BYTES
+from grasp_torque_opt.core.report import solution_dict
+from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
+from grasp_torque_opt.core.scenario import load_scenario, OBJECTIVES
+import numpy as np
 from rcl_interfaces.msg import (
     FloatingPointRange,
     IntegerRange,
     ParameterDescriptor,
     SetParametersResult,
 )
+import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.qos import HistoryPolicy, qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
@@ -45,29 +67,7 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
-from grasp_torque_opt.backends import (
-    BACKENDS,
-    available,
-    make_solver,
-    single_threaded_math,
-)
-from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-from grasp_torque_opt.control import diagnostics
-from grasp_torque_opt.control.controller import (
-    POLICIES,
-    CycleConfig,
-    CycleResult,
-    TorqueController,
-    stamp_seconds,
-)
-from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
-from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.hand import MAX_TORQUE_LIMIT, MAX_URDF_BYTES, Hand
-from grasp_torque_opt.core.report import solution_dict
-from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
-from grasp_torque_opt.core.scenario import OBJECTIVES, load_scenario
-
-NODE_NAME = "grasp_torque_node"
+NODE_NAME = 'grasp_torque_node'
 #: Commands: reliable, only the newest matters.
 COMMAND_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE)
 #: ~/solve: reliable, every request kept until it is taken (keep last 100 dropped 872 to
@@ -92,104 +92,105 @@ class Spec:
 
 #: Every parameter, declared in this order. Defaults come from the scenario.
 PARAMETERS: dict[str, Spec] = {
-    "scenario": Spec("Scenario file (docs/design.md section 4): hand, default contacts and load. "
+    'scenario': Spec("Scenario file (docs/design.md section 4): hand, default contacts and load. "
                      "A path, or the name of a bundled file in the package's config/.",
                      read_only=True),
-    "robot_description": Spec("URDF document of the hand (the ROS convention) or a path to "
+    'robot_description': Spec("URDF document of the hand (the ROS convention) or a path to "
                               "one; empty: the scenario's hand.urdf.", read_only=True),
-    "joints": Spec("Actuated joints in command order (default: the scenario's).",
+    'joints': Spec("Actuated joints in command order (default: the scenario's).",
                    read_only=True),
-    "object_origin": Spec("Object origin c in the base frame [m].", length="3"),
-    "mu_tangential": Spec("Tangential friction coefficient mu1 [-].", 1e-6, 10.0),
-    "mu_torsional": Spec("Torsional friction coefficient mu2 [m].", 1e-9, 1.0),
-    "polygon_sides": Spec("Sides N of the inscribed friction polygon [-].", 3, 64),
-    "min_normal_force": Spec("Minimum normal force per contact [N].", 0.0, 1000.0),
-    "torque_limits": Spec("|command_i| <= torque_limits[i] [N m], per joint; each at most "
+    'object_origin': Spec('Object origin c in the base frame [m].', length='3'),
+    'mu_tangential': Spec('Tangential friction coefficient mu1 [-].', 1e-6, 10.0),
+    'mu_torsional': Spec('Torsional friction coefficient mu2 [m].', 1e-9, 1.0),
+    'polygon_sides': Spec('Sides N of the inscribed friction polygon [-].', 3, 64),
+    'min_normal_force': Spec('Minimum normal force per contact [N].', 0.0, 1000.0),
+    'torque_limits': Spec("|command_i| <= torque_limits[i] [N m], per joint; each at most "
                           "the joint's URDF effort limit (the scenario's limit if the URDF "
-                          "gives none) unless torque_limits_above_urdf.", length="joints"),
-    "torque_limits_above_urdf": Spec("Allow torque_limits above the URDF's effort limits (up "
+                          "gives none) unless torque_limits_above_urdf.", length='joints'),
+    'torque_limits_above_urdf': Spec("Allow torque_limits above the URDF's effort limits (up "
                                      "to 1e4 N m); default: the scenario's "
                                      "hand.torque_limits_above_urdf.", read_only=True),
-    "weights": Spec("Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the "
-                    "largest at most 1e6 times the smallest [-].", length="joints"),
-    "friction_margin": Spec("Friction margin k: plan inside the cone of mu/(1+k), so the "
-                            "commanded wrenches hold with up to (1+k) times less friction "
-                            "(docs/planner.md) [-].", 0.0, 100.0),
-    "objective": Spec("'sum-of-squares' (the paper's, default: the scenario's) or 'min-max' "
+    'weights': Spec('Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the '
+                    'largest at most 1e6 times the smallest [-].', length='joints'),
+    'friction_margin': Spec('Friction margin k: plan inside the cone of mu/(1+k), so the '
+                            'commanded wrenches hold with up to (1+k) times less friction '
+                            '(docs/planner.md) [-].', 0.0, 100.0),
+    'objective': Spec("'sum-of-squares' (the paper's, default: the scenario's) or 'min-max' "
                       "(max |tau_i + g_i| / limit_i, an LP, then the sum of squares among its "
                       "optima; docs/planner.md)."),
-    "gravity_compensation": Spec("Add the fingers' own gravity torques g(q); the torque "
+    'gravity_compensation': Spec("Add the fingers' own gravity torques g(q); the torque "
                                  "limits then bound the sum."),
-    "gravity": Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
-                    "gravity, else [0, 0, -9.81].", length="3"),
-    "joint_state_timeout": Spec("Joint states older than this stop commands [s].", 1e-4, 10.0),
-    "contacts_timeout": Spec("Once contacts arrived, older than this stop commands [s]; "
-                             "0: never stale.", 0.0, 60.0),
-    "wrench_timeout": Spec("Once a load arrived, older than this stops commands [s]; "
-                           "0: never stale.", 0.0, 60.0),
-    "hold_time": Spec("How long a fault may hold the last certified command before the "
-                      "fault policy applies [s].", 0.0, 60.0),
-    "fault_policy": Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
+    'gravity': Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
+                    "gravity, else [0, 0, -9.81].", length='3'),
+    'joint_state_timeout': Spec('Joint states older than this stop commands [s].', 1e-4, 10.0),
+    'contacts_timeout': Spec('Once contacts arrived, older than this stop commands [s]; '
+                             '0: never stale.', 0.0, 60.0),
+    'wrench_timeout': Spec('Once a load arrived, older than this stops commands [s]; '
+                           '0: never stale.', 0.0, 60.0),
+    'hold_time': Spec('How long a fault may hold the last certified command before the '
+                      'fault policy applies [s].', 0.0, 60.0),
+    'fault_policy': Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
                          "controller keeps the last certified command) or 'zero' (publish "
                          "zero torques)."),
-    "max_message_bytes": Spec("A message on joint_states, contacts or external_wrench whose "
-                              "serialized form is longer than this is rejected before it is "
-                              "deserialized [bytes].", 1024, 16777216),
-    "max_joint_state_entries": Spec("A joint state with more names or positions than this is "
-                                    "rejected unread [-].", 1, 100000),
-    "max_wrench_force": Spec("A load whose force norm exceeds this is rejected [N].",
+    'max_message_bytes': Spec('A message on joint_states, contacts or external_wrench whose '
+                              'serialized form is longer than this is rejected before it is '
+                              'deserialized [bytes].', 1024, 16777216),
+    'max_joint_state_entries': Spec('A joint state with more names or positions than this is '
+                                    'rejected unread [-].', 1, 100000),
+    'max_wrench_force': Spec('A load whose force norm exceeds this is rejected [N].',
                              1e-6, 1e6),
-    "max_wrench_torque": Spec("A load whose moment norm exceeds this is rejected [N m].",
+    'max_wrench_torque': Spec('A load whose moment norm exceeds this is rejected [N m].',
                               1e-6, 1e6),
-    "max_contact_distance": Spec("A contact point farther than this from the base origin "
-                                 "stops commands [m].", 1e-3, 100.0),
-    "stamp_future_tolerance": Spec("A header stamp more than this ahead of the node's clock "
+    'max_contact_distance': Spec('A contact point farther than this from the base origin '
+                                 'stops commands [m].', 1e-3, 100.0),
+    'stamp_future_tolerance': Spec("A header stamp more than this ahead of the node's clock "
                                    "is rejected [s].", 0.0, 3600.0),
-    "cycle_budget": Spec("A cycle that takes longer publishes nothing (overrun); its "
-                         "solvers stop by it (or by joint_state_timeout if smaller) [s].",
+    'cycle_budget': Spec('A cycle that takes longer publishes nothing (overrun); its '
+                         'solvers stop by it (or by joint_state_timeout if smaller) [s].',
                          1e-4, 1.0),
-    "solver.method": Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
+    'solver.method': Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
                           "exact-cone optimum from QPs with a certified gap to it, "
                           "docs/adaptive.md; needs DAQP; about 3 times tau-qp's cycle with "
                           "DAQP, well within the default cycle_budget)."),
-    "solver.backend": Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
+    'solver.backend': Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
                            "without internal-force variables only); every result is "
                            "certified whichever solves it."),
-    "solver.fallback": Spec("Backend asked in the same cycle when solver.backend gives nothing "
+    'solver.fallback': Spec("Backend asked in the same cycle when solver.backend gives nothing "
                             "certifiable ('none': no second try); its answer is certified "
                             "the same way and counted (diagnostics solver.fallback_solves)."),
-    "solver.warm_start": Spec("Start each solve from the previous cycle's (ProxSuite: its "
+    'solver.warm_start': Spec("Start each solve from the previous cycle's (ProxSuite: its "
                               "result, preconditioner kept; DAQP: its active set); an answer "
                               "that is not solved, fails the KKT check or is not certified "
                               "is redone cold in the same cycle and counted (diagnostics "
                               "solver.warm_start_fallbacks). No effect on quadprog."),
-    "solver.eps_abs": Spec("Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) "
-                           "[-].", 1e-12, 1e-4),
-    "solver.max_iter": Spec("Solver iteration cap (ProxSuite outer, DAQP) [-].", 1, 10000),
-    "solver.max_iter_in": Spec("ProxSuite inner iteration cap; one outer iteration, up to "
-                               "this many inner ones, is how far a solve can run past its "
-                               "budget [-].", 1, 200),
-    "certificate_tolerance": Spec("Tolerance of the certificate on every residual [SI].",
+    'solver.eps_abs': Spec('Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) '
+                           '[-].', 1e-12, 1e-4),
+    'solver.max_iter': Spec('Solver iteration cap (ProxSuite outer, DAQP) [-].', 1, 10000),
+    'solver.max_iter_in': Spec('ProxSuite inner iteration cap; one outer iteration, up to '
+                               'this many inner ones, is how far a solve can run past its '
+                               'budget [-].', 1, 200),
+    'certificate_tolerance': Spec('Tolerance of the certificate on every residual [SI].',
                                   1e-12, 1e-2),
-    "diagnostics_period": Spec("Period of /diagnostics [s] (1 Hz, as diagnostic_updater).",
+    'diagnostics_period': Spec('Period of /diagnostics [s] (1 Hz, as diagnostic_updater).',
                                1e-3, 60.0, read_only=True),
-    "marker_period": Spec("Period of ~/contact_wrenches [s]; each arrow lives three periods, "
-                          "so they vanish when the node stops.", 1e-3, 60.0, read_only=True),
-    "watchdog_period": Spec("Period of the staleness check between joint states [s].",
+    'marker_period': Spec('Period of ~/contact_wrenches [s]; each arrow lives three periods, '
+                          'so they vanish when the node stops.', 1e-3, 60.0, read_only=True),
+    'watchdog_period': Spec('Period of the staleness check between joint states [s].',
                             1e-4, 1.0, read_only=True),
-    "startup_check_time": Spec("At start, how long grasp_torque_node looks for another node "
-                               "of its name on the domain before it takes any input; one "
-                               "found: it exits with an error (code 2). Later, one is "
-                               "reported (diagnostics ERROR) [s].", 0.0, 30.0, read_only=True),
-    "marker_scale": Spec("Arrow length per newton in ~/contact_wrenches [m/N].", 0.0, 10.0),
-    "publish_stamped_command": Spec("Also publish each command on ~/effort_commands_stamped "
-                                    "(sensor_msgs/JointState: joints, effort, and the stamp of "
-                                    "the joint state it was computed from).", read_only=True),
+    'startup_check_time': Spec('At start, how long grasp_torque_node looks for another node '
+                               'of its name on the domain before it takes any input; one '
+                               'found: it exits with an error (code 2). Later, one is '
+                               'reported (diagnostics ERROR) [s].', 0.0, 30.0, read_only=True),
+    'marker_scale': Spec('Arrow length per newton in ~/contact_wrenches [m/N].', 0.0, 10.0),
+    'publish_stamped_command': Spec('Also publish each command on ~/effort_commands_stamped '
+                                    '(sensor_msgs/JointState: joints, effort, and the stamp of '
+                                    'the joint state it was computed from).', read_only=True),
 }
 
 
 def received(info: dict | None) -> float:
-    """When the middleware received a message, on the monotonic clock [s].
+    """
+    When the middleware received a message, on the monotonic clock [s].
 
     rmw's message info carries ``received_timestamp``: the system clock
     (``CLOCK_REALTIME``) of this host when the subscription's middleware took the
@@ -198,7 +199,7 @@ def received(info: dict | None) -> float:
     (a clock step between the two counts as no wait; a message without it: now).
     """
     now = time.monotonic()
-    ns = (info or {}).get("received_timestamp") or 0
+    ns = (info or {}).get('received_timestamp') or 0
     if ns <= 0:
         return now
     return now - max(0.0, (time.time_ns() - ns) * 1e-9)
@@ -217,9 +218,9 @@ def descriptor(name: str) -> ParameterDescriptor:
 
 
 #: Values of ``solver.method``: the product's methods (the references are not for a cycle).
-CYCLE_METHODS = ("tau-qp", "tau-qp-adaptive")
+CYCLE_METHODS = ('tau-qp', 'tau-qp-adaptive')
 #: Values of ``solver.fallback``.
-FALLBACKS = (*BACKENDS, "none")
+FALLBACKS = (*BACKENDS, 'none')
 #: Each weight's range, and the largest ratio of two weights: W's condition number
 #: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
 WEIGHT_RANGE = (1e-6, 1e6)
@@ -230,14 +231,17 @@ SERVICE_SLICE_S = 0.005
 
 
 def _fallback(backend: str, fallback: str) -> str | None:
-    """The fallback backend to build: None for 'none', the backend itself, or one not installed
-    (a ROS distribution may lack DAQP; the node then runs without a second try)."""
-    return None if fallback in ("none", backend) or not available(fallback) else fallback
+    """
+    The fallback backend to build: None for 'none', the backend itself, or one not installed
+    (a ROS distribution may lack DAQP; the node then runs without a second try).
+    """
+    return None if fallback in ('none', backend) or not available(fallback) else fallback
 
 
 def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None,
           joints: list[str] | None = None) -> str:
-    """Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too.
+    """
+    Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too.
 
     Args:
         name: the parameter.
@@ -247,60 +251,61 @@ def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None
         joints: joint names, for messages.
     """
     spec = PARAMETERS[name]
-    if name == "fault_policy":
-        return "" if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
-    if name == "solver.backend":
+    if name == 'fault_policy':
+        return '' if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
+    if name == 'solver.backend':
         if value not in BACKENDS:
             return f"{name}: must be one of {', '.join(BACKENDS)}"
-        return "" if available(value) else f"{name}: {value} is not installed (pip install {value})"
-    if name == "solver.fallback":
-        return "" if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
-    if name == "solver.method":
+        return '' if available(value) else f'{name}: {value} is not installed (pip install {value})'
+    if name == 'solver.fallback':
+        return '' if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
+    if name == 'solver.method':
         if value not in CYCLE_METHODS:
             return f"{name}: must be one of {', '.join(CYCLE_METHODS)}"
-        return "" if value == "tau-qp" or available("daqp") else \
-            f"{name}: {value} needs daqp, which is not installed (pip install daqp)"
-    if name == "objective":
-        return "" if value in OBJECTIVES else f"{name}: must be one of {', '.join(OBJECTIVES)}"
+        return '' if value == 'tau-qp' or available('daqp') else \
+            f'{name}: {value} needs daqp, which is not installed (pip install daqp)'
+    if name == 'objective':
+        return '' if value in OBJECTIVES else f"{name}: must be one of {', '.join(OBJECTIVES)}"
     if spec.length is not None:
-        n = m if spec.length == "joints" else int(spec.length)
+        n = m if spec.length == 'joints' else int(spec.length)
         values = list(value)
         if len(values) != n:
-            return f"{name}: must have {n} entries, got {len(values)}"
+            return f'{name}: must have {n} entries, got {len(values)}'
         if not all(math.isfinite(v) for v in values):
-            return f"{name}: must be finite"
-        if name in ("torque_limits", "weights") and not all(v > 0 for v in values):
-            return f"{name}: every entry must be > 0"
-        if name == "torque_limits" and torque_bounds is not None:
+            return f'{name}: must be finite'
+        if name in ('torque_limits', 'weights') and not all(v > 0 for v in values):
+            return f'{name}: every entry must be > 0'
+        if name == 'torque_limits' and torque_bounds is not None:
             try:
                 Hand.check_limits(np.array(values, dtype=float), joints or [], torque_bounds,
-                                  name, "torque_limits_above_urdf (read-only: at start)")
+                                  name, 'torque_limits_above_urdf (read-only: at start)')
             except InputError as e:
                 return str(e)
-        if name == "weights":
+        if name == 'weights':
             low, high = WEIGHT_RANGE
             if not all(low <= v <= high for v in values):
-                return f"{name}: every entry must be in [{low:g}, {high:g}]"
+                return f'{name}: every entry must be in [{low:g}, {high:g}]'
             if max(values) > MAX_WEIGHT_RATIO * min(values):
-                return (f"{name}: the largest entry may be at most {MAX_WEIGHT_RATIO:g} times "
-                        f"the smallest, got {max(values) / min(values):.3g}")
-        return ""
+                return (f'{name}: the largest entry may be at most {MAX_WEIGHT_RATIO:g} times '
+                        f'the smallest, got {max(values) / min(values):.3g}')
+        return ''
     if isinstance(value, float) and not math.isfinite(value):
-        return f"{name}: must be finite"
+        return f'{name}: must be finite'
     if spec.low is not None and not (spec.low <= value <= spec.high):
-        return f"{name}: must be in [{spec.low}, {spec.high}], got {value}"
-    return ""
+        return f'{name}: must be in [{spec.low}, {spec.high}], got {value}'
+    return ''
 
 
 class GraspTorqueNode(Node):
     """Publishes certified effort commands on each joint state; answers ``~/solve``."""
 
     def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
-        """Args:
-            message_info: age inputs from the middleware's receipt time (rmw message
-                info); False: from the callback's time (rclpy 7.1's EventsExecutor
-                raises SystemError on subscriptions that take message info).
-            kwargs: for rclpy's Node (context, parameter_overrides, ...).
+        """
+        Args:
+        message_info: age inputs from the middleware's receipt time (rmw message
+            info); False: from the callback's time (rclpy 7.1's EventsExecutor
+            raises SystemError on subscriptions that take message info).
+        kwargs: for rclpy's Node (context, parameter_overrides, ...).
         """
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.Lock()
@@ -308,59 +313,59 @@ class GraspTorqueNode(Node):
         setup = self._load_setup()
         self._m = setup.hand.m
         defaults = {
-            "torque_limits_above_urdf": self._scenario.torque_limits_above_urdf,
-            "object_origin": [float(x) for x in setup.object_origin],
-            "mu_tangential": setup.friction.mu1,
-            "mu_torsional": setup.friction.mu2,
-            "polygon_sides": setup.friction.sides,
-            "min_normal_force": setup.friction.min_normal_force,
-            "torque_limits": [float(x) for x in setup.hand.torque_limits],
-            "weights": [float(x) for x in setup.weights],
-            "friction_margin": setup.friction.margin,
-            "objective": setup.objective,
-            "gravity_compensation": False,
+            'torque_limits_above_urdf': self._scenario.torque_limits_above_urdf,
+            'object_origin': [float(x) for x in setup.object_origin],
+            'mu_tangential': setup.friction.mu1,
+            'mu_torsional': setup.friction.mu2,
+            'polygon_sides': setup.friction.sides,
+            'min_normal_force': setup.friction.min_normal_force,
+            'torque_limits': [float(x) for x in setup.hand.torque_limits],
+            'weights': [float(x) for x in setup.weights],
+            'friction_margin': setup.friction.margin,
+            'objective': setup.objective,
+            'gravity_compensation': False,
             # One place for gravity: the scenario's, which also gives its load.
-            "gravity": ([float(x) for x in self._scenario_gravity]
+            'gravity': ([float(x) for x in self._scenario_gravity]
                         if self._scenario_gravity is not None else [0.0, 0.0, -9.81]),
-            "joint_state_timeout": 0.1,
-            "contacts_timeout": 0.5,
-            "wrench_timeout": 0.5,
-            "hold_time": 0.1,
-            "fault_policy": "hold",
-            "max_message_bytes": CycleConfig.max_message_bytes,
-            "max_joint_state_entries": CycleConfig.max_joint_state_entries,
-            "max_wrench_force": CycleConfig.max_wrench_force,
-            "max_wrench_torque": CycleConfig.max_wrench_torque,
-            "max_contact_distance": CycleConfig.max_contact_distance,
-            "stamp_future_tolerance": CycleConfig.stamp_future_tolerance,
-            "cycle_budget": CycleConfig.cycle_budget,
-            "solver.method": "tau-qp",
-            "solver.backend": BACKENDS[0],
-            "solver.fallback": "daqp",
-            "solver.warm_start": True,
-            "solver.eps_abs": ProxSuiteSettings.eps_abs,
-            "solver.max_iter": ProxSuiteSettings.max_iter,
-            "solver.max_iter_in": ProxSuiteSettings.max_iter_in,
-            "certificate_tolerance": CycleConfig.certificate_tolerance,
-            "diagnostics_period": 1.0,
-            "marker_period": 0.1,
-            "watchdog_period": 0.01,
-            "startup_check_time": 2.0,
-            "marker_scale": 0.02,
-            "publish_stamped_command": False,
+            'joint_state_timeout': 0.1,
+            'contacts_timeout': 0.5,
+            'wrench_timeout': 0.5,
+            'hold_time': 0.1,
+            'fault_policy': 'hold',
+            'max_message_bytes': CycleConfig.max_message_bytes,
+            'max_joint_state_entries': CycleConfig.max_joint_state_entries,
+            'max_wrench_force': CycleConfig.max_wrench_force,
+            'max_wrench_torque': CycleConfig.max_wrench_torque,
+            'max_contact_distance': CycleConfig.max_contact_distance,
+            'stamp_future_tolerance': CycleConfig.stamp_future_tolerance,
+            'cycle_budget': CycleConfig.cycle_budget,
+            'solver.method': 'tau-qp',
+            'solver.backend': BACKENDS[0],
+            'solver.fallback': 'daqp',
+            'solver.warm_start': True,
+            'solver.eps_abs': ProxSuiteSettings.eps_abs,
+            'solver.max_iter': ProxSuiteSettings.max_iter,
+            'solver.max_iter_in': ProxSuiteSettings.max_iter_in,
+            'certificate_tolerance': CycleConfig.certificate_tolerance,
+            'diagnostics_period': 1.0,
+            'marker_period': 0.1,
+            'watchdog_period': 0.01,
+            'startup_check_time': 2.0,
+            'marker_scale': 0.02,
+            'publish_stamped_command': False,
         }
         for name, value in defaults.items():
             self.declare_parameter(name, value, descriptor(name))
         self._torque_bounds = self._limit_bounds(
-            setup.hand, self.get_parameter("torque_limits_above_urdf").value)
+            setup.hand, self.get_parameter('torque_limits_above_urdf').value)
         for name in defaults:
             reason = self._check(name, self.get_parameter(name).value)
             if reason:
-                raise InputError(name, reason.split(": ", 1)[1])
+                raise InputError(name, reason.split(': ', 1)[1])
         self._base_setup = setup
-        backend = self.get_parameter("solver.backend").value
-        warm = self.get_parameter("solver.warm_start").value
-        fallback = _fallback(backend, self.get_parameter("solver.fallback").value)
+        backend = self.get_parameter('solver.backend').value
+        warm = self.get_parameter('solver.warm_start').value
+        fallback = _fallback(backend, self.get_parameter('solver.fallback').value)
         self._warn_missing_fallback()
         self.controller = TorqueController(*self._configure(setup, self._params()), backend,
                                            warm, fallback)
@@ -375,9 +380,9 @@ class GraspTorqueNode(Node):
 
         # Serialized (raw): a message is measured before it is deserialized. With message
         # info, inputs are aged from when the middleware received them.
-        for msg_type, topic, take in ((JointState, "joint_states", self._on_joint_state),
-                                      (PoseArray, "contacts", self._on_contacts),
-                                      (WrenchStamped, "external_wrench", self._on_wrench)):
+        for msg_type, topic, take in ((JointState, 'joint_states', self._on_joint_state),
+                                      (PoseArray, 'contacts', self._on_contacts),
+                                      (WrenchStamped, 'external_wrench', self._on_wrench)):
             def callback(data, info=None, msg_type=msg_type, topic=topic, take=take):
                 self._on_serialized(topic, msg_type, data, take, info)
             if message_info:
@@ -386,30 +391,30 @@ class GraspTorqueNode(Node):
                 sub_callback = (lambda cb: lambda data: cb(data))(callback)
             sub = self.create_subscription(msg_type, topic, sub_callback,
                                            qos_profile_sensor_data, raw=True)
-            if topic == "joint_states":
+            if topic == 'joint_states':
                 self._joint_states_topic = sub.topic_name  # remapped and resolved
-        self._command_pub = self.create_publisher(Float64MultiArray, "effort_commands",
+        self._command_pub = self.create_publisher(Float64MultiArray, 'effort_commands',
                                                   COMMAND_QOS)
         self._stamped_pub = None
-        if self.get_parameter("publish_stamped_command").value:
-            self._stamped_pub = self.create_publisher(JointState, "~/effort_commands_stamped",
+        if self.get_parameter('publish_stamped_command').value:
+            self._stamped_pub = self.create_publisher(JointState, '~/effort_commands_stamped',
                                                       COMMAND_QOS)
-        self._marker_pub = self.create_publisher(MarkerArray, "~/contact_wrenches", 1)
-        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
+        self._marker_pub = self.create_publisher(MarkerArray, '~/contact_wrenches', 1)
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         # The service solves in a worker thread while the executor goes on with the loop.
-        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="solve_service")
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solve_service')
         self._pending_solves = 0
         self._busy_answers = 0
         self._duplicates = 0
         # A group of its own: in the node's default (mutually exclusive) group, each call
         # held every callback of the node, the control loop's included, until its solve
         # was done; reentrant, so that requests are taken (and answered "busy") meanwhile.
-        self.create_service(Trigger, "~/solve", self._on_solve, qos_profile=SERVICE_QOS,
+        self.create_service(Trigger, '~/solve', self._on_solve, qos_profile=SERVICE_QOS,
                             callback_group=ReentrantCallbackGroup())
-        self.create_timer(self.get_parameter("watchdog_period").value, self._on_watchdog)
-        self.create_timer(self.get_parameter("diagnostics_period").value,
+        self.create_timer(self.get_parameter('watchdog_period').value, self._on_watchdog)
+        self.create_timer(self.get_parameter('diagnostics_period').value,
                           self._on_diagnostics)
-        self.create_timer(self.get_parameter("marker_period").value, self._on_markers)
+        self.create_timer(self.get_parameter('marker_period').value, self._on_markers)
         self.get_logger().info(
             f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
             f"{len(setup.contacts)} default contacts; commands on "
@@ -418,21 +423,21 @@ class GraspTorqueNode(Node):
     # -- configuration --------------------------------------------------------------------
 
     def _load_setup(self) -> GraspSetup:
-        name = self.declare_parameter("scenario", "", descriptor("scenario")).value
-        urdf = self.declare_parameter("robot_description", "",
-                                      descriptor("robot_description")).value
+        name = self.declare_parameter('scenario', '', descriptor('scenario')).value
+        urdf = self.declare_parameter('robot_description', '',
+                                      descriptor('robot_description')).value
         if not name:
-            raise InputError("scenario", "parameter not set (a scenario file gives the "
-                             "default contacts and load)")
+            raise InputError('scenario', 'parameter not set (a scenario file gives the '
+                             'default contacts and load)')
         scenario = self._scenario = load_scenario(find_config(name))
         self._scenario_gravity = scenario.gravity
-        if urdf and not urdf.lstrip().startswith("<"):
-            path = find_config(urdf, "robot_description")
-            urdf = decode_utf8(read_bounded(path, "robot_description", MAX_URDF_BYTES), path,
-                               "robot_description")
+        if urdf and not urdf.lstrip().startswith('<'):
+            path = find_config(urdf, 'robot_description')
+            urdf = decode_utf8(read_bounded(path, 'robot_description', MAX_URDF_BYTES), path,
+                               'robot_description')
         setup = GraspSetup.from_scenario(scenario, urdf or None)
-        joints = self.declare_parameter("joints", list(setup.hand.joints),
-                                        descriptor("joints")).value
+        joints = self.declare_parameter('joints', list(setup.hand.joints),
+                                        descriptor('joints')).value
         if list(joints) != list(setup.hand.joints):
             setup = GraspSetup.from_scenario(dataclasses.replace(scenario, joints=list(joints)),
                                              urdf or None)
@@ -441,8 +446,10 @@ class GraspTorqueNode(Node):
 
     @staticmethod
     def _limit_bounds(hand: Hand, above_urdf: bool) -> np.ndarray:
-        """The largest torque limit per joint [N m]: the URDF's effort limit, the
-        scenario's limit where the URDF gives none; MAX_TORQUE_LIMIT if allowed above."""
+        """
+        The largest torque limit per joint [N m]: the URDF's effort limit, the
+        scenario's limit where the URDF gives none; MAX_TORQUE_LIMIT if allowed above.
+        """
         if above_urdf:
             return np.full(hand.m, MAX_TORQUE_LIMIT)
         effort = hand.effort_limits
@@ -458,29 +465,29 @@ class GraspTorqueNode(Node):
                    ) -> tuple[GraspSetup, CycleConfig, ProxSuiteSettings]:
         """The controller's setup, cycle settings and solver settings from parameter values."""
         hand = setup.hand
-        if not np.array_equal(hand.torque_limits, p["torque_limits"]):
-            hand = dataclasses.replace(hand, torque_limits=np.array(p["torque_limits"]))
+        if not np.array_equal(hand.torque_limits, p['torque_limits']):
+            hand = dataclasses.replace(hand, torque_limits=np.array(p['torque_limits']))
         setup = dataclasses.replace(
-            setup, hand=hand, object_origin=np.array(p["object_origin"]),
-            weights=np.array(p["weights"]), objective=p["objective"],
-            friction=dataclasses.replace(setup.friction, mu1=p["mu_tangential"],
-                                         mu2=p["mu_torsional"], sides=p["polygon_sides"],
-                                         min_normal_force=p["min_normal_force"],
-                                         margin=p["friction_margin"]))
+            setup, hand=hand, object_origin=np.array(p['object_origin']),
+            weights=np.array(p['weights']), objective=p['objective'],
+            friction=dataclasses.replace(setup.friction, mu1=p['mu_tangential'],
+                                         mu2=p['mu_torsional'], sides=p['polygon_sides'],
+                                         min_normal_force=p['min_normal_force'],
+                                         margin=p['friction_margin']))
         config = CycleConfig(
-            joint_state_timeout=p["joint_state_timeout"],
-            contacts_timeout=p["contacts_timeout"], wrench_timeout=p["wrench_timeout"],
-            hold_time=p["hold_time"], fault_policy=p["fault_policy"],
-            gravity_compensation=p["gravity_compensation"], gravity=tuple(p["gravity"]),
-            certificate_tolerance=p["certificate_tolerance"],
-            max_joint_state_entries=p["max_joint_state_entries"],
-            max_message_bytes=p["max_message_bytes"],
-            max_wrench_force=p["max_wrench_force"], max_wrench_torque=p["max_wrench_torque"],
-            max_contact_distance=p["max_contact_distance"],
-            stamp_future_tolerance=p["stamp_future_tolerance"],
-            cycle_budget=p["cycle_budget"], method=p["solver.method"])
-        solver = ProxSuiteSettings(eps_abs=p["solver.eps_abs"], max_iter=p["solver.max_iter"],
-                                   max_iter_in=p["solver.max_iter_in"])
+            joint_state_timeout=p['joint_state_timeout'],
+            contacts_timeout=p['contacts_timeout'], wrench_timeout=p['wrench_timeout'],
+            hold_time=p['hold_time'], fault_policy=p['fault_policy'],
+            gravity_compensation=p['gravity_compensation'], gravity=tuple(p['gravity']),
+            certificate_tolerance=p['certificate_tolerance'],
+            max_joint_state_entries=p['max_joint_state_entries'],
+            max_message_bytes=p['max_message_bytes'],
+            max_wrench_force=p['max_wrench_force'], max_wrench_torque=p['max_wrench_torque'],
+            max_contact_distance=p['max_contact_distance'],
+            stamp_future_tolerance=p['stamp_future_tolerance'],
+            cycle_budget=p['cycle_budget'], method=p['solver.method'])
+        solver = ProxSuiteSettings(eps_abs=p['solver.eps_abs'], max_iter=p['solver.max_iter'],
+                                   max_iter_in=p['solver.max_iter_in'])
         return setup, config, solver
 
     def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
@@ -491,29 +498,29 @@ class GraspTorqueNode(Node):
                     return SetParametersResult(successful=False, reason=reason)
         # min-max is the tau-QP's objective only (docs/planner.md): refuse the pair.
         new = {param.name: param.value for param in params}
-        objective = new.get("objective", self.get_parameter("objective").value)
-        method = new.get("solver.method", self.get_parameter("solver.method").value)
-        if objective == "min-max" and method != "tau-qp":
+        objective = new.get('objective', self.get_parameter('objective').value)
+        method = new.get('solver.method', self.get_parameter('solver.method').value)
+        if objective == 'min-max' and method != 'tau-qp':
             return SetParametersResult(successful=False, reason=(
-                f"objective: min-max needs solver.method tau-qp, not {method}"))
+                f'objective: min-max needs solver.method tau-qp, not {method}'))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list[Parameter]) -> None:
         p = self._params()
         with self._lock:
-            warm_loop = p["solver.warm_start"] and p["solver.backend"] != "quadprog"
+            warm_loop = p['solver.warm_start'] and p['solver.backend'] != 'quadprog'
             for ctrl, warm, slice_s in ((self.controller, warm_loop, None),
                                         (self._service_controller, False, SERVICE_SLICE_S)):
                 setup, config, solver = self._configure(ctrl.setup, p)
                 ctrl.setup, ctrl.config = setup, config
                 if solver != ctrl.solver.settings or \
-                        p["solver.backend"] != getattr(ctrl.solver, "name", None) or \
-                        warm != getattr(ctrl.solver, "warm_start", False):
-                    ctrl.solver = make_solver(p["solver.backend"], solver, warm, slice_s)
-                fallback = _fallback(p["solver.backend"], p["solver.fallback"])
-                if ctrl is self.controller and any(x.name == "solver.fallback" for x in params):
+                        p['solver.backend'] != getattr(ctrl.solver, 'name', None) or \
+                        warm != getattr(ctrl.solver, 'warm_start', False):
+                    ctrl.solver = make_solver(p['solver.backend'], solver, warm, slice_s)
+                fallback = _fallback(p['solver.backend'], p['solver.fallback'])
+                if ctrl is self.controller and any(x.name == 'solver.fallback' for x in params):
                     self._warn_missing_fallback()
-                if fallback != getattr(ctrl.fallback, "name", None) or \
+                if fallback != getattr(ctrl.fallback, 'name', None) or \
                         (ctrl.fallback is not None and ctrl.fallback.settings != solver):
                     ctrl.fallback = make_solver(fallback, solver) if fallback else None
             # The change acts on the command in force at once (a new certified command,
@@ -523,10 +530,10 @@ class GraspTorqueNode(Node):
                 self._publish(result, self._last_stamp)
 
     def _warn_missing_fallback(self) -> None:
-        name = self.get_parameter("solver.fallback").value
-        if name != "none" and not available(name):
-            self.get_logger().warning(f"solver.fallback: {name} is not installed (pip install "
-                                      f"{name}); running without a fallback backend")
+        name = self.get_parameter('solver.fallback').value
+        if name != 'none' and not available(name):
+            self.get_logger().warning(f'solver.fallback: {name} is not installed (pip install '
+                                      f'{name}); running without a fallback backend')
 
     # -- inputs and cycle -----------------------------------------------------------------
 
@@ -536,32 +543,36 @@ class GraspTorqueNode(Node):
 
     def _on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
                        info: dict | None) -> None:
-        """A message as the middleware delivered it: its length checked, then deserialized
-        and taken (``take(msg, receipt)``)."""
+        """
+        A message as the middleware delivered it: its length checked, then deserialized
+        and taken (``take(msg, receipt)``).
+        """
         receipt = received(info) if info is not None else None
         with self._lock:
             try:
                 self.controller.check_bytes(topic, len(data))
             except InputError as e:
-                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
                 return
         take(deserialize_message(data, msg_type), receipt)
 
     def _on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
-        """A joint state; ``receipt``: when the middleware received it (monotonic [s];
-        None: now)."""
+        """
+        A joint state; ``receipt``: when the middleware received it (monotonic [s];
+        None: now).
+        """
         now = time.monotonic()
         receipt = now if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
                 # Sizes first: an oversized message is not even copied.
-                self.controller.check_size("joint_states",
+                self.controller.check_size('joint_states',
                                            max(len(msg.name), len(msg.position)))
                 self.controller.update_joint_state(list(msg.name), list(msg.position),
                                                    receipt, stamp, self._clock_now())
             except InputError as e:
-                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
                 return
             self._last_stamp = msg.header.stamp
             self._publish(self.controller.cycle(now), msg.header.stamp)
@@ -571,14 +582,14 @@ class GraspTorqueNode(Node):
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self._lock:
             try:
-                self.controller.check_size("contacts", len(msg.poses))
+                self.controller.check_size('contacts', len(msg.poses))
                 positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
                 quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
                          for p in msg.poses]
                 self.controller.update_contacts(msg.header.frame_id, np.array(positions),
                                                 np.array(quats), now, stamp, self._clock_now())
             except InputError as e:
-                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
 
     def _on_wrench(self, msg: WrenchStamped, receipt: float | None = None) -> None:
         now = time.monotonic() if receipt is None else receipt
@@ -589,7 +600,7 @@ class GraspTorqueNode(Node):
                 self.controller.update_wrench(msg.header.frame_id, [f.x, f.y, f.z],
                                               [t.x, t.y, t.z], now, stamp, self._clock_now())
             except InputError as e:
-                self.get_logger().warn(f"rejected: {e}", throttle_duration_sec=1.0)
+                self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
 
     def _on_watchdog(self) -> None:
         with self._lock:
@@ -599,14 +610,14 @@ class GraspTorqueNode(Node):
 
     def _publish(self, result: CycleResult, stamp: Any = None) -> None:
         if result.fault:
-            self.get_logger().warn(f"no command: {result.fault}", throttle_duration_sec=1.0)
+            self.get_logger().warn(f'no command: {result.fault}', throttle_duration_sec=1.0)
         if result.command is None:
             return
         cmd = result.command
         # The node's own promise, whatever the controller decided.
         if cmd.shape != (self._m,) or not np.all(np.isfinite(cmd)) or \
                 np.any(np.abs(cmd) > self.controller.setup.hand.torque_limits):
-            self.get_logger().error("refused to publish a malformed command")
+            self.get_logger().error('refused to publish a malformed command')
             return
         data = [float(x) for x in cmd]
         self._command_pub.publish(Float64MultiArray(data=data))
@@ -624,7 +635,8 @@ class GraspTorqueNode(Node):
         return sum(1 for n in self.get_node_names_and_namespaces() if tuple(n) == me) - 1
 
     def wait_for_duplicates(self, seconds: float) -> int:
-        """Look for other nodes of this name for up to ``seconds`` (discovery took 0.2 to
+        """
+        Look for other nodes of this name for up to ``seconds`` (discovery took 0.2 to
         2.8 s here), without spinning: nothing is taken or published meanwhile.
 
         Returns:
@@ -648,22 +660,22 @@ class GraspTorqueNode(Node):
         # either from locking the other out); say so, as the node cannot tell them apart.
         publishers = self.count_publishers(self._joint_states_topic)
         if publishers > 1:
-            self.get_logger().warn(f"{publishers} publishers on {self._joint_states_topic}: "
-                                   "their joint states are taken as one stream",
+            self.get_logger().warn(f'{publishers} publishers on {self._joint_states_topic}: '
+                                   'their joint states are taken as one stream',
                                    throttle_duration_sec=10.0)
-        values = [*rep.values, ("joint_states.publishers", str(publishers))]
+        values = [*rep.values, ('joint_states.publishers', str(publishers))]
         level, message = rep.level, rep.message
         self._duplicates = self.duplicates()  # about 1 us: rmw's graph cache
         if self._duplicates > 0:
             name = self.get_fully_qualified_name()
-            self.get_logger().error(f"another node named {name} is on this domain: both may "
-                                    "drive effort_commands and take parameters",
+            self.get_logger().error(f'another node named {name} is on this domain: both may '
+                                    'drive effort_commands and take parameters',
                                     throttle_duration_sec=10.0)
             level = diagnostics.ERROR
-            message = f"another node named {name} is on this domain; {message}"
-        values.append(("duplicate_nodes", str(self._duplicates)))
-        status = DiagnosticStatus(level=bytes([level]), name=f"{self.get_name()}: grasp "
-                                  "torques", message=message, hardware_id=hand,
+            message = f'another node named {name} is on this domain; {message}'
+        values.append(('duplicate_nodes', str(self._duplicates)))
+        status = DiagnosticStatus(level=bytes([level]), name=f'{self.get_name()}: grasp '
+                                  'torques', message=message, hardware_id=hand,
                                   values=[KeyValue(key=k, value=v) for k, v in values])
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
@@ -677,21 +689,21 @@ class GraspTorqueNode(Node):
 
     def _markers(self, last: CycleResult | None, base: str, stamp) -> MarkerArray:
         clear = Marker(action=Marker.DELETEALL)
-        if last is None or last.kind != "solution":
+        if last is None or last.kind != 'solution':
             return MarkerArray(markers=[clear])
-        scale = self.get_parameter("marker_scale").value
+        scale = self.get_parameter('marker_scale').value
         markers = [clear]
         for i, (frame, w) in enumerate(zip(last.maps.contacts, last.solution.wrenches)):
             force = frame.rotation @ w[:3]
             start, end = frame.position, frame.position + scale * force
-            m = Marker(type=Marker.ARROW, action=Marker.ADD, ns="contact_force", id=i)
+            m = Marker(type=Marker.ARROW, action=Marker.ADD, ns='contact_force', id=i)
             m.header.frame_id, m.header.stamp = base, stamp
             m.points = [Point(x=float(start[0]), y=float(start[1]), z=float(start[2])),
                         Point(x=float(end[0]), y=float(end[1]), z=float(end[2]))]
             m.pose.orientation.w = 1.0
             m.scale.x, m.scale.y, m.scale.z = 0.002, 0.004, 0.004
             m.color.g, m.color.a = 0.8, 1.0
-            m.lifetime = Duration(seconds=3 * self.get_parameter("marker_period").value).to_msg()
+            m.lifetime = Duration(seconds=3 * self.get_parameter('marker_period').value).to_msg()
             markers.append(m)
         return MarkerArray(markers=markers)
 
@@ -699,14 +711,16 @@ class GraspTorqueNode(Node):
 
     async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
                         ) -> Trigger.Response:
-        """Queue one solve for the worker, or answer "busy" at once when
+        """
+        Queue one solve for the worker, or answer "busy" at once when
         MAX_PENDING_SOLVES are queued: every request gets an answer, in bounded memory.
-        (Runs in the executor's thread only, as does the count.)"""
+        (Runs in the executor's thread only, as does the count.).
+        """
         if self._pending_solves >= MAX_PENDING_SOLVES:
             self._busy_answers += 1
             response.success = False
-            response.message = (f"busy: {self._pending_solves} solves queued (at most "
-                                f"{MAX_PENDING_SOLVES}); call again later")
+            response.message = (f'busy: {self._pending_solves} solves queued (at most '
+                                f'{MAX_PENDING_SOLVES}); call again later')
             return response
         with self._lock:
             inputs = self.controller.inputs
@@ -722,29 +736,32 @@ class GraspTorqueNode(Node):
         return response
 
     def _solve_for_service(self, inputs: Any, now: float, done: Future) -> None:
-        """One solve on a snapshot of the inputs, with the service's own controller
-        (own Pinocchio data and ProxSuite workspace): (success, CLI JSON or reason)."""
+        """
+        One solve on a snapshot of the inputs, with the service's own controller
+        (own Pinocchio data and ProxSuite workspace): (success, CLI JSON or reason).
+        """
         ctrl = self._service_controller
         try:
             stale = ctrl.stale(now, inputs)
             if stale:
-                done.set_result((False, f"cannot solve: {stale}"))
+                done.set_result((False, f'cannot solve: {stale}'))
                 return
             sol, maps, g = ctrl.solve_inputs(inputs, time.perf_counter() + ctrl.budget())
             cmd, _ = ctrl.gate(sol, g)
-            if sol.status == "infeasible":  # what can be held, and what binds (docs/planner.md)
+            if sol.status == 'infeasible':  # what can be held, and what binds (docs/planner.md)
                 from grasp_torque_opt.methods.explain import explain
 
                 sol.infeasibility = explain(ctrl.grasp_at(inputs)[0], maps).as_dict()
             d = solution_dict(sol, maps)
-            d["command"] = None if cmd is None else [float(x) for x in cmd]
-            d["gravity_torque"] = None if g is None else [float(x) for x in g]
+            d['command'] = None if cmd is None else [float(x) for x in cmd]
+            d['gravity_torque'] = None if g is None else [float(x) for x in g]
             done.set_result((cmd is not None, json.dumps(d)))
         except Exception as e:  # noqa: BLE001 -- the caller gets the reason, the node lives on
-            done.set_result((False, f"cannot solve: {type(e).__name__}: {e}"))
+            done.set_result((False, f'cannot solve: {type(e).__name__}: {e}'))
 
     def safe_stop(self) -> bool:
-        """The safe action when the node stops, per ``fault_policy``.
+        """
+        The safe action when the node stops, per ``fault_policy``.
 
         ``zero``: publish zero torques once and wait (up to 0.5 s) for the
         subscribers to acknowledge them, since the effort controller would keep
@@ -755,12 +772,12 @@ class GraspTorqueNode(Node):
             True if zero torques were published.
         """
         with self._lock:
-            if self.controller.config.fault_policy != "zero" or \
+            if self.controller.config.fault_policy != 'zero' or \
                     self.controller.counters.commands == 0 or not self.context.ok():
                 return False
             self._command_pub.publish(Float64MultiArray(data=[0.0] * self._m))
         self._command_pub.wait_for_all_acked(Duration(seconds=0.5))
-        self.get_logger().info("stopped: zero torques published (fault_policy zero)")
+        self.get_logger().info('stopped: zero torques published (fault_policy zero)')
         return True
 
     def destroy_node(self) -> None:
@@ -775,7 +792,8 @@ _stop_signal: int | None = None
 
 
 def _interrupt(signum: int, frame: Any) -> None:
-    """SIGINT/SIGTERM: ask ``main``'s spin loop to end; the node then stops cleanly.
+    """
+    SIGINT/SIGTERM: ask ``main``'s spin loop to end; the node then stops cleanly.
 
     Only a flag: an exception raised here would surface at whatever bytecode the main
     thread runs next -- inside rclpy's executor (between a handle's ``__enter__`` and its
@@ -790,19 +808,20 @@ def _interrupt(signum: int, frame: Any) -> None:
 
 
 #: Executors ``main`` can spin: rclpy's default and its experimental events executor.
-EXECUTORS = {"single": SingleThreadedExecutor, "events": EventsExecutor}
+EXECUTORS = {'single': SingleThreadedExecutor, 'events': EventsExecutor}
 
 
 def main(args: list[str] | None = None) -> int:
-    """Run the node (Jazzy pattern): spin, then destroy and shut down.
+    """
+    Run the node (Jazzy pattern): spin, then destroy and shut down.
 
     Besides the ROS arguments, ``--executor single|events`` picks the executor.
     """
     global _stop_signal
     argv = sys.argv if args is None else args
     parser = argparse.ArgumentParser(prog=NODE_NAME)
-    parser.add_argument("--executor", choices=sorted(EXECUTORS), default="single",
-                        help="rclpy executor to spin (default: single)")
+    parser.add_argument('--executor', choices=sorted(EXECUTORS), default='single',
+                        help='rclpy executor to spin (default: single)')
     opts = parser.parse_args(remove_ros_args(argv)[1:])
     single_threaded_math()
     # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the safe
@@ -815,16 +834,16 @@ def main(args: list[str] | None = None) -> int:
     executor = None
     code = 0
     try:
-        node = GraspTorqueNode(message_info=opts.executor != "events")
-        wait = node.get_parameter("startup_check_time").value
+        node = GraspTorqueNode(message_info=opts.executor != 'events')
+        wait = node.get_parameter('startup_check_time').value
         if wait > 0.0:
-            node.get_logger().info(f"looking for another {NODE_NAME} on this domain ({wait:g} s)")
+            node.get_logger().info(f'looking for another {NODE_NAME} on this domain ({wait:g} s)')
             if node.wait_for_duplicates(wait):
                 raise GraspTorqueError(
-                    f"another node named {node.get_fully_qualified_name()} is on this domain "
-                    f"(ROS_DOMAIN_ID {node.context.get_domain_id()}): refusing to run, as both "
-                    "would drive effort_commands (stop it, or give this one another name with "
-                    "--ros-args -r __node:=NAME)")
+                    f'another node named {node.get_fully_qualified_name()} is on this domain '
+                    f'(ROS_DOMAIN_ID {node.context.get_domain_id()}): refusing to run, as both '
+                    'would drive effort_commands (stop it, or give this one another name with '
+                    '--ros-args -r __node:=NAME)')
         # rclpy's MultiThreadedExecutor managed 30 of 100 joint states a second here;
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()
@@ -832,13 +851,13 @@ def main(args: list[str] | None = None) -> int:
         # A spin_once loop, so that the stop flag is seen: each wait ends by the next
         # watchdog tick at the latest. (EventsExecutor.spin() also delivered no subscription
         # callback with these wheels, rclpy 7.1.6 and Fast DDS, while keeping a core busy.)
-        timeout = 1.0 if opts.executor == "events" else None
+        timeout = 1.0 if opts.executor == 'events' else None
         while _stop_signal is None and rclpy.ok():
             executor.spin_once(timeout_sec=timeout)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except GraspTorqueError as e:
-        print(f"{NODE_NAME}: error: {e}", file=sys.stderr)
+        print(f'{NODE_NAME}: error: {e}', file=sys.stderr)
         code = 2
     finally:
         if executor is not None:
@@ -851,5 +870,5 @@ def main(args: list[str] | None = None) -> int:
     return code
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

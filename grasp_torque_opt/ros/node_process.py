@@ -1,4 +1,5 @@
-"""What the demo and the simulated hand share: a private ROS domain, and the node as a child.
+"""
+What the demo and the simulated hand share: a private ROS domain, and the node as a child.
 
 Both drivers can start ``grasp_torque_node`` themselves (``--with-node``) on the
 same params file they read their scenario from, and stop it with SIGINT when
@@ -7,20 +8,20 @@ they end, so that its safe stop runs.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 import contextlib
 import os
+from pathlib import Path
 import random
 import signal
 import subprocess
 import sys
-from collections.abc import Iterator
-from pathlib import Path
 
 
 def isolate() -> None:
     """A private ROS domain (unless one is set) and localhost-only discovery."""
-    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
-    os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    os.environ.setdefault('ROS_DOMAIN_ID', str(random.randint(1, 100)))
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 
 def scenario_of(params: Path) -> str:
@@ -28,21 +29,22 @@ def scenario_of(params: Path) -> str:
     import yaml
 
     doc = yaml.safe_load(params.read_text())
-    return next(iter(doc.values()))["ros__parameters"]["scenario"]
+    return next(iter(doc.values()))['ros__parameters']['scenario']
 
 
 @contextlib.contextmanager
 def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]:
-    """``grasp_torque_node`` on ``params`` in a child process while the block runs (if ``start``).
+    """
+    ``grasp_torque_node`` on ``params`` in a child process while the block runs (if ``start``).
 
     It is stopped with SIGINT (its safe stop: zero torques with the zero policy),
     killed if it has not ended after 10 s.
     """
     child = None
     if start:
-        child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node",
-                                  "--ros-args", "--params-file", str(params),
-                                  "--log-level", "error"])
+        child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
+                                  '--ros-args', '--params-file', str(params),
+                                  '--log-level', 'error'])
     try:
         yield child
     finally:

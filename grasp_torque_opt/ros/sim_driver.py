@@ -1,4 +1,5 @@
-"""A simulated hand driver: the scenario's hand and object in MuJoCo, on the node's topics.
+"""
+A simulated hand driver: the scenario's hand and object in MuJoCo, on the node's topics.
 
 What a real hand with a ros2_control effort controller would be (docs/simulation.md):
 MuJoCo steps in real time at 1 kHz; ``joint_states`` carries positions,
@@ -22,59 +23,58 @@ from __future__ import annotations
 import argparse
 import json
 import os
+from pathlib import Path
 import sys
 import time
-from pathlib import Path
-
-import numpy as np
 
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
+import numpy as np
 
-PROG = "grasp-torque-sim"
+PROG = 'grasp-torque-sim'
 
 
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog=PROG, description=__doc__.splitlines()[0])
-    p.add_argument("--params", default="allegro_right_node.yaml",
-                   help="node params file (bundled name or path); its scenario is simulated")
-    p.add_argument("--duration", type=float, default=3.0,
-                   help="seconds to hold after release [s]")
-    p.add_argument("--settle", type=float, default=0.3,
-                   help="seconds the commands press on the pinned object before release [s]")
-    p.add_argument("--kp", type=float, default=1.0, help="joint impedance stiffness [N m/rad]")
-    p.add_argument("--kd", type=float, default=0.01,
-                   help="joint impedance damping [N m s/rad]")
-    p.add_argument("--rate", type=float, default=250.0, help="joint state rate [Hz]")
-    p.add_argument("--contacts", action="store_true",
+    p.add_argument('--params', default='allegro_right_node.yaml',
+                   help='node params file (bundled name or path); its scenario is simulated')
+    p.add_argument('--duration', type=float, default=3.0,
+                   help='seconds to hold after release [s]')
+    p.add_argument('--settle', type=float, default=0.3,
+                   help='seconds the commands press on the pinned object before release [s]')
+    p.add_argument('--kp', type=float, default=1.0, help='joint impedance stiffness [N m/rad]')
+    p.add_argument('--kd', type=float, default=0.01,
+                   help='joint impedance damping [N m s/rad]')
+    p.add_argument('--rate', type=float, default=250.0, help='joint state rate [Hz]')
+    p.add_argument('--contacts', action='store_true',
                    help="publish the contact frames measured in the simulation on 'contacts'")
-    p.add_argument("--mu-tangential", type=float, default=None,
+    p.add_argument('--mu-tangential', type=float, default=None,
                    help="simulated tangential friction [-] (default: the scenario's)")
-    p.add_argument("--mu-torsional", type=float, default=None,
+    p.add_argument('--mu-torsional', type=float, default=None,
                    help="simulated torsional friction [m] (default: the scenario's)")
-    p.add_argument("--drift-limit", type=float, default=1.0,
-                   help="the object counts as held while it moves less than this [mm]")
-    p.add_argument("--picture", default="grasp_sim.png",
-                   help="PNG of the grasp written at the end (default: grasp_sim.png here)")
-    p.add_argument("--no-picture", action="store_true", help="write no picture")
-    p.add_argument("--with-node", action="store_true",
-                   help="start grasp_torque_node in a child process")
-    p.add_argument("--wait", type=float, default=30.0,
-                   help="how long to wait for the node and its first command [s]")
+    p.add_argument('--drift-limit', type=float, default=1.0,
+                   help='the object counts as held while it moves less than this [mm]')
+    p.add_argument('--picture', default='grasp_sim.png',
+                   help='PNG of the grasp written at the end (default: grasp_sim.png here)')
+    p.add_argument('--no-picture', action='store_true', help='write no picture')
+    p.add_argument('--with-node', action='store_true',
+                   help='start grasp_torque_node in a child process')
+    p.add_argument('--wait', type=float, default=30.0,
+                   help='how long to wait for the node and its first command [s]')
     return p
 
 
 def _check(args: argparse.Namespace) -> str:
-    for name in ("duration", "rate", "wait", "drift_limit"):
+    for name in ('duration', 'rate', 'wait', 'drift_limit'):
         if not getattr(args, name) > 0:
             return f"--{name.replace('_', '-')}: must be > 0"
-    for name in ("settle", "kp", "kd"):
+    for name in ('settle', 'kp', 'kd'):
         if not getattr(args, name) >= 0:
-            return f"--{name}: must be >= 0"
-    for name in ("mu_tangential", "mu_torsional"):
+            return f'--{name}: must be >= 0'
+    for name in ('mu_tangential', 'mu_torsional'):
         value = getattr(args, name)
         if value is not None and not value > 0:
             return f"--{name.replace('_', '-')}: must be > 0"
-    return ""
+    return ''
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -82,10 +82,10 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     reason = _check(args)
     if reason:
-        print(f"{PROG}: error: {reason}", file=sys.stderr)
+        print(f'{PROG}: error: {reason}', file=sys.stderr)
         return 2
     # Offscreen rendering through EGL: MuJoCo reads this when it is first imported.
-    os.environ.setdefault("MUJOCO_GL", "egl")
+    os.environ.setdefault('MUJOCO_GL', 'egl')
     try:
         import mujoco  # noqa: F401
     except ImportError:
@@ -95,23 +95,23 @@ def main(argv: list[str] | None = None) -> int:
     from grasp_torque_opt.core.exceptions import InputError
     from grasp_torque_opt.core.resources import find_config
     from grasp_torque_opt.core.scenario import load_scenario
-    from grasp_torque_opt.sim.model import SimSettings, build_model
+    from grasp_torque_opt.sim.model import build_model, SimSettings
 
     if args.with_node:
         isolate()
     try:
-        params = find_config(args.params, "--params")
+        params = find_config(args.params, '--params')
         scenario = load_scenario(find_config(scenario_of(params)))
         sim_model = build_model(scenario, SimSettings(mu_tangential=args.mu_tangential,
                                                       mu_torsional=args.mu_torsional))
     except InputError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
+        print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
         with node_process(params, args.with_node):
             return _run(args, scenario, sim_model)
     except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
+        print(f'{PROG}: interrupted', file=sys.stderr)
         return 130
 
 
@@ -120,29 +120,28 @@ def _predicted(message: str) -> list[np.ndarray] | None:
     try:
         doc = json.loads(message)
         out = []
-        for c in doc["contacts"]:
-            if c["wrench"] is None:
+        for c in doc['contacts']:
+            if c['wrench'] is None:
                 return None
-            x, z = np.array(c["tangent"]), np.array(c["normal"])
+            x, z = np.array(c['tangent']), np.array(c['normal'])
             R = np.column_stack((x, np.cross(z, x), z))
-            out.append(R @ np.array(c["wrench"][:3]))
+            out.append(R @ np.array(c['wrench'][:3]))
         return out
     except (ValueError, KeyError, TypeError):
         return None
 
 
 def _run(args: argparse.Namespace, scenario, sim_model) -> int:
-    import rclpy
     from geometry_msgs.msg import Pose, PoseArray
+    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
+    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME, SERVICE_QOS
+    from grasp_torque_opt.sim.simulator import friction_usage, HandSim
+    import rclpy
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
     from std_srvs.srv import Trigger
-
-    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
-    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME, SERVICE_QOS
-    from grasp_torque_opt.sim.simulator import HandSim, friction_usage
 
     setup = GraspSetup.from_scenario(scenario)
     hand = setup.hand
@@ -152,22 +151,22 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
 
     rclpy.init()
-    node = rclpy.create_node("grasp_sim_driver")
-    js_pub = node.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
-    contacts_pub = node.create_publisher(PoseArray, "contacts", qos_profile_sensor_data)
-    solve = node.create_client(Trigger, f"{NODE_NAME}/solve", qos_profile=SERVICE_QOS)
-    state = {"command": None, "commands": 0, "malformed": 0, "predicted": None,
-             "pending": None}
+    node = rclpy.create_node('grasp_sim_driver')
+    js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+    contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+    solve = node.create_client(Trigger, f'{NODE_NAME}/solve', qos_profile=SERVICE_QOS)
+    state = {'command': None, 'commands': 0, 'malformed': 0, 'predicted': None,
+             'pending': None}
 
     def on_command(msg: Float64MultiArray) -> None:
         cmd = np.array(msg.data, dtype=float)
         if cmd.shape != (m,) or not np.all(np.isfinite(cmd)):
-            state["malformed"] += 1
+            state['malformed'] += 1
             return
-        state["command"] = cmd
-        state["commands"] += 1
+        state['command'] = cmd
+        state['commands'] += 1
 
-    node.create_subscription(Float64MultiArray, "effort_commands", on_command, COMMAND_QOS)
+    node.create_subscription(Float64MultiArray, 'effort_commands', on_command, COMMAND_QOS)
 
     def close(code: int) -> int:
         node.destroy_node()
@@ -175,26 +174,26 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
         return code
 
     def ask_prediction() -> None:
-        if state["pending"] is None and solve.service_is_ready():
-            state["pending"] = solve.call_async(Trigger.Request())
+        if state['pending'] is None and solve.service_is_ready():
+            state['pending'] = solve.call_async(Trigger.Request())
 
     def take_prediction() -> None:
-        future = state["pending"]
+        future = state['pending']
         if future is not None and future.done():
-            state["pending"] = None
+            state['pending'] = None
             result = future.result()
             if result is not None and result.success:
-                state["predicted"] = _predicted(result.message) or state["predicted"]
+                state['predicted'] = _predicted(result.message) or state['predicted']
 
-    print(f"{PROG}: {Path(scenario.source).name} in MuJoCo {_mujoco_version()}, {m} joints, "
-          f"1 kHz physics, joint states at {args.rate:g} Hz, impedance Kp {args.kp:g} N m/rad "
-          f"Kd {args.kd:g} N m s/rad")
+    print(f'{PROG}: {Path(scenario.source).name} in MuJoCo {_mujoco_version()}, {m} joints, '
+          f'1 kHz physics, joint states at {args.rate:g} Hz, impedance Kp {args.kp:g} N m/rad '
+          f'Kd {args.kd:g} N m s/rad')
     deadline = time.monotonic() + args.wait
     while js_pub.get_subscription_count() == 0 and time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.1)
     if js_pub.get_subscription_count() == 0:
-        print(f"{PROG}: no {NODE_NAME} is listening on joint_states (start one, or "
-              "use --with-node)", file=sys.stderr)
+        print(f'{PROG}: no {NODE_NAME} is listening on joint_states (start one, or '
+              'use --with-node)', file=sys.stderr)
         return close(1)
 
     dt = sim_model.model.opt.timestep
@@ -217,8 +216,8 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
         t0_wall, t0_sim = time.monotonic(), hsim.time
         next_pub, next_second = t0_wall, t0_wall + 1.0
         while (now := time.monotonic()) < t0_wall + seconds:
-            if state["command"] is not None:
-                hsim.command = state["command"]
+            if state['command'] is not None:
+                hsim.command = state['command']
                 hsim.hold_joints = False
             behind = round((now - t0_wall - (hsim.time - t0_sim)) / dt)
             if behind > 0:
@@ -239,8 +238,8 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     # 1. Fingers held at the grasp configuration (as a driver's position mode would),
     #    object pinned, until the node commands.
     hsim.hold_joints = True
-    if not run_for(args.wait, until=lambda: state["commands"] > 0):
-        print(f"{PROG}: no effort command from {NODE_NAME} within {args.wait:g} s",
+    if not run_for(args.wait, until=lambda: state['commands'] > 0):
+        print(f'{PROG}: no effort command from {NODE_NAME} within {args.wait:g} s',
               file=sys.stderr)
         return close(1)
     # 2. The commands press the fingers on the pinned object, then it is let go.
@@ -248,91 +247,93 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     run_for(args.settle)
     hsim.release()
     t_release_wall, sim_release = time.monotonic(), hsim.time
-    counted_at_release = state["commands"]
+    counted_at_release = state['commands']
     limit = args.drift_limit * 1e-3
-    track = {"passed": None, "max_drift": 0.0, "lost": {}, "errors": [], "usage": []}
+    track = {'passed': None, 'max_drift': 0.0, 'lost': {}, 'errors': [], 'usage': []}
 
     def every_second() -> None:
         t = hsim.time - sim_release
         drift, rotation = hsim.motion()
         readings, unplanned = hsim.readings()
-        pred = state["predicted"]
-        parts = [f"t={t:4.1f} s  drift {drift * 1e3:7.3f} mm  rotation "
-                 f"{np.degrees(rotation):6.3f} deg"]
+        pred = state['predicted']
+        parts = [f't={t:4.1f} s  drift {drift * 1e3:7.3f} mm  rotation '
+                 f'{np.degrees(rotation):6.3f} deg']
         forces, usage = [], []
         for i, r in enumerate(readings):
             if not r.touching:
-                track["lost"].setdefault(setup.contacts[i].link, t)
-                forces.append("-/" + (f"{np.linalg.norm(pred[i]):.2f}" if pred else "?"))
+                track['lost'].setdefault(setup.contacts[i].link, t)
+                forces.append('-/' + (f'{np.linalg.norm(pred[i]):.2f}' if pred else '?'))
                 continue
-            forces.append(f"{np.linalg.norm(r.force):.2f}/"
-                          + (f"{np.linalg.norm(pred[i]):.2f}" if pred else "?"))
+            forces.append(f'{np.linalg.norm(r.force):.2f}/'
+                          + (f'{np.linalg.norm(pred[i]):.2f}' if pred else '?'))
             normal = r.normal
             fn = float(r.force @ normal)
             ft = float(np.linalg.norm(r.force - fn * normal))
             usage.append(friction_usage(np.array([ft, 0.0, fn, float(r.torque @ normal)]),
                                         mu1, mu2))
-        parts.append("forces sim/pred [N] " + " ".join(forces))
+        parts.append('forces sim/pred [N] ' + ' '.join(forces))
         if pred and all(r.touching for r in readings):
             err = max(np.linalg.norm(r.force - p) / np.linalg.norm(p)
                       for r, p in zip(readings, pred))
-            track["errors"].append(err)
-            parts.append(f"(max error {100 * err:.1f}%)")
+            track['errors'].append(err)
+            parts.append(f'(max error {100 * err:.1f}%)')
         if usage:
-            track["usage"].append(max(usage))
-            parts.append("friction (planned cone) " + " ".join(f"{100 * u:.0f}" for u in usage)
-                         + " %")
+            track['usage'].append(max(usage))
+            parts.append('friction (planned cone) ' + ' '.join(f'{100 * u:.0f}' for u in usage)
+                         + ' %')
         if unplanned > 1e-3:
-            parts.append(f"other contacts {unplanned:.2f} N")
-        print("  ".join(parts), flush=True)
+            parts.append(f'other contacts {unplanned:.2f} N')
+        print('  '.join(parts), flush=True)
         ask_prediction()
 
     def watch() -> bool:
         drift, _ = hsim.motion()
-        track["max_drift"] = max(track["max_drift"], drift)
-        if drift > limit and track["passed"] is None:
-            track["passed"] = hsim.time - sim_release
+        track['max_drift'] = max(track['max_drift'], drift)
+        if drift > limit and track['passed'] is None:
+            track['passed'] = hsim.time - sim_release
         return drift > max(20e-3, 10 * limit)  # fallen: no point in going on
 
     run_for(args.duration, until=watch, each_second=every_second)
     every_second()
     wall = time.monotonic() - t_release_wall
     simulated = hsim.time - sim_release
-    commands = state["commands"] - counted_at_release
+    commands = state['commands'] - counted_at_release
     drift, rotation = hsim.motion()
-    held = track["passed"] is None
+    held = track['passed'] is None
     if held:
-        why = (f"held: drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg "
-               f"after {simulated:.1f} s (limit {args.drift_limit:g} mm)")
+        why = (f'held: drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg '
+               f'after {simulated:.1f} s (limit {args.drift_limit:g} mm)')
     else:
         why = (f"NOT held: drift passed {args.drift_limit:g} mm at t = {track['passed']:.2f} s"
                f", {track['max_drift'] * 1e3:.1f} mm at most")
-        if track["lost"]:
-            first = min(track["lost"], key=track["lost"].get)
-            why += f"; contact lost first at {first}"
-        why += ("; the torques did not hold the object with this impedance and friction"
-                if commands else "; no command arrived after release")
+        if track['lost']:
+            first = min(track['lost'], key=track['lost'].get)
+            why += f'; contact lost first at {first}'
+        why += ('; the torques did not hold the object with this impedance and friction'
+                if commands else '; no command arrived after release')
     extra = []
-    if track["errors"]:
+    if track['errors']:
         extra.append(f"contact forces within {100 * max(track['errors']):.1f}% of the node's "
                      "predicted wrenches")
-    if track["usage"]:
+    if track['usage']:
         extra.append(f"friction usage up to {100 * max(track['usage']):.0f}% of the planned "
                      "cone (MuJoCo's elliptic cone is wider)")
     extra.append(f"{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed "
                  f"{state['malformed']})")
-    extra.append(f"real-time factor {simulated / max(wall, 1e-9):.2f}")
-    print("summary: " + why + "; " + "; ".join(extra))
+    extra.append(f'real-time factor {simulated / max(wall, 1e-9):.2f}')
+    print('summary: ' + why + '; ' + '; '.join(extra))
     if not args.no_picture:
-        print(_picture(hsim, args.picture, state["predicted"]))
+        print(_picture(hsim, args.picture, state['predicted']))
     return close(0 if held and commands > 0 else 1)
 
 
 def _publish_contacts(hsim, setup, pub, base, stamp, compute_grasp_maps, Pose, PoseArray
                       ) -> None:
-    """The contact frames measured in the simulation: the measured point and normal, the
+    """
+    The contact frames measured in the simulation: the measured point and normal, the
     x axis from the planned frame at the current configuration. Nothing while a planned
-    contact does not touch (the node's contacts_timeout then applies)."""
+    contact does not touch (the node's contacts_timeout then applies).
+    """
     readings, _ = hsim.readings()
     if not all(r.touching for r in readings):
         return
@@ -372,17 +373,17 @@ def _mujoco_version() -> str:
 
 
 def _picture(hsim, path: str, predicted) -> str:
-    from grasp_torque_opt.sim.render import RenderUnavailable, render_grasp
+    from grasp_torque_opt.sim.render import render_grasp, RenderUnavailable
 
     try:
         written = render_grasp(hsim, path, predicted)
     except RenderUnavailable as e:
-        return f"picture: not written, offscreen rendering is unavailable ({e})"
+        return f'picture: not written, offscreen rendering is unavailable ({e})'
     except OSError as e:
-        return f"picture: not written, cannot write {path}: {e.strerror}"
+        return f'picture: not written, cannot write {path}: {e.strerror}'
     return (f"picture: {written.resolve()} (simulated contact forces orange, the node's "
             "predicted green)")
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -1,4 +1,5 @@
-"""The hand in MuJoCo: a physics check of the certified torques (docs/simulation.md).
+"""
+The hand in MuJoCo: a physics check of the certified torques (docs/simulation.md).
 
 Optional: needs the ``sim`` extra (``pip install -e '.[sim]'``, which
 ``scripts/setup.sh`` installs). Nothing outside this family and
@@ -16,4 +17,4 @@ import os
 
 # Offscreen rendering needs no display: EGL (Mesa's software EGL will do). MuJoCo reads
 # this when it is first imported, so it is set before any module here imports it.
-os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault('MUJOCO_GL', 'egl')

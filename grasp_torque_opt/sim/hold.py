@@ -1,4 +1,5 @@
-"""A hold episode: the certified torques (plus g(q) and an impedance) on the simulated hand.
+"""
+A hold episode: the certified torques (plus g(q) and an impedance) on the simulated hand.
 
 What the node does for one grasp, without ROS: solve the scenario with the fingers'
 gravity torques g(q0) as the torque offset (the node's ``gravity_compensation``),
@@ -8,24 +9,24 @@ command tau + g(q) with g at the measured configuration, and watch the object.
 from __future__ import annotations
 
 import dataclasses
-import time
 from dataclasses import dataclass, field
-
-import numpy as np
-import pinocchio as pin
+import time
 
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import Scenario
 from grasp_torque_opt.core.solution import Solution
 from grasp_torque_opt.methods import solve
-from grasp_torque_opt.sim.model import SimSettings, build_model
-from grasp_torque_opt.sim.simulator import HandSim, friction_usage, wrench_in_frame
+from grasp_torque_opt.sim.model import build_model, SimSettings
+from grasp_torque_opt.sim.simulator import friction_usage, HandSim, wrench_in_frame
+import numpy as np
+import pinocchio as pin
 
 
 @dataclass(frozen=True)
 class HoldSettings:
-    """One hold episode.
+    """
+    One hold episode.
 
     Attributes:
         kp: joint impedance stiffness [N m/rad].
@@ -48,7 +49,8 @@ class HoldSettings:
 
 @dataclass(frozen=True)
 class ContactReport:
-    """One planned contact: certified against simulated wrench.
+    """
+    One planned contact: certified against simulated wrench.
 
     Attributes:
         link: the contact's link.
@@ -77,7 +79,8 @@ class ContactReport:
 
 @dataclass
 class HoldReport:
-    """Outcome of a hold episode.
+    """
+    Outcome of a hold episode.
 
     Attributes:
         held: the object moved less than the drift limit for the whole episode.
@@ -111,7 +114,8 @@ class HoldReport:
 
 def certified_torques(scenario: Scenario, urdf_xml: str | None = None
                       ) -> tuple[GraspSetup, GraspMaps, Solution, np.ndarray]:
-    """The scenario solved as the node solves it with gravity compensation.
+    """
+    The scenario solved as the node solves it with gravity compensation.
 
     Returns:
         The setup (with g(q0) as torque offset), its maps, the certified solution
@@ -135,7 +139,8 @@ def gravity_torque(setup: GraspSetup, q: np.ndarray, gravity: np.ndarray) -> np.
 def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
          sim_settings: SimSettings = SimSettings(), urdf_xml: str | None = None
          ) -> HoldReport:
-    """Run one hold episode of the scenario's certified torques.
+    """
+    Run one hold episode of the scenario's certified torques.
 
     Raises:
         InputError: the scenario cannot be simulated (field named).
@@ -144,7 +149,7 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
     t_wall = time.perf_counter()
     setup, maps, sol, _ = certified_torques(scenario, urdf_xml)
     if not sol.optimal:
-        raise ValueError(f"no certified torques to simulate: {sol.status} ({sol.message})")
+        raise ValueError(f'no certified torques to simulate: {sol.status} ({sol.message})')
     sim_model = build_model(scenario, sim_settings, urdf_xml)
     hand = setup.hand
     hsim = HandSim(sim_model, setup.q[hand.idx_q], settings.kp, settings.kd)
@@ -203,15 +208,15 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
     t_end = hsim.time - hsim.release_time
     limit_mm = settings.drift_limit * 1e3
     if passed_at is None:
-        reason = (f"drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg "
-                  f"after {t_end:.2f} s (limit {limit_mm:g} mm)")
+        reason = (f'drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg '
+                  f'after {t_end:.2f} s (limit {limit_mm:g} mm)')
     else:
-        reason = f"drift passed {limit_mm:g} mm at t = {passed_at:.2f} s"
-        reason += (f" and reached {max_drift * 1e3:.1f} mm (the object fell)"
-                   if max_drift > fallen else f", {drift * 1e3:.2f} mm at the end")
+        reason = f'drift passed {limit_mm:g} mm at t = {passed_at:.2f} s'
+        reason += (f' and reached {max_drift * 1e3:.1f} mm (the object fell)'
+                   if max_drift > fallen else f', {drift * 1e3:.2f} mm at the end')
         if lost:
             first = min(lost, key=lost.get)
-            reason += f"; contact lost first at {first} (t = {lost[first]:.2f} s)"
+            reason += f'; contact lost first at {first} (t = {lost[first]:.2f} s)'
     return HoldReport(held=passed_at is None, reason=reason, time=t_end, drift=drift,
                       max_drift=max_drift, rotation=rotation, contacts=contacts,
                       unplanned_force=unplanned, max_effort=max_effort, samples=samples,

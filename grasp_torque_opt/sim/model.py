@@ -1,4 +1,5 @@
-"""The MuJoCo model of a scenario: the hand from its URDF and the scenario's object.
+"""
+The MuJoCo model of a scenario: the hand from its URDF and the scenario's object.
 
 The URDF is adapted before MuJoCo compiles it (docs/simulation.md, "The model"):
 
@@ -24,24 +25,24 @@ the bundled grasp), ``impratio`` 10 and a few noslip iterations.
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-
-import mujoco
-import numpy as np
+import xml.etree.ElementTree as ET
 
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.scenario import ObjectSpec, Scenario
+import mujoco
+import numpy as np
 
 #: Contact bits: hand geoms (type 1, affinity 2) touch the object (type 2, affinity 1) only.
 _HAND_BITS, _OBJECT_BITS = (1, 2), (2, 1)
-OBJECT_BODY = "object"
+OBJECT_BODY = 'object'
 
 
 @dataclass(frozen=True)
 class SimSettings:
-    """How the scenario is simulated.
+    """
+    How the scenario is simulated.
 
     Attributes:
         timestep: integration step [s] (the driver steps at 1 kHz).
@@ -67,7 +68,8 @@ class SimSettings:
 
 @dataclass(frozen=True)
 class SimModel:
-    """A compiled model and where the scenario's parts are in it.
+    """
+    A compiled model and where the scenario's parts are in it.
 
     Attributes:
         model: the MuJoCo model (base frame = MuJoCo world).
@@ -98,7 +100,8 @@ class SimModel:
 
 
 def adapt_urdf(xml: str) -> str:
-    """The URDF as MuJoCo should load it: no joint friction or damping, no visuals,
+    """
+    The URDF as MuJoCo should load it: no joint friction or damping, no visuals,
     and a ``<mujoco><compiler .../></mujoco>`` extension (see the module docstring).
 
     Raises:
@@ -107,27 +110,27 @@ def adapt_urdf(xml: str) -> str:
     try:
         root = ET.fromstring(xml)
     except ET.ParseError as e:
-        raise InputError("hand.urdf", f"is not valid XML: {e}") from e
-    if root.tag != "robot":
-        raise InputError("hand.urdf", f"root element must be <robot>, got <{root.tag}>")
-    for link in root.iter("link"):
-        for visual in link.findall("visual"):
+        raise InputError('hand.urdf', f'is not valid XML: {e}') from e
+    if root.tag != 'robot':
+        raise InputError('hand.urdf', f'root element must be <robot>, got <{root.tag}>')
+    for link in root.iter('link'):
+        for visual in link.findall('visual'):
             link.remove(visual)
-    for dynamics in root.iter("dynamics"):
-        dynamics.set("friction", "0")
-        dynamics.set("damping", "0")
-    for old in root.findall("mujoco"):
+    for dynamics in root.iter('dynamics'):
+        dynamics.set('friction', '0')
+        dynamics.set('damping', '0')
+    for old in root.findall('mujoco'):
         root.remove(old)
-    ext = ET.SubElement(root, "mujoco")
-    ET.SubElement(ext, "compiler", balanceinertia="true", fusestatic="false",
-                  discardvisual="true", angle="radian")
-    return ET.tostring(root, encoding="unicode")
+    ext = ET.SubElement(root, 'mujoco')
+    ET.SubElement(ext, 'compiler', balanceinertia='true', fusestatic='false',
+                  discardvisual='true', angle='radian')
+    return ET.tostring(root, encoding='unicode')
 
 
 def rpy_quaternion(rpy: np.ndarray) -> np.ndarray:
     """Quaternion [w, x, y, z] of roll-pitch-yaw about fixed x, y, z (URDF's convention)."""
     quat = np.zeros(4)
-    mujoco.mju_euler2Quat(quat, np.asarray(rpy, dtype=float), "XYZ")
+    mujoco.mju_euler2Quat(quat, np.asarray(rpy, dtype=float), 'XYZ')
     return quat
 
 
@@ -135,15 +138,15 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec, mass: float, friction: lis
                 timeconst: float) -> None:
     body = spec.worldbody.add_body(name=OBJECT_BODY, pos=list(obj.position),
                                    quat=list(rpy_quaternion(obj.rpy)))
-    body.add_freejoint(name=f"{OBJECT_BODY}_free")
-    if obj.shape == "sphere":
+    body.add_freejoint(name=f'{OBJECT_BODY}_free')
+    if obj.shape == 'sphere':
         kind, size = mujoco.mjtGeom.mjGEOM_SPHERE, [obj.size[0], 0.0, 0.0]
-    elif obj.shape == "box":
+    elif obj.shape == 'box':
         kind, size = mujoco.mjtGeom.mjGEOM_BOX, list(np.asarray(obj.size) / 2)
     else:
         kind, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [obj.size[0], obj.size[1] / 2, 0.0]
     # Uniform density: the centre of mass is the shape's centre, the object's position.
-    body.add_geom(name=f"{OBJECT_BODY}_geom", type=kind, size=size, mass=mass,
+    body.add_geom(name=f'{OBJECT_BODY}_geom', type=kind, size=size, mass=mass,
                   friction=friction, condim=4, solref=[timeconst, 1.0],
                   contype=_OBJECT_BITS[0], conaffinity=_OBJECT_BITS[1],
                   rgba=[0.85, 0.45, 0.15, 1.0])
@@ -151,7 +154,8 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec, mass: float, friction: lis
 
 def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
                 urdf_xml: str | None = None) -> SimModel:
-    """Compile the scenario's hand and object into a MuJoCo model.
+    """
+    Compile the scenario's hand and object into a MuJoCo model.
 
     Args:
         scenario: a validated scenario with ``object`` and ``gravity``.
@@ -167,17 +171,17 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
             contact link without collision geometry.
     """
     if scenario.object is None:
-        raise InputError("object", "the simulation needs the scenario's object "
+        raise InputError('object', "the simulation needs the scenario's object "
                          "(shape, size, mass)")
     if scenario.gravity is None:
-        raise InputError("gravity", "the simulation needs the scenario's gravity")
+        raise InputError('gravity', "the simulation needs the scenario's gravity")
     if urdf_xml is None:
         urdf_xml = resolve_urdf(scenario.urdf, scenario.base_dir).read_text()
     try:
         spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml))
     except (ValueError, RuntimeError) as e:
-        raise InputError("hand.urdf", f"MuJoCo cannot load it: "
-                         f"{str(e).strip().splitlines()[0]}") from e
+        raise InputError('hand.urdf', f'MuJoCo cannot load it: '
+                         f'{str(e).strip().splitlines()[0]}') from e
     mu1 = scenario.friction.mu1 if settings.mu_tangential is None else settings.mu_tangential
     mu2 = scenario.friction.mu2 if settings.mu_torsional is None else settings.mu_torsional
     mass = scenario.object.mass if settings.mass is None else settings.mass
@@ -196,8 +200,8 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     try:
         model = spec.compile()
     except (ValueError, RuntimeError) as e:
-        raise InputError("hand.urdf", f"MuJoCo cannot compile it: "
-                         f"{str(e).strip().splitlines()[0]}") from e
+        raise InputError('hand.urdf', f'MuJoCo cannot compile it: '
+                         f'{str(e).strip().splitlines()[0]}') from e
 
     names = [model.joint(j).name for j in range(model.njnt)
              if int(model.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_HINGE),
@@ -205,11 +209,11 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     joints = scenario.joints if scenario.joints is not None else names
     for i, name in enumerate(joints):
         if name not in names:
-            raise InputError(f"hand.joints[{i}]", f"'{name}' is not a 1-DoF joint of the "
+            raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
                              "MuJoCo model")
     bodies = []
     for i, contact in enumerate(scenario.contacts):
-        field = f"grasp.contacts[{i}].link"
+        field = f'grasp.contacts[{i}].link'
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
         if body < 0:
             raise InputError(field, f"'{contact.link}' is not a link of the MuJoCo model "
@@ -218,7 +222,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
             raise InputError(field, f"link '{contact.link}' has no collision geometry to "
                              "touch the object with")
         bodies.append(body)
-    free = model.joint(f"{OBJECT_BODY}_free")
+    free = model.joint(f'{OBJECT_BODY}_free')
     hand_dofs = [model.jnt_dofadr[j] for j in range(model.njnt) if model.joint(j).name in names]
     model.dof_damping[hand_dofs] = settings.joint_damping
     return SimModel(

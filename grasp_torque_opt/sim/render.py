@@ -1,4 +1,5 @@
-"""One offscreen picture of the simulated grasp, contact forces drawn as arrows.
+"""
+One offscreen picture of the simulated grasp, contact forces drawn as arrows.
 
 Rendering is offscreen through EGL (``MUJOCO_GL=egl``, set by
 :mod:`grasp_torque_opt.sim` unless already set): no display and no GPU needed,
@@ -7,14 +8,13 @@ Mesa's software EGL does. The PNG is written with zlib, no imaging library.
 
 from __future__ import annotations
 
+from pathlib import Path
 import struct
 import zlib
-from pathlib import Path
-
-import mujoco
-import numpy as np
 
 from grasp_torque_opt.sim.simulator import HandSim
+import mujoco
+import numpy as np
 
 #: Arrow colours: simulated force on the object, certified (predicted) force.
 SIMULATED_RGBA = np.array([1.0, 0.55, 0.0, 1.0], dtype=np.float32)
@@ -28,15 +28,15 @@ class RenderUnavailable(RuntimeError):
 def write_png(path: str | Path, rgb: np.ndarray) -> None:
     """Write an RGB image, shape (h, w, 3) uint8, as PNG."""
     h, w, _ = rgb.shape
-    rows = b"".join(b"\x00" + np.ascontiguousarray(rgb[y]).tobytes() for y in range(h))
+    rows = b''.join(b'\x00' + np.ascontiguousarray(rgb[y]).tobytes() for y in range(h))
 
     def chunk(kind: bytes, data: bytes) -> bytes:
-        return (struct.pack(">I", len(data)) + kind + data
-                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+        return (struct.pack('>I', len(data)) + kind + data
+                + struct.pack('>I', zlib.crc32(kind + data) & 0xFFFFFFFF))
 
-    Path(path).write_bytes(b"\x89PNG\r\n\x1a\n"
-                           + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-                           + chunk(b"IDAT", zlib.compress(rows, 6)) + chunk(b"IEND", b""))
+    Path(path).write_bytes(b'\x89PNG\r\n\x1a\n'
+                           + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0))
+                           + chunk(b'IDAT', zlib.compress(rows, 6)) + chunk(b'IEND', b''))
 
 
 def _arrow(scene: mujoco.MjvScene, start: np.ndarray, end: np.ndarray, rgba: np.ndarray,
@@ -54,7 +54,8 @@ def render_grasp(hsim: HandSim, path: str | Path, predicted: list[np.ndarray] | 
                  scale: float = 0.03, size: tuple[int, int] = (800, 600),
                  azimuth: float = -90.0, elevation: float = -20.0, distance: float = 0.25
                  ) -> Path:
-    """Render the grasp and write it as PNG.
+    """
+    Render the grasp and write it as PNG.
 
     Args:
         hsim: the simulation, in the state to draw.
@@ -79,7 +80,7 @@ def render_grasp(hsim: HandSim, path: str | Path, predicted: list[np.ndarray] | 
     try:
         renderer = mujoco.Renderer(model, height, width)
     except Exception as e:  # noqa: BLE001 -- whatever the GL backend raises, say why
-        raise RenderUnavailable(f"{type(e).__name__}: {str(e).strip().splitlines()[0]}"
+        raise RenderUnavailable(f'{type(e).__name__}: {str(e).strip().splitlines()[0]}'
                                 if str(e).strip() else type(e).__name__) from e
     geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == hsim.sim.object_body]
     alpha = model.geom_rgba[geoms, 3].copy()

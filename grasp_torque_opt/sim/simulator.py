@@ -1,4 +1,5 @@
-"""A hand holding an object in MuJoCo, driven as an effort controller drives a hand.
+"""
+A hand holding an object in MuJoCo, driven as an effort controller drives a hand.
 
 The joints get the commanded torque plus a joint impedance around a reference
 configuration, as real hand drivers add (docs/simulation.md, "Impedance"):
@@ -16,15 +17,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from grasp_torque_opt.sim.model import SimModel
 import mujoco
 import numpy as np
-
-from grasp_torque_opt.sim.model import SimModel
 
 
 @dataclass(frozen=True)
 class ContactReading:
-    """What the simulation measures at one planned contact.
+    """
+    What the simulation measures at one planned contact.
 
     Attributes:
         touching: the link touches the object.
@@ -46,14 +47,15 @@ class HandSim:
 
     def __init__(self, sim: SimModel, q0: np.ndarray, kp: float = 1.0, kd: float = 0.01
                  ) -> None:
-        """Args:
-            sim: the compiled model.
-            q0: start configuration of the actuated joints [rad], shape (m,).
-            kp: impedance stiffness [N m/rad], every joint.
-            kd: impedance damping [N m s/rad], every joint.
+        """
+        Args:
+        sim: the compiled model.
+        q0: start configuration of the actuated joints [rad], shape (m,).
+        kp: impedance stiffness [N m/rad], every joint.
+        kd: impedance damping [N m s/rad], every joint.
         """
         if kp < 0 or kd < 0:
-            raise ValueError(f"kp and kd must be >= 0, got {kp}, {kd}")
+            raise ValueError(f'kp and kd must be >= 0, got {kp}, {kd}')
         self.sim = sim
         self.model = sim.model
         self.model.dof_damping[sim.dof_adr] += kd
@@ -130,8 +132,10 @@ class HandSim:
         return drift, 2.0 * float(np.arccos(dot))
 
     def readings(self) -> tuple[list[ContactReading], float]:
-        """Per planned contact what touches the object, and the force of every other
-        hand body on it (unplanned contacts) [N]."""
+        """
+        Per planned contact what touches the object, and the force of every other
+        hand body on it (unplanned contacts) [N].
+        """
         m, d, s = self.model, self.data, self.sim
         per = {b: [] for b in s.contact_bodies}
         other = np.zeros(3)
@@ -173,8 +177,10 @@ def wrench_in_frame(reading: ContactReading, rotation: np.ndarray) -> np.ndarray
 
 
 def friction_usage(wrench: np.ndarray, mu1: float, mu2: float) -> float:
-    """Share of the exact soft-finger cone a wrench uses, (||f_t||/mu1 + |mz|/mu2) / fz
-    (1: on the cone; inf when not pressing) [-]."""
+    """
+    Share of the exact soft-finger cone a wrench uses, (||f_t||/mu1 + |mz|/mu2) / fz
+    (1: on the cone; inf when not pressing) [-].
+    """
     if wrench[2] <= 0.0:
-        return float("inf")
+        return float('inf')
     return float((np.hypot(wrench[0], wrench[1]) / mu1 + abs(wrench[3]) / mu2) / wrench[2])

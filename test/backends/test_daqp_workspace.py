@@ -1,12 +1,13 @@
-"""DaqpWorkspace (the adaptive method's rounds): same optimum as an independent solver, its
-multipliers a KKT point, warm and cold alike, bad data refused."""
-
-import numpy as np
-import pytest
+"""
+DaqpWorkspace (the adaptive method's rounds): same optimum as an independent solver, its
+multipliers a KKT point, warm and cold alike, bad data refused.
+"""
 
 from grasp_torque_opt.backends.daqp import DaqpWorkspace, kkt_violation
 from grasp_torque_opt.core.tau_qp import build_tau_qp
 from grasp_torque_opt.reference.force_qp import solve_force_qp
+import numpy as np
+import pytest
 
 
 def built(setup):
@@ -22,16 +23,16 @@ def loaded(qp):
     return ws
 
 
-@pytest.mark.parametrize("name", ["planar", "allegro"])
+@pytest.mark.parametrize('name', ['planar', 'allegro'])
 def test_optimum_and_multipliers(name, request):
     setup = request.getfixturevalue(name)
     maps, qp = built(setup)
     ws = loaded(qp)
     raw = ws.solve()
-    assert raw.status == "solved"
+    assert raw.status == 'solved'
     tau = raw.x[:qp.m]
     ref = solve_force_qp(maps, setup.friction, setup.external_wrench, *setup.tau_bounds,
-                         setup.weights, objective="torque")  # Clarabel, force space
+                         setup.weights, objective='torque')  # Clarabel, force space
     tau_ref = maps.J.T @ ref.x
     assert tau @ (setup.weights * tau) == pytest.approx(tau_ref @ (setup.weights * tau_ref),
                                                         rel=1e-6)
@@ -50,7 +51,7 @@ def test_warm_and_cold_agree_and_data_can_change(allegro):
     looser = qp.u + 0.05
     warm = ws.solve(u=looser)
     cold = ws.solve(u=looser, cold=True)
-    assert warm.status == cold.status == "solved"
+    assert warm.status == cold.status == 'solved'
     np.testing.assert_allclose(warm.x, cold.x, atol=1e-7)
     assert np.abs(warm.x - first).max() > 1e-6  # the new rows were used
 
@@ -61,8 +62,8 @@ def test_non_finite_data_is_refused_and_a_failure_is_an_error(allegro):
     u = qp.u.copy()
     u[3] = np.nan
     raw = ws.solve(u=u)
-    assert raw.status == "error" and "not finite" in raw.message and ws.multipliers is None
+    assert raw.status == 'error' and 'not finite' in raw.message and ws.multipliers is None
     capped = DaqpWorkspace(max_iter=1)
     capped.load(qp.H, qp.g, qp.A, qp.b, qp.C, qp.u, qp.l_box, qp.u_box, semidefinite=False)
     raw = capped.solve()
-    assert raw.status == "error" and capped.multipliers is None
+    assert raw.status == 'error' and capped.multipliers is None

@@ -1,6 +1,8 @@
-"""The adversarial campaign, part 1: generated messages, parameter changes and failing
+"""
+The adversarial campaign, part 1: generated messages, parameter changes and failing
 solvers through a real node's own callbacks (no executor: every publish is seen), and
-generated scenario files through the CLI. Counts are printed at the end of the run."""
+generated scenario files through the CLI. Counts are printed at the end of the run.
+"""
 
 from __future__ import annotations
 
@@ -12,26 +14,25 @@ import json
 import math
 import time
 
-import numpy as np
-import pytest
-import rclpy
-import yaml
-from campaign import CAMPAIGN, COUNTS, FLOATS, broken, check_command, mutated
+from campaign import broken, CAMPAIGN, check_command, COUNTS, FLOATS, mutated
 from conftest import ALLEGRO, PLANAR
-from cycle_inputs import FAULT_MODES, Injected, base_poses, joint_state
+from cycle_inputs import base_poses, FAULT_MODES, Injected, joint_state
 from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+from grasp_torque_opt.cli import main as cli_main
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.core import scenario as schema
+from grasp_torque_opt.ros.node import GraspTorqueNode, PARAMETERS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from independent import assert_holds
+import numpy as np
+import pytest
+import rclpy
 from rclpy.parameter import Parameter
 from rclpy.task import Future
 from ros_harness import DOMAIN
 from sensor_msgs.msg import JointState
-
-from grasp_torque_opt.cli import main as cli_main
-from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.core import scenario as schema
-from grasp_torque_opt.ros.node import PARAMETERS, GraspTorqueNode
+import yaml
 
 #: No cycle may take longer than this, whatever the input: its solvers stop by its budget
 #: (at most cycle_budget's upper bound, 1 s) and overrun it by one outer iteration at most.
@@ -41,8 +42,10 @@ PUBLISH_MARGIN = 0.005
 
 
 class Recorder:
-    """Stands in front of the node's command publisher: publishes for real, and keeps
-    each command with the controller's decision it came from."""
+    """
+    Stands in front of the node's command publisher: publishes for real, and keeps
+    each command with the controller's decision it came from.
+    """
 
     def __init__(self, node: GraspTorqueNode):
         self.node, self.real, self.seen = node, node._command_pub, []
@@ -66,7 +69,7 @@ class Rig:
     def __init__(self, scenario, setup, **params):
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=DOMAIN)
-        overrides = [Parameter("scenario", value=str(scenario))]
+        overrides = [Parameter('scenario', value=str(scenario))]
         overrides += [Parameter(k, value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
         self.defaults = [Parameter(n, value=v) for n, v in self.node._params().items()
@@ -106,38 +109,38 @@ def operations(rig: Rig, size: int) -> st.SearchStrategy:
     js = mutated(rig.valid_js, rig.names)
     m = rig.setup.hand.m
     param = st.one_of(
-        st.tuples(st.sampled_from(["mu_tangential", "mu_torsional", "min_normal_force",
-                                   "hold_time", "joint_state_timeout", "max_wrench_force",
-                                   "max_contact_distance", "stamp_future_tolerance",
-                                   "cycle_budget", "certificate_tolerance"]), FLOATS),
-        st.tuples(st.sampled_from(["torque_limits", "weights", "object_origin", "gravity"]),
+        st.tuples(st.sampled_from(['mu_tangential', 'mu_torsional', 'min_normal_force',
+                                   'hold_time', 'joint_state_timeout', 'max_wrench_force',
+                                   'max_contact_distance', 'stamp_future_tolerance',
+                                   'cycle_budget', 'certificate_tolerance']), FLOATS),
+        st.tuples(st.sampled_from(['torque_limits', 'weights', 'object_origin', 'gravity']),
                   st.lists(FLOATS, max_size=20)),
-        st.tuples(st.sampled_from(["polygon_sides", "solver.max_iter", "solver.max_iter_in",
-                                   "max_joint_state_entries"]), st.integers(-5, 300)),
-        st.tuples(st.just("fault_policy"), st.sampled_from(["hold", "zero", "", "explode"])),
-        st.tuples(st.just("gravity_compensation"), st.booleans()),
+        st.tuples(st.sampled_from(['polygon_sides', 'solver.max_iter', 'solver.max_iter_in',
+                                   'max_joint_state_entries']), st.integers(-5, 300)),
+        st.tuples(st.just('fault_policy'), st.sampled_from(['hold', 'zero', '', 'explode'])),
+        st.tuples(st.just('gravity_compensation'), st.booleans()),
         # The issue's freeze: iteration caps, tolerance and the weights' ratio at their bounds.
-        st.tuples(st.just("solver.max_iter"), st.sampled_from([10000, 10001, 100000])),
-        st.tuples(st.just("solver.max_iter_in"), st.sampled_from([200, 201, 100000])),
-        st.tuples(st.just("solver.eps_abs"), st.just(1e-12)),
-        st.tuples(st.just("weights"), st.sampled_from(
+        st.tuples(st.just('solver.max_iter'), st.sampled_from([10000, 10001, 100000])),
+        st.tuples(st.just('solver.max_iter_in'), st.sampled_from([200, 201, 100000])),
+        st.tuples(st.just('solver.eps_abs'), st.just(1e-12)),
+        st.tuples(st.just('weights'), st.sampled_from(
             [[1e-3, 1e3] * (m // 2) + [1.0] * (m % 2), [1e-6] * (m - 1) + [1.0],
              [1e-12, 1e12] * (m // 2) + [1.0] * (m % 2)])),
-        st.tuples(st.just("cycle_budget"), st.sampled_from([1e-4, 1.0, 10.0])))
+        st.tuples(st.just('cycle_budget'), st.sampled_from([1e-4, 1.0, 10.0])))
     op = st.one_of(
-        st.tuples(st.just("joint_states"), js), st.tuples(st.just("joint_states"), js),
-        st.tuples(st.just("joint_states"), st.just(rig.valid_js)),
-        st.tuples(st.just("contacts"), mutated(rig.valid_contacts, rig.names)),
-        st.tuples(st.just("external_wrench"), mutated(rig.valid_wrench, rig.names)),
-        st.tuples(st.just("sleep"), st.sampled_from([0.005, 0.02, 0.05])),
-        st.tuples(st.just("watchdog"), st.none()),
-        st.tuples(st.just("solver"), st.sampled_from(FAULT_MODES + ["healthy"] * 4)),
-        st.tuples(st.just("param"), param),
+        st.tuples(st.just('joint_states'), js), st.tuples(st.just('joint_states'), js),
+        st.tuples(st.just('joint_states'), st.just(rig.valid_js)),
+        st.tuples(st.just('contacts'), mutated(rig.valid_contacts, rig.names)),
+        st.tuples(st.just('external_wrench'), mutated(rig.valid_wrench, rig.names)),
+        st.tuples(st.just('sleep'), st.sampled_from([0.005, 0.02, 0.05])),
+        st.tuples(st.just('watchdog'), st.none()),
+        st.tuples(st.just('solver'), st.sampled_from(FAULT_MODES + ['healthy'] * 4)),
+        st.tuples(st.just('param'), param),
         # Changes that make the command in force invalid: limits below it.
-        st.tuples(st.just("limits_below"), st.sampled_from([0.01, 0.3, 0.9])),
+        st.tuples(st.just('limits_below'), st.sampled_from([0.01, 0.3, 0.9])),
         # Two sources: one stamping ahead of (or behind) the clock, one on it.
-        st.tuples(st.just("skewed_joint_state"), st.sampled_from([0.4, 0.49, 0.6, -0.4])),
-        st.tuples(st.just("joint_state_on_clock"), st.none()))
+        st.tuples(st.just('skewed_joint_state'), st.sampled_from([0.4, 0.49, 0.6, -0.4])),
+        st.tuples(st.just('joint_state_on_clock'), st.none()))
     return st.lists(op, min_size=1, max_size=size)
 
 
@@ -146,71 +149,71 @@ def run(rig: Rig, ops) -> None:
     rig.reset()
     node = rig.node
     for kind, arg in ops:
-        COUNTS["inputs"] += 1
+        COUNTS['inputs'] += 1
         t0 = time.perf_counter()
-        if kind == "joint_states":
+        if kind == 'joint_states':
             node._on_joint_state(arg)
-        elif kind == "contacts":
+        elif kind == 'contacts':
             node._on_contacts(arg)
-        elif kind == "external_wrench":
+        elif kind == 'external_wrench':
             node._on_wrench(arg)
-        elif kind == "sleep":
+        elif kind == 'sleep':
             time.sleep(arg)
-        elif kind == "watchdog":
+        elif kind == 'watchdog':
             node._on_watchdog()
-        elif kind == "solver":
-            solver = Injected(arg if arg != "healthy" else FAULT_MODES[0])
-            solver.healthy = arg == "healthy"
+        elif kind == 'solver':
+            solver = Injected(arg if arg != 'healthy' else FAULT_MODES[0])
+            solver.healthy = arg == 'healthy'
             node.controller.solver = solver
-        elif kind == "limits_below":
+        elif kind == 'limits_below':
             seen = rig.recorder.seen  # the command in force: the last one published
             ref = seen[-1][0] if seen else node.controller.setup.hand.torque_limits
             limits = np.maximum(arg * np.abs(ref), 1e-3)
-            node.set_parameters([Parameter("torque_limits", value=[float(x) for x in limits])])
-        elif kind in ("skewed_joint_state", "joint_state_on_clock"):
+            node.set_parameters([Parameter('torque_limits', value=[float(x) for x in limits])])
+        elif kind in ('skewed_joint_state', 'joint_state_on_clock'):
             msg = copy.deepcopy(rig.valid_js)
             t = node._clock_now() + (arg or 0.0)
             msg.header.stamp.sec, msg.header.stamp.nanosec = int(t), int((t % 1.0) * 1e9)
-            before = node.controller.counters.rejected["joint_states"]
+            before = node.controller.counters.rejected['joint_states']
             node._on_joint_state(msg)
-            refused = node.controller.counters.rejected["joint_states"] > before
-            if kind == "joint_state_on_clock" and refused and \
-                    "header.stamp" in node.controller.last_rejection:
-                broken(f"a joint state on the clock refused: {node.controller.last_rejection}")
+            refused = node.controller.counters.rejected['joint_states'] > before
+            if kind == 'joint_state_on_clock' and refused and \
+                    'header.stamp' in node.controller.last_rejection:
+                broken(f'a joint state on the clock refused: {node.controller.last_rejection}')
         else:
             name, value = arg
-            if isinstance(value, list) and name in ("torque_limits", "weights"):
+            if isinstance(value, list) and name in ('torque_limits', 'weights'):
                 value = [float(v) for v in value]
             try:
                 node.set_parameters([Parameter(name, value=value)])
             except Exception as e:  # noqa: BLE001 -- a refused type is fine; anything else not
-                assert type(e).__name__ in ("InvalidParameterTypeException",
-                                            "InvalidParameterValueException"), e
-        if kind != "sleep" and time.perf_counter() - t0 > STALL:
-            broken(f"{kind} took {time.perf_counter() - t0:.2f} s")
+                assert type(e).__name__ in ('InvalidParameterTypeException',
+                                            'InvalidParameterValueException'), e
+        if kind != 'sleep' and time.perf_counter() - t0 > STALL:
+            broken(f'{kind} took {time.perf_counter() - t0:.2f} s')
         # What the effort controller holds is within the limits in force, whatever changed.
         if rig.recorder.seen:
             held = rig.recorder.seen[-1][0]
             limits = node.controller.setup.hand.torque_limits
             if held.shape == limits.shape and np.any(np.abs(held) > limits):
-                broken(f"the command in force exceeds the limits in force after {kind}")
+                broken(f'the command in force exceeds the limits in force after {kind}')
     ctrl = node.controller
     for cmd, decision, inputs, then, sent in rig.recorder.seen:
         check_command(cmd, rig.setup.hand.m, then.setup.hand.torque_limits)
         if decision is None or decision.command is None or \
                 not np.array_equal(decision.command, cmd):
             broken("a command that is not the controller's decision")
-        if decision.kind == "zero":
+        if decision.kind == 'zero':
             if np.any(cmd != 0.0):
-                broken("a zero-policy command that is not zero")
+                broken('a zero-policy command that is not zero')
             continue
         sol = decision.solution
-        if decision.kind != "solution" or not sol.optimal or not sol.certificate.ok:
-            broken(f"a command from an uncertified solution ({decision.kind})")
+        if decision.kind != 'solution' or not sol.optimal or not sol.certificate.ok:
+            broken(f'a command from an uncertified solution ({decision.kind})')
         if decision.cycle_time > then.config.cycle_budget:
-            broken(f"a command from a cycle over budget ({decision.cycle_time:.4f} s)")
+            broken(f'a command from a cycle over budget ({decision.cycle_time:.4f} s)')
         if sent - inputs.q_time > then.config.joint_state_timeout + PUBLISH_MARGIN:
-            broken(f"a command sent {sent - inputs.q_time:.4f} s after its joint state")
+            broken(f'a command sent {sent - inputs.q_time:.4f} s after its joint state')
         # Independently of the package's certificate, at the inputs and parameters it was
         # computed from (its limits are checked on the command above).
         setup, _ = then.grasp_at(inputs)
@@ -219,28 +222,28 @@ def run(rig: Rig, ops) -> None:
                 setup.hand, torque_limits=np.full(rig.setup.hand.m, np.inf))),
                 decision.maps, sol.tau, sol.wrenches)
         except AssertionError as e:
-            broken(f"a command fails the independent check: {e}")
+            broken(f'a command fails the independent check: {e}')
     # The service still answers, with a certified command or a reason.
     done = Future()
     node._solve_for_service(ctrl.inputs, time.monotonic(), done)
     success, message = done.result()
     if success:
         d = json.loads(message)
-        check_command(d["command"], rig.setup.hand.m, ctrl.setup.hand.torque_limits)
-    elif not message.startswith("cannot solve: ") and \
-            json.loads(message).get("command", "missing") is not None:
-        broken(f"service failed without a reason: {message[:200]}")
+        check_command(d['command'], rig.setup.hand.m, ctrl.setup.hand.torque_limits)
+    elif not message.startswith('cannot solve: ') and \
+            json.loads(message).get('command', 'missing') is not None:
+        broken(f'service failed without a reason: {message[:200]}')
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def planar_rig(planar):
     rig = Rig(PLANAR, planar, joint_state_timeout=0.03, contacts_timeout=0.06,
-              wrench_timeout=0.06, hold_time=0.02, fault_policy="zero")
+              wrench_timeout=0.06, hold_time=0.02, fault_policy='zero')
     yield rig
     rig.close()
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def allegro_rig(allegro):
     rig = Rig(ALLEGRO, allegro, joint_state_timeout=0.03, hold_time=0.02,
               gravity_compensation=True, gravity=[9.81, 0.0, 0.0])
@@ -254,9 +257,9 @@ def test_campaign_planar_node(planar_rig):
     def campaign(ops):
         run(planar_rig, ops)
 
-    before = COUNTS["commands"]
+    before = COUNTS['commands']
     campaign()
-    assert COUNTS["commands"] > before  # the campaign reached the solver, not only checks
+    assert COUNTS['commands'] > before  # the campaign reached the solver, not only checks
 
 
 def test_campaign_allegro_node(allegro_rig):
@@ -265,23 +268,25 @@ def test_campaign_allegro_node(allegro_rig):
     def campaign(ops):
         run(allegro_rig, ops)
 
-    before = COUNTS["commands"]
+    before = COUNTS['commands']
     campaign()
-    assert COUNTS["commands"] > before
+    assert COUNTS['commands'] > before
 
 
 # -- the CLI on generated scenario files ----------------------------------------------------
 
 
 def scenario_fields(doc: dict) -> list[tuple]:
-    """Paths of every field the schema allows, in a scenario document, in a fixed order:
+    """
+    Paths of every field the schema allows, in a scenario document, in a fixed order:
     the schema's sets iterate in an order that changes with each process's string hashes,
     which made the derandomized examples differ from run to run (and, now and then, none
-    of the 120 solve)."""
+    of the 120 solve).
+    """
     out = [(section, key) for section, keys in sorted(schema._SECTIONS.items())
            for key in sorted(keys)]
-    for i in range(len(doc["grasp"]["contacts"])):
-        out += [("grasp", "contacts", i, key) for key in sorted(schema._CONTACT_KEYS)]
+    for i in range(len(doc['grasp']['contacts'])):
+        out += [('grasp', 'contacts', i, key) for key in sorted(schema._CONTACT_KEYS)]
     return out
 
 
@@ -320,38 +325,38 @@ def scenario_docs(draw, doc: dict):
 
 def test_campaign_cli(tmp_path, planar_doc):
     doc = copy.deepcopy(planar_doc)
-    doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
-    path = tmp_path / "generated.yaml"
+    doc['hand']['urdf'] = str(PLANAR.parent / doc['hand']['urdf'])
+    path = tmp_path / 'generated.yaml'
 
     codes = []
 
     @settings(CAMPAIGN, max_examples=120)
     @given(scenario_docs(doc))
     def campaign(d):
-        COUNTS["inputs"] += 1
+        COUNTS['inputs'] += 1
         path.write_text(yaml.safe_dump(d))
         out, err = io.StringIO(), io.StringIO()
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            code = cli_main(["solve", str(path), "--json"])
+            code = cli_main(['solve', str(path), '--json'])
         codes.append(code)
         if code == 2:
             lines = err.getvalue().splitlines()
-            if len(lines) != 1 or not lines[0].startswith(f"grasp-torque-opt: error: {path}: "):
-                broken(f"bad input without one line naming the field: {err.getvalue()!r}")
+            if len(lines) != 1 or not lines[0].startswith(f'grasp-torque-opt: error: {path}: '):
+                broken(f'bad input without one line naming the field: {err.getvalue()!r}')
             return
         if code not in (0, 3, 4):
-            broken(f"exit code {code}")
+            broken(f'exit code {code}')
         r = json.loads(out.getvalue())
         if code == 0:
-            check_command(r["tau"], len(r["joints"]), np.full(len(r["joints"]), np.inf))
-            if not r["certificate"]["ok"] or r["status"] != "optimal":
-                broken("exit 0 without a certified optimum")
-            limits = d["hand"].get("torque_limits")
-            if isinstance(limits, list) and len(limits) == len(r["tau"]) and \
-                    np.any(np.abs(r["tau"]) > np.array(limits, dtype=float)):
-                broken("a torque over its limit")
-        elif r["tau"] is not None:
-            broken(f"exit {code} with torques")
+            check_command(r['tau'], len(r['joints']), np.full(len(r['joints']), np.inf))
+            if not r['certificate']['ok'] or r['status'] != 'optimal':
+                broken('exit 0 without a certified optimum')
+            limits = d['hand'].get('torque_limits')
+            if isinstance(limits, list) and len(limits) == len(r['tau']) and \
+                    np.any(np.abs(r['tau']) > np.array(limits, dtype=float)):
+                broken('a torque over its limit')
+        elif r['tau'] is not None:
+            broken(f'exit {code} with torques')
 
     campaign()
     assert {0, 2} <= set(codes)  # both solved and refused files were generated
@@ -365,37 +370,39 @@ FILE_STALL = 10.0
 
 @st.composite
 def hostile_texts(draw, text: str) -> bytes:
-    """A valid scenario's text made hostile: YAML aliases nested some levels deep, nesting,
-    bytes that are not UTF-8, many contacts, long strings, long integers, in some field."""
+    """
+    A valid scenario's text made hostile: YAML aliases nested some levels deep, nesting,
+    bytes that are not UTF-8, many contacts, long strings, long integers, in some field.
+    """
     lines = text.splitlines()
-    fields = [i for i, line in enumerate(lines) if ": " in line and not line.endswith(":")]
+    fields = [i for i, line in enumerate(lines) if ': ' in line and not line.endswith(':')]
     i = draw(st.sampled_from(fields))
-    key = lines[i].split(": ", 1)[0]
-    kind = draw(st.sampled_from(["aliases", "nesting", "bytes", "contacts", "string",
-                                 "integer"]))
-    if kind == "aliases":
+    key = lines[i].split(': ', 1)[0]
+    kind = draw(st.sampled_from(['aliases', 'nesting', 'bytes', 'contacts', 'string',
+                                 'integer']))
+    if kind == 'aliases':
         levels = draw(st.integers(1, 7))
         parts = ['&a0 ["lol", "lol", "lol"]'] + [
-            f"&a{k} [" + ", ".join([f"*a{k - 1}"] * draw(st.integers(2, 9))) + "]"
+            f'&a{k} [' + ', '.join([f'*a{k - 1}'] * draw(st.integers(2, 9))) + ']'
             for k in range(1, levels)]
         lines[i] = f"{key}: [{', '.join(parts)}]"
-    elif kind == "nesting":
+    elif kind == 'nesting':
         depth = draw(st.integers(5, 3000))
         lines[i] = f"{key}: {'[' * depth}1{']' * depth}"
-    elif kind == "string":
+    elif kind == 'string':
         lines[i] = f"{key}: {'x' * draw(st.integers(100, 200_000))}"
-    elif kind == "integer":
+    elif kind == 'integer':
         lines[i] = f"{key}: {'7' * draw(st.integers(10, 6000))}"
-    elif kind == "contacts":
+    elif kind == 'contacts':
         n = draw(st.integers(1, 300))
-        at = next(j for j, line in enumerate(lines) if line.strip() == "contacts:")
-        first = next(j for j in range(at + 1, len(lines)) if lines[j].lstrip().startswith("- "))
+        at = next(j for j, line in enumerate(lines) if line.strip() == 'contacts:')
+        first = next(j for j in range(at + 1, len(lines)) if lines[j].lstrip().startswith('- '))
         last = next((j for j in range(first + 1, len(lines))
-                     if lines[j].lstrip().startswith("- ") or not lines[j].startswith("  ")),
+                     if lines[j].lstrip().startswith('- ') or not lines[j].startswith('  ')),
                     len(lines))
         lines[first:first] = lines[first:last] * n
-    data = "\n".join(lines).encode() + b"\n"
-    if kind == "bytes":
+    data = '\n'.join(lines).encode() + b'\n'
+    if kind == 'bytes':
         at = draw(st.integers(0, len(data)))
         data = data[:at] + draw(st.binary(min_size=1, max_size=8)) + data[at:]
     return data
@@ -403,31 +410,31 @@ def hostile_texts(draw, text: str) -> bytes:
 
 def test_campaign_hostile_files(tmp_path, planar_doc):
     doc = copy.deepcopy(planar_doc)
-    doc["hand"]["urdf"] = str(PLANAR.parent / doc["hand"]["urdf"])
-    path = tmp_path / "hostile.yaml"
+    doc['hand']['urdf'] = str(PLANAR.parent / doc['hand']['urdf'])
+    path = tmp_path / 'hostile.yaml'
     codes = []
 
     @settings(CAMPAIGN, max_examples=80)
     @given(hostile_texts(yaml.safe_dump(doc)))
     def campaign(data):
-        COUNTS["inputs"] += 1
+        COUNTS['inputs'] += 1
         path.write_bytes(data)
         out, err = io.StringIO(), io.StringIO()
         t0 = time.perf_counter()
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            code = cli_main(["solve", str(path), "--json"])
+            code = cli_main(['solve', str(path), '--json'])
         if time.perf_counter() - t0 > FILE_STALL:
-            broken(f"a hostile file took {time.perf_counter() - t0:.1f} s")
+            broken(f'a hostile file took {time.perf_counter() - t0:.1f} s')
         codes.append(code)
         if code == 2:
             lines = err.getvalue().splitlines()
-            if len(lines) != 1 or not lines[0].startswith(f"grasp-torque-opt: error: {path}: ") \
+            if len(lines) != 1 or not lines[0].startswith(f'grasp-torque-opt: error: {path}: ') \
                     or len(lines[0]) > 1000:
-                broken(f"bad input without one short line naming it: {err.getvalue()[:300]!r}")
+                broken(f'bad input without one short line naming it: {err.getvalue()[:300]!r}')
         elif code in (0, 3, 4):
             json.loads(out.getvalue())
         else:
-            broken(f"exit code {code}")
+            broken(f'exit code {code}')
 
     campaign()
     assert 2 in codes

@@ -1,7 +1,9 @@
-"""The adversarial campaign, part 2: the node over real DDS. A 1 kHz burst of joint
+"""
+The adversarial campaign, part 2: the node over real DDS. A 1 kHz burst of joint
 states, some malformed, with the service called throughout and flooded once (300 calls);
 an input publisher that dies and comes back. Every command received is checked, every
-service call must be answered."""
+service call must be answered.
+"""
 
 from __future__ import annotations
 
@@ -10,21 +12,22 @@ import json
 import math
 import time
 
-import numpy as np
-import pytest
-from campaign import COUNTS, broken, check_command
+from campaign import broken, check_command, COUNTS
 from conftest import PLANAR
 from cycle_inputs import joint_state
+from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
+import pytest
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from ros_harness import Harness
 from std_srvs.srv import Trigger
 
-from grasp_torque_opt.methods.dispatch import solve
-
 
 def variants(setup, n: int, seed: int):
-    """n configurations near the grasp's, their names and positions, and the certified
-    torques of each (computed here, independently of the node)."""
+    """
+    N configurations near the grasp's, their names and positions, and the certified
+    torques of each (computed here, independently of the node).
+    """
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(n):
@@ -41,9 +44,9 @@ def malformed(names, pos, k: int):
     nan, inf = math.nan, math.inf
     kinds = [
         (names, [nan] + pos[1:]), (names, [inf] + pos[1:]), (names, pos[:-1]),
-        (names[:-1] + names[:1], pos), (names[:-1] + ["ghost"], pos), ([], []),
-        (names + [f"extra{i}" for i in range(300)], pos + [0.0] * 300),
-        (names[:2] + [""] + names[3:], pos), (names, [1e9] + pos[1:]),
+        (names[:-1] + names[:1], pos), (names[:-1] + ['ghost'], pos), ([], []),
+        (names + [f'extra{i}' for i in range(300)], pos + [0.0] * 300),
+        (names[:2] + [''] + names[3:], pos), (names, [1e9] + pos[1:]),
     ]
     return kinds[k % len(kinds)]
 
@@ -55,7 +58,7 @@ def check_all(h: Harness, refs: list[np.ndarray], zero_allowed: bool) -> None:
         if zero_allowed and np.all(cmd == 0.0):
             continue
         if not any(np.allclose(cmd, r, atol=1e-9) for r in refs):
-            broken(f"a command that is no certified solution of a state sent: {cmd}")
+            broken(f'a command that is no certified solution of a state sent: {cmd}')
 
 
 def test_burst_at_1khz_with_bad_messages_and_service_calls(planar):
@@ -68,12 +71,12 @@ def test_burst_at_1khz_with_bad_messages_and_service_calls(planar):
         period, n = 1e-3, 1000
         # A flood of the service mid-burst, from a client that keeps every request (the
         # node's old queue of 100 dropped the rest silently): each must be answered.
-        flood = h.tester.create_client(Trigger, "grasp_torque_node/solve", qos_profile=QoSProfile(
+        flood = h.tester.create_client(Trigger, 'grasp_torque_node/solve', qos_profile=QoSProfile(
             history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
         assert h.spin_until(flood.service_is_ready, 5.0)
         start = time.monotonic()
         for i in range(n):
-            COUNTS["inputs"] += 1
+            COUNTS['inputs'] += 1
             if i % 10 == 3:
                 h.send_joint_state(*malformed(*states[0][:2], i // 10))
                 sent_bad += 1
@@ -81,29 +84,29 @@ def test_burst_at_1khz_with_bad_messages_and_service_calls(planar):
                 h.send_joint_state(*states[i % len(states)][:2])
             if i % 20 == 0:
                 futures.append(h.solve_client.call_async(Trigger.Request()))
-                COUNTS["inputs"] += 1
+                COUNTS['inputs'] += 1
             if i == n // 2:
                 futures += [flood.call_async(Trigger.Request()) for _ in range(300)]
-                COUNTS["inputs"] += 300
+                COUNTS['inputs'] += 300
             deadline = start + (i + 1) * period
             while time.monotonic() < deadline:
                 h.executor.spin_once(timeout_sec=0)
         assert h.spin_until(lambda: all(f.done() for f in futures), 20.0), \
-            "the service stopped answering"
+            'the service stopped answering'
         elapsed = time.monotonic() - start
         for f in futures:
             r = f.result()
             if r.success:
-                check_command(json.loads(r.message)["command"], 4,
+                check_command(json.loads(r.message)['command'], 4,
                               h.node.controller.setup.hand.torque_limits)
-            elif not r.message.startswith(("cannot solve: ", "busy: ")) and \
-                    json.loads(r.message).get("command", "missing") is not None:
+            elif not r.message.startswith(('cannot solve: ', 'busy: ')) and \
+                    json.loads(r.message).get('command', 'missing') is not None:
                 # (A solve that failed, e.g. past its budget under this load, is a JSON
                 # answer without a command, its message saying why.)
-                broken(f"service failed without a reason: {r.message[:200]}")
+                broken(f'service failed without a reason: {r.message[:200]}')
         check_all(h, refs, zero_allowed=False)
         c = h.node.controller.counters
-        assert c.rejected["joint_states"] >= 1 and len(h.commands) >= 50, \
+        assert c.rejected['joint_states'] >= 1 and len(h.commands) >= 50, \
             (c, len(h.commands), elapsed)
         assert c.max_cycle_time < 1.0  # never a stall
         # Alive: the next good state is answered with its certified torques.
@@ -114,14 +117,14 @@ def test_burst_at_1khz_with_bad_messages_and_service_calls(planar):
         h.close()
 
 
-@pytest.mark.parametrize("policy", ["hold", "zero"])
+@pytest.mark.parametrize('policy', ['hold', 'zero'])
 def test_input_publisher_dies_and_comes_back(planar, policy):
     states = variants(planar, 1, seed=5)
     names, pos, tau = states[0]
     h = Harness(PLANAR, joint_state_timeout=0.05, hold_time=0.05, fault_policy=policy)
     try:
         for _ in range(20):
-            COUNTS["inputs"] += 1
+            COUNTS['inputs'] += 1
             h.send_joint_state(names, pos)
             h.spin_for(0.01)
         assert h.commands
@@ -131,7 +134,7 @@ def test_input_publisher_dies_and_comes_back(planar, policy):
         h.spin_for(0.4)
         # Commands already in flight when it died may still arrive (30 ms for delivery).
         after = [c for c in h.commands[n_before:] if c[0] > died + 0.03]
-        if policy == "zero":
+        if policy == 'zero':
             assert after and all(np.all(c == 0.0) for _, c in after)
             # Zero once hold_time has passed since the last certified command (seen here
             # a little after it left), and soon after the joint states went stale.
@@ -140,21 +143,21 @@ def test_input_publisher_dies_and_comes_back(planar, policy):
         else:
             assert after == []
         assert h.spin_until(lambda: h.diagnostics and
-                            "joint_states stale" in h.diagnostics[-1]["fault"], 2.0)
+                            'joint_states stale' in h.diagnostics[-1]['fault'], 2.0)
         # A new publisher: recovery at the first certified command.
         from rclpy.qos import qos_profile_sensor_data
         from sensor_msgs.msg import JointState
-        h.js_pub = h.tester.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+        h.js_pub = h.tester.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
         assert h.spin_until(lambda: h.js_pub.get_subscription_count() > 0, 5.0)
         n = len(h.commands)
         recoveries = h.node.controller.counters.recoveries
         for _ in range(10):
-            COUNTS["inputs"] += 1
+            COUNTS['inputs'] += 1
             h.send_joint_state(names, pos)
             h.spin_for(0.01)
         assert any(np.allclose(c, tau, atol=1e-9) for _, c in h.commands[n:])
         # At least this one (a loaded machine can add a stale gap and its recovery).
         assert h.node.controller.counters.recoveries >= recoveries + 1
-        check_all(h, [tau], zero_allowed=policy == "zero")
+        check_all(h, [tau], zero_allowed=policy == 'zero')
     finally:
         h.close()

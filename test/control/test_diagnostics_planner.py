@@ -2,10 +2,9 @@
 
 import dataclasses
 
-import numpy as np
 from cycle_inputs import fresh, joint_state
-
 from grasp_torque_opt.control.diagnostics import report
+import numpy as np
 
 
 def test_margined_usage_is_reported_on_the_unreduced_cone(allegro):
@@ -20,9 +19,9 @@ def test_margined_usage_is_reported_on_the_unreduced_cone(allegro):
     for i, (c, w) in enumerate(zip(allegro.contacts, r.solution.wrenches)):
         u = (np.hypot(w[0], w[1]) / fr.mu1 + abs(w[3]) / fr.mu2) / w[2]
         usages.append(u)
-        assert float(v[f"contact{i}.{c.link}.friction_usage"]) == float(f"{u:.4f}")
+        assert float(v[f'contact{i}.{c.link}.friction_usage']) == float(f'{u:.4f}')
         assert u <= 1 / 1.5 + 1e-7
-    assert float(v["friction_usage_max"]) == float(f"{max(usages):.4f}")
-    assert v["friction_margin"] == "0.5" and v["objective"] == "sum-of-squares"
+    assert float(v['friction_usage_max']) == float(f'{max(usages):.4f}')
+    assert v['friction_margin'] == '0.5' and v['objective'] == 'sum-of-squares'
     lim = allegro.hand.torque_limits
-    assert float(v["max_torque_ratio"]) == float(f"{np.max(np.abs(r.solution.tau) / lim):.4f}")
+    assert float(v['max_torque_ratio']) == float(f'{np.max(np.abs(r.solution.tau) / lim):.4f}')

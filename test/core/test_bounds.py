@@ -2,10 +2,6 @@
 
 import dataclasses
 
-import numpy as np
-import pytest
-from independent import polygon_rows
-
 from grasp_torque_opt.core.bounds import dual_bound, make_bounds
 from grasp_torque_opt.core.friction import (
     circumscribed_rows,
@@ -14,6 +10,9 @@ from grasp_torque_opt.core.friction import (
     tangent_rows,
 )
 from grasp_torque_opt.reference.exact_socp import solve_exact_socp
+from independent import polygon_rows
+import numpy as np
+import pytest
 
 MU1, MU2 = 0.5, 0.2
 
@@ -29,7 +28,7 @@ def exact_cone_points(rng, n, on_boundary=False):
     return np.column_stack((ft * np.cos(th), ft * np.sin(th), fz, mz))
 
 
-@pytest.mark.parametrize("N", [3, 4, 8, 16])
+@pytest.mark.parametrize('N', [3, 4, 8, 16])
 def test_circumscribed_polygon_is_the_papers_scaled_by_one_over_cos(N):
     """Each paper row (independent.polygon_rows) with its tangential part times cos(pi/N)."""
     paper = polygon_rows(MU1, MU2, N, 0.0)[0][:-1]
@@ -38,13 +37,13 @@ def test_circumscribed_polygon_is_the_papers_scaled_by_one_over_cos(N):
     np.testing.assert_allclose(circumscribed_rows(MU1, MU2, N), paper, atol=1e-14)
 
 
-@pytest.mark.parametrize("N", [3, 8, 16])
+@pytest.mark.parametrize('N', [3, 8, 16])
 def test_outer_cones_contain_the_exact_cone_and_touch_it(N):
     rng = np.random.default_rng(N)
     f = exact_cone_points(rng, 2000)
     assert np.all(cone_margin(f, MU1, MU2) >= -1e-12)
     rows = circumscribed_rows(MU1, MU2, N)
-    assert np.all(f @ rows.T <= 1e-12), "an exact-cone point outside the circumscribed cone"
+    assert np.all(f @ rows.T <= 1e-12), 'an exact-cone point outside the circumscribed cone'
     u = rng.normal(size=(50, 2))
     u /= np.linalg.norm(u, axis=1, keepdims=True)
     tang = tangent_rows(MU1, MU2, u).reshape(-1, 4)
@@ -52,7 +51,7 @@ def test_outer_cones_contain_the_exact_cone_and_touch_it(N):
     # Touch: the exact cone's boundary point along each direction meets its facet.
     fz = 2.0
     touch = np.column_stack((MU1 * fz * u, np.full(50, fz), np.zeros(50)))
-    np.testing.assert_allclose(np.einsum("ki,ki->k", tangent_rows(MU1, MU2, u)[:, 0], touch),
+    np.testing.assert_allclose(np.einsum('ki,ki->k', tangent_rows(MU1, MU2, u)[:, 0], touch),
                                0.0, atol=1e-12)
     # And the circumscribed polygon is strictly larger: its corner is outside the exact cone.
     corner = np.array([MU1 * fz / np.cos(np.pi / N), 0.0, fz, 0.0])
@@ -60,20 +59,24 @@ def test_outer_cones_contain_the_exact_cone_and_touch_it(N):
 
 
 def test_inflation_moves_every_facet_off_the_exact_cone():
-    """Inflated, no facet touches the exact cone any more (docs/adaptive.md: its dual
-    vectors lie strictly inside the dual cone)."""
+    """
+    Inflated, no facet touches the exact cone any more (docs/adaptive.md: its dual
+    vectors lie strictly inside the dual cone).
+    """
     u = np.array([[1.0, 0.0], [0.6, 0.8]])
     touch = np.column_stack((MU1 * u, np.ones(2), np.zeros(2)))  # fz = 1, on the cone
     plain, inflated = tangent_rows(MU1, MU2, u)[:, 0], tangent_rows(MU1, MU2, u, 1e-3)[:, 0]
-    np.testing.assert_allclose(np.einsum("ki,ki->k", plain, touch), 0.0, atol=1e-15)
-    assert np.all(np.einsum("ki,ki->k", inflated, touch) < -1e-4)
+    np.testing.assert_allclose(np.einsum('ki,ki->k', plain, touch), 0.0, atol=1e-15)
+    assert np.all(np.einsum('ki,ki->k', inflated, touch) < -1e-4)
     f = exact_cone_points(np.random.default_rng(1), 500, on_boundary=True)
     assert np.all(f @ circumscribed_rows(MU1, MU2, 8, 1e-3).T < 0.0)
 
 
 def test_dual_cone_margin_is_the_dual_cone():
-    """s with margin >= 0 has s . f >= 0 on the whole exact cone; s with margin < 0 has
-    an extreme ray of the cone with s . f < 0."""
+    """
+    S with margin >= 0 has s . f >= 0 on the whole exact cone; s with margin < 0 has
+    an extreme ray of the cone with s . f < 0.
+    """
     rng = np.random.default_rng(3)
     f = exact_cone_points(rng, 4000, on_boundary=True)
     s = rng.normal(size=(400, 4))
@@ -105,8 +108,10 @@ def random_dual_points(rng, maps, friction, k):
 
 
 def test_any_dual_feasible_point_bounds_the_socp_from_below(allegro):
-    """The bound holds for any (eta, y) whose sigma is in K* + R+ e_z: random ones, against
-    Clarabel's optimum of the exact SOCP (reference.exact_socp, no polygon in it)."""
+    """
+    The bound holds for any (eta, y) whose sigma is in K* + R+ e_z: random ones, against
+    Clarabel's optimum of the exact SOCP (reference.exact_socp, no polygon in it).
+    """
     maps = allegro.maps()
     assert np.linalg.matrix_rank(maps.J) == maps.J.shape[0]
     rng = np.random.default_rng(7)
@@ -116,13 +121,13 @@ def test_any_dual_feasible_point_bounds_the_socp_from_below(allegro):
         setup = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * w_scale)
         raw = solve_exact_socp(maps, setup.friction, setup.external_wrench, tmin, tmax,
                                setup.weights)
-        assert raw.status == "solved"
+        assert raw.status == 'solved'
         tau = maps.J.T @ raw.x[:4 * maps.p]
         E = float(tau @ (setup.weights * tau))
         for eta, v in random_dual_points(rng, maps, setup.friction, 40):
             d = dual_bound(maps.G, maps.J, setup.external_wrench, setup.friction,
                            setup.weights, tmin, tmax, eta, v)
-            assert d is not None, "a dual-feasible point was refused"
+            assert d is not None, 'a dual-feasible point was refused'
             assert d <= E + 1e-9
             checked += 1
     assert checked == 120
@@ -137,10 +142,10 @@ def test_a_point_outside_the_dual_cone_gives_no_bound(allegro):
 
 
 def test_bounds_are_square_roots_of_the_objective():
-    b = make_bounds(0.25, 0.2601, 1e-3, 2, 3, "refined")
+    b = make_bounds(0.25, 0.2601, 1e-3, 2, 3, 'refined')
     assert b.lower == pytest.approx(0.5) and b.upper == pytest.approx(0.51)
     assert b.gap == pytest.approx(0.02) and not b.converged
-    assert make_bounds(-np.inf, 0.26, 1e-3, 0, 1, "polygon").gap is None
-    d = make_bounds(0.25, 0.2500001, 1e-3, 1, 2, "refined").as_dict()
-    assert d["converged"] and set(d) == {"lower", "upper", "gap", "tolerance", "rounds",
-                                         "qp_solves", "source", "converged"}
+    assert make_bounds(-np.inf, 0.26, 1e-3, 0, 1, 'polygon').gap is None
+    d = make_bounds(0.25, 0.2500001, 1e-3, 1, 2, 'refined').as_dict()
+    assert d['converged'] and set(d) == {'lower', 'upper', 'gap', 'tolerance', 'rounds',
+                                         'qp_solves', 'source', 'converged'}

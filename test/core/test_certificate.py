@@ -1,17 +1,16 @@
 """The certificate catches each kind of wrong answer."""
 
+from grasp_torque_opt.core.certificate import certify
+from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
 import pytest
 
-from grasp_torque_opt.core.certificate import certify
-from grasp_torque_opt.methods.dispatch import solve
 
-
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def good(planar):
     maps = planar.maps()
     sol = solve(planar, maps=maps)
-    assert sol.status == "optimal"
+    assert sol.status == 'optimal'
     return planar, maps, sol.tau, sol.wrenches.ravel()
 
 

@@ -1,10 +1,9 @@
 """The pinned tangent rule of docs/design.md section 1."""
 
-import numpy as np
-import pytest
-
 from grasp_torque_opt.core.contact_frame import contact_rotation
 from grasp_torque_opt.core.exceptions import InputError
+import numpy as np
+import pytest
 
 
 def check_rotation(R):
@@ -12,7 +11,7 @@ def check_rotation(R):
     assert np.linalg.det(R) == pytest.approx(1.0)
 
 
-@pytest.mark.parametrize("normal,axis", [
+@pytest.mark.parametrize('normal,axis', [
     ([1, 0, 0], [0, 1, 0]),          # tie between e_y and e_z: the first, e_y
     ([0, 0, -1], [1, 0, 0]),
     ([0.2, 0.9, 0.1], [0, 0, 1]),
@@ -35,7 +34,7 @@ def test_given_tangent_is_projected():
 
 
 def test_zero_normal_and_parallel_tangent_are_refused():
-    with pytest.raises(InputError, match=r"c\[0\]\.normal: must be finite and not zero"):
-        contact_rotation(np.zeros(3), field="c[0]")
-    with pytest.raises(InputError, match=r"c\[1\]\.tangent: is parallel to the normal"):
-        contact_rotation(np.array([0, 1.0, 0]), np.array([0, -3.0, 0]), field="c[1]")
+    with pytest.raises(InputError, match=r'c\[0\]\.normal: must be finite and not zero'):
+        contact_rotation(np.zeros(3), field='c[0]')
+    with pytest.raises(InputError, match=r'c\[1\]\.tangent: is parallel to the normal'):
+        contact_rotation(np.array([0, 1.0, 0]), np.array([0, -3.0, 0]), field='c[1]')

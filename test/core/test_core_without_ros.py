@@ -5,23 +5,23 @@ import sys
 
 from conftest import PLANAR
 
-ROS = ("rclpy", "std_msgs", "sensor_msgs", "geometry_msgs", "std_srvs", "visualization_msgs",
-       "diagnostic_msgs", "rcl_interfaces")
-SOLVERS = ("proxsuite", "daqp", "quadprog", "clarabel", "osqp", "scipy.optimize", "mujoco")
+ROS = ('rclpy', 'std_msgs', 'sensor_msgs', 'geometry_msgs', 'std_srvs', 'visualization_msgs',
+       'diagnostic_msgs', 'rcl_interfaces')
+SOLVERS = ('proxsuite', 'daqp', 'quadprog', 'clarabel', 'osqp', 'scipy.optimize', 'mujoco')
 
 
 def run(script: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+    return subprocess.run([sys.executable, '-c', script], capture_output=True, text=True,
                           timeout=120)
 
 
 def blocked(names) -> str:
     """Python lines after which importing any of ``names`` raises ImportError."""
-    return "".join(f"sys.modules[{n!r}] = None\n" for n in names)
+    return ''.join(f'sys.modules[{n!r}] = None\n' for n in names)
 
 
 def test_everything_but_the_ros_family_imports_and_solves_without_ros():
-    done = run("import pkgutil, sys\n" + blocked(ROS) + f"""
+    done = run('import pkgutil, sys\n' + blocked(ROS) + f"""
 import grasp_torque_opt
 names = [m.name for m in pkgutil.walk_packages(grasp_torque_opt.__path__, "grasp_torque_opt.")
          if not m.name.startswith("grasp_torque_opt.ros")]
@@ -36,7 +36,7 @@ print(len(names))
 
 
 def test_the_core_imports_and_builds_with_every_solver_and_ros_blocked():
-    done = run("import pkgutil, sys\n" + blocked(ROS + SOLVERS) + f"""
+    done = run('import pkgutil, sys\n' + blocked(ROS + SOLVERS) + f"""
 import grasp_torque_opt.core as core
 names = [m.name for m in pkgutil.walk_packages(core.__path__, "grasp_torque_opt.core.")]
 for name in names:

@@ -1,8 +1,5 @@
 """The linearized cone S against the paper's inequalities and the exact cone."""
 
-import numpy as np
-import pytest
-
 from grasp_torque_opt.core.friction import (
     cone_margin,
     cone_rows,
@@ -10,6 +7,8 @@ from grasp_torque_opt.core.friction import (
     friction_matrix,
     friction_usage,
 )
+import numpy as np
+import pytest
 
 
 def paper_rows(mu1, mu2, N):
@@ -26,13 +25,13 @@ def paper_rows(mu1, mu2, N):
     return np.array(rows)
 
 
-@pytest.mark.parametrize("N", [3, 4, 5, 8, 13, 32])
-@pytest.mark.parametrize("mu1,mu2", [(0.5, 0.2), (1.2, 0.01), (0.1, 0.5)])
+@pytest.mark.parametrize('N', [3, 4, 5, 8, 13, 32])
+@pytest.mark.parametrize('mu1,mu2', [(0.5, 0.2), (1.2, 0.01), (0.1, 0.5)])
 def test_rows_are_the_papers_inequalities(N, mu1, mu2):
     np.testing.assert_allclose(cone_rows(mu1, mu2, N), paper_rows(mu1, mu2, N), atol=1e-15)
 
 
-@pytest.mark.parametrize("N", [3, 4, 6, 8, 16])
+@pytest.mark.parametrize('N', [3, 4, 6, 8, 16])
 def test_every_vertex_lies_on_the_exact_cone(N):
     mu1, mu2 = 0.5, 0.2
     S = cone_rows(mu1, mu2, N)
@@ -42,7 +41,7 @@ def test_every_vertex_lies_on_the_exact_cone(N):
     apexes = [[0.0, 0.0, fz, mu2 * fz], [0.0, 0.0, fz, -mu2 * fz]]
     for v in np.array(ring + apexes):
         assert np.all(S @ v <= 1e-12)
-        assert np.sum(np.abs(S @ v) < 1e-12) >= 2, "a vertex is where two or more facets meet"
+        assert np.sum(np.abs(S @ v) < 1e-12) >= 2, 'a vertex is where two or more facets meet'
         assert cone_margin(v[None], mu1, mu2)[0] == pytest.approx(0.0, abs=1e-12)
 
 
@@ -79,7 +78,7 @@ def test_normal_bound_and_block_structure():
 
 
 def test_fewer_than_three_sides_is_refused():
-    with pytest.raises(ValueError, match="polygon_sides must be >= 3"):
+    with pytest.raises(ValueError, match='polygon_sides must be >= 3'):
         cone_rows(0.5, 0.2, 2)
 
 

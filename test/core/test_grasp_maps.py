@@ -1,12 +1,11 @@
 """G and J from first principles: moments summed by hand, finite differences of kinematics."""
 
-import numpy as np
-import pinocchio as pin
-import pytest
-
 from grasp_torque_opt.core.exceptions import FrameNotFound
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
 from grasp_torque_opt.core.scenario import ContactSpec
+import numpy as np
+import pinocchio as pin
+import pytest
 
 
 def contact_point_and_rotation(setup, q, i):
@@ -18,7 +17,7 @@ def contact_point_and_rotation(setup, q, i):
     return oMf.act(spec.position), oMf.rotation.copy()
 
 
-@pytest.mark.parametrize("name", ["planar", "allegro"])
+@pytest.mark.parametrize('name', ['planar', 'allegro'])
 def test_jacobian_matches_finite_differences(name, request):
     setup = request.getfixturevalue(name)
     maps = setup.maps()
@@ -38,7 +37,7 @@ def test_jacobian_matches_finite_differences(name, request):
         np.testing.assert_allclose(maps.J[4 * i:4 * i + 4], J_fd, atol=1e-7)
 
 
-@pytest.mark.parametrize("name", ["planar", "allegro"])
+@pytest.mark.parametrize('name', ['planar', 'allegro'])
 def test_grasp_matrix_sums_forces_and_moments(name, request):
     setup = request.getfixturevalue(name)
     maps = setup.maps()
@@ -61,14 +60,14 @@ def test_contact_frames_follow_the_scenario(planar):
 
 
 def test_default_normal_points_to_the_object_origin(planar):
-    spec = ContactSpec(link="finger1_tip", position=np.zeros(3))
+    spec = ContactSpec(link='finger1_tip', position=np.zeros(3))
     maps = compute_grasp_maps(planar.hand, planar.q, [spec], planar.object_origin)
     d = planar.object_origin - maps.contacts[0].position
     np.testing.assert_allclose(maps.contacts[0].normal, d / np.linalg.norm(d))
 
 
 def test_unknown_frame_is_named(planar):
-    spec = ContactSpec(link="finger3_tip", position=np.zeros(3))
+    spec = ContactSpec(link='finger3_tip', position=np.zeros(3))
     with pytest.raises(FrameNotFound, match=r"grasp\.contacts\[0\]\.link: unknown frame "
                                             r"'finger3_tip' \(model frames: .*finger1_tip"):
         compute_grasp_maps(planar.hand, planar.q, [spec], planar.object_origin)

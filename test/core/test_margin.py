@@ -3,15 +3,14 @@
 import copy
 import dataclasses
 
-import numpy as np
-import pytest
 from conftest import CONFIG, setup_from_doc
-from independent import assert_holds
-
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.margin import cone_usage, planned_friction, torque_ratio
 from grasp_torque_opt.core.scenario import Friction, parse_scenario
 from grasp_torque_opt.methods.dispatch import solve
+from independent import assert_holds
+import numpy as np
+import pytest
 
 
 def test_planned_friction_divides_both_coefficients_by_one_plus_k():
@@ -37,19 +36,19 @@ def test_torque_ratio_counts_the_offset_and_the_weights():
                         weights=np.array([10.0, 1.0])) == pytest.approx(1.0)
 
 
-@pytest.mark.parametrize("value, problem", [(-0.1, "must be >= 0"), ("x", "must be a number"),
-                                            (float("inf"), "must be finite")])
+@pytest.mark.parametrize('value, problem', [(-0.1, 'must be >= 0'), ('x', 'must be a number'),
+                                            (float('inf'), 'must be finite')])
 def test_a_bad_margin_names_the_field(allegro_doc, value, problem):
     doc = copy.deepcopy(allegro_doc)
-    doc["friction"]["margin"] = value
-    with pytest.raises(InputError, match=f"friction.margin: {problem}"):
+    doc['friction']['margin'] = value
+    with pytest.raises(InputError, match=f'friction.margin: {problem}'):
         parse_scenario(doc, CONFIG)
 
 
-@pytest.mark.parametrize("k", [0.1, 0.25, 1.0])
+@pytest.mark.parametrize('k', [0.1, 0.25, 1.0])
 def test_margined_torques_satisfy_the_reduced_cone(allegro_doc, k):
     doc = copy.deepcopy(allegro_doc)
-    doc["friction"]["margin"] = k
+    doc['friction']['margin'] = k
     setup = setup_from_doc(doc)
     maps = setup.maps()
     sol = solve(setup, maps=maps)
@@ -73,6 +72,6 @@ def test_the_adaptive_method_plans_with_the_margin_too(allegro):
     k = 0.25
     setup = dataclasses.replace(allegro, friction=dataclasses.replace(allegro.friction,
                                                                       margin=k))
-    sol = solve(setup, "tau-qp-adaptive")
+    sol = solve(setup, 'tau-qp-adaptive')
     assert sol.optimal and sol.friction_margin == k
     assert sol.friction_usage.max() <= 1 / (1 + k) + 1e-7

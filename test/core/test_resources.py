@@ -1,13 +1,12 @@
 """Bundled config files are found by name, from the source tree or an install."""
 
-import pytest
 from conftest import CONFIG
-
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.resources import config_dirs, find_config
+import pytest
 
 
-@pytest.mark.parametrize("name", sorted(p.name for p in CONFIG.glob("*.yaml")))
+@pytest.mark.parametrize('name', sorted(p.name for p in CONFIG.glob('*.yaml')))
 def test_every_bundled_file_is_found_by_its_name(name):
     assert find_config(name).read_bytes() == (CONFIG / name).read_bytes()
 
@@ -17,5 +16,5 @@ def test_the_source_trees_config_is_a_candidate():
 
 
 def test_a_missing_file_names_the_field_and_where_it_looked():
-    with pytest.raises(InputError, match=r"params: file not found: nope\.yaml \(nor in .*config"):
-        find_config("nope.yaml", "params")
+    with pytest.raises(InputError, match=r'params: file not found: nope\.yaml \(nor in .*config'):
+        find_config('nope.yaml', 'params')

@@ -2,18 +2,17 @@
 
 import dataclasses
 
-import numpy as np
-import pytest
-from independent import assert_holds, lp_feasible
-
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.core.tau_qp import build_tau_qp, decompose
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.reference.exact_socp import solve_exact_socp
 from grasp_torque_opt.reference.force_qp import solve_force_qp
+from independent import assert_holds, lp_feasible
+import numpy as np
+import pytest
 
-CASES = ["planar", "hyperstatic", "allegro"]
+CASES = ['planar', 'hyperstatic', 'allegro']
 
 
 def built(setup):
@@ -22,7 +21,7 @@ def built(setup):
                               *setup.tau_bounds, setup.weights)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize('name', CASES)
 def test_parametrization_balances_the_load(name, request):
     setup = request.getfixturevalue(name)
     maps, qp = built(setup)
@@ -41,19 +40,19 @@ def test_parametrization_balances_the_load(name, request):
 def test_planar_grasp_is_rank_deficient_and_solves(planar):
     maps, qp = built(planar)
     assert np.linalg.matrix_rank(np.vstack((maps.G, maps.J.T))) < 4 * maps.p
-    assert qp.N.shape[1] >= 1, "internal forces the joints cannot feel need z"
-    assert qp.A.shape[0] >= 1, "the compatibility equalities are needed"
+    assert qp.N.shape[1] >= 1, 'internal forces the joints cannot feel need z'
+    assert qp.A.shape[0] >= 1, 'the compatibility equalities are needed'
     sol = solve(planar)
-    assert sol.status == "optimal"
+    assert sol.status == 'optimal'
     assert_holds(planar, maps, sol.tau, sol.wrenches)
 
 
 def test_hyperstatic_grasp_solves(hyperstatic):
     maps = hyperstatic.maps()
-    assert maps.p == 3 and [c.link for c in maps.contacts][:2] == ["finger1_tip",
-                                                                   "finger1_distal"]
+    assert maps.p == 3 and [c.link for c in maps.contacts][:2] == ['finger1_tip',
+                                                                   'finger1_distal']
     sol = solve(hyperstatic)
-    assert sol.status == "optimal"
+    assert sol.status == 'optimal'
     assert_holds(hyperstatic, maps, sol.tau, sol.wrenches)
 
 
@@ -61,22 +60,22 @@ def torque_objective(setup, tau):
     return float(tau @ (setup.weights * tau))
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize('name', CASES)
 def test_optimum_equals_force_space_qp_with_torque_objective(name, request):
     setup = request.getfixturevalue(name)
     maps = setup.maps()
     ours = solve(setup, maps=maps)
     raw = solve_force_qp(maps, setup.friction, setup.external_wrench,
-                         *setup.tau_bounds, setup.weights, objective="torque")
-    assert raw.status == "solved"
+                         *setup.tau_bounds, setup.weights, objective='torque')
+    assert raw.status == 'solved'
     tau_f = maps.J.T @ raw.x
-    assert ours.status == "optimal"
+    assert ours.status == 'optimal'
     assert torque_objective(setup, ours.tau) == pytest.approx(
         torque_objective(setup, tau_f), rel=1e-6, abs=1e-9)
     np.testing.assert_allclose(ours.tau, tau_f, atol=1e-5)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize('name', CASES)
 def test_never_below_the_exact_cone_optimum(name, request):
     setup = request.getfixturevalue(name)
     maps = setup.maps()
@@ -100,9 +99,9 @@ def test_random_allegro_grasps_agree_with_independent_solvers(allegro):
         setup = dataclasses.replace(allegro, external_wrench=w)
         ours = solve(setup, maps=maps, solver=solver)
         raw = solve_force_qp(maps, setup.friction, w, *setup.tau_bounds, setup.weights,
-                             objective="torque")
-        if ours.status != "optimal":
-            assert ours.status == "infeasible" and raw.status == "infeasible"
+                             objective='torque')
+        if ours.status != 'optimal':
+            assert ours.status == 'infeasible' and raw.status == 'infeasible'
             continue
         checked += 1
         assert_holds(setup, maps, ours.tau, ours.wrenches)
@@ -119,12 +118,12 @@ def test_weights_shift_effort(planar):
     """A heavier weight on a joint lowers its share of the effort, still certified."""
     heavy = dataclasses.replace(planar, weights=np.array([10.0, 1.0, 1.0, 1.0]))
     a, b = solve(planar), solve(heavy)
-    assert b.status == "optimal"
+    assert b.status == 'optimal'
     assert abs(b.tau[0]) <= abs(a.tau[0]) + 1e-9
     assert_holds(heavy, heavy.maps(), b.tau, b.wrenches)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize('name', CASES)
 def test_decomposition_against_numpy_pinv(name, request):
     """QR path (full column rank) or SVD path: pinv, null space and left null space are right."""
     maps = request.getfixturevalue(name).maps()
@@ -147,20 +146,22 @@ def test_feasible_load_is_not_declared_infeasible(allegro):
     maps = setup.maps()
     assert lp_feasible(setup, maps)
     sol = solve(setup, maps=maps)
-    assert sol.status == "optimal", sol.message
+    assert sol.status == 'optimal', sol.message
     assert_holds(setup, maps, sol.tau, sol.wrenches)
 
 
 def test_a_hessian_that_is_not_diagonal_is_solved_as_dense(allegro):
-    """The default Hessian type is Diagonal (build_tau_qp's H is); a coupled H must still
-    give its own optimum, the one DAQP finds for it, not the diagonal one."""
+    """
+    The default Hessian type is Diagonal (build_tau_qp's H is); a coupled H must still
+    give its own optimum, the one DAQP finds for it, not the diagonal one.
+    """
     maps = allegro.maps()
     qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,
                       allegro.weights)
     v = np.linspace(1.0, 2.0, qp.m)
     coupled = dataclasses.replace(qp, H=qp.H + 4.0 * np.outer(v, v))
     x = TauQPSolver().solve(coupled).x
-    ref = make_solver("daqp").solve(coupled).x
+    ref = make_solver('daqp').solve(coupled).x
     diagonal_only = TauQPSolver().solve(qp).x
     np.testing.assert_allclose(x, ref, atol=1e-6)
     assert np.abs(x - diagonal_only).max() > 1e-3

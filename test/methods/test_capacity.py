@@ -3,19 +3,18 @@
 import copy
 import dataclasses
 
+from conftest import setup_from_doc
+from grasp_torque_opt.methods.capacity import direction_capacities, DIRECTIONS, load_capacity
+from grasp_torque_opt.methods.dispatch import solve
+from independent import assert_holds, lp_capacity, lp_feasible
 import numpy as np
 import pytest
-from conftest import setup_from_doc
-from independent import assert_holds, lp_capacity, lp_feasible
-
-from grasp_torque_opt.methods.capacity import DIRECTIONS, direction_capacities, load_capacity
-from grasp_torque_opt.methods.dispatch import solve
 
 
 def holds(setup, maps, load) -> bool:
     """The tau-QP certifies torques for this load."""
     return solve(dataclasses.replace(setup, external_wrench=np.asarray(load, float)),
-                 maps=maps, backend="daqp").optimal
+                 maps=maps, backend='daqp').optimal
 
 
 def reduced(setup):
@@ -31,14 +30,14 @@ def above_is_infeasible(setup, maps, load) -> bool:
                                                external_wrench=np.asarray(load, float)), maps)
 
 
-@pytest.mark.parametrize("margin", [0.0, 0.3])
+@pytest.mark.parametrize('margin', [0.0, 0.3])
 def test_allegro_capacity_holds_at_alpha_and_not_just_above(allegro_doc, margin):
     doc = copy.deepcopy(allegro_doc)
-    doc["friction"]["margin"] = margin
+    doc['friction']['margin'] = margin
     setup = setup_from_doc(doc)
     maps = setup.maps()
     cap = load_capacity(setup, maps)
-    assert cap.status == "optimal" and cap.certificate.ok and cap.value > 1
+    assert cap.status == 'optimal' and cap.certificate.ok and cap.value > 1
     w = setup.external_wrench
     assert holds(setup, maps, (1 - 1e-6) * cap.value * w)
     assert above_is_infeasible(setup, maps, (1 + 1e-4) * cap.value * w)
@@ -65,8 +64,8 @@ def test_axis_capacities_hold_at_their_value_and_not_above(allegro):
         i, sign = DIRECTIONS[name]
         d = np.zeros(6)
         d[i] = sign
-        assert cap.status == "optimal", (name, cap.message)
-        assert cap.unit == ("N" if name[1] == "F" else "N m")
+        assert cap.status == 'optimal', (name, cap.message)
+        assert cap.unit == ('N' if name[1] == 'F' else 'N m')
         assert holds(allegro, maps, (1 - 1e-6) * cap.value * d), name
         assert above_is_infeasible(allegro, maps, (1 + 1e-4) * cap.value * d), name
 
@@ -75,7 +74,7 @@ def test_planar_capacity_with_internal_forces(planar):
     """The rank-deficient planar hand (null-space internal forces): the same two checks."""
     maps = planar.maps()
     cap = load_capacity(planar, maps)
-    assert cap.status == "optimal" and cap.certificate.ok
+    assert cap.status == 'optimal' and cap.certificate.ok
     w = planar.external_wrench
     assert holds(planar, maps, (1 - 1e-6) * cap.value * w)
     assert above_is_infeasible(planar, maps, (1 + 1e-4) * cap.value * w)
@@ -83,24 +82,24 @@ def test_planar_capacity_with_internal_forces(planar):
 
 def test_no_capacity_when_not_even_zero_load_holds(allegro_doc):
     doc = copy.deepcopy(allegro_doc)
-    doc["friction"]["min_normal_force"] = 50.0  # no joint can squeeze this hard
+    doc['friction']['min_normal_force'] = 50.0  # no joint can squeeze this hard
     setup = setup_from_doc(doc)
     cap = load_capacity(setup)
-    assert cap.status == "infeasible" and cap.value is None
-    assert "minimum normal force" in cap.message
+    assert cap.status == 'infeasible' and cap.value is None
+    assert 'minimum normal force' in cap.message
 
 
-@pytest.mark.parametrize("scale", [1e-200, 1e-6, 1e6, 1e200])
+@pytest.mark.parametrize('scale', [1e-200, 1e-6, 1e6, 1e200])
 def test_the_capacity_scales_with_the_load(allegro, scale):
     """alpha(s w) = alpha(w) / s: the LP runs on the unit direction whatever the load's size."""
     maps = allegro.maps()
     base = load_capacity(allegro, maps).value
     cap = load_capacity(allegro, maps, load=scale * allegro.external_wrench)
-    assert cap.status == "optimal" and cap.value == pytest.approx(base / scale, rel=1e-9)
+    assert cap.status == 'optimal' and cap.value == pytest.approx(base / scale, rel=1e-9)
 
 
 def test_a_zero_load_has_no_finite_capacity(allegro):
-    assert load_capacity(allegro, load=np.zeros(6)).status == "unbounded"
+    assert load_capacity(allegro, load=np.zeros(6)).status == 'unbounded'
 
 
 def random_grasps(base, count, seed):
@@ -121,5 +120,5 @@ def test_capacity_equals_an_independent_lp_on_random_grasps(allegro):
         maps = setup.maps()
         cap = load_capacity(setup, maps)
         alpha, _ = lp_capacity(setup, maps, setup.external_wrench)
-        assert cap.status == "optimal" and cap.certificate.ok
+        assert cap.status == 'optimal' and cap.certificate.ok
         assert cap.value == pytest.approx(alpha, rel=1e-6)

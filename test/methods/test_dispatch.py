@@ -3,42 +3,41 @@
 import dataclasses
 import re
 
-import numpy as np
-import pytest
-from independent import assert_holds, lp_feasible
-
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.methods.dispatch import METHODS, solve
+from independent import assert_holds, lp_feasible
+import numpy as np
+import pytest
 
-CASES = ["planar", "hyperstatic", "allegro"]
+CASES = ['planar', 'hyperstatic', 'allegro']
 
 
-@pytest.mark.parametrize("method", METHODS)
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize('method', METHODS)
+@pytest.mark.parametrize('name', CASES)
 def test_every_result_holds_the_load(name, method, request):
     setup = request.getfixturevalue(name)
     maps = setup.maps()
     sol = solve(setup, method, maps=maps)
-    assert sol.status == "optimal", sol.message
+    assert sol.status == 'optimal', sol.message
     assert sol.certificate.ok and sol.tau.shape == (setup.hand.m,)
     assert_holds(setup, maps, sol.tau, sol.wrenches)
 
 
-@pytest.mark.parametrize("name", CASES)
+@pytest.mark.parametrize('name', CASES)
 def test_exact_methods_agree(name, request):
     """SOCP (interior point) and SLSQP reach the same exact-cone optimum."""
     setup = request.getfixturevalue(name)
     maps = setup.maps()
-    socp, nlp = solve(setup, "socp", maps=maps), solve(setup, "nlp", maps=maps)
+    socp, nlp = solve(setup, 'socp', maps=maps), solve(setup, 'nlp', maps=maps)
     assert socp.torque_norm == pytest.approx(nlp.torque_norm, rel=1e-4)
 
 
 def test_heavy_load_is_infeasible_and_the_lp_agrees(planar):
     heavy = dataclasses.replace(planar, external_wrench=planar.external_wrench * 200.0)
     maps = heavy.maps()
-    for method in ("tau-qp", "force-qp", "socp"):
+    for method in ('tau-qp', 'force-qp', 'socp'):
         sol = solve(heavy, method, maps=maps)
-        assert sol.status == "infeasible", (method, sol.message)
+        assert sol.status == 'infeasible', (method, sol.message)
         assert sol.tau is None and sol.wrenches is None
     assert not lp_feasible(heavy, maps)
     assert lp_feasible(planar, planar.maps())
@@ -49,7 +48,7 @@ def test_torque_limits_alone_make_it_infeasible(allegro):
         allegro.hand, torque_limits=np.full(allegro.hand.m, 1e-3)))
     maps = weak.maps()
     assert not lp_feasible(weak, maps)
-    assert solve(weak, maps=maps).status == "infeasible"
+    assert solve(weak, maps=maps).status == 'infeasible'
 
 
 def test_min_normal_force_is_respected(planar):
@@ -58,7 +57,7 @@ def test_min_normal_force_is_respected(planar):
     squeeze = dataclasses.replace(planar, friction=dataclasses.replace(
         planar.friction, min_normal_force=fmin))
     sol = solve(squeeze)
-    assert sol.status == "optimal"
+    assert sol.status == 'optimal'
     assert np.all(sol.wrenches[:, 2] >= fmin - 1e-6)
     assert sol.torque_norm > free.torque_norm
 
@@ -66,28 +65,30 @@ def test_min_normal_force_is_respected(planar):
 def test_a_result_that_fails_its_certificate_is_not_returned(planar):
     """An impossible tolerance: the solver succeeds, the certificate does not, no torque."""
     sol = solve(planar, tolerance=-1.0)
-    assert sol.status == "failed"
+    assert sol.status == 'failed'
     assert sol.tau is None and sol.wrenches is None
-    assert "certificate failed" in sol.message and "LP finds the load holdable" in sol.message
+    assert 'certificate failed' in sol.message and 'LP finds the load holdable' in sol.message
 
 
 def test_unknown_method_is_refused(planar):
-    with pytest.raises(ValueError, match="method must be one of tau-qp, tau-qp-adaptive, force-qp, socp, nlp"):
-        solve(planar, "lp")
+    with pytest.raises(ValueError, match='method must be one of tau-qp, tau-qp-adaptive, force-qp, socp, nlp'):
+        solve(planar, 'lp')
 
 
-@pytest.mark.parametrize("name", ["planar", "allegro"])
-@pytest.mark.parametrize("N", [3, 4, 6, 8, 16, 32])
+@pytest.mark.parametrize('name', ['planar', 'allegro'])
+@pytest.mark.parametrize('N', [3, 4, 6, 8, 16, 32])
 def test_polygon_optimum_is_sandwiched_by_exact_cones(name, N, request):
-    """The inscribed N-gon contains the exact cone with mu1 cos(pi/N) and is inside the one
-    with mu1: its optimum lies between the two exact (SOCP) optima."""
+    """
+    The inscribed N-gon contains the exact cone with mu1 cos(pi/N) and is inside the one
+    with mu1: its optimum lies between the two exact (SOCP) optima.
+    """
     setup = request.getfixturevalue(name)
     fr = dataclasses.replace(setup.friction, sides=N)
     shrunk = dataclasses.replace(fr, mu1=fr.mu1 * np.cos(np.pi / N))
     maps = setup.maps()
     ours = solve(dataclasses.replace(setup, friction=fr), maps=maps)
-    lower = solve(dataclasses.replace(setup, friction=fr), "socp", maps=maps)
-    upper = solve(dataclasses.replace(setup, friction=shrunk), "socp", maps=maps)
+    lower = solve(dataclasses.replace(setup, friction=fr), 'socp', maps=maps)
+    upper = solve(dataclasses.replace(setup, friction=shrunk), 'socp', maps=maps)
     assert ours.optimal and lower.optimal and upper.optimal
     assert lower.torque_norm - 1e-7 <= ours.torque_norm <= upper.torque_norm + 1e-7
 
@@ -99,8 +100,8 @@ def test_nested_polygons_never_increase_the_optimum(planar):
     assert all(b <= a + 1e-9 for a, b in zip(norms, norms[1:]))
 
 
-@pytest.mark.parametrize("joint", range(4))
-@pytest.mark.parametrize("scale", [-2.5, -1.5, 1.5, 2.5])
+@pytest.mark.parametrize('joint', range(4))
+@pytest.mark.parametrize('scale', [-2.5, -1.5, 1.5, 2.5])
 def test_torque_offset_beyond_the_limit(planar, joint, scale):
     """An offset past a limit: the verdict (optimal or infeasible) matches the LP's."""
     off = np.zeros(4)
@@ -108,7 +109,7 @@ def test_torque_offset_beyond_the_limit(planar, joint, scale):
     shifted = dataclasses.replace(planar, torque_offset=off)
     maps = shifted.maps()
     sol = solve(shifted, maps=maps)
-    assert sol.status == ("optimal" if lp_feasible(shifted, maps) else "infeasible")
+    assert sol.status == ('optimal' if lp_feasible(shifted, maps) else 'infeasible')
     if sol.optimal:
         assert_holds(shifted, maps, sol.tau, sol.wrenches)
 
@@ -122,7 +123,7 @@ def test_torque_offset_shifts_the_limits(planar):
     off[0] = -np.sign(free.tau[0]) * (lim[0] - abs(free.tau[0]) - 1e-3)
     shifted = dataclasses.replace(planar, torque_offset=off)
     sol = solve(shifted)
-    assert sol.status == "optimal"
+    assert sol.status == 'optimal'
     assert_holds(shifted, shifted.maps(), sol.tau, sol.wrenches)
     np.testing.assert_allclose(sol.tau, free.tau, atol=1e-7)
 
@@ -130,22 +131,22 @@ def test_torque_offset_shifts_the_limits(planar):
 class ShortAnswer:
     """A solver that claims success with one variable too few (a broken backend)."""
 
-    name = "short"
+    name = 'short'
 
     def solve(self, qp):
-        raw = make_solver("daqp").solve(qp)
+        raw = make_solver('daqp').solve(qp)
         return dataclasses.replace(raw, x=raw.x[:-1])
 
 
-@pytest.mark.parametrize("name", ["planar", "allegro"])
+@pytest.mark.parametrize('name', ['planar', 'allegro'])
 def test_an_answer_of_the_wrong_size_is_an_error_and_the_fallback_answers(name, request):
     setup = request.getfixturevalue(name)
     alone = solve(setup, solver=ShortAnswer())
-    assert alone.status == "failed" and alone.tau is None
-    got, n = map(int, re.search(r"x has shape \((\d+),\) for (\d+) variables",
+    assert alone.status == 'failed' and alone.tau is None
+    got, n = map(int, re.search(r'x has shape \((\d+),\) for (\d+) variables',
                                 alone.message).groups())
     assert got == n - 1 and n >= setup.hand.m
-    rescued = solve(setup, solver=ShortAnswer(), fallback=make_solver("daqp"))
-    assert rescued.optimal and rescued.backend == "daqp"
-    assert "fallback after" in rescued.message and "x has shape" in rescued.message
+    rescued = solve(setup, solver=ShortAnswer(), fallback=make_solver('daqp'))
+    assert rescued.optimal and rescued.backend == 'daqp'
+    assert 'fallback after' in rescued.message and 'x has shape' in rescued.message
     assert_holds(setup, setup.maps(), rescued.tau, rescued.wrenches)

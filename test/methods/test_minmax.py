@@ -3,14 +3,13 @@
 import copy
 import dataclasses
 
-import numpy as np
-import pytest
 from conftest import CONFIG, setup_from_doc
-from independent import assert_holds, lp_minmax
-
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.scenario import parse_scenario
 from grasp_torque_opt.methods.dispatch import solve
+from independent import assert_holds, lp_minmax
+import numpy as np
+import pytest
 
 LOADS = [[1.4715, 0, 0, 0, 0, 0], [-1.4715, 0, 0, 0, 0, 0], [0, 1.4715, 0, 0, 0, 0],
          [0, 0, 1.4715, 0, 0.01, 0], [3.0, 0.5, -1.0, 0, 0, 0.005]]
@@ -22,20 +21,20 @@ def ratio(setup, tau, weights=None):
     return float((w * np.abs(tau + off) / setup.hand.torque_limits).max())
 
 
-@pytest.mark.parametrize("load", LOADS)
+@pytest.mark.parametrize('load', LOADS)
 def test_minmax_is_certified_and_optimal_against_a_force_space_lp(allegro, load):
     setup = dataclasses.replace(allegro, external_wrench=np.array(load, float),
-                                objective="min-max")
+                                objective='min-max')
     maps = setup.maps()
     sol = solve(setup, maps=maps)
-    assert sol.optimal and sol.objective == "min-max", sol.message
+    assert sol.optimal and sol.objective == 'min-max', sol.message
     assert_holds(setup, maps, sol.tau, sol.wrenches)
     best = lp_minmax(setup, maps)
     assert ratio(setup, sol.tau) <= best * (1 + 1e-6) + 1e-9
     assert ratio(setup, sol.tau) >= best * (1 - 1e-6) - 1e-9  # else the LP above is wrong
     assert sol.max_torque_ratio == pytest.approx(ratio(setup, sol.tau), rel=1e-12)
     # Among min-max optima it is the least effort, so never below the sum-of-squares optimum.
-    sos = solve(dataclasses.replace(setup, objective="sum-of-squares"), maps=maps)
+    sos = solve(dataclasses.replace(setup, objective='sum-of-squares'), maps=maps)
     assert sol.torque_norm >= sos.torque_norm - 1e-9
     assert ratio(setup, sos.tau) >= best * (1 - 1e-6) - 1e-9
 
@@ -45,7 +44,7 @@ def test_minmax_with_weights_and_a_torque_offset(allegro):
     weights = rng.uniform(0.5, 2.0, allegro.hand.m)
     offset = rng.uniform(-0.05, 0.05, allegro.hand.m)
     setup = dataclasses.replace(allegro, weights=weights, torque_offset=offset,
-                                objective="min-max",
+                                objective='min-max',
                                 external_wrench=np.array([-1.4715, 0, 0, 0, 0, 0]))
     maps = setup.maps()
     sol = solve(setup, maps=maps)
@@ -56,7 +55,7 @@ def test_minmax_with_weights_and_a_torque_offset(allegro):
 
 
 def test_minmax_on_the_planar_hand(planar):
-    setup = dataclasses.replace(planar, objective="min-max")
+    setup = dataclasses.replace(planar, objective='min-max')
     maps = setup.maps()
     sol = solve(setup, maps=maps)
     assert sol.optimal
@@ -64,35 +63,35 @@ def test_minmax_on_the_planar_hand(planar):
 
 
 def test_an_infeasible_load_is_infeasible_for_minmax_too(allegro):
-    setup = dataclasses.replace(allegro, objective="min-max",
+    setup = dataclasses.replace(allegro, objective='min-max',
                                 external_wrench=10 * allegro.external_wrench)
-    assert solve(setup).status == "infeasible"
+    assert solve(setup).status == 'infeasible'
 
 
 def test_the_objective_key_of_the_scenario(allegro_doc):
     doc = copy.deepcopy(allegro_doc)
-    doc["objective"] = {"type": "min-max"}
-    assert setup_from_doc(doc).objective == "min-max"
-    doc["objective"] = {"type": "minimax"}
-    with pytest.raises(InputError, match="objective.type: must be one of sum-of-squares, "
-                                         "min-max"):
+    doc['objective'] = {'type': 'min-max'}
+    assert setup_from_doc(doc).objective == 'min-max'
+    doc['objective'] = {'type': 'minimax'}
+    with pytest.raises(InputError, match='objective.type: must be one of sum-of-squares, '
+                                         'min-max'):
         parse_scenario(doc, CONFIG)
 
 
 def test_minmax_with_a_reference_method_is_refused(allegro):
-    with pytest.raises(InputError, match="objective.type: min-max is solved by the tau-qp"):
-        solve(dataclasses.replace(allegro, objective="min-max"), "socp")
+    with pytest.raises(InputError, match='objective.type: min-max is solved by the tau-qp'):
+        solve(dataclasses.replace(allegro, objective='min-max'), 'socp')
 
 
 def test_minmax_equals_an_independent_lp_on_random_grasps(allegro):
     from test_capacity import random_grasps
 
-    for setup in random_grasps(dataclasses.replace(allegro, objective="min-max"), 8, seed=12):
+    for setup in random_grasps(dataclasses.replace(allegro, objective='min-max'), 8, seed=12):
         maps = setup.maps()
         sol = solve(setup, maps=maps)
         best = lp_minmax(setup, maps)
         if best is None:
-            assert sol.status == "infeasible"
+            assert sol.status == 'infeasible'
             continue
         assert sol.optimal, sol.message
         assert_holds(setup, maps, sol.tau, sol.wrenches)
@@ -100,9 +99,11 @@ def test_minmax_equals_an_independent_lp_on_random_grasps(allegro):
 
 
 def test_the_min_max_lp_keeps_a_deadline(allegro):
-    """The min-max objective's LP runs before the QP in the node's cycle: on a 32-contact
+    """
+    The min-max objective's LP runs before the QP in the node's cycle: on a 32-contact
     grasp it took up to 175 ms here, past a 50 ms budget. Under a deadline it stops by it,
-    and none starts past it."""
+    and none starts past it.
+    """
     import time
 
     from grasp_torque_opt.core.scenario import ContactSpec
@@ -118,7 +119,7 @@ def test_the_min_max_lp_keeps_a_deadline(allegro):
                       big.weights)
     past = minmax_stage(qp, big.hand.torque_limits, big.weights,
                         deadline=time.perf_counter() - 1.0)
-    assert past.status == "failed" and "time budget spent" in past.message
+    assert past.status == 'failed' and 'time budget spent' in past.message
     t0 = time.perf_counter()
     minmax_stage(qp, big.hand.torque_limits, big.weights, deadline=t0 + 0.02)
     assert time.perf_counter() - t0 < 0.02 + 0.5

@@ -1,47 +1,48 @@
-"""Batch scoring: the batch's scores equal single solves, bad lines are named and skipped,
-and the process pool and a local Dask cluster give the serial answers."""
+"""
+Batch scoring: the batch's scores equal single solves, bad lines are named and skipped,
+and the process pool and a local Dask cluster give the serial answers.
+"""
 
 import copy
 import json
 
-import numpy as np
-import pytest
-import yaml
 from conftest import ALLEGRO
-
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.capacity import direction_capacities, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
-from grasp_torque_opt.methods.score import ScoreJob, merge, rank, score_batch
+from grasp_torque_opt.methods.score import merge, rank, score_batch, ScoreJob
+import numpy as np
+import pytest
+import yaml
 
-MOVED = {"joint_1.0": 0.12, "joint_13.0": 0.6}
+MOVED = {'joint_1.0': 0.12, 'joint_13.0': 0.6}
 GOOD = [
-    {"id": "as-is"},
-    {"id": "moved", "grasp": {"joint_positions": MOVED}},
-    {"id": "load", "gravity": None, "load": {"external_wrench": [0, 0.5, -1.0, 0, 0.01, 0]}},
-    {"id": "heavy", "object": {"mass": 1.5}},  # ten times the ball: infeasible
-    {"id": "margin", "friction": {"margin": 0.2}},
-    {"id": "minmax", "objective": {"type": "min-max"}},
-    {"id": "three", "grasp": {"contacts": [{"link": "link_3.0_tip",
-                                            "position": [0.0072, -0.0051, 0.0081]},
-                                           {"link": "link_7.0_tip",
-                                            "position": [0.0120, 0.0, -0.0011]},
-                                           {"link": "link_15.0_tip",
-                                            "position": [0.0072, -0.0052, 0.0081]}]}},
+    {'id': 'as-is'},
+    {'id': 'moved', 'grasp': {'joint_positions': MOVED}},
+    {'id': 'load', 'gravity': None, 'load': {'external_wrench': [0, 0.5, -1.0, 0, 0.01, 0]}},
+    {'id': 'heavy', 'object': {'mass': 1.5}},  # ten times the ball: infeasible
+    {'id': 'margin', 'friction': {'margin': 0.2}},
+    {'id': 'minmax', 'objective': {'type': 'min-max'}},
+    {'id': 'three', 'grasp': {'contacts': [{'link': 'link_3.0_tip',
+                                            'position': [0.0072, -0.0051, 0.0081]},
+                                           {'link': 'link_7.0_tip',
+                                            'position': [0.0120, 0.0, -0.0011]},
+                                           {'link': 'link_15.0_tip',
+                                            'position': [0.0072, -0.0052, 0.0081]}]}},
 ]
 BAD = [  # (line text, what the error must name)
-    ("{not json", "not valid JSON"),
-    ('["a list"]', "must be a JSON object"),
-    ('{"hand": {"urdf": "x.urdf"}}', "hand: unknown or fixed field"),
-    ('{"friction": {"mu_tangential": -1}}', "friction.mu_tangential: must be > 0"),
-    ('{"grasp": {"contacts": [{"link": "no_such_tip"}]}}', "grasp.contacts[0].link"),
-    ('{"grasp": {"joint_positions": {"joint_99": 0}}}', "grasp.joint_positions.joint_99"),
-    ('{"objective": {"weights": [1, 2]}}', "objective.weights"),
-    ('{"load": {"external_wrench": [NaN, 0, 0, 0, 0, 0]}}', "load.external_wrench[0]: must be "
-                                                             "finite"),
-    ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
-    ('{"grasp": {"contacts": []}}', "grasp.contacts: must be a non-empty list"),
-    ('{"object": {"mass": 1e400}}', "object.mass"),
+    ('{not json', 'not valid JSON'),
+    ('["a list"]', 'must be a JSON object'),
+    ('{"hand": {"urdf": "x.urdf"}}', 'hand: unknown or fixed field'),
+    ('{"friction": {"mu_tangential": -1}}', 'friction.mu_tangential: must be > 0'),
+    ('{"grasp": {"contacts": [{"link": "no_such_tip"}]}}', 'grasp.contacts[0].link'),
+    ('{"grasp": {"joint_positions": {"joint_99": 0}}}', 'grasp.joint_positions.joint_99'),
+    ('{"objective": {"weights": [1, 2]}}', 'objective.weights'),
+    ('{"load": {"external_wrench": [NaN, 0, 0, 0, 0, 0]}}', 'load.external_wrench[0]: must be '
+                                                             'finite'),
+    ('[' * 100_000 + ']' * 100_000, 'nested too deeply'),
+    ('{"grasp": {"contacts": []}}', 'grasp.contacts: must be a non-empty list'),
+    ('{"object": {"mass": 1e400}}', 'object.mass'),
 ]
 
 
@@ -58,86 +59,86 @@ def independent_merge(base, over):
     return out
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def job():
     return ScoreJob.from_file(ALLEGRO)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def lines():
     return [(i + 1, json.dumps(c)) for i, c in enumerate(GOOD)]
 
 
 def test_batch_scores_equal_single_solves(job, lines, tmp_path, allegro_doc):
-    records = score_batch(job, lines, engine="serial")
-    assert [r["id"] for r in records] == [c["id"] for c in GOOD]
+    records = score_batch(job, lines, engine='serial')
+    assert [r['id'] for r in records] == [c['id'] for c in GOOD]
     for cand, rec in zip(GOOD, records):
-        over = {k: v for k, v in cand.items() if k != "id"}
+        over = {k: v for k, v in cand.items() if k != 'id'}
         doc = independent_merge(allegro_doc, over)
         path = tmp_path / f"{cand['id']}.yaml"
-        doc["hand"]["urdf"] = allegro_doc["hand"]["urdf"]
+        doc['hand']['urdf'] = allegro_doc['hand']['urdf']
         path.write_text(yaml.safe_dump(doc))
         setup = GraspSetup.from_file(path)
         maps = setup.maps()
-        sol = solve(setup, maps=maps, backend="daqp")
-        assert rec["status"] == sol.status, cand["id"]
+        sol = solve(setup, maps=maps, backend='daqp')
+        assert rec['status'] == sol.status, cand['id']
         cap = load_capacity(setup, maps)
-        assert rec["capacity"] == pytest.approx(cap.value, rel=1e-9), cand["id"]
+        assert rec['capacity'] == pytest.approx(cap.value, rel=1e-9), cand['id']
         caps = direction_capacities(setup, maps)
         for k, c in caps.items():
-            assert rec["capacities"][k] == pytest.approx(c.value, rel=1e-9), (cand["id"], k)
+            assert rec['capacities'][k] == pytest.approx(c.value, rel=1e-9), (cand['id'], k)
         if sol.optimal:
-            assert rec["torque_norm"] == pytest.approx(sol.torque_norm, rel=1e-9)
-            assert rec["max_torque_ratio"] == pytest.approx(sol.max_torque_ratio, rel=1e-9)
-            np.testing.assert_allclose(rec["friction_usage"], sol.friction_usage, rtol=1e-9)
-            assert rec["holdable_fraction"] is None
+            assert rec['torque_norm'] == pytest.approx(sol.torque_norm, rel=1e-9)
+            assert rec['max_torque_ratio'] == pytest.approx(sol.max_torque_ratio, rel=1e-9)
+            np.testing.assert_allclose(rec['friction_usage'], sol.friction_usage, rtol=1e-9)
+            assert rec['holdable_fraction'] is None
         else:
-            assert rec["torque_norm"] is None and rec["holdable_fraction"] == rec["capacity"] < 1
-    by_id = {r["id"]: r for r in records}
-    assert by_id["heavy"]["status"] == "infeasible"
-    assert by_id["margin"]["friction_usage_max"] <= 1 / 1.2 + 1e-7
-    assert by_id["three"]["status"] == "optimal" and len(by_id["three"]["friction_usage"]) == 3
+            assert rec['torque_norm'] is None and rec['holdable_fraction'] == rec['capacity'] < 1
+    by_id = {r['id']: r for r in records}
+    assert by_id['heavy']['status'] == 'infeasible'
+    assert by_id['margin']['friction_usage_max'] <= 1 / 1.2 + 1e-7
+    assert by_id['three']['status'] == 'optimal' and len(by_id['three']['friction_usage']) == 3
 
 
 def test_bad_lines_name_line_and_field_and_the_batch_goes_on(job):
     texts = [json.dumps(GOOD[0])] + [t for t, _ in BAD] + [json.dumps(GOOD[1])]
-    records = score_batch(job, list(enumerate(texts, 1)), engine="serial")
+    records = score_batch(job, list(enumerate(texts, 1)), engine='serial')
     assert len(records) == len(texts)
-    assert records[0]["status"] == records[-1]["status"] == "optimal"
+    assert records[0]['status'] == records[-1]['status'] == 'optimal'
     for rec, (_, expected) in zip(records[1:-1], BAD):
-        assert rec["status"] == "error"
-        assert rec["error"].startswith(f"line {rec['line']}: "), rec["error"]
-        assert expected in rec["error"], rec["error"]
-        assert "\n" not in rec["error"]
+        assert rec['status'] == 'error'
+        assert rec['error'].startswith(f"line {rec['line']}: "), rec['error']
+        assert expected in rec['error'], rec['error']
+        assert '\n' not in rec['error']
 
 
 def test_merge_copies_only_what_changes():
-    base = {"a": {"b": 1, "c": [1, 2]}, "d": 2}
-    out = merge(base, {"a": {"b": 3}, "d": None})
-    assert out == {"a": {"b": 3, "c": [1, 2]}} and base == {"a": {"b": 1, "c": [1, 2]}, "d": 2}
+    base = {'a': {'b': 1, 'c': [1, 2]}, 'd': 2}
+    out = merge(base, {'a': {'b': 3}, 'd': None})
+    assert out == {'a': {'b': 3, 'c': [1, 2]}} and base == {'a': {'b': 1, 'c': [1, 2]}, 'd': 2}
 
 
 def test_ranking_puts_optimal_first_by_capacity(job, lines):
-    ranked = rank(score_batch(job, lines, engine="serial"))
-    caps = [r["capacity"] for r in ranked if r["status"] == "optimal"]
+    ranked = rank(score_batch(job, lines, engine='serial'))
+    caps = [r['capacity'] for r in ranked if r['status'] == 'optimal']
     assert caps == sorted(caps, reverse=True)
-    assert ranked[-1]["status"] == "infeasible"
+    assert ranked[-1]['status'] == 'infeasible'
 
 
 def test_the_process_pool_gives_the_serial_records(job, lines):
-    serial = score_batch(job, lines, engine="serial")
+    serial = score_batch(job, lines, engine='serial')
     seen = []
-    pooled = score_batch(job, lines, engine="processes", workers=2, chunk=2,
+    pooled = score_batch(job, lines, engine='processes', workers=2, chunk=2,
                          progress=lambda done, total: seen.append((done, total)))
-    drop = ("time_s", "solve_time_s")
+    drop = ('time_s', 'solve_time_s')
     assert [{k: v for k, v in r.items() if k not in drop} for r in pooled] == \
         [{k: v for k, v in r.items() if k not in drop} for r in serial]
     assert seen[-1] == (len(lines), len(lines))
 
 
 def test_a_local_dask_cluster_gives_the_serial_records(job, lines):
-    pytest.importorskip("distributed")
-    serial = score_batch(job, lines, engine="serial")
-    dask = score_batch(job, lines, engine="dask", workers=2, chunk=3)
-    assert [(r["id"], r["status"], r["capacity"], r["torque_norm"]) for r in dask] == \
-        [(r["id"], r["status"], r["capacity"], r["torque_norm"]) for r in serial]
+    pytest.importorskip('distributed')
+    serial = score_batch(job, lines, engine='serial')
+    dask = score_batch(job, lines, engine='dask', workers=2, chunk=3)
+    assert [(r['id'], r['status'], r['capacity'], r['torque_norm']) for r in dask] == \
+        [(r['id'], r['status'], r['capacity'], r['torque_norm']) for r in serial]

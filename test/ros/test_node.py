@@ -3,37 +3,36 @@
 import dataclasses
 import json
 import os
+from pathlib import Path
 import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
+from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
+from cycle_inputs import base_poses, joint_state, Slow
+from geometry_msgs.msg import PoseArray, WrenchStamped
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
 import numpy as np
 import pinocchio as pin
 import pytest
 import rclpy
-from conftest import ALLEGRO, ALLEGRO_URDF, PLANAR, ROOT
-from cycle_inputs import Slow, base_poses, joint_state
-from geometry_msgs.msg import PoseArray, WrenchStamped
 from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
-from rclpy.qos import ReliabilityPolicy, qos_profile_sensor_data
+from rclpy.qos import qos_profile_sensor_data, ReliabilityPolicy
 from ros_harness import DOMAIN, Harness
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker
 
-from grasp_torque_opt.core.exceptions import InputError
-from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.hand import resolve_urdf
-from grasp_torque_opt.methods.dispatch import solve
-from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
-
 # Each run on its own domain, heard only on this machine.
-os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 
 
 @pytest.fixture
@@ -55,19 +54,19 @@ def test_published_torques_are_the_cores_solution(planar_node, planar):
     # The same state, joints shuffled and an extra joint with NaN: the same torques.
     names, pos = joint_state(planar, q)
     order = [2, 0, 3, 1]
-    planar_node.send_joint_state([names[i] for i in order] + ["wrist"],
-                                 [pos[i] for i in order] + [float("nan")])
+    planar_node.send_joint_state([names[i] for i in order] + ['wrist'],
+                                 [pos[i] for i in order] + [float('nan')])
     np.testing.assert_allclose(planar_node.next_command(), cmd, atol=1e-12)
     # Arrows for RViz: one per contact, from the contact point.
     assert planar_node.spin_until(lambda: any(len(m.markers) == 3
                                               for m in planar_node.markers), 2.0)
     arrows = [m for m in planar_node.markers[-1].markers if m.action == Marker.ADD]
-    assert len(arrows) == 2 and arrows[0].header.frame_id == "palm"
+    assert len(arrows) == 2 and arrows[0].header.frame_id == 'palm'
     # They vanish if the node dies: a finite lifetime of three marker periods (0.1 s).
     assert all(Duration.from_msg(m.lifetime).nanoseconds == 300_000_000 for m in arrows)
     # Diagnostics name the hand of the URDF.
     assert planar_node.spin_until(lambda: planar_node.diagnostics, 2.0)
-    assert planar_node.diagnostics[-1]["_hardware_id"] == planar.hand.model.name
+    assert planar_node.diagnostics[-1]['_hardware_id'] == planar.hand.model.name
     maps = dataclasses.replace(planar, q=q).maps()
     start = arrows[0].points[0]
     np.testing.assert_allclose([start.x, start.y, start.z], maps.contacts[0].position,
@@ -82,10 +81,10 @@ def test_service_returns_the_cli_json(planar_node, planar):
     res = future.result()
     assert res.success, res.message
     d = json.loads(res.message)
-    assert {"status", "method", "joints", "tau", "torque_norm", "solve_time_s", "certificate",
-            "contacts"} <= set(d)
-    assert d["status"] == "optimal" and d["joints"] == planar.hand.joints
-    np.testing.assert_allclose(d["command"], cmd, atol=1e-12)
+    assert {'status', 'method', 'joints', 'tau', 'torque_norm', 'solve_time_s', 'certificate',
+            'contacts'} <= set(d)
+    assert d['status'] == 'optimal' and d['joints'] == planar.hand.joints
+    np.testing.assert_allclose(d['command'], cmd, atol=1e-12)
     # Many calls while the loop runs: each answered, the loop keeps publishing.
     futures = [planar_node.solve_client.call_async(Trigger.Request()) for _ in range(20)]
     n = len(planar_node.commands)
@@ -101,28 +100,28 @@ def test_service_says_why_without_inputs(planar_node):
     future = planar_node.solve_client.call_async(Trigger.Request())
     assert planar_node.spin_until(future.done, 5.0)
     assert not future.result().success
-    assert future.result().message == "cannot solve: no joint state yet"
+    assert future.result().message == 'cannot solve: no joint state yet'
 
 
-@pytest.mark.parametrize("name,value,reason", [
-    ("torque_limits", [1.0, 2.0], "torque_limits: must have 4 entries, got 2"),
-    ("torque_limits", [1.0, -2.0, 1.0, 1.0], "torque_limits: every entry must be > 0"),
-    ("polygon_sides", 2, "polygon_sides"),
-    ("fault_policy", "explode", "fault_policy: must be one of hold, zero"),
-    ("mu_tangential", 0.0, "mu_tangential"),
-    ("joints", ["joint1"], "read-only parameter: joints"),
+@pytest.mark.parametrize('name,value,reason', [
+    ('torque_limits', [1.0, 2.0], 'torque_limits: must have 4 entries, got 2'),
+    ('torque_limits', [1.0, -2.0, 1.0, 1.0], 'torque_limits: every entry must be > 0'),
+    ('polygon_sides', 2, 'polygon_sides'),
+    ('fault_policy', 'explode', 'fault_policy: must be one of hold, zero'),
+    ('mu_tangential', 0.0, 'mu_tangential'),
+    ('joints', ['joint1'], 'read-only parameter: joints'),
     # The issue's freeze: accepted as in range, they let one solve run for minutes.
-    ("solver.max_iter", 100000, "solver.max_iter"),
-    ("solver.max_iter_in", 100000, "solver.max_iter_in"),
-    ("weights", [1e-12, 1e12, 1e-12, 1e12], "weights: every entry must be in [1e-06, 1e+06]"),
-    ("weights", [1e-4, 1e3, 1.0, 1.0], "weights: the largest entry may be at most 1e+06 times "
-     "the smallest, got 1e+07"),
-    ("cycle_budget", 10.0, "cycle_budget"),
+    ('solver.max_iter', 100000, 'solver.max_iter'),
+    ('solver.max_iter_in', 100000, 'solver.max_iter_in'),
+    ('weights', [1e-12, 1e12, 1e-12, 1e12], 'weights: every entry must be in [1e-06, 1e+06]'),
+    ('weights', [1e-4, 1e3, 1.0, 1.0], 'weights: the largest entry may be at most 1e+06 times '
+     'the smallest, got 1e+07'),
+    ('cycle_budget', 10.0, 'cycle_budget'),
     # Unbounded limits: 1e6 and 1e300 N m were accepted (URDF effort limits 10, 5, 10, 5).
-    ("torque_limits", [1e6, 1.0, 1.0, 1.0], "torque_limits: 1e+06 N m for joint 'joint1' "
+    ('torque_limits', [1e6, 1.0, 1.0, 1.0], "torque_limits: 1e+06 N m for joint 'joint1' "
      "exceeds the URDF effort limit (10 N m); set torque_limits_above_urdf"),
-    ("torque_limits", [1.0, 1.0, 1.0, 1e300], "exceeds the URDF effort limit (5 N m)"),
-    ("torque_limits", [10.0, 5.0, 10.0, 5.1], "joint 'joint4'"),
+    ('torque_limits', [1.0, 1.0, 1.0, 1e300], 'exceeds the URDF effort limit (5 N m)'),
+    ('torque_limits', [10.0, 5.0, 10.0, 5.1], "joint 'joint4'"),
 ])
 def test_bad_parameter_is_refused_with_its_reason(planar_node, name, value, reason):
     before = planar_node.node.get_parameter(name).value
@@ -137,7 +136,7 @@ def test_good_parameter_change_takes_effect(planar_node, planar):
     free = planar_node.next_command()
     fmin = 1.5 * float(np.max(solve(planar).wrenches[:, 2]))
     assert planar_node.node.set_parameters(
-        [Parameter("min_normal_force", value=fmin)])[0].successful
+        [Parameter('min_normal_force', value=fmin)])[0].successful
     planar_node.send_joint_state(*joint_state(planar))
     squeezed = planar_node.next_command()
     ref = solve(dataclasses.replace(planar, friction=dataclasses.replace(
@@ -148,10 +147,10 @@ def test_good_parameter_change_takes_effect(planar_node, planar):
 
 def malformed_joint_states(setup):
     names, pos = joint_state(setup)
-    yield "length", names, pos[:-1], "4 names but 3 positions"
-    yield "duplicate", names[:3] + names[:1], pos, "duplicate joint name 'joint1'"
-    yield "missing", names[:3] + ["other"], pos, "missing commanded joint(s) joint4"
-    yield "nan", names, [pos[0], float("nan")] + pos[2:], "position of 'joint2' is not finite"
+    yield 'length', names, pos[:-1], '4 names but 3 positions'
+    yield 'duplicate', names[:3] + names[:1], pos, "duplicate joint name 'joint1'"
+    yield 'missing', names[:3] + ['other'], pos, 'missing commanded joint(s) joint4'
+    yield 'nan', names, [pos[0], float('nan')] + pos[2:], "position of 'joint2' is not finite"
 
 
 def test_malformed_inputs_give_no_command_and_a_diagnostic(planar_node, planar):
@@ -160,26 +159,26 @@ def test_malformed_inputs_give_no_command_and_a_diagnostic(planar_node, planar):
         planar_node.send_joint_state(names, pos)
         assert planar_node.spin_until(
             lambda: planar_node.diagnostics and
-            planar_node.diagnostics[-1]["last_rejection"] == f"joint_states: {reason}", 2.0), \
+            planar_node.diagnostics[-1]['last_rejection'] == f'joint_states: {reason}', 2.0), \
             reason
         assert len(planar_node.commands) == n
-    assert planar_node.diagnostics[-1]["rejected.joint_states"] == "4"
+    assert planar_node.diagnostics[-1]['rejected.joint_states'] == '4'
     pos, quat = base_poses(planar)
-    bad_contacts = [("palm", pos, quat * 1.1, "contacts.poses[0].orientation: is not a unit "
-                     "quaternion"),
-                    ("finger9", pos, quat, "contacts.header.frame_id: unknown frame "
+    bad_contacts = [('palm', pos, quat * 1.1, 'contacts.poses[0].orientation: is not a unit '
+                     'quaternion'),
+                    ('finger9', pos, quat, "contacts.header.frame_id: unknown frame "
                      "'finger9'"),
-                    ("palm", pos[:1], quat[:1], "contacts: 1 poses for 2 contacts")]
+                    ('palm', pos[:1], quat[:1], 'contacts: 1 poses for 2 contacts')]
     for frame, p, q, reason in bad_contacts:
         planar_node.send_contacts(frame, p, q)
         assert planar_node.spin_until(
             lambda: planar_node.diagnostics and
-            planar_node.diagnostics[-1]["last_rejection"].startswith(reason), 2.0), reason
+            planar_node.diagnostics[-1]['last_rejection'].startswith(reason), 2.0), reason
     assert planar_node.commands == []  # rejected inputs never triggered a command
     # The bad contacts were not used: a good joint state gives the default grasp's torques.
     planar_node.send_joint_state(*joint_state(planar))
     np.testing.assert_allclose(planar_node.next_command(), solve(planar).tau, atol=1e-9)
-    assert planar_node.diagnostics[-1]["rejected.contacts"] == "3"
+    assert planar_node.diagnostics[-1]['rejected.contacts'] == '3'
 
 
 def test_stale_contacts_stop_commands_within_timeout_plus_one_cycle(planar):
@@ -187,7 +186,7 @@ def test_stale_contacts_stop_commands_within_timeout_plus_one_cycle(planar):
     h = Harness(PLANAR, contacts_timeout=timeout, joint_state_timeout=1.0)
     try:
         pos, quat = base_poses(planar)
-        h.send_contacts("palm", pos, quat)
+        h.send_contacts('palm', pos, quat)
         h.spin_for(0.05)
         t_contacts = time.monotonic()
         end = t_contacts + 0.6
@@ -198,13 +197,13 @@ def test_stale_contacts_stop_commands_within_timeout_plus_one_cycle(planar):
         assert len([t for t in times if t <= t_contacts + timeout]) >= 3
         # 30 ms for delivery and scheduling on a loaded 2-core machine.
         assert max(times) <= t_contacts + timeout + period + 0.03
-        assert "contacts stale" in h.diagnostics[-1]["fault"]
+        assert 'contacts stale' in h.diagnostics[-1]['fault']
     finally:
         h.close()
 
 
 def test_stale_joint_states_apply_the_zero_policy(planar):
-    h = Harness(PLANAR, joint_state_timeout=0.05, hold_time=0.05, fault_policy="zero")
+    h = Harness(PLANAR, joint_state_timeout=0.05, hold_time=0.05, fault_policy='zero')
     try:
         h.send_joint_state(*joint_state(planar))
         first = h.next_command()
@@ -212,7 +211,7 @@ def test_stale_joint_states_apply_the_zero_policy(planar):
         zero = h.next_command(1.0)
         assert zero is not None and np.all(zero == 0.0)
         assert h.spin_until(lambda: h.diagnostics and
-                            h.diagnostics[-1]["_message"].startswith("zero torques"), 2.0)
+                            h.diagnostics[-1]['_message'].startswith('zero torques'), 2.0)
     finally:
         h.close()
 
@@ -225,7 +224,7 @@ def test_gravity_compensation_adds_g_of_q(allegro):
         q[allegro.hand.idx_q[5]] += 0.05
         h.send_joint_state(*joint_state(allegro, q))
         cmd = h.next_command()
-        model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path("."))))
+        model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path('.'))))
         model.gravity.linear = np.array(gravity)
         g = pin.computeGeneralizedGravity(model, model.createData(), q)[allegro.hand.idx_v]
         ref = solve(dataclasses.replace(GraspSetup.from_file(ALLEGRO), q=q, torque_offset=g))
@@ -240,34 +239,34 @@ def test_qos_of_every_endpoint(planar_node):
     t = planar_node.tester
 
     def mine(infos):
-        return [i for i in infos if i.node_name == "grasp_torque_node"]
+        return [i for i in infos if i.node_name == 'grasp_torque_node']
 
-    for topic in ("/joint_states", "/contacts", "/external_wrench"):
+    for topic in ('/joint_states', '/contacts', '/external_wrench'):
         (sub,) = mine(t.get_subscriptions_info_by_topic(topic))
         assert sub.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT, topic
-        assert str(sub.topic_type).startswith(("sensor_msgs", "geometry_msgs"))
-    (cmd,) = mine(t.get_publishers_info_by_topic("/effort_commands"))
+        assert str(sub.topic_type).startswith(('sensor_msgs', 'geometry_msgs'))
+    (cmd,) = mine(t.get_publishers_info_by_topic('/effort_commands'))
     assert cmd.qos_profile.reliability == ReliabilityPolicy.RELIABLE
-    assert cmd.topic_type == "std_msgs/msg/Float64MultiArray"
-    (diag,) = mine(t.get_publishers_info_by_topic("/diagnostics"))
+    assert cmd.topic_type == 'std_msgs/msg/Float64MultiArray'
+    (diag,) = mine(t.get_publishers_info_by_topic('/diagnostics'))
     assert diag.qos_profile.reliability == ReliabilityPolicy.RELIABLE
-    (mk,) = mine(t.get_publishers_info_by_topic("/grasp_torque_node/contact_wrenches"))
-    assert mk.topic_type == "visualization_msgs/msg/MarkerArray"
+    (mk,) = mine(t.get_publishers_info_by_topic('/grasp_torque_node/contact_wrenches'))
+    assert mk.topic_type == 'visualization_msgs/msg/MarkerArray'
     services = dict(t.get_service_names_and_types())
-    assert services["/grasp_torque_node/solve"] == ["std_srvs/srv/Trigger"]
+    assert services['/grasp_torque_node/solve'] == ['std_srvs/srv/Trigger']
 
 
 def test_the_docs_document_every_parameter():
     from grasp_torque_opt.ros.node import PARAMETERS
 
-    readme = "".join(p.read_text() for p in [ROOT / "README.md", *sorted(ROOT.glob("docs/*.md"))])
+    readme = ''.join(p.read_text() for p in [ROOT / 'README.md', *sorted(ROOT.glob('docs/*.md'))])
     for name in PARAMETERS:
-        assert f"| `{name}` |" in readme, name
+        assert f'| `{name}` |' in readme, name
 
 
-@pytest.mark.parametrize("as_path", [False, True])
+@pytest.mark.parametrize('as_path', [False, True])
 def test_robot_description_gives_the_hand(planar, as_path):
-    urdf = PLANAR.parent.parent / "urdf" / "planar_two_finger.urdf"
+    urdf = PLANAR.parent.parent / 'urdf' / 'planar_two_finger.urdf'
     h = Harness(PLANAR, robot_description=str(urdf) if as_path else urdf.read_text())
     try:
         h.send_joint_state(*joint_state(planar))
@@ -280,12 +279,12 @@ def test_startup_errors_name_the_parameter():
     ctx = rclpy.Context()
     rclpy.init(context=ctx, domain_id=DOMAIN)
     try:
-        with pytest.raises(InputError, match="^scenario: parameter not set"):
+        with pytest.raises(InputError, match='^scenario: parameter not set'):
             GraspTorqueNode(context=ctx)
-        with pytest.raises(InputError, match="^torque_limits: must have 4 entries, got 1"):
+        with pytest.raises(InputError, match='^torque_limits: must have 4 entries, got 1'):
             GraspTorqueNode(context=ctx, parameter_overrides=[
-                Parameter("scenario", value=str(PLANAR)),
-                Parameter("torque_limits", value=[1.0])])
+                Parameter('scenario', value=str(PLANAR)),
+                Parameter('torque_limits', value=[1.0])])
     finally:
         rclpy.try_shutdown(context=ctx)
 
@@ -294,10 +293,10 @@ def test_stamped_command_carries_the_joint_states_stamp(planar):
     h = Harness(PLANAR, publish_stamped_command=True)
     try:
         stamped = []
-        h.tester.create_subscription(JointState, "grasp_torque_node/effort_commands_stamped",
+        h.tester.create_subscription(JointState, 'grasp_torque_node/effort_commands_stamped',
                                      stamped.append, COMMAND_QOS)
         h.spin_until(lambda: h.node.count_subscribers(
-            "grasp_torque_node/effort_commands_stamped") > 0, 5.0)
+            'grasp_torque_node/effort_commands_stamped') > 0, 5.0)
         msg = JointState(name=list(planar.hand.joints),
                          position=[float(planar.q[i]) for i in planar.hand.idx_q])
         msg.header.stamp.sec, msg.header.stamp.nanosec = 1234, 5678
@@ -312,7 +311,7 @@ def test_stamped_command_carries_the_joint_states_stamp(planar):
 
 
 def test_stopping_applies_the_policy_in_process(planar):
-    for policy, expect_zero in (("zero", True), ("hold", False)):
+    for policy, expect_zero in (('zero', True), ('hold', False)):
         # Long timeouts: the only zero command can come from the stop.
         h = Harness(PLANAR, fault_policy=policy, joint_state_timeout=5.0, hold_time=5.0)
         try:
@@ -329,26 +328,28 @@ def test_stopping_applies_the_policy_in_process(planar):
             h.close()
 
 
-@pytest.mark.parametrize("sig,executor", [(signal.SIGINT, "single"), (signal.SIGTERM, "single"),
-                                          (signal.SIGINT, "events")])
+@pytest.mark.parametrize('sig,executor', [(signal.SIGINT, 'single'), (signal.SIGTERM, 'single'),
+                                          (signal.SIGINT, 'events')])
 def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig, executor):
-    """grasp_torque_node as users run it (either executor): it answers joint states, a signal
-    stops it, and with fault_policy zero the effort controller is left with zero torques."""
-    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
-    child = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--executor",
-                              executor, "--ros-args",
-                              "-p", f"scenario:={PLANAR}", "-p", "fault_policy:=zero",
-                              "-p", "joint_state_timeout:=5.0", "-p", "hold_time:=5.0"],
+    """
+    grasp_torque_node as users run it (either executor): it answers joint states, a signal
+    stops it, and with fault_policy zero the effort controller is left with zero torques.
+    """
+    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node', '--executor',
+                              executor, '--ros-args',
+                              '-p', f'scenario:={PLANAR}', '-p', 'fault_policy:=zero',
+                              '-p', 'joint_state_timeout:=5.0', '-p', 'hold_time:=5.0'],
                              env=env, stderr=subprocess.PIPE, text=True)
     ctx = rclpy.Context()
     rclpy.init(context=ctx, domain_id=DOMAIN)
-    tester = rclpy.create_node("stop_tester", context=ctx)
+    tester = rclpy.create_node('stop_tester', context=ctx)
     executor = SingleThreadedExecutor(context=ctx)
     executor.add_node(tester)
     commands = []
-    tester.create_subscription(Float64MultiArray, "effort_commands",
+    tester.create_subscription(Float64MultiArray, 'effort_commands',
                                lambda m: commands.append(np.array(m.data)), COMMAND_QOS)
-    pub = tester.create_publisher(JointState, "joint_states", qos_profile_sensor_data)
+    pub = tester.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
 
     def spin_until(pred, timeout):
         end = time.monotonic() + timeout
@@ -373,8 +374,8 @@ def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, si
         # stderr while waiting, so a chatty child cannot block on a full pipe.
         _, err = child.communicate(timeout=10)
         assert child.returncode == 0, err
-        assert "Traceback" not in err, err
-        assert "stopped: zero torques published" in err, err
+        assert 'Traceback' not in err, err
+        assert 'stopped: zero torques published' in err, err
     finally:
         if child.poll() is None:
             child.kill()
@@ -383,7 +384,7 @@ def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, si
         rclpy.try_shutdown(context=ctx)
 
 
-@pytest.mark.parametrize("backend", ["daqp", "quadprog"])
+@pytest.mark.parametrize('backend', ['daqp', 'quadprog'])
 def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, backend):
     h = Harness(ALLEGRO)
     try:
@@ -392,23 +393,25 @@ def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, ba
         h.send_joint_state(names, positions)
         before = h.next_command(5.0)
         assert before is not None
-        assert h.node.set_parameters([Parameter("solver.backend", value=backend)])[0].successful
+        assert h.node.set_parameters([Parameter('solver.backend', value=backend)])[0].successful
         assert h.node.controller.solver.name == backend
         h.send_joint_state(names, positions)
         after = h.next_command(5.0)
         assert after is not None
         np.testing.assert_allclose(after, before, atol=1e-6)
-        refused = h.node.set_parameters([Parameter("solver.backend", value="osqp")])[0]
-        assert not refused.successful and "solver.backend" in refused.reason
+        refused = h.node.set_parameters([Parameter('solver.backend', value='osqp')])[0]
+        assert not refused.successful and 'solver.backend' in refused.reason
     finally:
         h.close()
 
 
 def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegro):
-    """Hold policy, 0.63 N m in force, torque_limits lowered to 0.2 N m (unholdable): zeros
+    """
+    Hold policy, 0.63 N m in force, torque_limits lowered to 0.2 N m (unholdable): zeros
     reach the effort controller at once, without another joint state; before, nothing new
-    was published and the controller kept 0.63 N m forever."""
-    h = Harness(ALLEGRO, fault_policy="hold", hold_time=10.0, joint_state_timeout=10.0)
+    was published and the controller kept 0.63 N m forever.
+    """
+    h = Harness(ALLEGRO, fault_policy='hold', hold_time=10.0, joint_state_timeout=10.0)
     try:
         w = WrenchStamped()
         w.wrench.force.x = float(allegro.external_wrench[0] * 6.2)
@@ -418,7 +421,7 @@ def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegr
         cmd = h.next_command()
         assert cmd is not None and np.abs(cmd).max() > 0.6
         n = len(h.commands)
-        assert h.node.set_parameters([Parameter("torque_limits", value=[0.2] * 16)])[0].successful
+        assert h.node.set_parameters([Parameter('torque_limits', value=[0.2] * 16)])[0].successful
         assert h.spin_until(lambda: len(h.commands) > n, 2.0)
         assert np.all(h.commands[-1][1] == 0.0) and len(h.commands) == n + 1
     finally:
@@ -429,9 +432,9 @@ def test_limits_above_the_urdf_only_when_allowed_at_start(planar):
     h = Harness(PLANAR, torque_limits_above_urdf=True)
     try:
         node = h.node
-        assert node.set_parameters([Parameter("torque_limits", value=[20.0] * 4)])[0].successful
-        refused = node.set_parameters([Parameter("torque_limits", value=[2e4] * 4)])[0]
-        assert not refused.successful and "exceeds the largest limit accepted (10000 N m)" in \
+        assert node.set_parameters([Parameter('torque_limits', value=[20.0] * 4)])[0].successful
+        refused = node.set_parameters([Parameter('torque_limits', value=[2e4] * 4)])[0]
+        assert not refused.successful and 'exceeds the largest limit accepted (10000 N m)' in \
             refused.reason
         h.send_joint_state(*joint_state(planar))
         assert h.next_command() is not None
@@ -440,16 +443,18 @@ def test_limits_above_the_urdf_only_when_allowed_at_start(planar):
 
 
 def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothing(planar):
-    """Inputs are aged from the middleware's receipt, not from the callback: a joint state
+    """
+    Inputs are aged from the middleware's receipt, not from the callback: a joint state
     that waited 0.3 s for the executor (timeout 0.1 s) is stale when its callback runs. Before,
-    a flood or a slow cycle let commands leave 165 ms after their joint state."""
+    a flood or a slow cycle let commands leave 165 ms after their joint state.
+    """
     h = Harness(PLANAR, joint_state_timeout=0.1, hold_time=10.0)
     try:
         h.send_joint_state(*joint_state(planar))
         time.sleep(0.3)  # the executor is busy elsewhere: the message waits in the queue
         h.spin_for(0.3)
         assert h.commands == []
-        assert h.node.controller.fault.startswith("joint_states stale")
+        assert h.node.controller.fault.startswith('joint_states stale')
         h.send_joint_state(*joint_state(planar))
         assert h.next_command() is not None  # taken at once: fresh
     finally:
@@ -457,17 +462,19 @@ def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothin
 
 
 def test_an_oversized_message_is_rejected_before_it_is_deserialized(planar):
-    """20000 poses (1.1 MB) on contacts: refused by its serialized length. Deserializing
-    10^5 poses took 0.8 s here, and a flood of them cut the command rate from 200 to 38 Hz."""
+    """
+    20000 poses (1.1 MB) on contacts: refused by its serialized length. Deserializing
+    10^5 poses took 0.8 s here, and a flood of them cut the command rate from 200 to 38 Hz.
+    """
     from geometry_msgs.msg import Pose
 
     h = Harness(PLANAR)
     try:
         big = PoseArray(poses=[Pose() for _ in range(20000)])
         h.contacts_pub.publish(big)
-        assert h.spin_until(lambda: h.node.controller.counters.rejected["contacts"] == 1, 5.0)
+        assert h.spin_until(lambda: h.node.controller.counters.rejected['contacts'] == 1, 5.0)
         assert h.node.controller.last_rejection == \
-            "contacts: 1120028 bytes serialized, more than max_message_bytes (65536)"
+            'contacts: 1120028 bytes serialized, more than max_message_bytes (65536)'
         h.send_joint_state(*joint_state(planar))  # the loop goes on
         np.testing.assert_allclose(h.next_command(), solve(planar).tau, atol=1e-9)
     finally:
@@ -475,17 +482,18 @@ def test_an_oversized_message_is_rejected_before_it_is_deserialized(planar):
 
 
 def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
-    """300 concurrent ~/solve calls: each answered, solved or "busy" (before, beyond the 100
+    """
+    300 concurrent ~/solve calls: each answered, solved or "busy" (before, beyond the 100
     queued requests the rest never were, silently: 872 to 900 of 1000). With solves slower
     than the calls come, at most MAX_PENDING_SOLVES are queued and the rest are "busy", and
-    the control loop goes on meanwhile."""
-    from rclpy.qos import HistoryPolicy, QoSProfile
-
+    the control loop goes on meanwhile.
+    """
     from grasp_torque_opt.ros import node as node_module
+    from rclpy.qos import HistoryPolicy, QoSProfile
 
     h = Harness(PLANAR, joint_state_timeout=10.0)
     try:
-        client = h.tester.create_client(Trigger, "grasp_torque_node/solve", qos_profile=QoSProfile(
+        client = h.tester.create_client(Trigger, 'grasp_torque_node/solve', qos_profile=QoSProfile(
             history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
         assert h.spin_until(client.service_is_ready, 5.0)
         h.send_joint_state(*joint_state(planar))
@@ -496,14 +504,14 @@ def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
             assert h.spin_until(lambda: all(f.done() for f in futures), 30.0), \
                 sum(f.done() for f in futures)
             answers = [f.result() for f in futures]
-            busy = [a for a in answers if a.message.startswith("busy: ")]
-            assert all(a.success for a in answers if not a.message.startswith("busy: "))
+            busy = [a for a in answers if a.message.startswith('busy: ')]
+            assert all(a.success for a in answers if not a.message.startswith('busy: '))
             assert all(not a.success for a in busy)
             return len(answers) - len(busy), len(busy)
 
         solved, _ = flood(300)
         assert solved >= node_module.MAX_PENDING_SOLVES
-        monkeypatch.setattr(node_module, "MAX_PENDING_SOLVES", 4)
+        monkeypatch.setattr(node_module, 'MAX_PENDING_SOLVES', 4)
         h.node._service_controller.solver = Slow(0.05)
         n = len(h.commands)
         futures = [client.call_async(Trigger.Request()) for _ in range(20)]
@@ -513,20 +521,22 @@ def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
         assert len(h.commands) - n >= 5
         assert h.spin_until(lambda: all(f.done() for f in futures), 30.0)
         answers = [f.result() for f in futures]
-        busy = [a for a in answers if a.message.startswith("busy: 4 solves queued")]
+        busy = [a for a in answers if a.message.startswith('busy: 4 solves queued')]
         assert busy and all(a.success for a in answers if a not in busy)
     finally:
         h.close()
 
 
 def test_a_second_node_of_the_same_name_refuses_to_run(planar):
-    """Two grasp_torque_nodes on one domain both drove effort_commands, and parameter reads
+    """
+    Two grasp_torque_nodes on one domain both drove effort_commands, and parameter reads
     and writes went to either. One already running: a second one started exits with code 2
-    and one line naming the other, before it takes any input; the first reports it."""
+    and one line naming the other, before it takes any input; the first reports it.
+    """
     first = Harness(PLANAR)
-    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
-    second = subprocess.Popen([sys.executable, "-m", "grasp_torque_opt.ros.node", "--ros-args",
-                               "-p", f"scenario:={PLANAR}", "-p", "startup_check_time:=10.0"],
+    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    second = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node', '--ros-args',
+                               '-p', f'scenario:={PLANAR}', '-p', 'startup_check_time:=10.0'],
                               env=env, stderr=subprocess.PIPE, text=True)
     try:
         first.send_joint_state(*joint_state(planar))
@@ -536,11 +546,11 @@ def test_a_second_node_of_the_same_name_refuses_to_run(planar):
             first.spin_for(0.1)
         assert second.returncode == 2
         err = second.stderr.read()
-        lines = [line for line in err.splitlines() if "error" in line]
-        assert lines == ["grasp_torque_node: error: another node named /grasp_torque_node is on "
-                         f"this domain (ROS_DOMAIN_ID {DOMAIN}): refusing to run, as both would "
-                         "drive effort_commands (stop it, or give this one another name with "
-                         "--ros-args -r __node:=NAME)"], err
+        lines = [line for line in err.splitlines() if 'error' in line]
+        assert lines == ['grasp_torque_node: error: another node named /grasp_torque_node is on '
+                         f'this domain (ROS_DOMAIN_ID {DOMAIN}): refusing to run, as both would '
+                         'drive effort_commands (stop it, or give this one another name with '
+                         '--ros-args -r __node:=NAME)'], err
         first.send_joint_state(*joint_state(planar))  # the first goes on
         assert first.next_command() is not None
     finally:
@@ -552,13 +562,13 @@ def test_a_second_node_of_the_same_name_refuses_to_run(planar):
 def test_a_running_node_reports_another_of_its_name(planar):
     h = Harness(PLANAR)
     other = GraspTorqueNode(context=h.context,
-                            parameter_overrides=[Parameter("scenario", value=str(PLANAR))])
+                            parameter_overrides=[Parameter('scenario', value=str(PLANAR))])
     try:
         assert h.spin_until(lambda: h.diagnostics and
-                            h.diagnostics[-1].get("duplicate_nodes") == "1", 5.0)
+                            h.diagnostics[-1].get('duplicate_nodes') == '1', 5.0)
         d = h.diagnostics[-1]
-        assert d["_level"] == 2 and d["_message"].startswith(
-            "another node named /grasp_torque_node is on this domain; ")
+        assert d['_level'] == 2 and d['_message'].startswith(
+            'another node named /grasp_torque_node is on this domain; ')
     finally:
         other.destroy_node()
         h.close()

@@ -3,14 +3,13 @@
 import dataclasses
 import json
 
-import numpy as np
 from conftest import ALLEGRO
 from cycle_inputs import joint_state
+from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
 from rclpy.parameter import Parameter
 from ros_harness import Harness
 from std_srvs.srv import Trigger
-
-from grasp_torque_opt.methods.dispatch import solve
 
 
 def test_the_adaptive_method_commands_the_exact_optimum_and_reports_its_bounds(allegro):
@@ -21,11 +20,11 @@ def test_the_adaptive_method_commands_the_exact_optimum_and_reports_its_bounds(a
         q = q.copy()
         q[allegro.hand.idx_q] += 1e-3 * (k % 2 - 0.5)
         qs.append(q)
-        exact.append(solve(dataclasses.replace(allegro, q=q), "socp").torque_norm)
+        exact.append(solve(dataclasses.replace(allegro, q=q), 'socp').torque_norm)
     polygon = solve(dataclasses.replace(allegro, q=q)).tau
-    h = Harness(ALLEGRO, solver__method="tau-qp-adaptive")
+    h = Harness(ALLEGRO, solver__method='tau-qp-adaptive')
     try:
-        assert h.node.controller.config.method == "tau-qp-adaptive"
+        assert h.node.controller.config.method == 'tau-qp-adaptive'
         for q, e in zip(qs, exact):  # warm across cycles (solver.warm_start's default)
             h.send_joint_state(*joint_state(allegro, q))
             cmd = h.next_command(5.0)
@@ -39,14 +38,14 @@ def test_the_adaptive_method_commands_the_exact_optimum_and_reports_its_bounds(a
         assert h.spin_until(future.done, 5.0)
         assert future.result().success, future.result().message
         d = json.loads(future.result().message)
-        assert d["method"] == "tau-qp-adaptive" and d["status"] == "optimal"
-        b = d["bounds"]
-        assert b["converged"] and b["lower"] <= e * (1 + 1e-8) <= b["upper"] * (1 + 1e-8)
+        assert d['method'] == 'tau-qp-adaptive' and d['status'] == 'optimal'
+        b = d['bounds']
+        assert b['converged'] and b['lower'] <= e * (1 + 1e-8) <= b['upper'] * (1 + 1e-8)
         # Back to the paper's polygon at run time; a method the node does not run is refused.
-        assert h.node.set_parameters([Parameter("solver.method", value="tau-qp")])[0].successful
+        assert h.node.set_parameters([Parameter('solver.method', value='tau-qp')])[0].successful
         h.send_joint_state(*joint_state(allegro, q))
         np.testing.assert_allclose(h.next_command(5.0), polygon, atol=1e-6)
-        refused = h.node.set_parameters([Parameter("solver.method", value="socp")])[0]
-        assert not refused.successful and "solver.method: must be one of" in refused.reason
+        refused = h.node.set_parameters([Parameter('solver.method', value='socp')])[0]
+        assert not refused.successful and 'solver.method: must be one of' in refused.reason
     finally:
         h.close()

@@ -1,32 +1,31 @@
 """The bundled params files apply under any node name and namespace (keyed /**:)."""
 
+from conftest import CONFIG
+from grasp_torque_opt.ros.node import GraspTorqueNode
 import pytest
 import rclpy
-import yaml
-from conftest import CONFIG
 from ros_harness import DOMAIN
+import yaml
 
-from grasp_torque_opt.ros.node import GraspTorqueNode
-
-FILES = sorted(CONFIG.glob("*_node.yaml"))
+FILES = sorted(CONFIG.glob('*_node.yaml'))
 
 
-@pytest.mark.parametrize("path", FILES, ids=[p.name for p in FILES])
-@pytest.mark.parametrize("remap", [[], ["-r", "__node:=right_hand_torques"],
-                                   ["-r", "__ns:=/right_hand"]])
+@pytest.mark.parametrize('path', FILES, ids=[p.name for p in FILES])
+@pytest.mark.parametrize('remap', [[], ['-r', '__node:=right_hand_torques'],
+                                   ['-r', '__ns:=/right_hand']])
 def test_every_parameter_of_the_file_applies_whatever_the_name(path, remap):
-    params = next(iter(yaml.safe_load(path.read_text()).values()))["ros__parameters"]
+    params = next(iter(yaml.safe_load(path.read_text()).values()))['ros__parameters']
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=DOMAIN)
     try:
         node = GraspTorqueNode(context=context,
-                               cli_args=["--ros-args", "--params-file", str(path), *remap])
+                               cli_args=['--ros-args', '--params-file', str(path), *remap])
         try:
             for name, value in params.items():
                 got = node.get_parameter(name).value
                 assert (list(got) if isinstance(value, list) else got) == value, name
             if remap:
-                assert "right_hand" in node.get_fully_qualified_name()
+                assert 'right_hand' in node.get_fully_qualified_name()
         finally:
             node.destroy_node()
     finally:

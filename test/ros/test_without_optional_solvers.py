@@ -1,14 +1,16 @@
-"""The node runs with a ROS distribution's packages alone: no Clarabel, DAQP, quadprog,
-threadpoolctl, OSQP or MuJoCo (pip installs them; rosdep may not have them)."""
+"""
+The node runs with a ROS distribution's packages alone: no Clarabel, DAQP, quadprog,
+threadpoolctl, OSQP or MuJoCo (pip installs them; rosdep may not have them).
+"""
 
 import subprocess
 import sys
 
 from conftest import ALLEGRO, ROOT
 
-TEST_DIR = ROOT / "test"  # for cycle_inputs
+TEST_DIR = ROOT / 'test'  # for cycle_inputs
 
-OPTIONAL = ("clarabel", "daqp", "quadprog", "threadpoolctl", "osqp", "mujoco")
+OPTIONAL = ('clarabel', 'daqp', 'quadprog', 'threadpoolctl', 'osqp', 'mujoco')
 
 SCRIPT = f"""
 import sys, time, warnings
@@ -42,7 +44,7 @@ print("ok")
 
 
 def test_the_node_solves_with_the_optional_solvers_absent():
-    done = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True,
+    done = subprocess.run([sys.executable, '-c', SCRIPT], capture_output=True, text=True,
                           timeout=120, cwd=TEST_DIR)
     assert done.returncode == 0, done.stderr[-3000:]
-    assert "solver.fallback: daqp is not installed" in done.stderr
+    assert 'solver.fallback: daqp is not installed' in done.stderr

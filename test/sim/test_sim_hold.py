@@ -1,25 +1,24 @@
 """The certified torques hold the ball in MuJoCo; the same impedance without them drops it."""
 
-import numpy as np
-import pytest
 from conftest import ALLEGRO
-
 from grasp_torque_opt.core.scenario import load_scenario
-from grasp_torque_opt.sim.hold import HoldSettings, certified_torques, hold
+from grasp_torque_opt.sim.hold import certified_torques, hold, HoldSettings
 from grasp_torque_opt.sim.model import build_model
 from grasp_torque_opt.sim.render import render_grasp
 from grasp_torque_opt.sim.simulator import HandSim
+import numpy as np
+import pytest
 
 #: The bundled Allegro grasp's impedance in the driver (docs/simulation.md).
-IMPEDANCE = {"kp": 1.0, "kd": 0.01}
+IMPEDANCE = {'kp': 1.0, 'kd': 0.01}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def scenario():
     return load_scenario(ALLEGRO)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def held(scenario):
     return hold(scenario, HoldSettings(**IMPEDANCE, duration=2.0))
 
@@ -34,7 +33,7 @@ def test_certified_torques_hold_the_ball_within_a_millimetre(held):
 def test_the_same_impedance_without_feedforward_drops_it(scenario):
     r = hold(scenario, HoldSettings(**IMPEDANCE, duration=1.0, feedforward=0.0))
     assert not r.held and r.max_drift > 10e-3, r.reason
-    assert "fell" in r.reason
+    assert 'fell' in r.reason
 
 
 def test_simulated_contact_forces_equal_the_certified_wrenches(held, scenario):
@@ -56,7 +55,7 @@ def test_a_picture_is_written(tmp_path, scenario):
     hsim = HandSim(build_model(scenario), setup.q[setup.hand.idx_q], **IMPEDANCE)
     hsim.command = sol.tau + g
     hsim.step(100)
-    path = render_grasp(hsim, tmp_path / "grasp.png", size=(320, 240))
+    path = render_grasp(hsim, tmp_path / 'grasp.png', size=(320, 240))
     data = path.read_bytes()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    assert int.from_bytes(data[16:20], "big") == 320 and int.from_bytes(data[20:24], "big") == 240
+    assert data[:8] == b'\x89PNG\r\n\x1a\n'
+    assert int.from_bytes(data[16:20], 'big') == 320 and int.from_bytes(data[20:24], 'big') == 240

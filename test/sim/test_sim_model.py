@@ -2,25 +2,24 @@
 
 import copy
 
+from conftest import ALLEGRO, CONFIG, PLANAR, scenario_doc
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import load_scenario, parse_scenario
+from grasp_torque_opt.sim.model import build_model, SimSettings
 import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import ALLEGRO, CONFIG, PLANAR, scenario_doc
-
-from grasp_torque_opt.core.exceptions import InputError
-from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import load_scenario, parse_scenario
-from grasp_torque_opt.sim.model import SimSettings, build_model
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def allegro_sim():
     return build_model(load_scenario(ALLEGRO))
 
 
 def test_gravity_torques_equal_pinocchios(allegro_sim, allegro):
-    """balanceinertia changes no mass or centre of mass: MuJoCo's g(q) is Pinocchio's."""
+    """Balanceinertia changes no mass or centre of mass: MuJoCo's g(q) is Pinocchio's."""
     m = allegro_sim.model
     d = mujoco.MjData(m)
     model = allegro.hand.model.copy()
@@ -40,7 +39,7 @@ def test_gravity_torques_equal_pinocchios(allegro_sim, allegro):
 def test_what_the_model_keeps_and_drops(allegro_sim):
     m = allegro_sim.model
     names = [m.body(b).name for b in range(m.nbody)]
-    assert {"link_3.0_tip", "link_7.0_tip", "link_11.0_tip", "link_15.0_tip"} <= set(names)
+    assert {'link_3.0_tip', 'link_7.0_tip', 'link_11.0_tip', 'link_15.0_tip'} <= set(names)
     assert np.all(m.dof_frictionloss[allegro_sim.dof_adr] == 0.0)  # the URDF says 5-12 N m
     assert np.all(m.dof_damping[allegro_sim.dof_adr] == 0.0)
     hand = [g for g in range(m.ngeom) if m.geom_bodyid[g] != allegro_sim.object_body]
@@ -67,13 +66,13 @@ def test_settings_override_friction_mass_and_damping():
     assert np.all(m.dof_damping[sim.dof_adr] == 0.02)
 
 
-@pytest.mark.parametrize("shape,size,inertia_z", [
-    ("box", [0.06, 0.04, 0.02], 0.2 * (0.06 ** 2 + 0.04 ** 2) / 12),
-    ("cylinder", [0.03, 0.08], 0.2 * 0.03 ** 2 / 2),
+@pytest.mark.parametrize('shape,size,inertia_z', [
+    ('box', [0.06, 0.04, 0.02], 0.2 * (0.06 ** 2 + 0.04 ** 2) / 12),
+    ('cylinder', [0.03, 0.08], 0.2 * 0.03 ** 2 / 2),
 ])
 def test_box_and_cylinder(shape, size, inertia_z):
     doc = scenario_doc(ALLEGRO)
-    doc["object"] = {"shape": shape, "size": size, "mass": 0.2}
+    doc['object'] = {'shape': shape, 'size': size, 'mass': 0.2}
     sim = build_model(parse_scenario(doc, CONFIG))
     m = sim.model
     assert m.body_mass[sim.object_body] == pytest.approx(0.2)
@@ -84,20 +83,22 @@ def test_refusals_name_the_field():
     with pytest.raises(InputError, match=r"^object: .*needs the scenario's object"):
         build_model(load_scenario(PLANAR))
     doc = scenario_doc(PLANAR)
-    doc["object"] = {"shape": "sphere", "size": [0.035], "mass": 0.1}
-    with pytest.raises(InputError, match=r"^gravity: "):
+    doc['object'] = {'shape': 'sphere', 'size': [0.035], 'mass': 0.1}
+    with pytest.raises(InputError, match=r'^gravity: '):
         build_model(parse_scenario(copy.deepcopy(doc), CONFIG))
-    doc["gravity"] = [0.0, -9.81, 0.0]
+    doc['gravity'] = [0.0, -9.81, 0.0]
     # The planar hand's tips are frames without collision geometry: nothing to touch with.
-    with pytest.raises(InputError, match=r"^grasp.contacts\[0\].link: .*no collision geometry"):
+    with pytest.raises(InputError, match=r'^grasp.contacts\[0\].link: .*no collision geometry'):
         build_model(parse_scenario(doc, CONFIG))
-    with pytest.raises(InputError, match=r"^hand.urdf: "):
+    with pytest.raises(InputError, match=r'^hand.urdf: '):
         build_model(load_scenario(ALLEGRO), urdf_xml="<robot><link name='a'>")
 
 
 def test_the_planned_contacts_touch_the_object_at_the_grasp(allegro_sim, allegro):
-    """The bundled grasp's tips are tangent to the ball: MuJoCo finds one contact on each,
-    within 0.1 mm of the planned point, normal within 1 degree."""
+    """
+    The bundled grasp's tips are tangent to the ball: MuJoCo finds one contact on each,
+    within 0.1 mm of the planned point, normal within 1 degree.
+    """
     m = allegro_sim.model
     d = mujoco.MjData(m)
     d.qpos[allegro_sim.qpos_adr] = allegro.q[allegro.hand.idx_q]

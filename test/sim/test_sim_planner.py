@@ -1,18 +1,19 @@
-"""The planner's numbers on physics: a friction margin holds where the minimum-effort
-torques slip, and the ball falls just above the mass the capacity LP predicts."""
+"""
+The planner's numbers on physics: a friction margin holds where the minimum-effort
+torques slip, and the ball falls just above the mass the capacity LP predicts.
+"""
 
 import dataclasses
 
-import pytest
 from conftest import ALLEGRO
-
 from grasp_torque_opt.core.scenario import load_scenario, weight_wrench
 from grasp_torque_opt.methods.capacity import load_capacity
-from grasp_torque_opt.sim.hold import HoldSettings, certified_torques, hold
+from grasp_torque_opt.sim.hold import certified_torques, hold, HoldSettings
 from grasp_torque_opt.sim.model import SimSettings
+import pytest
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def scenario():
     return load_scenario(ALLEGRO)
 

@@ -9,7 +9,7 @@ BLOCK = "import sys\nsys.modules['mujoco'] = None\n"
 
 
 def run(script):
-    return subprocess.run([sys.executable, "-c", BLOCK + script], capture_output=True,
+    return subprocess.run([sys.executable, '-c', BLOCK + script], capture_output=True,
                           text=True, timeout=120)
 
 
@@ -35,7 +35,7 @@ assert "mujoco" not in [m for m in sys.modules if sys.modules[m] is not None]
 
 
 def test_the_simulated_hand_says_mujoco_is_missing():
-    done = run("from grasp_torque_opt.ros.sim_driver import main\nsys.exit(main([]))")
+    done = run('from grasp_torque_opt.ros.sim_driver import main\nsys.exit(main([]))')
     assert done.returncode == 2
-    assert done.stderr.startswith("grasp-torque-sim: error: MuJoCo is not installed")
+    assert done.stderr.startswith('grasp-torque-sim: error: MuJoCo is not installed')
     assert len(done.stderr.splitlines()) == 1
