@@ -2,13 +2,21 @@
 Time the full control cycle on the bundled scenarios, per QP backend.
 
 Usage: .venv/bin/python bench/cycle.py [--repeats 3000]
-       [--backends proxsuite,daqp,quadprog,proxsuite+warm,daqp+warm] [--out FILE]
+       [--backends proxsuite,daqp,quadprog,proxsuite+warm,daqp+warm]
+       [--motions jitter,smooth] [--out FILE]
 
-Two paths, median and p99 over the repeats, with the machine it ran on:
+Two paths, median and p99 over the repeats, with the machine it ran on, for two
+motions of the fingers (a warm start's work depends on how far the grasp moved):
+
+- ``jitter``: every joint moves by a fresh random 1 mrad (standard deviation)
+  between cycles, the hard case for a warm start;
+- ``smooth``: every joint follows 2 mrad x sin(2 pi 1 Hz t + 0.4 j) sampled at
+  1 kHz, as joint states from a hand holding a grasp arrive.
+
+The paths:
 
 - ``core``: kinematics and maps, build, solve, certificate (``solve.solve`` with
-  a solver reused across cycles, the fingers moving by 1 mrad between cycles),
-  with each stage's share of the total;
+  a solver reused across cycles), with each stage's share of the total;
 - ``controller``: what the node runs on each joint state, without ROS: the joint
   state checked and taken, then ``TorqueController.cycle`` (kinematics, gravity
   torques when compensated, maps, build, solve, certificate, gate).
@@ -40,7 +48,7 @@ STAGES = ['maps', 'build', 'solve', 'certify']
 
 
 def machine() -> dict:
-    """What this ran on."""
+    """Describe the machine this ran on: CPU, cores, Python, versions, date."""
     cpu = platform.processor() or platform.machine()
     try:
         for line in Path('/proc/cpuinfo').read_text().splitlines():
@@ -61,7 +69,7 @@ def machine() -> dict:
 
 
 def machine_line(m: dict) -> str:
-    """One line naming the machine and the date."""
+    """Return one line naming the machine and the date."""
     return (f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}, "
             f"ProxSuite {m['versions']['proxsuite']}, DAQP {m['versions']['daqp']}, "
             f"Pinocchio {m['versions']['pin']}; {m['date']}")
@@ -77,30 +85,42 @@ def report(results: dict, table_text: str, out: Path | None, detail: str = '') -
 
 
 def summary(samples: list[float]) -> dict:
-    """Median and p99 [s]."""
+    """Return the median and p99 [s]."""
     return {'median_s': float(np.median(samples)), 'p99_s': float(np.percentile(samples, 99))}
 
 
 def solver_of(variant: str):
-    """A solver from a variant name: a backend, ``+warm`` for its verified warm start."""
+    """Make a solver from a variant name: a backend, ``+warm`` for its verified warm start."""
     backend, _, warm = variant.partition('+')
     return make_solver(backend, warm_start=warm == 'warm')
 
 
-def moving(setup: GraspSetup, count: int) -> list[GraspSetup]:
-    """The grasp with the fingers moving by 1 mrad (seeded) from cycle to cycle."""
-    rng = np.random.default_rng(0)
+#: Motions of the fingers from cycle to cycle (see the module's docstring).
+MOTIONS = ('jitter', 'smooth')
+
+
+def offsets(m: int, count: int, motion: str) -> np.ndarray:
+    """Return joint offsets from the grasp's q, shape (count, m) [rad]."""
+    if motion == 'jitter':
+        return np.random.default_rng(0).normal(scale=1e-3, size=(count, m))
+    t = np.arange(count)[:, None] * 1e-3  # 1 kHz
+    return 2e-3 * np.sin(2.0 * np.pi * t + 0.4 * np.arange(m))
+
+
+def moving(setup: GraspSetup, count: int, motion: str = 'jitter') -> list[GraspSetup]:
+    """Return the grasp with the fingers moving by ``motion`` from cycle to cycle."""
     out = []
-    for _ in range(count):
+    for dq in offsets(setup.hand.m, count, motion):
         q = setup.q.copy()
-        q[setup.hand.idx_q] += rng.normal(scale=1e-3, size=setup.hand.m)
+        q[setup.hand.idx_q] += dq
         out.append(dataclasses.replace(setup, q=q))
     return out
 
 
-def bench_core(setup: GraspSetup, variant: str, repeats: int) -> dict:
+def bench_core(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jitter'
+               ) -> dict:
     """
-    The core cycle on a moving grasp: maps, build, solve, certify; per stage and in total.
+    Time the core cycle on a moving grasp: maps, build, solve, certify; per stage, total.
 
     As in the node, DAQP is the fallback of the other backends; ``fallbacks``
     counts the cycles it answered, ``failed`` those nobody certified.
@@ -112,7 +132,7 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int) -> dict:
         return {'skipped': sol.message}
     samples = {k: [] for k in STAGES + ['total']}
     fallbacks = failed = 0
-    for i, grasp in enumerate(moving(setup, repeats + 50)):
+    for i, grasp in enumerate(moving(setup, repeats + 50, motion)):
         t0 = time.perf_counter()
         sol = solve(grasp, solver=solver, fallback=fallback)
         total = time.perf_counter() - t0
@@ -133,18 +153,18 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int) -> dict:
     return out
 
 
-def bench_controller(setup: GraspSetup, variant: str, repeats: int) -> dict:
-    """The node's cycle without ROS: take a joint state, then run the cycle."""
+def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jitter'
+                     ) -> dict:
+    """Time the node's cycle without ROS: take a joint state, then run the cycle."""
     backend = variant.partition('+')[0]
     ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True), backend=backend,
                             warm_start=variant.endswith('+warm'),
                             fallback=None if backend == 'daqp' else 'daqp')
     names = list(setup.hand.joints)
     q0 = setup.q[setup.hand.idx_q]
-    rng = np.random.default_rng(0)
     samples, published = [], 0
-    for i in range(repeats + 50):
-        positions = (q0 + rng.normal(scale=1e-3, size=q0.size)).tolist()
+    for i, dq in enumerate(offsets(q0.size, repeats + 50, motion)):
+        positions = (q0 + dq).tolist()
         now = time.monotonic()
         t0 = time.perf_counter()
         ctrl.update_joint_state(names, positions, now)
@@ -153,46 +173,54 @@ def bench_controller(setup: GraspSetup, variant: str, repeats: int) -> dict:
         if i >= 50:
             samples.append(elapsed)
             published += result.kind == 'solution'
-    return {'total': summary(samples), 'certified_commands': published, 'cycles': repeats}
+    solver = ctrl.solver
+    return {'total': summary(samples), 'certified_commands': published, 'cycles': repeats,
+            'warm_solves': getattr(solver, 'warm_solves', 0),
+            'warm_start_fallbacks': getattr(solver, 'fallbacks', 0)}
 
 
 #: What is timed: each backend, and DAQP with its verified warm start.
 VARIANTS = (*BACKENDS, 'proxsuite+warm', 'daqp+warm')
 
 
-def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS) -> dict:
-    """Every scenario and backend, both paths."""
+def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS,
+        motions: tuple[str, ...] = MOTIONS) -> dict:
+    """Time every scenario, motion and backend, both paths."""
     out = {'machine': machine(), 'repeats': repeats, 'scenarios': {}}
     for name in SCENARIOS:
         setup = GraspSetup.from_file(ROOT / 'config' / name)
         res = out['scenarios'][name] = {}
-        for b in backends:
-            core = bench_core(setup, b, repeats)
-            res[b] = {'core': core}
-            if 'skipped' not in core:
-                res[b]['controller'] = bench_controller(setup, b, repeats)
+        for motion in motions:
+            for b in backends:
+                core = bench_core(setup, b, repeats, motion)
+                r = res[f'{b} {motion}'] = {'core': core}
+                if 'skipped' not in core:
+                    r['controller'] = bench_controller(setup, b, repeats, motion)
     return out
 
 
 def table(results: dict) -> str:
-    """A markdown table: per scenario and backend, stage medians [us] and the totals."""
-    head = ('| scenario | backend | maps | build | solve | certify | core median | core p99 '
-            '| fallbacks / failed | node cycle median | node cycle p99 |')
-    lines = [head, '|' + '---|' * 11]
+    """Format a markdown table: per scenario and backend, stage medians [us], totals."""
+    head = ('| scenario | backend, motion | maps | build | solve | certify | core median '
+            '| core p99 | fallbacks / failed | node cycle median | node cycle p99 '
+            '| warm redone cold |')
+    lines = [head, '|' + '---|' * 12]
     for name, res in results['scenarios'].items():
         for b, r in res.items():
             core = r['core']
             if 'skipped' in core:
                 lines.append(f"| {name} | {b} | - | - | - | - | skipped: {core['skipped']} "
-                             "| | | | |")
+                             '| | | | | |')
                 continue
             stages = ' | '.join(f"{1e6 * core[k]['median_s']:.0f} ({100 * core[k]['share']:.0f}%)"
                                 for k in STAGES)
             ctl = r['controller']['total']
+            redone = (f"{r['controller']['warm_start_fallbacks']} of "
+                      f"{r['controller']['warm_solves']}" if '+warm' in b else '-')
             lines.append(f"| {name} | {b} | {stages} | {1e6 * core['total']['median_s']:.0f} | "
                          f"{1e6 * core['total']['p99_s']:.0f} | {core['fallbacks']} / "
                          f"{core['failed']} | {1e6 * ctl['median_s']:.0f} | "
-                         f"{1e6 * ctl['p99_s']:.0f} |")
+                         f"{1e6 * ctl['p99_s']:.0f} | {redone} |")
     return '\n'.join(lines) + '\n\n(times in us; share of the core cycle in parentheses)'
 
 
@@ -200,10 +228,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--repeats', type=int, default=3000)
     parser.add_argument('--backends', default=','.join(VARIANTS))
+    parser.add_argument('--motions', default=','.join(MOTIONS))
     parser.add_argument('--out', type=Path, help='also write the results here (JSON)')
     args = parser.parse_args()
     single_threaded_math()
-    results = run(args.repeats, tuple(args.backends.split(',')))
+    results = run(args.repeats, tuple(args.backends.split(',')),
+                  tuple(args.motions.split(',')))
     report(results, table(results), args.out)
 
 
