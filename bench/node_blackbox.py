@@ -13,7 +13,10 @@ separate process publishes Allegro joint states at the rate with sensor-data
 QoS for ``--duration`` seconds once the answering node is discovered and has
 answered once, and counts the ``effort_commands`` that arrive (a plain
 subscriber, reliable, depth 10, as ``ros2 topic hz`` would see them) until 0.5 s
-after its last joint state. "answered" is commands over joint states published.
+after its last joint state. "answered" is commands over joint states published;
+"CPU per joint state" is the answering process's CPU time (user and system, all
+its threads, from /proc) over the published window divided by the joint states:
+the headroom a rate leaves on this machine.
 
 This differs from ``node_load.py`` on purpose: no stamped second topic (the node
 publishes only what a user's controller reads), no warm-up excluded, no stamp
@@ -25,6 +28,7 @@ from __future__ import annotations
 import argparse
 from datetime import datetime, timezone
 import json
+import os
 from pathlib import Path
 import sys
 import tempfile
@@ -52,7 +56,7 @@ READY_TIMEOUT_S = 15.0
 
 
 def count_main(args: argparse.Namespace) -> int:
-    """The user's process: publish joint states, count the commands, write JSON."""
+    """Run the user's process: publish joint states, count the commands, write JSON."""
     from grasp_torque_opt.core.grasp_setup import GraspSetup
     import numpy as np
     import rclpy
@@ -101,14 +105,29 @@ def count_main(args: argparse.Namespace) -> int:
         published += 1
         return True
 
+    cpu0 = process_cpu_s(args.target_pid)
     pacer.run(tick)
+    cpu1 = process_cpu_s(args.target_pid)
     pacer.spin_for(DRAIN_S)
     node.destroy_node()
     rclpy.try_shutdown()
     Path(args.result).write_text(json.dumps({
         'published': published, 'commands': len(received),
-        'wrong_length': sum(n != len(names) for n in received)}))
+        'wrong_length': sum(n != len(names) for n in received),
+        'target_cpu_s': None if cpu0 is None or cpu1 is None else cpu1 - cpu0}))
     return 0
+
+
+def process_cpu_s(pid: int | None) -> float | None:
+    """Return the CPU time a process used so far, user and system [s] (None: unknown)."""
+    if pid is None:
+        return None
+    try:
+        stat = Path(f'/proc/{pid}/stat').read_text()
+    except OSError:
+        return None
+    fields = stat.rsplit(')', 1)[1].split()  # after the command name, which may hold spaces
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
 def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) -> dict:
@@ -132,7 +151,7 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
     share = CpuShare()
     with open(tmp / f'{tag}.target.log', 'w') as tlog, open(tmp / f'{tag}.user.log', 'w') as ulog:
         answering = Child(cmd, env, tlog)
-        counter = Child(user, env, ulog)
+        counter = Child(user + ['--target-pid', str(answering.pid)], env, ulog)
         try:
             code = counter.proc.wait(timeout=READY_TIMEOUT_S + duration + 30)
         finally:
@@ -142,6 +161,9 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
     if code == 0 and result.exists():
         r = json.loads(result.read_text())
         out.update(r, answered_pct=100.0 * r['commands'] / r['published'])
+        cpu = r.get('target_cpu_s')
+        out['target_cpu_per_state_us'] = (None if cpu is None or not r['published']
+                                          else 1e6 * cpu / r['published'])
     else:
         out['error'] = f'user process exit {code} (logs in {tmp})'
     return out
@@ -149,15 +171,17 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
 
 def table(cases: list[dict]) -> str:
     lines = ['| rate [Hz] | answering process | run | joint states | commands | answered [%] '
-             '| other work [cores] |', '|---:|---|---:|---:|---:|---:|---:|']
+             '| CPU per joint state [us] | other work [cores] |',
+             '|---:|---|---:|---:|---:|---:|---:|---:|']
     for c in cases:
         if 'error' in c:
             lines.append(f"| {c['rate_hz']:g} | {c['target']} | {c['run']} | failed: "
-                         f"{c['error']} ||||")
+                         f"{c['error']} |||||")
             continue
-        other = c['other_processes_cores']
+        other, cpu = c['other_processes_cores'], c.get('target_cpu_per_state_us')
         lines.append(f"| {c['rate_hz']:g} | {c['target']} | {c['run']} | {c['published']} | "
                      f"{c['commands']} | {c['answered_pct']:.1f} | "
+                     f"{'-' if cpu is None else f'{cpu:.0f}'} | "
                      f"{'-' if other is None else f'{other:.2f}'} |")
     return '\n'.join(lines)
 
@@ -172,6 +196,7 @@ def main() -> int:
     parser.add_argument('--role', choices=['run', 'user'], default='run', help=argparse.SUPPRESS)
     parser.add_argument('--rate', type=float, help=argparse.SUPPRESS)
     parser.add_argument('--result', help=argparse.SUPPRESS)
+    parser.add_argument('--target-pid', type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.role == 'user':
         return count_main(args)
@@ -189,9 +214,10 @@ def main() -> int:
         c = run_case(target, rate, args.duration, domain, tmp)
         c['run'] = run
         cases.append(c)
-        print(f'  {rate:6g} Hz  {target:38} ' + (c.get('error') or
-              f"answered {c['answered_pct']:5.1f}% ({c['commands']} of {c['published']})"),
-              flush=True)
+        line = c.get('error') or (
+            f"answered {c['answered_pct']:5.1f}% ({c['commands']} of {c['published']}), "
+            f"CPU per joint state {c.get('target_cpu_per_state_us') or 0:.0f} us")
+        print(f'  {rate:6g} Hz  {target:38} {line}', flush=True)
     print()
     print(table(cases))
     args.out.parent.mkdir(parents=True, exist_ok=True)
