@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import os
 import sys
 import time
@@ -17,7 +16,7 @@ import time
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.report import solution_dict
+from grasp_torque_opt.core.report import solution_dict, strict_json
 from grasp_torque_opt.core.scenario import OBJECTIVES
 from grasp_torque_opt.core.solution import INFEASIBLE, OPTIMAL
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
@@ -215,13 +214,13 @@ def _main(argv: list[str] | None) -> int:
             if args.capacity:
                 d['capacity'] = _capacity_dict(setup, maps)
             if args.json:
-                print(json.dumps(d))
+                print(strict_json(d))
             else:
                 _print_solution(d)
             return _exit_code(sol.status)
         comparison = compare(setup)
         if args.json:
-            print(json.dumps({'scenario': args.scenario, **comparison.as_dict()}))
+            print(strict_json({'scenario': args.scenario, **comparison.as_dict()}))
         else:
             print(f'{args.scenario}: {len(setup.hand.joints)} joints, '
                   f'{len(setup.contacts)} contacts, N = {setup.friction.sides}')

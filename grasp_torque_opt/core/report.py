@@ -2,10 +2,33 @@
 
 from __future__ import annotations
 
+import json
+import math
 from typing import Any
 
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.solution import Solution
+
+
+def _finite_or_null(v: Any) -> Any:
+    if isinstance(v, float):
+        return v if math.isfinite(v) else None
+    if isinstance(v, dict):
+        return {k: _finite_or_null(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_finite_or_null(x) for x in v]
+    return v
+
+
+def strict_json(data: Any) -> str:
+    """
+    Return ``data`` as strict JSON (RFC 8259): a non-finite number becomes null.
+
+    Python's ``json`` writes ``Infinity`` and ``NaN``, which strict parsers refuse;
+    the certificate of a non-finite candidate has infinite residuals (docs/design.md
+    section 4.2). Every JSON the package prints or answers goes through here.
+    """
+    return json.dumps(_finite_or_null(data), allow_nan=False)
 
 
 def _floats(a) -> list[float] | None:

@@ -45,6 +45,7 @@ from typing import Any
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.report import strict_json
 from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
 from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 from grasp_torque_opt.methods.dispatch import solve
@@ -430,13 +431,5 @@ def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
 
 
 def record_json(record: dict[str, Any]) -> str:
-    """One record as strict JSON (a non-finite number becomes null)."""
-    def clean(v):
-        if isinstance(v, float) and not math.isfinite(v):
-            return None
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, list):
-            return [clean(x) for x in v]
-        return v
-    return json.dumps(clean(record))
+    """Return one record as strict JSON (a non-finite number becomes null)."""
+    return strict_json(record)

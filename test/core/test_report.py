@@ -1,0 +1,45 @@
+"""The package's JSON is strict: a non-finite number is written as null, never Infinity."""
+
+import json
+
+from grasp_torque_opt.core.certificate import certify
+from grasp_torque_opt.core.report import solution_dict, strict_json
+from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
+
+
+def strict_loads(text: str):
+    """Parse as a strict (RFC 8259) parser does: Infinity and NaN are errors."""
+    def refuse(name):
+        raise ValueError(f'not strict JSON: {name}')
+    return json.loads(text, parse_constant=refuse)
+
+
+def test_non_finite_numbers_become_null_at_any_depth():
+    data = {'a': float('inf'), 'b': [1.0, float('nan'), (float('-inf'), 2.5)],
+            'c': {'d': {'e': float('nan')}}, 'f': 'inf', 'g': 3, 'h': None}
+    out = strict_loads(strict_json(data))
+    assert out == {'a': None, 'b': [1.0, None, [None, 2.5]], 'c': {'d': {'e': None}},
+                   'f': 'inf', 'g': 3, 'h': None}
+
+
+def test_finite_numbers_round_trip_exactly():
+    values = [0.1, 1e-300, -1.7976931348623157e308, 123456789.123456789, 5e-324]
+    assert strict_loads(strict_json(values)) == values
+
+
+def test_the_certificate_of_a_non_finite_candidate_is_strict_json(planar):
+    maps = planar.maps()
+    sol = solve(planar, maps=maps)
+    tau = sol.tau.copy()
+    tau[0] = np.nan
+    cert = certify(maps.G, maps.J, planar.external_wrench, planar.friction,
+                   -planar.hand.torque_limits, planar.hand.torque_limits, tau,
+                   sol.wrenches.ravel())
+    assert not cert.ok and cert.worst == float('inf')
+    sol.certificate = cert
+    out = strict_loads(strict_json(solution_dict(sol, maps)))
+    assert out['certificate']['equilibrium'] is None
+    assert out['certificate']['ok'] is False
+    # Python's own json would have written Infinity here.
+    assert 'Infinity' in json.dumps(solution_dict(sol, maps))
