@@ -39,8 +39,10 @@ import time
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report, ROOT  # noqa: E402
+from cycle import machine, report, ROOT  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver, single_threaded_math  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner  # noqa: E402
@@ -241,7 +243,7 @@ def table(results: dict) -> str:
     lines.append("Times: median / p99 over the grasps of each grasp's median [us] of "
                  "solve(); own N: the scenario's polygon (planar 3, Allegro 8); fastest / "
                  "fastest: the ratio of each grasp's fastest calls, adaptive over own N "
-                 "daqp (the figure a shared machine touches least).")
+                 'daqp (the figure a shared machine touches least).')
     mv = results.get('moving')
     if mv:
         lines += ['', f"Moving Allegro grasp, {mv['steps']} cycles, warm: adaptive gap max "

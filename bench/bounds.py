@@ -126,7 +126,7 @@ def main() -> int:
         budgeted = ' | '.join(f"{1e3 * r[f'max_cycle_s@{b}']:.1f} | "
                               f"{1e3 * max(0.0, r[f'max_overrun_s@{b}']):.1f}" for b in BUDGETS)
         lines.append(f"| {label} | {r['cycles']} | {r['commands']} | {r['unholdable']} | "
-                     f"{unbudgeted} | {budgeted} |")
+                     f'{unbudgeted} | {budgeted} |')
     report({'machine': machine(), 'rows': rows, 'settings': dataclasses.asdict(BOUNDS)},
            '\n'.join(lines), args.out, "solver settings at the node's bounds")
     return 0

@@ -21,6 +21,8 @@ import json
 from pathlib import Path
 import sys
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasps import draw_candidates, SCENARIO  # noqa: E402

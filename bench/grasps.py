@@ -34,8 +34,10 @@ import sys
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report, ROOT  # noqa: E402
+from cycle import machine, report, ROOT  # noqa: E402, I100
 from grasp_torque_opt.core.exceptions import GraspTorqueError  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.reference.feasibility import linearized_feasible  # noqa: E402

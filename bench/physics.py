@@ -40,8 +40,10 @@ import time
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report  # noqa: E402
+from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.core.resources import find_config  # noqa: E402
 from grasp_torque_opt.core.scenario import load_scenario, Scenario, weight_wrench  # noqa: E402
 from grasp_torque_opt.methods.capacity import load_capacity  # noqa: E402
@@ -200,7 +202,7 @@ def tables(r: dict) -> str:
         lines.append(f"| {row['direction']} | {row['max_command_Nm']:.3f} | "
                      + ' | '.join(cell(row['episodes'][k]) for k in gains) + ' |')
     mass_gains = gains + ['3.0']
-    lines += ['', f"(b) mass (weight along +x); the optimizer certifies up to "
+    lines += ['', f'(b) mass (weight along +x); the optimizer certifies up to '
               f"{r['mass']['capacity_kg']:.3f} kg (first infeasible mass, bisection to 1 g)", '',
               '| mass [kg] | ' + ' | '.join(f'Kp {k}' for k in mass_gains) + ' |',
               '|---|' + '---|' * len(mass_gains)]
@@ -224,7 +226,7 @@ def tables(r: dict) -> str:
         e = row['episodes']
         lines.append(f"| {row['kp']:g} | {cell(e['1.0'])} | {cell(e['0.9'])} | "
                      f"{cell(e['1.1'])} |")
-    lines += ['', "(f) friction margin: torques planned with margin k (the cone of mu/(1+k)) "
+    lines += ['', '(f) friction margin: torques planned with margin k (the cone of mu/(1+k)) '
               "against simulated friction 1/(1+k') of the planned one "
               f"(Kp {' / '.join(gains)} N m/rad)", '',
               '| planned margin k | usage of the cone | norm tau [N m] | '
@@ -240,7 +242,7 @@ def tables(r: dict) -> str:
     lines += ['', f"(g) load capacity: the capacity LP holds {c['alpha']:.3f} times the "
               f"0.15 kg ball, {c['capacity_kg']:.3f} kg ({c['binding']}); the simulated ball "
               f"at multiples of it, Kp {c['kp']:g} N m/rad, commanded the certified torques "
-              "for its mass (above the capacity: for 0.999 of it)", '',
+              'for its mass (above the capacity: for 0.999 of it)', '',
               '| mass / capacity | simulated mass [kg] | planned for [kg] | outcome |',
               '|---|---|---|---|']
     for row in c['rows']:

@@ -41,8 +41,10 @@ import time
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report  # noqa: E402
+from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
@@ -176,7 +178,8 @@ def main() -> None:
     res = run(args.grasps, args.seed, args.rounds, args.workers, tuple(args.backends),
               args.worker_threads)
     report(res, table(res), args.out,
-           f"{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
+           f'{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; '
+           f"threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
 
 
 if __name__ == '__main__':

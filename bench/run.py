@@ -42,6 +42,8 @@ import sys
 import time
 
 HERE = Path(__file__).resolve().parent
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402).
 sys.path.insert(0, str(HERE))
 
 import adaptive  # noqa: E402

@@ -30,6 +30,8 @@ from pathlib import Path
 import sys
 import time
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from candidates import candidate_lines  # noqa: E402
 from cycle import machine, report  # noqa: E402
@@ -105,7 +107,7 @@ def main() -> int:
     p.add_argument('--out', type=Path, help='write the results as JSON here')
     a = p.parse_args()
     res = run(a.count, a.seed, a.workers, tuple(a.backends), a.dask)
-    report(res, table(res), a.out, f"{a.count} candidates, seed {a.seed}; threads: "
+    report(res, table(res), a.out, f'{a.count} candidates, seed {a.seed}; threads: '
            f"{res['blas_threads']}")
     return 0
 

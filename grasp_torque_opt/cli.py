@@ -54,7 +54,7 @@ def _parser() -> argparse.ArgumentParser:
                          help="objective instead of the scenario's objective.type")
     p_solve.add_argument('--margin', type=_margin, metavar='K',
                          help="friction margin k >= 0 instead of the scenario's friction.margin: "
-                              "plan in the cone of mu/(1+k)")
+                              'plan in the cone of mu/(1+k)')
     p_solve.add_argument('--capacity', action='store_true',
                          help='also the load capacity and the 12 axis capacities')
     p_cmp = sub.add_parser('compare', help="every method side by side (the paper's Table 2)")
@@ -76,6 +76,8 @@ def _rounds(text: str) -> int:
     if not 0 <= value <= 100:
         raise argparse.ArgumentTypeError(f'must be in [0, 100], got {text}')
     return value
+
+
 def _margin(text: str) -> float:
     try:
         k = float(text)
@@ -132,14 +134,14 @@ def _print_solution(d: dict) -> None:
     if b is not None:
         gap = '-' if b['gap'] is None else f"{100 * b['gap']:.3g}%"
         lower = 'none' if b['lower'] is None else f"{b['lower']:.6f}"
-        print(f"bounds on the exact optimum of sqrt(tau^T W tau): lower {lower} N m, "
+        print(f'bounds on the exact optimum of sqrt(tau^T W tau): lower {lower} N m, '
               f"this torque {b['upper']:.6f} N m, gap {gap} ({b['rounds']} rounds, "
               f"{b['qp_solves']} QPs, from {b['source']})" if b['upper'] is not None else
               f'bounds: lower {lower} N m, no certified torque')
     if d['tau'] is not None:
         usage = ' '.join(f"{100 * c['friction_usage']:.0f}%" for c in d['contacts'])
         print(f"objective: {d['objective']}, max |tau|/limit {d['max_torque_ratio']:.3f}, "
-              f"friction usage per contact {usage} of the cone (margin "
+              f'friction usage per contact {usage} of the cone (margin '
               f"{d['friction_margin']:g})")
     if d.get('capacity'):
         cap = d['capacity']
@@ -261,14 +263,14 @@ def _score_parser(sub) -> None:
     p.add_argument('--metrics', choices=METRICS, default='full',
                    help='full (with the capacities, the default) or basic (solve only)')
     p.add_argument('--workers', type=_count(1, 256), help="processes (default: the machine's "
-                   "cores), 1 to 256")
+                   'cores), 1 to 256')
     p.add_argument('--engine', choices=ENGINES, default='processes',
                    help='processes (default), serial, or dask (Dask distributed)')
     p.add_argument('--scheduler', help='Dask scheduler address (engine dask; default: a '
                    'local cluster)')
     p.add_argument('--backend', choices=BACKENDS, default='daqp',
                    help='QP backend (default: daqp, the fastest on these grasps)')
-    p.add_argument('--objective', choices=OBJECTIVES, help="objective instead of the "
+    p.add_argument('--objective', choices=OBJECTIVES, help='objective instead of the '
                    "scenario's")
     p.add_argument('--no-progress', action='store_true', help='no progress bar')
 
@@ -287,7 +289,7 @@ class _Progress:
         filled = width * done // max(total, 1)
         rate = done / max(time.perf_counter() - self.t0, 1e-9)
         sys.stderr.write(f"\rscoring [{'#' * filled}{'.' * (width - filled)}] {done}/{total} "
-                         f"({rate:.0f}/s)")
+                         f'({rate:.0f}/s)')
         if done >= total:
             sys.stderr.write('\n')
         sys.stderr.flush()

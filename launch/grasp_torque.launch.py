@@ -19,11 +19,10 @@ parameter; otherwise the scenario's ``hand.urdf`` is used.
 import os
 
 from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
-
-from launch import LaunchDescription
 
 PACKAGE = 'grasp_torque_opt'
 

@@ -86,4 +86,3 @@ def contact_rotations(normals: np.ndarray, tangents: list[np.ndarray | None],
         yx, yy, yz = zy * xz - zz * xy, zz * xx - zx * xz, zx * xy - zy * xx
         out.append(((xx, yx, zx), (xy, yy, zy), (xz, yz, zz)))
     return np.array(out, dtype=float).reshape(-1, 3, 3)
-

@@ -66,7 +66,7 @@ class FrameNotFound(InputError):
         self.available = sorted(available)
         super().__init__(field,
                          f"unknown frame '{cut(name)}' (model frames: "
-                         f"{_choices(self.available)})")
+                         f'{_choices(self.available)})')
 
 
 class JointNotFound(InputError):

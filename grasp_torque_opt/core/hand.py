@@ -195,7 +195,7 @@ class Hand:
             what = ('the URDF effort limit' if bounds[i] < MAX_TORQUE_LIMIT
                     else 'the largest limit accepted')
             raise InputError(field, f"{limits[i]:g} N m for joint '{joints[i]}' exceeds "
-                             f"{what} ({bounds[i]:g} N m)" + (
+                             f'{what} ({bounds[i]:g} N m)' + (
                                  f'; set {override}: true to allow it'
                                  if bounds[i] < MAX_TORQUE_LIMIT else ''))
 
@@ -237,7 +237,7 @@ class Hand:
                 if not (np.isfinite(lim) and lim > 0.0):
                     raise InputError('hand.torque_limits',
                                      f"the URDF gives no effort limit for joint '{name}'; "
-                                     "set hand.torque_limits")
+                                     'set hand.torque_limits')
         else:
             limits = np.asarray(torque_limits, dtype=float)
             if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):

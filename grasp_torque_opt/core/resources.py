@@ -37,7 +37,7 @@ def find_config(name: str, field: str = 'scenario') -> Path:
         for d in config_dirs():
             if (d / path).is_file():
                 return d / path
-    raise InputError(field, f"file not found: {cut(name, PATH_LENGTH)} "
+    raise InputError(field, f'file not found: {cut(name, PATH_LENGTH)} '
                      f"(nor in {', '.join(map(str, config_dirs()))})")
 
 

@@ -147,7 +147,7 @@ class Scenario:
     external_wrench: np.ndarray
     weights: list[float] | None = None
     source: str = field(default='<memory>')
-    object: ObjectSpec | None = None
+    object: ObjectSpec | None = None  # noqa: A003 -- the scenario's object section, by name
     gravity: np.ndarray | None = None
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
     objective: str = 'sum-of-squares'
@@ -186,7 +186,7 @@ def _object(value: Any, origin: np.ndarray) -> ObjectSpec:
     entries = SHAPES[shape]
     size = _vector(_require(section, 'size', 'object'), 'object.size')
     if len(size) != len(entries):
-        raise InputError('object.size', f"must have {len(entries)} entries for a {shape} "
+        raise InputError('object.size', f'must have {len(entries)} entries for a {shape} '
                          f"({', '.join(entries)}), got {len(size)}")
     for i, x in enumerate(size):
         if x <= 0.0:
@@ -395,10 +395,10 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
     kind = objective.get('type', OBJECTIVES[0])
     if kind not in OBJECTIVES:
         raise InputError('objective.type', f"must be one of {', '.join(OBJECTIVES)}, "
-                         f"got {kind!r}")
+                         f'got {kind!r}')
     if joints is None and (isinstance(limits, list) or weights is not None):
         per_joint = 'hand.torque_limits' if isinstance(limits, list) else 'objective.weights'
-        raise InputError('hand.joints', f"required when {per_joint} gives one value per joint "
+        raise InputError('hand.joints', f'required when {per_joint} gives one value per joint '
                          "(without it the values would follow Pinocchio's joint order, which "
                          "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,

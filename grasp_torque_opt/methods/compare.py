@@ -100,6 +100,6 @@ def format_table(comparison: Comparison) -> str:
         excess = comparison.excess_over_exact('tau-qp-adaptive')
         lines.append("Lower bound, gap: the adaptive method's certified bound on the "
                      "exact-cone optimum of sqrt(tau^T W tau) [N m] and its torque's gap to "
-                     "it (docs/adaptive.md); its excess over the SOCP: "
+                     'it (docs/adaptive.md); its excess over the SOCP: '
                      + ('-' if excess is None else f'{100 * excess:.2g}%') + '.')
     return '\n'.join(lines)

@@ -210,8 +210,8 @@ def solve(setup: GraspSetup, method: str = 'tau-qp', *, maps: GraspMaps | None =
 
     def certified(tau, f) -> Certificate | None:
         return None if f is None else certify(maps.G, J, setup.external_wrench,
-                                               friction, tau_min, tau_max, tau, f,
-                                               tolerance)
+                                              friction, tau_min, tau_max, tau, f,
+                                              tolerance)
 
     cert = certified(tau, f)
     if method == 'tau-qp' and getattr(solver, 'last_warm', False) and \

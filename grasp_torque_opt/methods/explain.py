@@ -46,7 +46,7 @@ class Explanation:
         if c.status != 'optimal':
             return f'no explanation: the capacity LP {c.status} ({c.message})'
         if c.value >= 1.0:
-            return (f"the capacity LP finds the whole load holdable ({c.value:.4g} times over): "
+            return (f'the capacity LP finds the whole load holdable ({c.value:.4g} times over): '
                     "the solver's verdict and the LP disagree")
         return (f'at most {100 * c.value:.1f}% of this load can be held; there, '
                 f'{c.binding.text()}')

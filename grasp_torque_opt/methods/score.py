@@ -136,7 +136,7 @@ class Scorer:
             raise ValueError(f"metrics must be one of {', '.join(METRICS)}, got {job.metrics!r}")
         if job.objective is not None and job.objective not in OBJECTIVES:
             raise InputError('objective', f"must be one of {', '.join(OBJECTIVES)}, "
-                             f"got {job.objective!r}")
+                             f'got {job.objective!r}')
         self.job = job
         try:
             doc = yaml.safe_load(job.scenario_text)
@@ -170,7 +170,7 @@ class Scorer:
                              f'{type(data).__name__}')
         for key in data:
             if key not in CANDIDATE_KEYS:
-                raise InputError(f'line {lineno}: {key}', "unknown or fixed field (allowed: "
+                raise InputError(f'line {lineno}: {key}', 'unknown or fixed field (allowed: '
                                  f"{', '.join(CANDIDATE_KEYS)}; the hand is the base "
                                  "scenario's)")
         ident = data.pop('id', lineno)
@@ -399,7 +399,7 @@ def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
     for r in records:
         counts[r['status']] = counts.get(r['status'], 0) + 1
     parts = ', '.join(f'{counts.get(s, 0)} {s}' for s in ('optimal', 'infeasible', 'failed',
-                                                           'error'))
+                                                          'error'))
     rate = len(records) / seconds if seconds > 0 else float('inf')
     return f'scored {len(records)} candidates in {seconds:.2f} s ({rate:.0f}/s): {parts}'
 

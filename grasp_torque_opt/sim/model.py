@@ -172,7 +172,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     """
     if scenario.object is None:
         raise InputError('object', "the simulation needs the scenario's object "
-                         "(shape, size, mass)")
+                         '(shape, size, mass)')
     if scenario.gravity is None:
         raise InputError('gravity', "the simulation needs the scenario's gravity")
     if urdf_xml is None:
@@ -210,17 +210,17 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     for i, name in enumerate(joints):
         if name not in names:
             raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
-                             "MuJoCo model")
+                             'MuJoCo model')
     bodies = []
     for i, contact in enumerate(scenario.contacts):
         field = f'grasp.contacts[{i}].link'
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
         if body < 0:
             raise InputError(field, f"'{contact.link}' is not a link of the MuJoCo model "
-                             "(the simulation needs contacts on URDF links)")
+                             '(the simulation needs contacts on URDF links)')
         if model.body_geomnum[body] == 0:
             raise InputError(field, f"link '{contact.link}' has no collision geometry to "
-                             "touch the object with")
+                             'touch the object with')
         bodies.append(body)
     free = model.joint(f'{OBJECT_BODY}_free')
     hand_dofs = [model.jnt_dofadr[j] for j in range(model.njnt) if model.joint(j).name in names]

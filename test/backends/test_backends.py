@@ -164,6 +164,7 @@ def test_warm_start_across_a_change_of_polygon_sides_or_contact_count(planar_doc
         np.testing.assert_allclose(got.tau, ref.tau, atol=1e-7)
     assert warm.warm_solves == 2  # the repeated 8-gon and the repeated extra contact
 
+
 def test_kkt_violation_sees_a_suboptimal_point(allegro):
     """The optimality check itself: the solver's point passes, a feasible detour does not."""
     import daqp
@@ -239,6 +240,7 @@ def test_warm_answer_off_the_certificate_is_redone_cold(allegro, backend):
     base = {'daqp': DaqpSolver, 'proxsuite': TauQPSolver}[backend]
 
     class WrongWhenWarm(base):
+
         def solve(self, qp, cold=False):
             raw = super().solve(qp, cold)
             return dataclasses.replace(raw, x=raw.x * 1.05) if self.last_warm else raw
@@ -251,6 +253,7 @@ def test_warm_answer_off_the_certificate_is_redone_cold(allegro, backend):
     assert warm.warm_solves == 1 and warm.fallbacks == 1
     assert sol.optimal and sol.backend == backend
     np.testing.assert_allclose(sol.tau, solve(moved, backend='daqp').tau, atol=AGREE[backend])
+
 
 def drifting_rotating(setup, steps):
     """

@@ -134,7 +134,8 @@ def test_fallback_answers_for_a_backend_that_cannot(planar, capsys):
     """Quadprog cannot take the planar grasp's internal force: DAQP answers, unless told not to."""
     code, out, _ = run(['solve', str(PLANAR), '--backend', 'quadprog', '--json'], capsys)
     d = json.loads(out)
-    assert code == 0 and d['certificate']['ok'] is True and 'fallback after quadprog' in d['message']
+    assert code == 0 and d['certificate']['ok'] is True
+    assert 'fallback after quadprog' in d['message']
     code, out, _ = run(['solve', str(PLANAR), '--backend', 'quadprog', '--fallback', 'none',
                         '--json'], capsys)
     assert code == 4 and json.loads(out)['tau'] is None
@@ -142,7 +143,7 @@ def test_fallback_answers_for_a_backend_that_cannot(planar, capsys):
 
 @pytest.mark.parametrize('urdf', ['a\nb.urdf', '\x85', 'x\u2028y.urdf', 'tab\there.urdf'])
 def test_line_breaks_in_the_input_stay_escaped_in_the_one_line(tmp_path, capsys, planar_doc,
-                                                                urdf):
+                                                               urdf):
     r"""str.splitlines() breaks at \\x85 and \\u2028 too: the quoted input must not."""
     doc = mutated(planar_doc, ('hand', 'urdf'), urdf)
     bad = tmp_path / 'bad.yaml'

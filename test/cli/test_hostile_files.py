@@ -29,7 +29,8 @@ def chain_urdf(n: int) -> str:
     """A URDF of n revolute joints in a chain (170 KB at 500)."""
     inertia = ('<inertial><mass value="0.01"/><inertia ixx="1e-6" iyy="1e-6" izz="1e-6" '
                'ixy="0" ixz="0" iyz="0"/></inertial>')
-    links = ['<link name="l0"/>'] + [f'<link name="l{i}">{inertia}</link>' for i in range(1, n + 1)]
+    links = ['<link name="l0"/>'] + [f'<link name="l{i}">{inertia}</link>'
+                                     for i in range(1, n + 1)]
     joints = [f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
               '<origin xyz="0 0.01 0"/><axis xyz="0 0 1"/>'
               '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'

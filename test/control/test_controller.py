@@ -273,7 +273,7 @@ def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
     for k in range(200):  # one second: the driver every 5 ms, the skewed source every 40 ms
         t = 100.0 + 0.005 * k
         for source, stamp in (('driver', t - 0.001),) + ((('skewed', t + 0.4),) if k % 8 == 0
-                                                          else ()):
+                                                         else ()):
             try:
                 ctrl.update_joint_state(*js, now=t, stamp=stamp, clock=t)
                 accepted[source] += 1
@@ -353,7 +353,7 @@ def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar)
     ctrl.update_joint_state(*joint_state(planar), 0.0)
     r = ctrl.cycle(0.0)
     assert r.command is None and r.fault.startswith('inputs went stale during the cycle: '
-                                                     'joint_states stale')
+                                                    'joint_states stale')
     assert ctrl.counters.commands == 0 and ctrl.last_command is None
     ctrl.solver = Slow(0.0)
     ctrl.update_joint_state(*joint_state(planar), 1.0)

@@ -68,6 +68,6 @@ def test_default_normal_points_to_the_object_origin(planar):
 
 def test_unknown_frame_is_named(planar):
     spec = ContactSpec(link='finger3_tip', position=np.zeros(3))
-    with pytest.raises(FrameNotFound, match=r"grasp\.contacts\[0\]\.link: unknown frame "
+    with pytest.raises(FrameNotFound, match=r'grasp\.contacts\[0\]\.link: unknown frame '
                                             r"'finger3_tip' \(model frames: .*finger1_tip"):
         compute_grasp_maps(planar.hand, planar.q, [spec], planar.object_origin)

@@ -30,7 +30,7 @@ def test_joint_order_is_command_order():
 
 
 def test_fixed_joint_is_not_actuated():
-    with pytest.raises(JointNotFound, match=r"hand.joints\[0\]: unknown joint "
+    with pytest.raises(JointNotFound, match=r'hand.joints\[0\]: unknown joint '
                                             r"'finger1_tip_joint' \(1-DoF joints: joint1"):
         Hand.from_urdf(ROOT / 'urdf/planar_two_finger.urdf', ['finger1_tip_joint'])
 
@@ -46,8 +46,8 @@ def test_urdf_string_is_parsed():
 def test_limits_above_the_urdf_effort_are_refused_unless_allowed():
     urdf = ROOT / 'urdf/planar_two_finger.urdf'  # effort limits 10, 5, 10, 5 N m
     with pytest.raises(InputError, match=r"^hand.torque_limits: 6 N m for joint 'joint2' "
-                       r"exceeds the URDF effort limit \(5 N m\); set "
-                       r"hand.torque_limits_above_urdf: true to allow it$"):
+                       r'exceeds the URDF effort limit \(5 N m\); set '
+                       r'hand.torque_limits_above_urdf: true to allow it$'):
         Hand.from_urdf(urdf, None, [10.0, 6.0, 10.0, 5.0])
     hand = Hand.from_urdf(urdf, None, [10.0, 6.0, 10.0, 5.0], above_urdf=True)
     np.testing.assert_array_equal(hand.torque_limits, [10.0, 6.0, 10.0, 5.0])

@@ -71,7 +71,8 @@ def test_a_result_that_fails_its_certificate_is_not_returned(planar):
 
 
 def test_unknown_method_is_refused(planar):
-    with pytest.raises(ValueError, match='method must be one of tau-qp, tau-qp-adaptive, force-qp, socp, nlp'):
+    with pytest.raises(ValueError,
+                       match='method must be one of tau-qp, tau-qp-adaptive, force-qp, socp, nlp'):
         solve(planar, 'lp')
 
 

@@ -39,7 +39,7 @@ BAD = [  # (line text, what the error must name)
     ('{"grasp": {"joint_positions": {"joint_99": 0}}}', 'grasp.joint_positions.joint_99'),
     ('{"objective": {"weights": [1, 2]}}', 'objective.weights'),
     ('{"load": {"external_wrench": [NaN, 0, 0, 0, 0, 0]}}', 'load.external_wrench[0]: must be '
-                                                             'finite'),
+                                                            'finite'),
     ('[' * 100_000 + ']' * 100_000, 'nested too deeply'),
     ('{"grasp": {"contacts": []}}', 'grasp.contacts: must be a non-empty list'),
     ('{"object": {"mass": 1e400}}', 'object.mass'),
