@@ -62,7 +62,7 @@ def _sides(setup: GraspSetup, n: int) -> GraspSetup:
 
 
 def _median_time(fn, repeats: int, fastest: list | None = None) -> float:
-    """The median of ``repeats`` calls [s]; their fastest appended to ``fastest``."""
+    """Return the median of ``repeats`` calls [s], appending their fastest to ``fastest``."""
     samples = []
     for _ in range(repeats):
         t0 = time.perf_counter()
@@ -148,7 +148,7 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
 
 
 def walking(setup: GraspSetup, steps: int, seed: int = 0) -> list[GraspSetup]:
-    """The grasp with the fingers walking by 1 mrad per cycle, the load turning once."""
+    """Return the grasp with the fingers walking by 1 mrad per cycle, the load turning once."""
     rng = np.random.default_rng(seed)
     out, q = [], setup.q.copy()
     weight = float(np.linalg.norm(setup.external_wrench[:3]))
@@ -163,7 +163,7 @@ def walking(setup: GraspSetup, steps: int, seed: int = 0) -> list[GraspSetup]:
 
 
 def moving_case(steps: int, settings: AdaptiveSettings) -> dict:
-    """The node's case, warm (JSON-able); the exact optimum on every tenth cycle."""
+    """Time the node's case warm (JSON-able), with the exact optimum on every tenth cycle."""
     seq = walking(GraspSetup.from_file(SCENARIO_ALLEGRO), steps)
     variants = {'adaptive warm': None, 'tau-qp daqp warm': make_solver('daqp', warm_start=True),
                 'tau-qp proxsuite warm': make_solver('proxsuite', warm_start=True)}

@@ -1,5 +1,5 @@
 """
-The control cycle at the edges of the node's parameter ranges: how long can one take?
+How long one control cycle can take at the edges of the node's parameter ranges.
 
 Usage: .venv/bin/python bench/bounds.py [--grasps 40] [--out FILE]
 
@@ -48,7 +48,7 @@ def weight_patterns(m: int) -> dict[str, np.ndarray]:
 
 
 def many_contacts(setup: GraspSetup, p: int) -> GraspSetup:
-    """The grasp with p contacts: each fingertip's, repeated at points spread on its pad."""
+    """Return the grasp with p contacts: each fingertip's, repeated at points spread on its pad."""
     rng = np.random.default_rng(0)
     contacts = []
     for k in range(p):

@@ -55,7 +55,7 @@ THREAD_VARS = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')
 
 def blas_threads() -> dict:
     """
-    The thread settings this process runs with (None: the library's default, all cores).
+    Return the thread settings this process runs with (None: the library's default, all cores).
 
     Multi-threaded OpenBLAS on the tiny matrices here can cost milliseconds per
     call on a busy machine, so every benchmark records them.
@@ -82,7 +82,7 @@ def draw_candidates(base: GraspSetup, seed: int):
 
 def allegro_grasps_with_stats(count: int = 200, seed: int = 0,
                               base: GraspSetup | None = None) -> tuple[list[GraspSetup], dict]:
-    """The grasp set and how it was drawn (candidates drawn, rejected and why)."""
+    """Return the grasp set and how it was drawn (candidates drawn, rejected and why)."""
     base = base or GraspSetup.from_file(SCENARIO)
     tau_min, tau_max = base.tau_bounds
     kept: list[GraspSetup] = []
@@ -143,7 +143,7 @@ def run(count: int = 200, seed: int = 0) -> dict:
 
 
 def table(results: dict) -> str:
-    """A short markdown table of the set's make-up."""
+    """Format a short markdown table of the set's make-up."""
     r = results
     rej = r['rejected']
     return '\n'.join([

@@ -1,5 +1,5 @@
 """
-Physics benchmark: does the simulated Allegro hold the ball, and with what margin?
+Physics benchmark: whether the simulated Allegro holds the ball, and with what margin.
 
 Usage: .venv/bin/python bench/physics.py [--duration 2] [--kd 0.01]
        [--out bench/results/physics.json]
@@ -58,7 +58,7 @@ DIRECTIONS = {'+x': (1, 0, 0), '-x': (-1, 0, 0), '+y': (0, 1, 0), '-y': (0, -1, 
 
 
 def loaded(scenario: Scenario, gravity=None, mass=None) -> Scenario:
-    """The scenario with another gravity or ball mass, its load recomputed."""
+    """Return the scenario with another gravity or ball mass, its load recomputed."""
     gravity = scenario.gravity if gravity is None else np.asarray(gravity, dtype=float)
     obj = scenario.object if mass is None else dataclasses.replace(scenario.object, mass=mass)
     wrench = scenario.extra_wrench + weight_wrench(obj, gravity, scenario.object_origin)
@@ -68,8 +68,9 @@ def loaded(scenario: Scenario, gravity=None, mass=None) -> Scenario:
 def episode(scenario: Scenario, duration: float, kp: float, kd: float,
             feedforward: float = 1.0, friction: float = 1.0, mass: float | None = None) -> dict:
     """
-    One hold episode as a JSON-able record (``mass``: the ball's simulated mass [kg]
-    instead of the planned one).
+    Run one hold episode, as a JSON-able record.
+
+    ``mass``: the ball's simulated mass [kg] instead of the planned one.
     """
     sim = SimSettings(mu_tangential=friction * scenario.friction.mu1,
                       mu_torsional=friction * scenario.friction.mu2, mass=mass)
@@ -84,6 +85,8 @@ def episode(scenario: Scenario, duration: float, kp: float, kd: float,
 
 def cell(e: dict) -> str:
     """
+    Format an episode's table cell.
+
     Held with its largest drift and final rotation; fell (left the grasp, > 20 mm) or
     slid (moved more than 1 mm, stayed in the hand), with when it passed 1 mm.
     """
@@ -100,7 +103,7 @@ def _passed(reason: str) -> str:
 
 
 def capacity(scenario: Scenario, low: float, high: float, tol: float = 1e-3) -> float:
-    """The largest ball mass [kg] the optimizer certifies (bisection on the status)."""
+    """Find the largest ball mass [kg] the optimizer certifies (bisection on the status)."""
     assert certified_torques(loaded(scenario, mass=low))[2].optimal
     while certified_torques(loaded(scenario, mass=high))[2].optimal:
         low, high = high, 2 * high

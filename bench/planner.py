@@ -81,7 +81,7 @@ def _warm_up(chunk: tuple[np.ndarray, np.ndarray]) -> int:
 
 
 def chunks(qs: np.ndarray, ws: np.ndarray, rounds: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The batch, ``rounds`` times over, cut into chunks of :data:`CHUNK`."""
+    """Return the batch, ``rounds`` times over, cut into chunks of :data:`CHUNK`."""
     out = []
     for _ in range(rounds):
         for i in range(0, len(qs), CHUNK):

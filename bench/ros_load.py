@@ -42,7 +42,7 @@ def private_domains(n: int) -> list[int]:
 
 
 def isolated_env(domain: int) -> dict[str, str]:
-    """The environment of every process of a run: a private domain, localhost only."""
+    """Return the environment of every process of a run: a private domain, localhost only."""
     env = dict(os.environ)
     env['ROS_DOMAIN_ID'] = str(domain)
     env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -116,7 +116,7 @@ def interrupt_on_signals() -> None:
 
 
 def stamp_ns(stamp) -> int:
-    """A builtin_interfaces/Time as integer nanoseconds."""
+    """Convert a builtin_interfaces/Time to integer nanoseconds."""
     return stamp.sec * 1_000_000_000 + stamp.nanosec
 
 

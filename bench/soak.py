@@ -683,7 +683,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
 
 
 def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -> list[dict]:
-    """Latency per tenth of the run: does it drift?"""
+    """Return the latency per tenth of the run, to show whether it drifts."""
     out = []
     width = duration / MEMORY_SAMPLES
     for i in range(MEMORY_SAMPLES):
@@ -694,7 +694,7 @@ def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -
 
 
 def report(r: dict) -> str:
-    """The soak run as a markdown block."""
+    """Format the soak run as a markdown block."""
     c = r['node_counters']
 
     def during(key: str) -> str:

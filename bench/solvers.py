@@ -112,7 +112,7 @@ def variant_label(v: ProxSuiteSettings) -> str:
 
 
 def variant_grid() -> list[ProxSuiteSettings]:
-    """ProxSuite dense variants: Hessian type, dense backend, tolerance, preconditioner."""
+    """List ProxSuite's dense variants: Hessian type, dense backend, tolerance, preconditioner."""
     return [ProxSuiteSettings(eps_abs=e, hessian_type=h, dense_backend=b, preconditioner=pc)
             for h in ('Dense', 'Diagonal')
             for b in ('Automatic', 'PrimalDualLDLT', 'PrimalLDLT')
@@ -338,7 +338,7 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
 
 def sequence(base: GraspSetup, steps: int, kind: str, seed: int = 0) -> list[GraspSetup]:
     """
-    A slowly moving sequence: the load's force rotating once around base y.
+    Return a slowly moving sequence: the load's force rotating once around base y.
 
     ``kind``: ``load`` only that; ``drift`` every joint also drifting sinusoidally by up
     to 0.05 rad; ``step`` the rotating load 1000 times heavier (infeasible) for 10
@@ -444,7 +444,7 @@ def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
 
 def run(grasps: int = 200, seed: int = 0, repeats: int = 5, scenario_repeats: int = 200,
         steps: int = 500) -> dict:
-    """The whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
+    """Run the whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
     tuning = tune_proxsuite(allegro_grasps(TUNING_GRASPS, seed + TUNING_SEED_OFFSET),
                             max(1, min(repeats, 3)))
     variant = ProxSuiteSettings(**tuning['best']['variant']) if tuning['best'] else \

@@ -89,7 +89,7 @@ def _margin(text: str) -> float:
 
 
 def _count(low: int, high: int):
-    """An argparse type: an integer in [low, high]."""
+    """Make an argparse type: an integer in [low, high]."""
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -102,7 +102,7 @@ def _count(low: int, high: int):
 
 
 def _overridden(setup: GraspSetup, args: argparse.Namespace) -> GraspSetup:
-    """The setup with the command line's --objective and --margin."""
+    """Return the setup with the command line's --objective and --margin."""
     if getattr(args, 'objective', None):
         setup = dataclasses.replace(setup, objective=args.objective)
     if getattr(args, 'margin', None) is not None:
@@ -158,7 +158,7 @@ def _cap(value, unit: str, status: str) -> str:
 
 
 def _capacity_dict(setup: GraspSetup, maps) -> dict:
-    """The solve --capacity JSON: ``load`` and ``directions`` (docs/planner.md)."""
+    """Build the solve --capacity JSON: ``load`` and ``directions`` (docs/planner.md)."""
     from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 
     lp = CapacityLP(setup, maps)

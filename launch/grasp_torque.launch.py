@@ -28,7 +28,7 @@ PACKAGE = 'grasp_torque_opt'
 
 
 def _node(context):
-    """The node, with the arguments resolved."""
+    """Describe the node, with the arguments resolved."""
     params = LaunchConfiguration('params_file').perform(context)
     controller = LaunchConfiguration('controller').perform(context).strip('/')
     urdf = LaunchConfiguration('robot_description').perform(context)

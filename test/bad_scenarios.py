@@ -5,7 +5,7 @@ import math
 
 
 def mutated(doc, path, value):
-    """A copy of ``doc`` with the item at ``path`` (keys and indices) set, or removed if None."""
+    """Copy ``doc`` with the item at ``path`` (keys and indices) set, or removed if None."""
     out = copy.deepcopy(doc)
     node = out
     for key in path[:-1]:

@@ -26,7 +26,7 @@ def _ago(now: float, t: float | None) -> str:
 
 def report(controller: TorqueController, now: float) -> Report:
     """
-    The controller's state as a diagnostic status.
+    Report the controller's state as a diagnostic status.
 
     Level: STALE before the first joint state, OK while certified commands flow,
     WARN during a fault while the last certified command is held (within

@@ -43,12 +43,12 @@ class Certificate:
 
     @property
     def ok(self) -> bool:
-        """True when the solution is finite and every residual is within tolerance."""
+        """Return True when the solution is finite and every residual is within tolerance."""
         return self.finite and self.worst <= self.tolerance
 
     @property
     def worst(self) -> float:
-        """The largest residual."""
+        """Return the largest residual."""
         return max(self.equilibrium, self.torque, self.cone, self.normal_force,
                    self.torque_limit)
 

@@ -13,8 +13,10 @@ _REPR.maxstring = _REPR.maxother = QUOTE_LENGTH
 
 def quote(value: object) -> str:
     """
-    ``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time whatever
-    its size (a value quoted whole once printed a 4.3 MB "one line").
+    Return ``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time.
+
+    The time is bounded whatever the value's size (a value quoted whole once printed a
+    4.3 MB "one line").
     """
     text = _REPR.repr(value)
     return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + '...'
@@ -26,8 +28,9 @@ PATH_LENGTH = 240
 
 def cut(name: object, limit: int = QUOTE_LENGTH) -> str:
     """
-    A name from the input as quoted in messages: ``str(name)`` cut to ``limit``
-    characters (:data:`PATH_LENGTH` for paths).
+    Quote a name from the input for messages: ``str(name)`` cut to ``limit`` characters.
+
+    ``limit`` is :data:`PATH_LENGTH` for paths.
     """
     text = str(name) if not isinstance(name, str) else name
     return text if len(text) <= limit else text[:limit - 3] + '...'

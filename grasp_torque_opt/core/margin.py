@@ -27,7 +27,7 @@ import numpy as np
 
 def planned_friction(friction: Friction) -> Friction:
     """
-    The friction the optimization and the certificate use: the cone reduced by the margin.
+    Return the friction the optimization and the certificate use: the cone reduced by the margin.
 
     Returns:
         ``friction`` itself when its margin is 0, else a copy with mu1/(1+k),

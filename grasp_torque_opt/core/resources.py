@@ -1,6 +1,8 @@
 """
-Where the package's bundled files (config/, urdf/) are, installed or in the source tree,
-and how any input file is read: a regular file, within a size bound.
+Where the package's bundled files are, and how any input file is read.
+
+The bundled files (config/, urdf/) are found installed or in the source tree; an input
+file is read only if it is a regular file, within a size bound.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ def config_dirs() -> list[Path]:
 
 def find_config(name: str, field: str = 'scenario') -> Path:
     """
-    A file given as a path, or by name among the bundled config files.
+    Find a file given as a path, or by name among the bundled config files.
 
     Raises:
         InputError: naming ``field``, when neither exists.
@@ -43,7 +45,7 @@ def find_config(name: str, field: str = 'scenario') -> Path:
 
 def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
     """
-    The bytes of a regular file of at most ``limit`` bytes.
+    Read the bytes of a regular file of at most ``limit`` bytes.
 
     Opened without blocking and checked on the open descriptor, so a device, a
     pipe or a symlink to one is refused before anything is read (``/dev/zero``

@@ -157,8 +157,9 @@ class Scenario:
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
                   origin: np.ndarray) -> np.ndarray:
     """
-    The object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,);
-    zero without an object or without gravity.
+    Return the object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,).
+
+    Zero without an object or without gravity.
     """
     if obj is None or gravity is None:
         return np.zeros(6)
@@ -243,7 +244,7 @@ def _positive(value: Any, name: str) -> float:
 
 
 def _margin(value: Any, name: str = 'friction.margin') -> float:
-    """A friction margin k: finite and >= 0 [-]."""
+    """Parse a friction margin k: finite and >= 0 [-]."""
     k = _number(value, name)
     if k < 0.0:
         raise InputError(name, f'must be >= 0, got {value!r}')

@@ -67,7 +67,7 @@ class Solution:
 
     @property
     def optimal(self) -> bool:
-        """True for a certified optimum."""
+        """Return True for a certified optimum."""
         return self.status == OPTIMAL
 
     @property

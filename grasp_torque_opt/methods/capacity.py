@@ -154,7 +154,7 @@ class CapacityLP:
     def solve(self, load: np.ndarray, unit: str = '-', highs_only: bool = False,
               binding: bool = True) -> Capacity:
         """
-        The largest alpha with alpha * load holdable, certified.
+        Find the largest alpha with alpha * load holdable, certified.
 
         Args:
             load: the load direction w_ext, shape (6,) [N, N m] (about the object
@@ -256,7 +256,7 @@ def direction_capacities(setup: GraspSetup, maps: GraspMaps | None = None,
                          lp: CapacityLP | None = None, binding: bool = True
                          ) -> dict[str, Capacity]:
     """
-    The largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
+    Find the largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
 
     Args:
         setup: the grasp.

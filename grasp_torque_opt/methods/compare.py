@@ -64,7 +64,7 @@ def _pct(x: float | None) -> str:
 
 
 def format_table(comparison: Comparison) -> str:
-    """A fixed-width table: torques per joint and method, norms, reductions, times."""
+    """Format a fixed-width table: torques per joint and method, norms, reductions, times."""
     sols = comparison.solutions
     methods = list(sols)
     joints = next(iter(sols.values())).joints

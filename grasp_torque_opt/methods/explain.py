@@ -53,7 +53,9 @@ class Explanation:
 
     def as_dict(self) -> dict:
         """
-        Plain data (JSON): ``holdable_fraction``, ``binding``, ``status``, ``certified``,
+        Return plain data (JSON).
+
+        The keys are ``holdable_fraction``, ``binding``, ``status``, ``certified`` and
         ``text``.
         """
         d = self.capacity.as_dict()
@@ -62,5 +64,5 @@ class Explanation:
 
 
 def explain(setup: GraspSetup, maps: GraspMaps | None = None) -> Explanation:
-    """The largest holdable fraction of the setup's load and what binds there."""
+    """Find the largest holdable fraction of the setup's load and what binds there."""
     return Explanation(load_capacity(setup, maps))

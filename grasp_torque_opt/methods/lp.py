@@ -64,8 +64,9 @@ class LPResult:
 
 class DaqpForm:
     """
-    DAQP's view of the bounds (clipped to its infinity, equality flags, zero Hessian),
-    built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp).
+    DAQP's view of the bounds: clipped to its infinity, equality flags, zero Hessian.
+
+    Built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp).
     """
 
     def __init__(self, n: int, lower: np.ndarray, upper: np.ndarray) -> None:
@@ -117,7 +118,7 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
 
 
 def _spent(deadline: float | None):
-    """The failure of an LP not started past ``deadline`` (None if there is time)."""
+    """Return the failure of an LP not started past ``deadline`` (None if there is time)."""
     if deadline is not None and time.perf_counter() >= deadline:
         return ('failed', None, None, 'time budget spent')
     return None

@@ -92,7 +92,7 @@ class ScoreJob:
     @classmethod
     def from_file(cls, path: str | Path, **options: Any) -> ScoreJob:
         """
-        The job of a base scenario file.
+        Make the job of a base scenario file.
 
         Raises:
             InputError: the file cannot be read (field ``scenario``).
@@ -107,13 +107,13 @@ class ScoreJob:
 
     @property
     def key(self) -> str:
-        """A digest that identifies the job (a worker's cache key)."""
+        """Return a digest that identifies the job (a worker's cache key)."""
         return hashlib.sha256(repr(self).encode()).hexdigest()
 
 
 def merge(base: Any, override: Any) -> Any:
     """
-    A candidate merged into the base document: mappings key by key, ``None`` removes.
+    Merge a candidate into the base document: mappings key by key, ``None`` removes.
 
     Copies only what changes; the base is never modified.
     """
@@ -152,7 +152,7 @@ class Scorer:
 
     def candidate(self, lineno: int, text: str) -> tuple[Any, GraspSetup]:
         """
-        The candidate of one line, bound to the base hand.
+        Return the candidate of one line, bound to the base hand.
 
         Raises:
             InputError: naming the line and the field.
@@ -193,7 +193,7 @@ class Scorer:
         return ident, setup
 
     def score_line(self, lineno: int, text: str) -> dict[str, Any]:
-        """The record of one line (a bad line gives status ``error``; never raises)."""
+        """Return the record of one line (a bad line gives status ``error``; never raises)."""
         t0 = time.perf_counter()
         record: dict[str, Any] = {'line': lineno, 'id': None}
         try:
@@ -218,7 +218,7 @@ class Scorer:
         return record
 
     def score(self, setup: GraspSetup, maps) -> dict[str, Any]:
-        """The metrics of one bound candidate (plain data)."""
+        """Return the metrics of one bound candidate (plain data)."""
         sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback)
         usage = sol.friction_usage
         out: dict[str, Any] = {
@@ -239,7 +239,7 @@ class Scorer:
         return out
 
     def score_lines(self, lines: Iterable[tuple[int, str]]) -> list[dict[str, Any]]:
-        """Records of (line number, text) pairs, in order."""
+        """Score (line number, text) pairs into records, in order."""
         return [self.score_line(n, t) for n, t in lines]
 
 
@@ -271,7 +271,7 @@ def read_candidates(path: str | Path) -> list[tuple[int, str]]:
 
 
 def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tuple[int, str]]]:
-    """The lines cut into tasks of ``size``."""
+    """Cut the lines into tasks of ``size``."""
     return [list(lines[i:i + size]) for i in range(0, len(lines), size)]
 
 
@@ -405,7 +405,7 @@ def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
 
 
 def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
-    """The ranked table (text, not a contract)."""
+    """Format the ranked table (text, not a contract)."""
     def num(v, fmt):
         return format(v, fmt) if v is not None else '-'.rjust(int(fmt.split('.')[0]))
 

@@ -19,13 +19,13 @@ import sys
 
 
 def isolate() -> None:
-    """A private ROS domain (unless one is set) and localhost-only discovery."""
+    """Use a private ROS domain (unless one is set) and localhost-only discovery."""
     os.environ.setdefault('ROS_DOMAIN_ID', str(random.randint(1, 100)))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 
 def scenario_of(params: Path) -> str:
-    """The ``scenario`` parameter of a node params file."""
+    """Return the ``scenario`` parameter of a node params file."""
     import yaml
 
     doc = yaml.safe_load(params.read_text())

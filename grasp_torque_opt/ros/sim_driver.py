@@ -330,9 +330,11 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
 def _publish_contacts(hsim, setup, pub, base, stamp, compute_grasp_maps, Pose, PoseArray
                       ) -> None:
     """
-    The contact frames measured in the simulation: the measured point and normal, the
-    x axis from the planned frame at the current configuration. Nothing while a planned
-    contact does not touch (the node's contacts_timeout then applies).
+    Publish the contact frames measured in the simulation.
+
+    Each has the measured point and normal, and the x axis from the planned frame at the
+    current configuration. Nothing is published while a planned contact does not touch
+    (the node's contacts_timeout then applies).
     """
     readings, _ = hsim.readings()
     if not all(r.touching for r in readings):

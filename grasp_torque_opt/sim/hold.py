@@ -115,7 +115,7 @@ class HoldReport:
 def certified_torques(scenario: Scenario, urdf_xml: str | None = None
                       ) -> tuple[GraspSetup, GraspMaps, Solution, np.ndarray]:
     """
-    The scenario solved as the node solves it with gravity compensation.
+    Solve the scenario as the node solves it with gravity compensation.
 
     Returns:
         The setup (with g(q0) as torque offset), its maps, the certified solution

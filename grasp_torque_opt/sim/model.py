@@ -101,8 +101,10 @@ class SimModel:
 
 def adapt_urdf(xml: str) -> str:
     """
-    The URDF as MuJoCo should load it: no joint friction or damping, no visuals,
-    and a ``<mujoco><compiler .../></mujoco>`` extension (see the module docstring).
+    Rewrite the URDF as MuJoCo should load it.
+
+    No joint friction or damping, no visuals, and a ``<mujoco><compiler .../></mujoco>``
+    extension (see the module docstring).
 
     Raises:
         InputError: the document is not XML with a ``robot`` root (field ``hand.urdf``).

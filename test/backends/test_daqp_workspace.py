@@ -1,6 +1,7 @@
 """
-DaqpWorkspace (the adaptive method's rounds): same optimum as an independent solver, its
-multipliers a KKT point, warm and cold alike, bad data refused.
+DaqpWorkspace, the adaptive method's rounds: the same optimum as an independent solver.
+
+Its multipliers are a KKT point, warm and cold alike, and bad data is refused.
 """
 
 from grasp_torque_opt.backends.daqp import DaqpWorkspace, kkt_violation

@@ -101,8 +101,9 @@ def test_console_script_runs_as_installed():
                                         (('objective',), {'weights': [1.0, 2.0, 1.0, 2.0]})])
 def test_per_joint_lists_without_joints_exit_2(tmp_path, capsys, planar_doc, path, value):
     """
-    Without hand.joints, per-joint values would follow Pinocchio's joint order, not the
-    URDF file's (the Allegro's model order is 0-3, 12-15, 4-7, 8-11): they need the order.
+    Per-joint values need hand.joints: without it they would follow Pinocchio's joint order.
+
+    That order is not the URDF file's (the Allegro's model order is 0-3, 12-15, 4-7, 8-11).
     """
     doc = mutated(mutated(planar_doc, ('hand', 'joints'), None), path, value)
     doc['hand']['urdf'] = str(PLANAR.parent / doc['hand']['urdf'])

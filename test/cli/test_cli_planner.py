@@ -1,6 +1,7 @@
 """
-The planner's command line: --objective, --margin, --capacity, the infeasible explanation,
-and ``score`` on a generated batch (bad lines named, the rest scored, files written).
+The planner's command line: --objective, --margin, --capacity, the infeasible explanation.
+
+Also ``score`` on a generated batch: bad lines named, the rest scored, files written.
 """
 
 import copy

@@ -1,8 +1,9 @@
 """
-Hostile scenario files through the CLI: exit 2 and one line naming the problem, in
-bounded time and memory, never a traceback (an alias bomb took over 4 GB, so did
-/dev/zero; 5000 levels of nesting raised RecursionError; a Latin-1 byte,
-UnicodeDecodeError; a directory as hand.urdf was "file not found").
+Hostile scenario files through the CLI: exit 2 and one line naming the problem.
+
+The answer comes in bounded time and memory, never as a traceback (an alias bomb took
+over 4 GB, so did /dev/zero; 5000 levels of nesting raised RecursionError; a Latin-1
+byte, UnicodeDecodeError; a directory as hand.urdf was "file not found").
 
 The files are run in one child process whose address space is capped at 1.5 GB, so a
 file that blows up kills the child, not the test run.
@@ -26,7 +27,7 @@ TIME_CAP = 60
 
 
 def chain_urdf(n: int) -> str:
-    """A URDF of n revolute joints in a chain (170 KB at 500)."""
+    """Build a URDF of n revolute joints in a chain (170 KB at 500)."""
     inertia = ('<inertial><mass value="0.01"/><inertia ixx="1e-6" iyy="1e-6" izz="1e-6" '
                'ixy="0" ixz="0" iyz="0"/></inertial>')
     links = ['<link name="l0"/>'] + [f'<link name="l{i}">{inertia}</link>'

@@ -12,7 +12,7 @@ import pytest
 
 
 def paper_rows(mu1, mu2, N):
-    """The paper's 2N inequalities, written out term by term (Section 1)."""
+    """Write out the paper's 2N inequalities term by term (Section 1)."""
     s = lambda j: np.sin(2 * np.pi * j / N)  # noqa: E731 -- the paper's s_j, as it writes it
     c = lambda j: np.cos(2 * np.pi * j / N)  # noqa: E731 -- the paper's c_j, as it writes it
     sN = np.sin(2 * np.pi / N)

@@ -58,8 +58,9 @@ def test_limits_above_the_urdf_effort_are_refused_unless_allowed():
 
 def test_pinocchio_orders_joints_unlike_the_urdf_file():
     """
-    Why per-joint lists need hand.joints: the Allegro's model order is 0-3, 12-15, 4-7,
-    8-11, not the file's 0-15.
+    Pinocchio orders joints unlike the URDF file: why per-joint lists need hand.joints.
+
+    The Allegro's model order is 0-3, 12-15, 4-7, 8-11, not the file's 0-15.
     """
     hand = Hand.from_urdf(resolve_urdf(ALLEGRO_URDF, ROOT))
     assert [int(float(n.split('_')[1])) for n in hand.joints] == \

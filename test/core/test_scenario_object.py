@@ -12,7 +12,7 @@ import pytest
 
 @pytest.fixture(scope='module')
 def weighed_doc():
-    """The planar scenario with a box of 0.2 kg under gravity along -y, off-centre."""
+    """Return the planar scenario with a box of 0.2 kg under gravity along -y, off-centre."""
     doc = scenario_doc(PLANAR)
     del doc['load']
     doc['gravity'] = [0.0, -9.81, 0.0]

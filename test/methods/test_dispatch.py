@@ -80,8 +80,10 @@ def test_unknown_method_is_refused(planar):
 @pytest.mark.parametrize('N', [3, 4, 6, 8, 16, 32])
 def test_polygon_optimum_is_sandwiched_by_exact_cones(name, N, request):
     """
+    The polygon's optimum lies between two exact (SOCP) optima.
+
     The inscribed N-gon contains the exact cone with mu1 cos(pi/N) and is inside the one
-    with mu1: its optimum lies between the two exact (SOCP) optima.
+    with mu1.
     """
     setup = request.getfixturevalue(name)
     fr = dataclasses.replace(setup.friction, sides=N)

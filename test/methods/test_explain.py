@@ -11,8 +11,9 @@ import pytest
 
 def named_are_active(setup):
     """
-    The explanation's fraction equals an independent HiGHS LP's, and every constraint it
-    names is active at that LP's optimum.
+    Check that the explanation's fraction equals an independent HiGHS LP's.
+
+    Every constraint it names must also be active at that LP's optimum.
     """
     maps = setup.maps()
     assert solve(setup, maps=maps).status == 'infeasible'

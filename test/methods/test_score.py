@@ -1,6 +1,8 @@
 """
-Batch scoring: the batch's scores equal single solves, bad lines are named and skipped,
-and the process pool and a local Dask cluster give the serial answers.
+Batch scoring: the batch's scores equal single solves.
+
+Bad lines are named and skipped, and the process pool and a local Dask cluster give the
+serial answers.
 """
 
 import copy
@@ -47,7 +49,7 @@ BAD = [  # (line text, what the error must name)
 
 
 def independent_merge(base, over):
-    """The documented merge rule, written again: mappings merge, null removes, else replace."""
+    """Merge by the documented rule, written again: mappings merge, null removes, else replace."""
     out = copy.deepcopy(base)
     for k, v in over.items():
         if v is None:

@@ -46,7 +46,7 @@ def test_simulated_contact_forces_equal_the_certified_wrenches(held, scenario):
 
 
 def held_force(contact):
-    """The simulated contact force in base axes, from the contact-frame wrench."""
+    """Return the simulated contact force in base axes, from the contact-frame wrench."""
     return contact.rotation @ contact.simulated[:3]
 
 

@@ -96,8 +96,10 @@ def test_refusals_name_the_field():
 
 def test_the_planned_contacts_touch_the_object_at_the_grasp(allegro_sim, allegro):
     """
-    The bundled grasp's tips are tangent to the ball: MuJoCo finds one contact on each,
-    within 0.1 mm of the planned point, normal within 1 degree.
+    The bundled grasp's tips are tangent to the ball.
+
+    MuJoCo finds one contact on each, within 0.1 mm of the planned point, normal within 1
+    degree.
     """
     m = allegro_sim.model
     d = mujoco.MjData(m)

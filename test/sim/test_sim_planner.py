@@ -1,6 +1,8 @@
 """
-The planner's numbers on physics: a friction margin holds where the minimum-effort
-torques slip, and the ball falls just above the mass the capacity LP predicts.
+The planner's numbers on physics.
+
+A friction margin holds where the minimum-effort torques slip, and the ball falls just
+above the mass the capacity LP predicts.
 """
 
 import dataclasses
