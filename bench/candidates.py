@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Write a batch of candidate Allegro grasps as JSON Lines, for ``grasp-torque-opt score``.
 
@@ -21,6 +29,8 @@ import json
 from pathlib import Path
 import sys
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasps import draw_candidates, SCENARIO  # noqa: E402

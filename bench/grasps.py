@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 A fixed, seeded set of random feasible Allegro grasps for the benchmarks.
 
@@ -34,8 +42,10 @@ import sys
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report, ROOT  # noqa: E402
+from cycle import machine, report, ROOT  # noqa: E402, I100
 from grasp_torque_opt.core.exceptions import GraspTorqueError  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.reference.feasibility import linearized_feasible  # noqa: E402
@@ -53,7 +63,7 @@ THREAD_VARS = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')
 
 def blas_threads() -> dict:
     """
-    The thread settings this process runs with (None: the library's default, all cores).
+    Return the thread settings this process runs with (None: the library's default, all cores).
 
     Multi-threaded OpenBLAS on the tiny matrices here can cost milliseconds per
     call on a busy machine, so every benchmark records them.
@@ -80,7 +90,7 @@ def draw_candidates(base: GraspSetup, seed: int):
 
 def allegro_grasps_with_stats(count: int = 200, seed: int = 0,
                               base: GraspSetup | None = None) -> tuple[list[GraspSetup], dict]:
-    """The grasp set and how it was drawn (candidates drawn, rejected and why)."""
+    """Return the grasp set and how it was drawn (candidates drawn, rejected and why)."""
     base = base or GraspSetup.from_file(SCENARIO)
     tau_min, tau_max = base.tau_bounds
     kept: list[GraspSetup] = []
@@ -141,7 +151,7 @@ def run(count: int = 200, seed: int = 0) -> dict:
 
 
 def table(results: dict) -> str:
-    """A short markdown table of the set's make-up."""
+    """Format a short markdown table of the set's make-up."""
     r = results
     rej = r['rejected']
     return '\n'.join([

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 The tau-QP against the reference methods on seeded random loads.
 
@@ -21,8 +29,10 @@ import sys
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, ROOT, SCENARIOS  # noqa: E402
+from cycle import machine, ROOT, SCENARIOS  # noqa: E402, I100
 from grasp_torque_opt.backends.proxsuite import TauQPSolver  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.dispatch import METHODS, solve  # noqa: E402
@@ -97,7 +107,7 @@ def main() -> None:
             if st['n']:
                 print(f"  {label}: median {100 * st['median']:.2f}%, p90 {100 * st['p90']:.2f}%,"
                       f" max {100 * st['max']:.2f}% (n = {st['n']})")
-        print(f"  tau-QP and force QP disagree on feasibility: "
+        print(f'  tau-QP and force QP disagree on feasibility: '
               f"{res['feasibility_disagreements_tau_vs_force']}")
     if args.json:
         args.json.write_text(json.dumps(out, indent=2))

@@ -1,5 +1,13 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-Physics benchmark: does the simulated Allegro hold the ball, and with what margin?
+Physics benchmark: whether the simulated Allegro holds the ball, and with what margin.
 
 Usage: .venv/bin/python bench/physics.py [--duration 2] [--kd 0.01]
        [--out bench/results/physics.json]
@@ -40,8 +48,10 @@ import time
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report  # noqa: E402
+from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.core.resources import find_config  # noqa: E402
 from grasp_torque_opt.core.scenario import load_scenario, Scenario, weight_wrench  # noqa: E402
 from grasp_torque_opt.methods.capacity import load_capacity  # noqa: E402
@@ -56,7 +66,7 @@ DIRECTIONS = {'+x': (1, 0, 0), '-x': (-1, 0, 0), '+y': (0, 1, 0), '-y': (0, -1, 
 
 
 def loaded(scenario: Scenario, gravity=None, mass=None) -> Scenario:
-    """The scenario with another gravity or ball mass, its load recomputed."""
+    """Return the scenario with another gravity or ball mass, its load recomputed."""
     gravity = scenario.gravity if gravity is None else np.asarray(gravity, dtype=float)
     obj = scenario.object if mass is None else dataclasses.replace(scenario.object, mass=mass)
     wrench = scenario.extra_wrench + weight_wrench(obj, gravity, scenario.object_origin)
@@ -66,8 +76,9 @@ def loaded(scenario: Scenario, gravity=None, mass=None) -> Scenario:
 def episode(scenario: Scenario, duration: float, kp: float, kd: float,
             feedforward: float = 1.0, friction: float = 1.0, mass: float | None = None) -> dict:
     """
-    One hold episode as a JSON-able record (``mass``: the ball's simulated mass [kg]
-    instead of the planned one).
+    Run one hold episode, as a JSON-able record.
+
+    ``mass``: the ball's simulated mass [kg] instead of the planned one.
     """
     sim = SimSettings(mu_tangential=friction * scenario.friction.mu1,
                       mu_torsional=friction * scenario.friction.mu2, mass=mass)
@@ -82,6 +93,8 @@ def episode(scenario: Scenario, duration: float, kp: float, kd: float,
 
 def cell(e: dict) -> str:
     """
+    Format an episode's table cell.
+
     Held with its largest drift and final rotation; fell (left the grasp, > 20 mm) or
     slid (moved more than 1 mm, stayed in the hand), with when it passed 1 mm.
     """
@@ -98,7 +111,7 @@ def _passed(reason: str) -> str:
 
 
 def capacity(scenario: Scenario, low: float, high: float, tol: float = 1e-3) -> float:
-    """The largest ball mass [kg] the optimizer certifies (bisection on the status)."""
+    """Find the largest ball mass [kg] the optimizer certifies (bisection on the status)."""
     assert certified_torques(loaded(scenario, mass=low))[2].optimal
     while certified_torques(loaded(scenario, mass=high))[2].optimal:
         low, high = high, 2 * high
@@ -200,7 +213,7 @@ def tables(r: dict) -> str:
         lines.append(f"| {row['direction']} | {row['max_command_Nm']:.3f} | "
                      + ' | '.join(cell(row['episodes'][k]) for k in gains) + ' |')
     mass_gains = gains + ['3.0']
-    lines += ['', f"(b) mass (weight along +x); the optimizer certifies up to "
+    lines += ['', f'(b) mass (weight along +x); the optimizer certifies up to '
               f"{r['mass']['capacity_kg']:.3f} kg (first infeasible mass, bisection to 1 g)", '',
               '| mass [kg] | ' + ' | '.join(f'Kp {k}' for k in mass_gains) + ' |',
               '|---|' + '---|' * len(mass_gains)]
@@ -224,7 +237,7 @@ def tables(r: dict) -> str:
         e = row['episodes']
         lines.append(f"| {row['kp']:g} | {cell(e['1.0'])} | {cell(e['0.9'])} | "
                      f"{cell(e['1.1'])} |")
-    lines += ['', "(f) friction margin: torques planned with margin k (the cone of mu/(1+k)) "
+    lines += ['', '(f) friction margin: torques planned with margin k (the cone of mu/(1+k)) '
               "against simulated friction 1/(1+k') of the planned one "
               f"(Kp {' / '.join(gains)} N m/rad)", '',
               '| planned margin k | usage of the cone | norm tau [N m] | '
@@ -240,7 +253,7 @@ def tables(r: dict) -> str:
     lines += ['', f"(g) load capacity: the capacity LP holds {c['alpha']:.3f} times the "
               f"0.15 kg ball, {c['capacity_kg']:.3f} kg ({c['binding']}); the simulated ball "
               f"at multiples of it, Kp {c['kp']:g} N m/rad, commanded the certified torques "
-              "for its mass (above the capacity: for 0.999 of it)", '',
+              'for its mass (above the capacity: for 0.999 of it)', '',
               '| mass / capacity | simulated mass [kg] | planned for [kg] | outcome |',
               '|---|---|---|---|']
     for row in c['rows']:

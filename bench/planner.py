@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Planner throughput: Allegro grasps scored per second, one core and several.
 
@@ -41,8 +49,10 @@ import time
 
 import numpy as np
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report  # noqa: E402
+from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
@@ -79,7 +89,7 @@ def _warm_up(chunk: tuple[np.ndarray, np.ndarray]) -> int:
 
 
 def chunks(qs: np.ndarray, ws: np.ndarray, rounds: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """The batch, ``rounds`` times over, cut into chunks of :data:`CHUNK`."""
+    """Return the batch, ``rounds`` times over, cut into chunks of :data:`CHUNK`."""
     out = []
     for _ in range(rounds):
         for i in range(0, len(qs), CHUNK):
@@ -176,7 +186,8 @@ def main() -> None:
     res = run(args.grasps, args.seed, args.rounds, args.workers, tuple(args.backends),
               args.worker_threads)
     report(res, table(res), args.out,
-           f"{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
+           f'{args.grasps} grasps x {args.rounds} rounds, seed {args.seed}; '
+           f"threads: {res['blas_threads']} (pool workers: {args.worker_threads})")
 
 
 if __name__ == '__main__':

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Pieces shared by the ROS 2 benchmarks ``node_load.py`` and ``soak.py``.
 
@@ -42,7 +50,7 @@ def private_domains(n: int) -> list[int]:
 
 
 def isolated_env(domain: int) -> dict[str, str]:
-    """The environment of every process of a run: a private domain, localhost only."""
+    """Return the environment of every process of a run: a private domain, localhost only."""
     env = dict(os.environ)
     env['ROS_DOMAIN_ID'] = str(domain)
     env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -116,7 +124,7 @@ def interrupt_on_signals() -> None:
 
 
 def stamp_ns(stamp) -> int:
-    """A builtin_interfaces/Time as integer nanoseconds."""
+    """Convert a builtin_interfaces/Time to integer nanoseconds."""
     return stamp.sec * 1_000_000_000 + stamp.nanosec
 
 

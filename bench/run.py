@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 The whole benchmark suite, one command: results as JSON and one markdown summary.
 
@@ -42,6 +50,8 @@ import sys
 import time
 
 HERE = Path(__file__).resolve().parent
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402).
 sys.path.insert(0, str(HERE))
 
 import adaptive  # noqa: E402

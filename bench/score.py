@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Batch scoring throughput: ``grasp-torque-opt score``'s candidates per second on the Allegro.
 
@@ -30,6 +38,8 @@ from pathlib import Path
 import sys
 import time
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from candidates import candidate_lines  # noqa: E402
 from cycle import machine, report  # noqa: E402
@@ -105,7 +115,7 @@ def main() -> int:
     p.add_argument('--out', type=Path, help='write the results as JSON here')
     a = p.parse_args()
     res = run(a.count, a.seed, a.workers, tuple(a.backends), a.dask)
-    report(res, table(res), a.out, f"{a.count} candidates, seed {a.seed}; threads: "
+    report(res, table(res), a.out, f'{a.count} candidates, seed {a.seed}; threads: '
            f"{res['blas_threads']}")
     return 0
 

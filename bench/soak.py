@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 The soak run: grasp_torque_node at 1 kHz for minutes under valid, invalid and infeasible inputs.
 
@@ -57,8 +65,10 @@ import time
 import numpy as np
 import yaml
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ros_load import (  # noqa: E402
+from ros_load import (  # noqa: E402, I100
     Child,
     CONFIG,
     CpuShare,
@@ -221,13 +231,13 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
           f"{mach['date']}")
     print(f'soak: {args.duration:g} s at {args.rate:g} Hz, seed {args.seed}, node pid '
           f'{node.pid}, ROS_DOMAIN_ID {domain}, logs {logs}')
-    print(f"mix: joint states {100 * (1 - P_JS_INVALID):.0f}% valid, "
+    print(f'mix: joint states {100 * (1 - P_JS_INVALID):.0f}% valid, '
           f"{100 * P_JS_INVALID:.0f}% invalid ({', '.join(JS_INVALID)}); contacts and load at "
-          f"{SLOW_RATE_HZ:g} Hz, {100 * P_SLOW_INVALID:.0f}% invalid (contacts: "
+          f'{SLOW_RATE_HZ:g} Hz, {100 * P_SLOW_INVALID:.0f}% invalid (contacts: '
           f"{', '.join(CONTACT_INVALID)}; load: {', '.join(WRENCH_INVALID)}); "
           f"{mix['silences']} silences and {mix['infeasible_load_phases']} infeasible loads "
-          f"({INFEASIBLE_FORCE_N:g} N) of {PHASE_S:g} s; fault_policy {policy}, stop bound "
-          f"{timeout:g} + {hold:g} + {DELIVERY_MARGIN_S:g} s", flush=True)
+          f'({INFEASIBLE_FORCE_N:g} N) of {PHASE_S:g} s; fault_policy {policy}, stop bound '
+          f'{timeout:g} + {hold:g} + {DELIVERY_MARGIN_S:g} s', flush=True)
 
     rclpy.init()
     ros = rclpy.create_node('grasp_soak_driver')
@@ -618,7 +628,8 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             continue
         if kind == 'silence':
             bound = a + int(1e9 * stop_bound_s)
-            late = [t for t, zero in commands if bound < t <= b and not (zero and policy == 'zero')]
+            late = [t for t, zero in commands
+                    if bound < t <= b and not (zero and policy == 'zero')]
             if late:
                 broken('command_during_silence',
                        f'{len(late)} command(s) {1e-9 * (late[0] - a):.3f} s into a silence')
@@ -680,7 +691,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
 
 
 def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -> list[dict]:
-    """Latency per tenth of the run: does it drift?"""
+    """Return the latency per tenth of the run, to show whether it drifts."""
     out = []
     width = duration / MEMORY_SAMPLES
     for i in range(MEMORY_SAMPLES):
@@ -691,7 +702,7 @@ def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -
 
 
 def report(r: dict) -> str:
-    """The soak run as a markdown block."""
+    """Format the soak run as a markdown block."""
     c = r['node_counters']
 
     def during(key: str) -> str:
@@ -718,25 +729,25 @@ def report(r: dict) -> str:
         f"{r['mix']['infeasible_load_phases']} |",
         '| skewed-source / limits-below / solver-bounds / service-flood phases | '
         + ' / '.join(str(r['mix'][f'{k}_phases']) for k in ISSUE13_PHASES) + ' |',
-        f"| service calls (solved / busy / cannot solve / unanswered) | "
+        f'| service calls (solved / busy / cannot solve / unanswered) | '
         f"{r['service_flood']['calls']} ({r['service_flood']['solved']} / "
         f"{r['service_flood']['busy']} / {r['service_flood']['cannot_solve']} / "
         f"{r['service_flood']['unanswered']}) |",
         f"| commands received | {r['commands_received']} |",
         f"| commands counted by the node | {during('commands')} |",
         f"| node cycles | {during('cycles')} |",
-        f"| rejected by the node: joint_states / contacts / external_wrench | "
+        f'| rejected by the node: joint_states / contacts / external_wrench | '
         f"{during('rejected.joint_states')} / {during('rejected.contacts')} / "
         f"{during('rejected.external_wrench')} |",
         f"| faults / recoveries | {during('faults')} / {during('recoveries')} |",
         f"| overruns / solver failures | {during('overruns')} / {during('solver_failures')} |",
         f"| latency p50 / p99 / max [ms] | {_f(r['latency_ms']['p50_ms'])} / "
         f"{_f(r['latency_ms']['p99_ms'])} / {_f(r['latency_ms']['max_ms'])} |",
-        f"| commands received over joint_state_timeout + {DELIVERY_MARGIN_S:g} s after their "
+        f'| commands received over joint_state_timeout + {DELIVERY_MARGIN_S:g} s after their '
         f"stamp | {r['late_receipts']} |",
         f"| node VmRSS start / end [MiB] | {_mib(mem[0]['vm_rss_kib'])} / "
         f"{_mib(mem[-1]['vm_rss_kib'])} |",
-        f"| node VmRSS samples [MiB] | "
+        f'| node VmRSS samples [MiB] | '
         f"{', '.join(_mib(x['vm_rss_kib']) for x in mem)} |",
         f"| other work on the machine [cores] | {_f(r['other_processes_cores'], '.2f')} |",
         f"| **invariants broken** | **{r['invariants_broken']}** |",
@@ -747,7 +758,7 @@ def report(r: dict) -> str:
     sent = ', '.join(f'{k} {v}' for k, v in js.items() if k != 'valid')
     lines += ['', f'invalid joint states sent: {sent}',
               'invalid contacts sent: ' + ', '.join(f'{k} {v}' for k, v in ct.items()
-                                                     if k != 'valid'),
+                                                    if k != 'valid'),
               'invalid loads sent: ' + ', '.join(f'{k} {v}' for k, v in wr.items()
                                                  if k not in ('valid', 'infeasible'))]
     return '\n'.join(lines)

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 QP solvers side by side on the tau-QP, the exact-cone references, and warm starts.
 
@@ -74,8 +82,10 @@ import osqp
 import proxsuite
 import scipy.sparse as sp
 
+# The imports below need bench/ on sys.path for its sibling modules, so they follow
+# code (E402) and stay out of the alphabetical block above (I100).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from cycle import machine, report, ROOT, SCENARIOS  # noqa: E402
+from cycle import machine, report, ROOT, SCENARIOS  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings  # noqa: E402
 from grasp_torque_opt.core.certificate import certify  # noqa: E402
@@ -110,7 +120,7 @@ def variant_label(v: ProxSuiteSettings) -> str:
 
 
 def variant_grid() -> list[ProxSuiteSettings]:
-    """ProxSuite dense variants: Hessian type, dense backend, tolerance, preconditioner."""
+    """List ProxSuite's dense variants: Hessian type, dense backend, tolerance, preconditioner."""
     return [ProxSuiteSettings(eps_abs=e, hessian_type=h, dense_backend=b, preconditioner=pc)
             for h in ('Dense', 'Diagonal')
             for b in ('Automatic', 'PrimalDualLDLT', 'PrimalLDLT')
@@ -317,8 +327,9 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
                     dev = max(dev, float(np.max(np.abs(tau - ref))))
             times.append(float(np.median(ts)))
             failed += not good
-        tried.append({'variant': dataclasses.asdict(v), 'label': variant_label(v), 'failed': failed,
-                      'max_abs_tau_dev': dev, 'median_s': float(np.median(times))})
+        tried.append({'variant': dataclasses.asdict(v), 'label': variant_label(v),
+                      'failed': failed, 'max_abs_tau_dev': dev,
+                      'median_s': float(np.median(times))})
     good = [t for t in tried if t['failed'] == 0 and t['max_abs_tau_dev'] <= AGREE_TOL]
     best = None
     if good:
@@ -335,7 +346,7 @@ def tune_proxsuite(setups: list[GraspSetup], repeats: int) -> dict:
 
 def sequence(base: GraspSetup, steps: int, kind: str, seed: int = 0) -> list[GraspSetup]:
     """
-    A slowly moving sequence: the load's force rotating once around base y.
+    Return a slowly moving sequence: the load's force rotating once around base y.
 
     ``kind``: ``load`` only that; ``drift`` every joint also drifting sinusoidally by up
     to 0.05 rad; ``step`` the rotating load 1000 times heavier (infeasible) for 10
@@ -441,7 +452,7 @@ def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
 
 def run(grasps: int = 200, seed: int = 0, repeats: int = 5, scenario_repeats: int = 200,
         steps: int = 500) -> dict:
-    """The whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
+    """Run the whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
     tuning = tune_proxsuite(allegro_grasps(TUNING_GRASPS, seed + TUNING_SEED_OFFSET),
                             max(1, min(repeats, 3)))
     variant = ProxSuiteSettings(**tuning['best']['variant']) if tuning['best'] else \
@@ -473,7 +484,8 @@ def table(results: dict) -> str:
                   '|---|---:|---:|---:|---:|---:|---|']
         for r, row in res['rows'].items():
             dev = '-' if row['max_abs_tau_dev'] is None else f"{row['max_abs_tau_dev']:.1e}"
-            ratio = '-' if row['ratio_to_proxsuite'] is None else f"{row['ratio_to_proxsuite']:.2f}"
+            ratio = ('-' if row['ratio_to_proxsuite'] is None
+                     else f"{row['ratio_to_proxsuite']:.2f}")
             ex = row.get('excess_polygon_over_exact')
             ex = '' if not ex else f"{100 * ex['median']:.2f}% / {100 * ex['max']:.2f}%"
             lines.append(f"| {r} | {row['failed']} | {dev} | {_us(row['median_s'])} | "
@@ -485,8 +497,8 @@ def table(results: dict) -> str:
             speed = ', '.join(f"{r} {slsqp['median_s'] / rows[r]['median_s']:.0f}x"
                               for r in ('proxsuite', 'proxsuite-tuned', 'daqp', 'quadprog')
                               if rows.get(r, {}).get('median_s'))
-            lines += ['', f"Faster than SLSQP on the exact cone (median over median; target "
-                      f"1000x): {speed}; torque-norm excess of the polygon optimum over the "
+            lines += ['', f'Faster than SLSQP on the exact cone (median over median; target '
+                      f'1000x): {speed}; torque-norm excess of the polygon optimum over the '
                       f"exact one: median {100 * ex['median']:.2f}%, p90 {100 * ex['p90']:.2f}%,"
                       f" max {100 * ex['max']:.2f}%."]
         lines.append('')
@@ -524,7 +536,8 @@ def main() -> None:
     args = parser.parse_args()
     res = run(args.grasps, args.seed, args.repeats, args.scenario_repeats, args.steps)
     report(res, table(res), args.out,
-           f"{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp; threads: {res['blas_threads']}")
+           f'{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp; '
+           f"threads: {res['blas_threads']}")
 
 
 if __name__ == '__main__':

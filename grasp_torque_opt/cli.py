@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Command line: ``grasp-torque-opt solve|compare SCENARIO``, ``grasp-torque-opt score CANDIDATES``.
 
@@ -53,7 +61,7 @@ def _parser() -> argparse.ArgumentParser:
                          help="objective instead of the scenario's objective.type")
     p_solve.add_argument('--margin', type=_margin, metavar='K',
                          help="friction margin k >= 0 instead of the scenario's friction.margin: "
-                              "plan in the cone of mu/(1+k)")
+                              'plan in the cone of mu/(1+k)')
     p_solve.add_argument('--capacity', action='store_true',
                          help='also the load capacity and the 12 axis capacities')
     p_cmp = sub.add_parser('compare', help="every method side by side (the paper's Table 2)")
@@ -75,6 +83,8 @@ def _rounds(text: str) -> int:
     if not 0 <= value <= 100:
         raise argparse.ArgumentTypeError(f'must be in [0, 100], got {text}')
     return value
+
+
 def _margin(text: str) -> float:
     try:
         k = float(text)
@@ -86,7 +96,7 @@ def _margin(text: str) -> float:
 
 
 def _count(low: int, high: int):
-    """An argparse type: an integer in [low, high]."""
+    """Make an argparse type: an integer in [low, high]."""
     def parse(text: str) -> int:
         try:
             value = int(text)
@@ -99,7 +109,7 @@ def _count(low: int, high: int):
 
 
 def _overridden(setup: GraspSetup, args: argparse.Namespace) -> GraspSetup:
-    """The setup with the command line's --objective and --margin."""
+    """Return the setup with the command line's --objective and --margin."""
     if getattr(args, 'objective', None):
         setup = dataclasses.replace(setup, objective=args.objective)
     if getattr(args, 'margin', None) is not None:
@@ -131,14 +141,14 @@ def _print_solution(d: dict) -> None:
     if b is not None:
         gap = '-' if b['gap'] is None else f"{100 * b['gap']:.3g}%"
         lower = 'none' if b['lower'] is None else f"{b['lower']:.6f}"
-        print(f"bounds on the exact optimum of sqrt(tau^T W tau): lower {lower} N m, "
+        print(f'bounds on the exact optimum of sqrt(tau^T W tau): lower {lower} N m, '
               f"this torque {b['upper']:.6f} N m, gap {gap} ({b['rounds']} rounds, "
               f"{b['qp_solves']} QPs, from {b['source']})" if b['upper'] is not None else
               f'bounds: lower {lower} N m, no certified torque')
     if d['tau'] is not None:
         usage = ' '.join(f"{100 * c['friction_usage']:.0f}%" for c in d['contacts'])
         print(f"objective: {d['objective']}, max |tau|/limit {d['max_torque_ratio']:.3f}, "
-              f"friction usage per contact {usage} of the cone (margin "
+              f'friction usage per contact {usage} of the cone (margin '
               f"{d['friction_margin']:g})")
     if d.get('capacity'):
         cap = d['capacity']
@@ -155,7 +165,7 @@ def _cap(value, unit: str, status: str) -> str:
 
 
 def _capacity_dict(setup: GraspSetup, maps) -> dict:
-    """The solve --capacity JSON: ``load`` and ``directions`` (docs/planner.md)."""
+    """Build the solve --capacity JSON: ``load`` and ``directions`` (docs/planner.md)."""
     from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 
     lp = CapacityLP(setup, maps)
@@ -260,14 +270,14 @@ def _score_parser(sub) -> None:
     p.add_argument('--metrics', choices=METRICS, default='full',
                    help='full (with the capacities, the default) or basic (solve only)')
     p.add_argument('--workers', type=_count(1, 256), help="processes (default: the machine's "
-                   "cores), 1 to 256")
+                   'cores), 1 to 256')
     p.add_argument('--engine', choices=ENGINES, default='processes',
                    help='processes (default), serial, or dask (Dask distributed)')
     p.add_argument('--scheduler', help='Dask scheduler address (engine dask; default: a '
                    'local cluster)')
     p.add_argument('--backend', choices=BACKENDS, default='daqp',
                    help='QP backend (default: daqp, the fastest on these grasps)')
-    p.add_argument('--objective', choices=OBJECTIVES, help="objective instead of the "
+    p.add_argument('--objective', choices=OBJECTIVES, help='objective instead of the '
                    "scenario's")
     p.add_argument('--no-progress', action='store_true', help='no progress bar')
 
@@ -286,7 +296,7 @@ class _Progress:
         filled = width * done // max(total, 1)
         rate = done / max(time.perf_counter() - self.t0, 1e-9)
         sys.stderr.write(f"\rscoring [{'#' * filled}{'.' * (width - filled)}] {done}/{total} "
-                         f"({rate:.0f}/s)")
+                         f'({rate:.0f}/s)')
         if done >= total:
             sys.stderr.write('\n')
         sys.stderr.flush()

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Scenario documents made bad one field at a time, with the field each error must name."""
 
 import copy
@@ -5,7 +13,7 @@ import math
 
 
 def mutated(doc, path, value):
-    """A copy of ``doc`` with the item at ``path`` (keys and indices) set, or removed if None."""
+    """Copy ``doc`` with the item at ``path`` (keys and indices) set, or removed if None."""
     out = copy.deepcopy(doc)
     node = out
     for key in path[:-1]:

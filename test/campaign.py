@@ -1,6 +1,16 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-The adversarial campaign's tools: messages generated from their definitions, the
-invariants every published command must meet, and the counts printed after the run.
+The adversarial campaign's tools: generated messages, invariants and counts.
+
+The messages are generated from their definitions, the invariants are those every
+published command must meet, and the counts are printed after the run.
 
 Strategies start from a valid message and overwrite some of its fields, each chosen
 among the leaf fields that ``get_fields_and_field_types`` lists and filled with a value
@@ -36,14 +46,15 @@ FLOATS = st.one_of(
 
 
 def message_class(type_name: str):
-    """The Python class of a ROS type such as ``geometry_msgs/Pose``."""
+    """Return the Python class of a ROS type such as ``geometry_msgs/Pose``."""
     package, name = type_name.split('/')
     return getattr(importlib.import_module(f'{package}.msg'), name)
 
 
 def leaf_fields(cls, prefix: str = '') -> list[tuple[str, str]]:
     """
-    (dotted path, type) of every leaf field of a message class, from its definition.
+    Return (dotted path, type) of every leaf field of a message class, from its definition.
+
     Sequences of messages are leaves (their length and content are generated whole).
     """
     out = []
@@ -105,7 +116,7 @@ def set_field(msg, path: str, value) -> None:
 
 @st.composite
 def mutated(draw, valid, names: list[str], max_mutations: int = 3):
-    """A copy of a valid message with up to ``max_mutations`` leaf fields regenerated."""
+    """Draw a copy of a valid message with up to ``max_mutations`` leaf fields regenerated."""
     msg = copy.deepcopy(valid)
     leaves = leaf_fields(type(valid))
     for _ in range(draw(st.integers(0, max_mutations))):
@@ -122,7 +133,7 @@ def mutated(draw, valid, names: list[str], max_mutations: int = 3):
 
 
 def check_command(cmd, m: int, limits: np.ndarray) -> None:
-    """The invariant on what reaches the motors: len(joints) finite values within limits."""
+    """Check the invariant on what reaches the motors: len(joints) finite values within limits."""
     COUNTS['commands'] += 1
     cmd = np.asarray(cmd, dtype=float)
     ok = cmd.shape == (m,) and bool(np.all(np.isfinite(cmd))) and \

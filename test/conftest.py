@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Shared fixtures: the bundled scenarios and small variations of them."""
 
 from __future__ import annotations
@@ -19,7 +27,7 @@ ALLEGRO_URDF = 'example-robot-data:allegro_hand_description/urdf/allegro_right_h
 
 
 def scenario_doc(path: Path) -> dict:
-    """A bundled scenario as plain data, to vary in a test."""
+    """Load a bundled scenario as plain data, to vary in a test."""
     return yaml.safe_load(path.read_text())
 
 
@@ -49,7 +57,7 @@ def allegro(allegro_doc) -> GraspSetup:
 
 
 def with_contacts(doc: dict, contacts: list[dict]) -> dict:
-    """A copy of a scenario document with other contacts."""
+    """Return a copy of a scenario document with other contacts."""
     out = copy.deepcopy(doc)
     out['grasp']['contacts'] = contacts
     return out
@@ -57,14 +65,18 @@ def with_contacts(doc: dict, contacts: list[dict]) -> dict:
 
 @pytest.fixture(scope='session')
 def hyperstatic(planar_doc) -> GraspSetup:
-    """The planar hand with two contacts on finger 1 (distal link and tip) and one on finger 2."""
+    """
+    Return the planar hand with two contacts on finger 1 and one on finger 2.
+
+    The two on finger 1 are on its distal link and its tip.
+    """
     contacts = copy.deepcopy(planar_doc['grasp']['contacts'])
     contacts.insert(1, {'link': 'finger1_distal', 'position': [0.0, 0.03, 0.0]})
     return setup_from_doc(with_contacts(planar_doc, contacts))
 
 
 def pytest_terminal_summary(terminalreporter):
-    """The adversarial campaign's counts (test_campaign*.py), printed even without -s."""
+    """Print the adversarial campaign's counts (test_campaign*.py), even without -s."""
     from campaign import COUNTS
 
     if COUNTS['inputs']:

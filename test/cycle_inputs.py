@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Inputs for the control cycle shared by the controller, node and campaign tests.
 
@@ -26,8 +34,9 @@ def joint_state(setup, q=None, names=None):
 
 def fresh(setup, **config):
     """
-    A controller of its own; the cycle budget is generous unless a test is about it
-    (other processes may load this machine).
+    Make a controller of its own, with a generous cycle budget unless a test is about it.
+
+    Other processes may load this machine.
     """
     config.setdefault('cycle_budget', 10.0)
     return TorqueController(dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)),
@@ -35,7 +44,7 @@ def fresh(setup, **config):
 
 
 def base_poses(setup, q=None):
-    """The default contact frames at q, as (positions, xyzw quaternions) in the base frame."""
+    """Give the default contact frames at q, as (positions, xyzw quaternions) in the base frame."""
     maps = dataclasses.replace(setup, q=setup.q if q is None else q).maps()
     pos = np.array([f.position for f in maps.contacts])
     quat = np.array([pin.Quaternion(f.rotation).coeffs() for f in maps.contacts])
@@ -44,7 +53,8 @@ def base_poses(setup, q=None):
 
 class Injected:
     """
-    A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose:
+    A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose.
+
     ``mode`` says how; ``healthy`` makes it the real one again.
     """
 
@@ -80,8 +90,9 @@ class Injected:
 
 class Slow:
     """
-    A solver that answers correctly, late (it takes no deadline): a cycle or a service
-    call that outlasts its budget or its inputs.
+    A solver that answers correctly, late (it takes no deadline).
+
+    With it a cycle or a service call outlasts its budget or its inputs.
     """
 
     def __init__(self, delay: float):

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Checks written from the paper and docs/design.md, without the package's own builders."""
 
 import numpy as np
@@ -18,7 +26,7 @@ def polygon_rows(mu1: float, mu2: float, N: int, fmin: float) -> tuple[np.ndarra
 
 
 def lp_feasible(setup, maps) -> bool:
-    """HiGHS on: G f + w_ext = 0, polygon cones, |J^T f + offset| <= limits."""
+    """Run HiGHS on: G f + w_ext = 0, polygon cones, |J^T f + offset| <= limits."""
     fr = setup.friction
     S_i, b_i = polygon_rows(fr.mu1, fr.mu2, fr.sides, fr.min_normal_force)
     p = maps.p
@@ -71,8 +79,10 @@ def _f_space(setup, maps):
 
 def lp_capacity(setup, maps, load):
     """
-    HiGHS in contact-force space: max alpha with G f + alpha load = 0, the planned
-    polygons and |J^T f + offset| <= limits. Returns (alpha, f) or (None, None).
+    Maximize alpha in contact-force space with HiGHS.
+
+    The LP: max alpha with G f + alpha load = 0, the planned polygons and
+    |J^T f + offset| <= limits. Returns (alpha, f) or (None, None).
     """
     S, b, lim, off = _f_space(setup, maps)
     nf = 4 * maps.p
@@ -92,8 +102,10 @@ def lp_capacity(setup, maps, load):
 
 def lp_minmax(setup, maps, weights=None):
     """
-    HiGHS in contact-force space: min t with G f + w_ext = 0, the planned polygons,
-    w_i |(J^T f)_i + offset_i| <= t limit_i and |J^T f + offset| <= limits. Returns t or None.
+    Minimize t in contact-force space with HiGHS.
+
+    The LP: min t with G f + w_ext = 0, the planned polygons, w_i |(J^T f)_i + offset_i|
+    <= t limit_i and |J^T f + offset| <= limits. Returns t or None.
     """
     S, b, lim, off = _f_space(setup, maps)
     m = setup.hand.m

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """What the node says on /diagnostics: a pure function of the controller's state."""
 
 from __future__ import annotations
@@ -26,7 +34,7 @@ def _ago(now: float, t: float | None) -> str:
 
 def report(controller: TorqueController, now: float) -> Report:
     """
-    The controller's state as a diagnostic status.
+    Report the controller's state as a diagnostic status.
 
     Level: STALE before the first joint state, OK while certified commands flow,
     WARN during a fault while the last certified command is held (within

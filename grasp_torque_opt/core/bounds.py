@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Certified bounds on the exact-cone optimum (docs/adaptive.md).
 
@@ -74,7 +82,7 @@ class Bounds:
 
     @property
     def converged(self) -> bool:
-        """True when the certified gap is within the tolerance."""
+        """Return True when the certified gap is within the tolerance."""
         return self.gap is not None and self.gap <= self.tolerance
 
     def as_dict(self) -> dict:
@@ -90,6 +98,10 @@ def make_bounds(lower_objective: float, upper_objective: float | None, tolerance
     Args:
         lower_objective: the best lower bound on tau^T W tau (-inf or <= 0: none).
         upper_objective: the returned torque's tau^T W tau (None: no torque).
+        tolerance: the gap tolerance (:attr:`Bounds.tolerance`).
+        rounds: refinement rounds run (:attr:`Bounds.rounds`).
+        qp_solves: QPs solved.
+        source: what the torque came from (:attr:`Bounds.source`).
     """
     lower = math.sqrt(lower_objective) if lower_objective > 0.0 else None
     upper = None if upper_objective is None else math.sqrt(max(upper_objective, 0.0))
@@ -125,7 +137,7 @@ def dual_bound(G: np.ndarray, J: np.ndarray, external_wrench: np.ndarray, fricti
                eta: np.ndarray, v: np.ndarray,
                gt_pinv: np.ndarray | None = None) -> float | None:
     """
-    A checked lower bound on the exact optimum of tau^T W tau (module docstring).
+    Compute a checked lower bound on the exact optimum of tau^T W tau (module docstring).
 
     y is the least-squares solution of G^T y = J eta - v, so that sigma is -v
     where the relaxation's stationarity holds exactly; the bound's validity does

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 The certificate every result must pass before anyone sees it.
 
@@ -43,12 +51,12 @@ class Certificate:
 
     @property
     def ok(self) -> bool:
-        """True when the solution is finite and every residual is within tolerance."""
+        """Return True when the solution is finite and every residual is within tolerance."""
         return self.finite and self.worst <= self.tolerance
 
     @property
     def worst(self) -> float:
-        """The largest residual."""
+        """Return the largest residual."""
         return max(self.equilibrium, self.torque, self.cone, self.normal_force,
                    self.torque_limit)
 

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Contact frames by the pinned rule (docs/design.md section 1).
 
@@ -86,4 +94,3 @@ def contact_rotations(normals: np.ndarray, tangents: list[np.ndarray | None],
         yx, yy, yz = zy * xz - zz * xy, zz * xx - zx * xz, zx * xy - zy * xx
         out.append(((xx, yx, zx), (xy, yy, zy), (xz, yz, zz)))
     return np.array(out, dtype=float).reshape(-1, 3, 3)
-

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Exceptions of grasp_torque_opt: one base class, subclasses that name the bad input."""
 
 from collections.abc import Iterable
@@ -13,8 +21,10 @@ _REPR.maxstring = _REPR.maxother = QUOTE_LENGTH
 
 def quote(value: object) -> str:
     """
-    ``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time whatever
-    its size (a value quoted whole once printed a 4.3 MB "one line").
+    Return ``repr(value)`` cut to :data:`QUOTE_LENGTH` characters, in bounded time.
+
+    The time is bounded whatever the value's size (a value quoted whole once printed a
+    4.3 MB "one line").
     """
     text = _REPR.repr(value)
     return text if len(text) <= QUOTE_LENGTH else text[:QUOTE_LENGTH - 3] + '...'
@@ -26,8 +36,9 @@ PATH_LENGTH = 240
 
 def cut(name: object, limit: int = QUOTE_LENGTH) -> str:
     """
-    A name from the input as quoted in messages: ``str(name)`` cut to ``limit``
-    characters (:data:`PATH_LENGTH` for paths).
+    Quote a name from the input for messages: ``str(name)`` cut to ``limit`` characters.
+
+    ``limit`` is :data:`PATH_LENGTH` for paths.
     """
     text = str(name) if not isinstance(name, str) else name
     return text if len(text) <= limit else text[:limit - 3] + '...'
@@ -66,7 +77,7 @@ class FrameNotFound(InputError):
         self.available = sorted(available)
         super().__init__(field,
                          f"unknown frame '{cut(name)}' (model frames: "
-                         f"{_choices(self.available)})")
+                         f'{_choices(self.available)})')
 
 
 class JointNotFound(InputError):

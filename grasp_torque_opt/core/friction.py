@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Soft-finger friction: the paper's linearized cone S and the exact-cone margin.
 
@@ -29,7 +37,7 @@ import scipy.linalg
 
 def cone_rows(mu1: float, mu2: float, sides: int) -> np.ndarray:
     """
-    The 2N rows of one contact's linearized cone, S_c f_i <= 0.
+    Return the 2N rows of one contact's linearized cone, S_c f_i <= 0.
 
     Args:
         mu1: tangential friction coefficient [-].
@@ -55,7 +63,7 @@ def cone_rows(mu1: float, mu2: float, sides: int) -> np.ndarray:
 def circumscribed_rows(mu1: float, mu2: float, sides: int,
                        inflation: float = 0.0) -> np.ndarray:
     """
-    The 2N rows of the circumscribed N-gon's cone, an outer approximation of the exact one.
+    Return the 2N rows of the circumscribed N-gon's cone, an outer approximation of the exact one.
 
     The paper's N-gon scaled by 1/cos(pi/N): each edge moved out until it touches
     the disc, so sqrt(fx^2 + fy^2)/mu1 + |mz|/mu2 <= fz implies every row.
@@ -143,7 +151,7 @@ def contact_block(mu1: float, mu2: float, sides: int,
 def friction_matrix(p: int, mu1: float, mu2: float, sides: int,
                     min_normal_force: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """
-    The paper's S for p contacts (block diagonal) and its right-hand side.
+    Return the paper's S for p contacts (block diagonal) and its right-hand side.
 
     Cached: the same friction gives the same (read-only) arrays every cycle.
 

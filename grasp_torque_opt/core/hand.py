@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 The hand: a Pinocchio model loaded from URDF, its actuated joints and torque limits.
 
@@ -95,7 +103,7 @@ def resolve_urdf(spec: str, base_dir: Path) -> Path:
 
 def bounded_urdf(xml: str, field_name: str) -> str:
     """
-    A URDF document within :data:`MAX_URDF_BYTES` and :data:`MAX_URDF_ELEMENTS`.
+    Return ``xml`` if within :data:`MAX_URDF_BYTES` and :data:`MAX_URDF_ELEMENTS`.
 
     Raises:
         InputError: naming ``field_name``.
@@ -153,14 +161,15 @@ class Hand:
 
     @property
     def m(self) -> int:
-        """Number of actuated joints."""
+        """Return the number of actuated joints."""
         return len(self.joints)
 
     @cached_property
     def base_frame(self) -> str:
         """
-        Name of the root link: the base frame (looked up once: the node stamps every
-        command with it).
+        Return the name of the root link: the base frame.
+
+        Looked up once: the node stamps every command with it.
         """
         return next(f.name for f in self.model.frames
                     if f.type == pin.FrameType.BODY and f.parentJoint == 0)
@@ -173,7 +182,7 @@ class Hand:
 
     @property
     def effort_limits(self) -> np.ndarray:
-        """The URDF's effort limit of each actuated joint [N m], inf where it gives none."""
+        """Return the URDF's effort limit of each actuated joint [N m], inf where it gives none."""
         e = np.asarray(self.model.effortLimit, dtype=float)[self.idx_v]
         return np.where(np.isfinite(e) & (e > 0.0), e, np.inf)
 
@@ -195,7 +204,7 @@ class Hand:
             what = ('the URDF effort limit' if bounds[i] < MAX_TORQUE_LIMIT
                     else 'the largest limit accepted')
             raise InputError(field, f"{limits[i]:g} N m for joint '{joints[i]}' exceeds "
-                             f"{what} ({bounds[i]:g} N m)" + (
+                             f'{what} ({bounds[i]:g} N m)' + (
                                  f'; set {override}: true to allow it'
                                  if bounds[i] < MAX_TORQUE_LIMIT else ''))
 
@@ -237,7 +246,7 @@ class Hand:
                 if not (np.isfinite(lim) and lim > 0.0):
                     raise InputError('hand.torque_limits',
                                      f"the URDF gives no effort limit for joint '{name}'; "
-                                     "set hand.torque_limits")
+                                     'set hand.torque_limits')
         else:
             limits = np.asarray(torque_limits, dtype=float)
             if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):
@@ -260,8 +269,9 @@ class Hand:
                   torque_limits: float | list[float] | np.ndarray | None = None,
                   above_urdf: bool = False) -> Hand:
         """
-        Load a hand from a URDF file (fixed base; meshes are not needed), within the
-        module's bounds.
+        Load a hand from a URDF file, within the module's bounds.
+
+        The base is fixed; meshes are not needed.
         """
         path = Path(path)
         xml = decode_utf8(read_bounded(path, 'hand.urdf', MAX_URDF_BYTES), path, 'hand.urdf')
@@ -277,8 +287,9 @@ class Hand:
                          torque_limits: float | list[float] | np.ndarray | None = None,
                          above_urdf: bool = False) -> Hand:
         """
-        Load a hand from a URDF document (e.g. the ``robot_description`` parameter),
-        within the module's bounds.
+        Load a hand from a URDF document, within the module's bounds.
+
+        The document may be, e.g., the ``robot_description`` parameter.
         """
         try:
             model = pin.buildModelFromXML(bounded_urdf(xml, 'robot_description'))

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Friction margin and the numbers a planner reads off a solution (docs/planner.md).
 
@@ -27,7 +35,7 @@ import numpy as np
 
 def planned_friction(friction: Friction) -> Friction:
     """
-    The friction the optimization and the certificate use: the cone reduced by the margin.
+    Return the friction the optimization and the certificate use: the cone reduced by the margin.
 
     Returns:
         ``friction`` itself when its margin is 0, else a copy with mu1/(1+k),

@@ -1,6 +1,16 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-Where the package's bundled files (config/, urdf/) are, installed or in the source tree,
-and how any input file is read: a regular file, within a size bound.
+Where the package's bundled files are, and how any input file is read.
+
+The bundled files (config/, urdf/) are found installed or in the source tree; an input
+file is read only if it is a regular file, within a size bound.
 """
 
 from __future__ import annotations
@@ -25,7 +35,7 @@ def config_dirs() -> list[Path]:
 
 def find_config(name: str, field: str = 'scenario') -> Path:
     """
-    A file given as a path, or by name among the bundled config files.
+    Find a file given as a path, or by name among the bundled config files.
 
     Raises:
         InputError: naming ``field``, when neither exists.
@@ -37,13 +47,13 @@ def find_config(name: str, field: str = 'scenario') -> Path:
         for d in config_dirs():
             if (d / path).is_file():
                 return d / path
-    raise InputError(field, f"file not found: {cut(name, PATH_LENGTH)} "
+    raise InputError(field, f'file not found: {cut(name, PATH_LENGTH)} '
                      f"(nor in {', '.join(map(str, config_dirs()))})")
 
 
 def read_bounded(path: Path, field_name: str, limit: int) -> bytes:
     """
-    The bytes of a regular file of at most ``limit`` bytes.
+    Read the bytes of a regular file of at most ``limit`` bytes.
 
     Opened without blocking and checked on the open descriptor, so a device, a
     pipe or a symlink to one is refused before anything is read (``/dev/zero``

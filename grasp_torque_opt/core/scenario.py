@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Scenario files (YAML, schema in docs/design.md section 4): load and validate.
 
@@ -147,7 +155,7 @@ class Scenario:
     external_wrench: np.ndarray
     weights: list[float] | None = None
     source: str = field(default='<memory>')
-    object: ObjectSpec | None = None
+    object: ObjectSpec | None = None  # noqa: A003 -- the scenario's object section, by name
     gravity: np.ndarray | None = None
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
     objective: str = 'sum-of-squares'
@@ -157,8 +165,9 @@ class Scenario:
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
                   origin: np.ndarray) -> np.ndarray:
     """
-    The object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,);
-    zero without an object or without gravity.
+    Return the object's weight as a wrench about ``origin``, base axes [N, N m], shape (6,).
+
+    Zero without an object or without gravity.
     """
     if obj is None or gravity is None:
         return np.zeros(6)
@@ -186,7 +195,7 @@ def _object(value: Any, origin: np.ndarray) -> ObjectSpec:
     entries = SHAPES[shape]
     size = _vector(_require(section, 'size', 'object'), 'object.size')
     if len(size) != len(entries):
-        raise InputError('object.size', f"must have {len(entries)} entries for a {shape} "
+        raise InputError('object.size', f'must have {len(entries)} entries for a {shape} '
                          f"({', '.join(entries)}), got {len(size)}")
     for i, x in enumerate(size):
         if x <= 0.0:
@@ -243,7 +252,7 @@ def _positive(value: Any, name: str) -> float:
 
 
 def _margin(value: Any, name: str = 'friction.margin') -> float:
-    """A friction margin k: finite and >= 0 [-]."""
+    """Parse a friction margin k: finite and >= 0 [-]."""
     k = _number(value, name)
     if k < 0.0:
         raise InputError(name, f'must be >= 0, got {value!r}')
@@ -395,10 +404,10 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
     kind = objective.get('type', OBJECTIVES[0])
     if kind not in OBJECTIVES:
         raise InputError('objective.type', f"must be one of {', '.join(OBJECTIVES)}, "
-                         f"got {kind!r}")
+                         f'got {kind!r}')
     if joints is None and (isinstance(limits, list) or weights is not None):
         per_joint = 'hand.torque_limits' if isinstance(limits, list) else 'objective.weights'
-        raise InputError('hand.joints', f"required when {per_joint} gives one value per joint "
+        raise InputError('hand.joints', f'required when {per_joint} gives one value per joint '
                          "(without it the values would follow Pinocchio's joint order, which "
                          "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,

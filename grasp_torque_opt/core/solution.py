@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The result type shared by every method."""
 
 from __future__ import annotations
@@ -67,7 +75,7 @@ class Solution:
 
     @property
     def optimal(self) -> bool:
-        """True for a certified optimum."""
+        """Return True for a certified optimum."""
         return self.status == OPTIMAL
 
     @property

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Method ``tau-qp-adaptive``: the exact-cone optimum from QPs, with a certified gap.
 
@@ -214,8 +222,10 @@ class Refiner:
 
 class _Rounds:
     """
-    One grasp's rounds (the arrays they share). Each numpy call costs about a
-    microsecond here, so the pieces are written in few of them.
+    One grasp's rounds (the arrays they share).
+
+    Each numpy call costs about a microsecond here, so the pieces are written in few of
+    them.
     """
 
     #: ``time.perf_counter()`` value by which every QP must stop (None: none).
@@ -287,8 +297,9 @@ class _Rounds:
 
     def _turn(self, u: np.ndarray, ok: np.ndarray) -> None:
         """
-        Tangent slots at the directions u (core.friction.tangent_rows; the spare rows
-        where no direction is defined).
+        Set the tangent slots at the directions u (core.friction.tangent_rows).
+
+        The spare rows go where no direction is defined.
         """
         slots = self.slots
         slots[:, :, :2] = self.a * u[:, None, :]
@@ -314,7 +325,7 @@ class _Rounds:
         return self.base.H + (Bp.T * w) @ Bp, Bp.T @ (w * c)
 
     def _bound(self, lam: np.ndarray, y: np.ndarray) -> float:
-        """The checked dual bound from these multipliers and the current rows."""
+        """Return the checked dual bound from these multipliers and the current rows."""
         eta, v = relaxation_duals(self.base, self.rows, lam, y)
         d = dual_bound(self.maps.G, self.maps.J, self.setup.external_wrench, self.fr,
                        self.W, self.tau_min, self.tau_max, eta, v, self.gt_pinv)
@@ -386,7 +397,7 @@ class _Rounds:
 
     def _kkt_bound(self, duals) -> float:
         """
-        The dual bound from the multipliers that make the restored point a KKT point.
+        Return the dual bound from the multipliers that make the restored point a KKT point.
 
         Near the optimum they are the exact problem's own multipliers (the
         rows are the exact cone's gradients there), so no QP is needed for a
@@ -433,7 +444,7 @@ class _Rounds:
     # -- the rounds -------------------------------------------------------------------
 
     def _key(self) -> tuple:
-        """What a warm start needs to be the same: sizes and the cone."""
+        """Return what a warm start needs to be the same: sizes and the cone."""
         return self.p, self.n, self.m, self.R, self.fr.mu1, self.fr.mu2
 
     def run(self) -> Refined:
@@ -473,9 +484,17 @@ class _Rounds:
     def _rounds(self, lower: float, best, source: str, point, nu: np.ndarray, start: int,
                 first=None) -> Refined:
         """
-        The refinement rounds from a point's directions and multipliers nu.
+        Run the refinement rounds from a point's directions and multipliers nu.
 
         Args:
+            lower: the best checked lower bound on tau^T W tau so far (-inf: none).
+            best: the best certified candidate so far, as :meth:`_candidate` returns it,
+                or None.
+            source: what ``best`` came from (``refined`` or ``circumscribed``).
+            point: the point whose directions the first step starts at, as :meth:`_point`
+                returns it (its f is not used: None for a warm start).
+            nu: per contact, the multipliers of its cone rows but the last, summed,
+                shape (p,).
             start: 0 after round 0 (a gap check first), 1 for a warm start (a step
                 first, at the last answer's directions).
             first: round 0's (rows, multipliers) for a bound if no round gives one.

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Load capacity: how many times over a grasp holds its load, and how much along each axis.
 
@@ -154,7 +162,7 @@ class CapacityLP:
     def solve(self, load: np.ndarray, unit: str = '-', highs_only: bool = False,
               binding: bool = True) -> Capacity:
         """
-        The largest alpha with alpha * load holdable, certified.
+        Find the largest alpha with alpha * load holdable, certified.
 
         Args:
             load: the load direction w_ext, shape (6,) [N, N m] (about the object
@@ -256,7 +264,7 @@ def direction_capacities(setup: GraspSetup, maps: GraspMaps | None = None,
                          lp: CapacityLP | None = None, binding: bool = True
                          ) -> dict[str, Capacity]:
     """
-    The largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
+    Find the largest load along each of the 12 axis directions (:data:`DIRECTIONS`).
 
     Args:
         setup: the grasp.

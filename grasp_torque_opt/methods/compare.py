@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Every method on one grasp, side by side (the paper's Table 2, extended)."""
 
 from __future__ import annotations
@@ -64,7 +72,7 @@ def _pct(x: float | None) -> str:
 
 
 def format_table(comparison: Comparison) -> str:
-    """A fixed-width table: torques per joint and method, norms, reductions, times."""
+    """Format a fixed-width table: torques per joint and method, norms, reductions, times."""
     sols = comparison.solutions
     methods = list(sols)
     joints = next(iter(sols.values())).joints
@@ -100,6 +108,6 @@ def format_table(comparison: Comparison) -> str:
         excess = comparison.excess_over_exact('tau-qp-adaptive')
         lines.append("Lower bound, gap: the adaptive method's certified bound on the "
                      "exact-cone optimum of sqrt(tau^T W tau) [N m] and its torque's gap to "
-                     "it (docs/adaptive.md); its excess over the SOCP: "
+                     'it (docs/adaptive.md); its excess over the SOCP: '
                      + ('-' if excess is None else f'{100 * excess:.2g}%') + '.')
     return '\n'.join(lines)

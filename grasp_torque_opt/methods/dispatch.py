@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 One entry point for every method: kinematics, build, solve, certify, decide.
 
@@ -50,9 +58,10 @@ _TAKES_DEADLINE: dict[type, bool] = {}
 
 def _timed(solver, qp: TauQP, deadline: float | None, **kwargs) -> RawResult:
     """
-    ``solver.solve(qp)``, with the deadline passed when there is one and the solver
-    takes it (every backend does; a solver of the caller's own that does not runs on
-    its iteration caps alone).
+    Call ``solver.solve(qp)``, passing the deadline when there is one and the solver takes it.
+
+    Every backend takes it; a solver of the caller's own that does not runs on its
+    iteration caps alone.
     """
     if deadline is not None:
         takes = _TAKES_DEADLINE.get(type(solver))
@@ -84,9 +93,10 @@ def qp_answer(qp: TauQP, raw: RawResult
 
 def planner_metrics(out: Solution, setup: GraspSetup) -> Solution:
     """
-    Fill the planner's numbers of a solution (docs/planner.md): the objective and the
-    margin planned with, and for an optimum the friction usage on the *unreduced* cone and
-    max |tau + offset| / limit.
+    Fill the planner's numbers of a solution (docs/planner.md).
+
+    They are the objective and the margin planned with, and for an optimum the friction
+    usage on the *unreduced* cone and max |tau + offset| / limit.
     """
     out.objective, out.friction_margin = setup.objective, setup.friction.margin
     if out.optimal:
@@ -210,8 +220,8 @@ def solve(setup: GraspSetup, method: str = 'tau-qp', *, maps: GraspMaps | None =
 
     def certified(tau, f) -> Certificate | None:
         return None if f is None else certify(maps.G, J, setup.external_wrench,
-                                               friction, tau_min, tau_max, tau, f,
-                                               tolerance)
+                                              friction, tau_min, tau_max, tau, f,
+                                              tolerance)
 
     cert = certified(tau, f)
     if method == 'tau-qp' and getattr(solver, 'last_warm', False) and \
@@ -265,10 +275,12 @@ def _solve_adaptive(setup: GraspSetup, maps: GraspMaps | None, solver, backend: 
                     fallback, tolerance: float, refiner: Refiner | None,
                     deadline: float | None = None) -> Solution:
     """
-    tau-qp-adaptive: the rounds of :mod:`~grasp_torque_opt.methods.adaptive`, certified
-    bounds attached; the paper's N-gon (the tau-qp path) when no round gave a candidate
-    (or DAQP, which the rounds need, is not installed). Under a deadline the rounds get
-    :data:`PRIMARY_SHARE` of the time left and the polygon the rest.
+    Solve with tau-qp-adaptive: the rounds of :mod:`~grasp_torque_opt.methods.adaptive`.
+
+    The answer has its certified bounds attached. It is the paper's N-gon's (the tau-qp
+    path) when no round gave a candidate (or DAQP, which the rounds need, is not
+    installed). Under a deadline the rounds get :data:`PRIMARY_SHARE` of the time left and
+    the polygon the rest.
     """
     t0 = time.perf_counter()
     if maps is None:

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Why a load is infeasible: the largest holdable fraction of it, and what binds there.
 
@@ -46,14 +54,16 @@ class Explanation:
         if c.status != 'optimal':
             return f'no explanation: the capacity LP {c.status} ({c.message})'
         if c.value >= 1.0:
-            return (f"the capacity LP finds the whole load holdable ({c.value:.4g} times over): "
+            return (f'the capacity LP finds the whole load holdable ({c.value:.4g} times over): '
                     "the solver's verdict and the LP disagree")
         return (f'at most {100 * c.value:.1f}% of this load can be held; there, '
                 f'{c.binding.text()}')
 
     def as_dict(self) -> dict:
         """
-        Plain data (JSON): ``holdable_fraction``, ``binding``, ``status``, ``certified``,
+        Return plain data (JSON).
+
+        The keys are ``holdable_fraction``, ``binding``, ``status``, ``certified`` and
         ``text``.
         """
         d = self.capacity.as_dict()
@@ -62,5 +72,5 @@ class Explanation:
 
 
 def explain(setup: GraspSetup, maps: GraspMaps | None = None) -> Explanation:
-    """The largest holdable fraction of the setup's load and what binds there."""
+    """Find the largest holdable fraction of the setup's load and what binds there."""
     return Explanation(load_capacity(setup, maps))

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Small dense LPs for the planner's metrics: DAQP, KKT-checked, with SciPy HiGHS behind it.
 
@@ -64,8 +72,9 @@ class LPResult:
 
 class DaqpForm:
     """
-    DAQP's view of the bounds (clipped to its infinity, equality flags, zero Hessian),
-    built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp).
+    DAQP's view of the bounds: clipped to its infinity, equality flags, zero Hessian.
+
+    Built once for LPs that differ only in A's entries (the 13 capacity LPs of a grasp).
     """
 
     def __init__(self, n: int, lower: np.ndarray, upper: np.ndarray) -> None:
@@ -117,7 +126,7 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
 
 
 def _spent(deadline: float | None):
-    """The failure of an LP not started past ``deadline`` (None if there is time)."""
+    """Return the failure of an LP not started past ``deadline`` (None if there is time)."""
     if deadline is not None and time.perf_counter() >= deadline:
         return ('failed', None, None, 'time budget spent')
     return None

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 Batch scoring for grasp planners: many candidate grasps of one hand, in parallel.
 
@@ -93,7 +101,7 @@ class ScoreJob:
     @classmethod
     def from_file(cls, path: str | Path, **options: Any) -> ScoreJob:
         """
-        The job of a base scenario file.
+        Make the job of a base scenario file.
 
         Raises:
             InputError: the file cannot be read (field ``scenario``).
@@ -108,13 +116,13 @@ class ScoreJob:
 
     @property
     def key(self) -> str:
-        """A digest that identifies the job (a worker's cache key)."""
+        """Return a digest that identifies the job (a worker's cache key)."""
         return hashlib.sha256(repr(self).encode()).hexdigest()
 
 
 def merge(base: Any, override: Any) -> Any:
     """
-    A candidate merged into the base document: mappings key by key, ``None`` removes.
+    Merge a candidate into the base document: mappings key by key, ``None`` removes.
 
     Copies only what changes; the base is never modified.
     """
@@ -137,7 +145,7 @@ class Scorer:
             raise ValueError(f"metrics must be one of {', '.join(METRICS)}, got {job.metrics!r}")
         if job.objective is not None and job.objective not in OBJECTIVES:
             raise InputError('objective', f"must be one of {', '.join(OBJECTIVES)}, "
-                             f"got {job.objective!r}")
+                             f'got {job.objective!r}')
         self.job = job
         try:
             doc = yaml.safe_load(job.scenario_text)
@@ -153,7 +161,7 @@ class Scorer:
 
     def candidate(self, lineno: int, text: str) -> tuple[Any, GraspSetup]:
         """
-        The candidate of one line, bound to the base hand.
+        Return the candidate of one line, bound to the base hand.
 
         Raises:
             InputError: naming the line and the field.
@@ -171,7 +179,7 @@ class Scorer:
                              f'{type(data).__name__}')
         for key in data:
             if key not in CANDIDATE_KEYS:
-                raise InputError(f'line {lineno}: {key}', "unknown or fixed field (allowed: "
+                raise InputError(f'line {lineno}: {key}', 'unknown or fixed field (allowed: '
                                  f"{', '.join(CANDIDATE_KEYS)}; the hand is the base "
                                  "scenario's)")
         ident = data.pop('id', lineno)
@@ -194,7 +202,7 @@ class Scorer:
         return ident, setup
 
     def score_line(self, lineno: int, text: str) -> dict[str, Any]:
-        """The record of one line (a bad line gives status ``error``; never raises)."""
+        """Return the record of one line (a bad line gives status ``error``; never raises)."""
         t0 = time.perf_counter()
         record: dict[str, Any] = {'line': lineno, 'id': None}
         try:
@@ -219,7 +227,7 @@ class Scorer:
         return record
 
     def score(self, setup: GraspSetup, maps) -> dict[str, Any]:
-        """The metrics of one bound candidate (plain data)."""
+        """Return the metrics of one bound candidate (plain data)."""
         sol = solve(setup, maps=maps, solver=self.solver, fallback=self.fallback)
         usage = sol.friction_usage
         out: dict[str, Any] = {
@@ -240,7 +248,7 @@ class Scorer:
         return out
 
     def score_lines(self, lines: Iterable[tuple[int, str]]) -> list[dict[str, Any]]:
-        """Records of (line number, text) pairs, in order."""
+        """Score (line number, text) pairs into records, in order."""
         return [self.score_line(n, t) for n, t in lines]
 
 
@@ -272,7 +280,7 @@ def read_candidates(path: str | Path) -> list[tuple[int, str]]:
 
 
 def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tuple[int, str]]]:
-    """The lines cut into tasks of ``size``."""
+    """Cut the lines into tasks of ``size``."""
     return [list(lines[i:i + size]) for i in range(0, len(lines), size)]
 
 
@@ -400,13 +408,13 @@ def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
     for r in records:
         counts[r['status']] = counts.get(r['status'], 0) + 1
     parts = ', '.join(f'{counts.get(s, 0)} {s}' for s in ('optimal', 'infeasible', 'failed',
-                                                           'error'))
+                                                          'error'))
     rate = len(records) / seconds if seconds > 0 else float('inf')
     return f'scored {len(records)} candidates in {seconds:.2f} s ({rate:.0f}/s): {parts}'
 
 
 def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
-    """The ranked table (text, not a contract)."""
+    """Format the ranked table (text, not a contract)."""
     def num(v, fmt):
         return format(v, fmt) if v is not None else '-'.rjust(int(fmt.split('.')[0]))
 

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 A demo driver that needs no robot: it plays a scenario as a hand would.
 
@@ -182,11 +190,10 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
             solve_ms = 1e3 * float(diag.get('solve_time_s', 'nan'))
             if args.watch:
                 next_tick = next_print
-            print(f"t={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  "
+            print(f't={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  '
                   f"|command| {norm:.4f} N m  status {diag.get('status', '-')}  "
                   f"fault {diag.get('fault', '-')}")
-        rclpy.spin_once(node, timeout_sec=max(0.0, min(next_tick, next_print)
-                                                   - time.monotonic()))
+        rclpy.spin_once(node, timeout_sec=max(0.0, min(next_tick, next_print) - time.monotonic()))
     played = dict(diag)  # the node's state while joint states flowed
     end = time.monotonic() + 0.2  # the last commands in flight
     while time.monotonic() < end:

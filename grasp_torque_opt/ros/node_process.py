@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 What the demo and the simulated hand share: a private ROS domain, and the node as a child.
 
@@ -19,13 +27,13 @@ import sys
 
 
 def isolate() -> None:
-    """A private ROS domain (unless one is set) and localhost-only discovery."""
+    """Use a private ROS domain (unless one is set) and localhost-only discovery."""
     os.environ.setdefault('ROS_DOMAIN_ID', str(random.randint(1, 100)))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 
 def scenario_of(params: Path) -> str:
-    """The ``scenario`` parameter of a node params file."""
+    """Return the ``scenario`` parameter of a node params file."""
     import yaml
 
     doc = yaml.safe_load(params.read_text())

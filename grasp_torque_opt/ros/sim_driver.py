@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 A simulated hand driver: the scenario's hand and object in MuJoCo, on the node's topics.
 
@@ -87,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
     # Offscreen rendering through EGL: MuJoCo reads this when it is first imported.
     os.environ.setdefault('MUJOCO_GL', 'egl')
     try:
-        import mujoco  # noqa: F401
+        import mujoco  # noqa: F401 -- only whether MuJoCo is installed
     except ImportError:
         print(f"{PROG}: error: MuJoCo is not installed (the 'sim' extra: "
               "pip install -e '.[sim]', or bash scripts/setup.sh)", file=sys.stderr)
@@ -230,8 +238,8 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
             if each_second is not None and now >= next_second:
                 next_second += 1.0
                 each_second()
-            rclpy.spin_once(node, timeout_sec=max(0.0, min(next_pub, t0_wall + seconds)
-                                                   - time.monotonic()))
+            wait = min(next_pub, t0_wall + seconds) - time.monotonic()
+            rclpy.spin_once(node, timeout_sec=max(0.0, wait))
             take_prediction()
         return False
 
@@ -314,11 +322,11 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     extra = []
     if track['errors']:
         extra.append(f"contact forces within {100 * max(track['errors']):.1f}% of the node's "
-                     "predicted wrenches")
+                     'predicted wrenches')
     if track['usage']:
         extra.append(f"friction usage up to {100 * max(track['usage']):.0f}% of the planned "
                      "cone (MuJoCo's elliptic cone is wider)")
-    extra.append(f"{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed "
+    extra.append(f'{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed '
                  f"{state['malformed']})")
     extra.append(f'real-time factor {simulated / max(wall, 1e-9):.2f}')
     print('summary: ' + why + '; ' + '; '.join(extra))
@@ -330,9 +338,11 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
 def _publish_contacts(hsim, setup, pub, base, stamp, compute_grasp_maps, Pose, PoseArray
                       ) -> None:
     """
-    The contact frames measured in the simulation: the measured point and normal, the
-    x axis from the planned frame at the current configuration. Nothing while a planned
-    contact does not touch (the node's contacts_timeout then applies).
+    Publish the contact frames measured in the simulation.
+
+    Each has the measured point and normal, and the x axis from the planned frame at the
+    current configuration. Nothing is published while a planned contact does not touch
+    (the node's contacts_timeout then applies).
     """
     readings, _ = hsim.readings()
     if not all(r.touching for r in readings):
@@ -382,7 +392,7 @@ def _picture(hsim, path: str, predicted) -> str:
     except OSError as e:
         return f'picture: not written, cannot write {path}: {e.strerror}'
     return (f"picture: {written.resolve()} (simulated contact forces orange, the node's "
-            "predicted green)")
+            'predicted green)')
 
 
 if __name__ == '__main__':

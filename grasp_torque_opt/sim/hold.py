@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 A hold episode: the certified torques (plus g(q) and an impedance) on the simulated hand.
 
@@ -115,7 +123,7 @@ class HoldReport:
 def certified_torques(scenario: Scenario, urdf_xml: str | None = None
                       ) -> tuple[GraspSetup, GraspMaps, Solution, np.ndarray]:
     """
-    The scenario solved as the node solves it with gravity compensation.
+    Solve the scenario as the node solves it with gravity compensation.
 
     Returns:
         The setup (with g(q0) as torque offset), its maps, the certified solution

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 The MuJoCo model of a scenario: the hand from its URDF and the scenario's object.
 
@@ -101,8 +109,10 @@ class SimModel:
 
 def adapt_urdf(xml: str) -> str:
     """
-    The URDF as MuJoCo should load it: no joint friction or damping, no visuals,
-    and a ``<mujoco><compiler .../></mujoco>`` extension (see the module docstring).
+    Rewrite the URDF as MuJoCo should load it.
+
+    No joint friction or damping, no visuals, and a ``<mujoco><compiler .../></mujoco>``
+    extension (see the module docstring).
 
     Raises:
         InputError: the document is not XML with a ``robot`` root (field ``hand.urdf``).
@@ -172,7 +182,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     """
     if scenario.object is None:
         raise InputError('object', "the simulation needs the scenario's object "
-                         "(shape, size, mass)")
+                         '(shape, size, mass)')
     if scenario.gravity is None:
         raise InputError('gravity', "the simulation needs the scenario's gravity")
     if urdf_xml is None:
@@ -210,17 +220,17 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     for i, name in enumerate(joints):
         if name not in names:
             raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
-                             "MuJoCo model")
+                             'MuJoCo model')
     bodies = []
     for i, contact in enumerate(scenario.contacts):
         field = f'grasp.contacts[{i}].link'
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
         if body < 0:
             raise InputError(field, f"'{contact.link}' is not a link of the MuJoCo model "
-                             "(the simulation needs contacts on URDF links)")
+                             '(the simulation needs contacts on URDF links)')
         if model.body_geomnum[body] == 0:
             raise InputError(field, f"link '{contact.link}' has no collision geometry to "
-                             "touch the object with")
+                             'touch the object with')
         bodies.append(body)
     free = model.joint(f'{OBJECT_BODY}_free')
     hand_dofs = [model.jnt_dofadr[j] for j in range(model.njnt) if model.joint(j).name in names]

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
 A hand holding an object in MuJoCo, driven as an effort controller drives a hand.
 
@@ -48,11 +56,13 @@ class HandSim:
     def __init__(self, sim: SimModel, q0: np.ndarray, kp: float = 1.0, kd: float = 0.01
                  ) -> None:
         """
+        Start a simulation at ``q0``, the object pinned.
+
         Args:
-        sim: the compiled model.
-        q0: start configuration of the actuated joints [rad], shape (m,).
-        kp: impedance stiffness [N m/rad], every joint.
-        kd: impedance damping [N m s/rad], every joint.
+            sim: the compiled model.
+            q0: start configuration of the actuated joints [rad], shape (m,).
+            kp: impedance stiffness [N m/rad], every joint.
+            kd: impedance damping [N m s/rad], every joint.
         """
         if kp < 0 or kd < 0:
             raise ValueError(f'kp and kd must be >= 0, got {kp}, {kd}')
@@ -74,7 +84,7 @@ class HandSim:
 
     @property
     def time(self) -> float:
-        """Simulated time [s]."""
+        """Return the simulated time [s]."""
         return float(self.data.time)
 
     @property
@@ -133,8 +143,9 @@ class HandSim:
 
     def readings(self) -> tuple[list[ContactReading], float]:
         """
-        Per planned contact what touches the object, and the force of every other
-        hand body on it (unplanned contacts) [N].
+        Read what touches the object at each planned contact, and the unplanned contacts' force.
+
+        The latter is the force of every other hand body on the object [N].
         """
         m, d, s = self.model, self.data, self.sim
         per = {b: [] for b in s.contact_bodies}
@@ -171,15 +182,16 @@ class HandSim:
 
 
 def wrench_in_frame(reading: ContactReading, rotation: np.ndarray) -> np.ndarray:
-    """A reading as [fx, fy, fz, mz] in a contact frame (columns x, y, z in base axes)."""
+    """Express a reading as [fx, fy, fz, mz] in a contact frame (columns x, y, z in base axes)."""
     f = rotation.T @ reading.force
     return np.array([f[0], f[1], f[2], float(rotation[:, 2] @ reading.torque)])
 
 
 def friction_usage(wrench: np.ndarray, mu1: float, mu2: float) -> float:
     """
-    Share of the exact soft-finger cone a wrench uses, (||f_t||/mu1 + |mz|/mu2) / fz
-    (1: on the cone; inf when not pressing) [-].
+    Return the share of the exact soft-finger cone a wrench uses [-].
+
+    The share is (||f_t||/mu1 + |mz|/mu2) / fz: 1 on the cone, inf when not pressing.
     """
     if wrench[2] <= 0.0:
         return float('inf')

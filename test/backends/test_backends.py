@@ -1,4 +1,12 @@
-"""Every QP backend: the same certified optimum as an independent solver, and no stall on bad data."""
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""Every QP backend: an independent solver's optimum, certified, and no stall on bad data."""
 
 import copy
 import dataclasses
@@ -95,7 +103,7 @@ def test_unknown_backend_is_named():
 
 
 def moving_sequence(setup, steps):
-    """A slowly rotating load with the fingers drifting: what the node sees cycle to cycle."""
+    """Yield a slowly turning load with drifting fingers: what the node sees cycle to cycle."""
     scale = np.linalg.norm(setup.external_wrench[:3])
     for k in range(steps):
         th = 2 * np.pi * k / steps
@@ -129,8 +137,9 @@ def test_warm_start_gives_the_cold_optimum(name, backend, request):
 @pytest.mark.parametrize('backend', WARM_BACKENDS)
 def test_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro, backend):
     """
-    From a feasible grasp's solution to an infeasible load and back: each result is the
-    cold one, and every warm answer that was not optimal was redone cold (and counted).
+    From a feasible grasp's solution to an infeasible load and back, each result is the cold one.
+
+    Every warm answer that was not optimal was redone cold (and counted).
     """
     warm = make_solver(backend, warm_start=True)
     heavy = dataclasses.replace(allegro, external_wrench=allegro.external_wrench * 1e3)
@@ -145,8 +154,9 @@ def test_warm_start_that_fails_falls_back_to_cold_in_the_same_call(allegro, back
 @pytest.mark.parametrize('backend', WARM_BACKENDS)
 def test_warm_start_across_a_change_of_polygon_sides_or_contact_count(planar_doc, backend):
     """
-    A QP of another size is a new workspace (cold), then warm again; always the optimum
-    of an independent cold solve.
+    A QP of another size is a new workspace (cold), then warm again.
+
+    Every answer is the optimum of an independent cold solve.
     """
     warm = make_solver(backend, warm_start=True)
     docs = []
@@ -163,6 +173,7 @@ def test_warm_start_across_a_change_of_polygon_sides_or_contact_count(planar_doc
         assert got.status == ref.status == 'optimal'
         np.testing.assert_allclose(got.tau, ref.tau, atol=1e-7)
     assert warm.warm_solves == 2  # the repeated 8-gon and the repeated extra contact
+
 
 def test_kkt_violation_sees_a_suboptimal_point(allegro):
     """The optimality check itself: the solver's point passes, a feasible detour does not."""
@@ -233,12 +244,14 @@ def test_fallback_is_not_asked_when_the_first_backend_certifies(allegro):
 @pytest.mark.parametrize('backend', WARM_BACKENDS)
 def test_warm_answer_off_the_certificate_is_redone_cold(allegro, backend):
     """
-    A warm answer that the solver accepts but the certificate refuses (injected: the warm
-    x moved by 5%) is solved again cold in the same call, and counted.
+    A warm answer that the certificate refuses is solved again cold in the same call, and counted.
+
+    The solver accepts the answer; the fault is injected (the warm x moved by 5%).
     """
     base = {'daqp': DaqpSolver, 'proxsuite': TauQPSolver}[backend]
 
     class WrongWhenWarm(base):
+
         def solve(self, qp, cold=False):
             raw = super().solve(qp, cold)
             return dataclasses.replace(raw, x=raw.x * 1.05) if self.last_warm else raw
@@ -252,10 +265,13 @@ def test_warm_answer_off_the_certificate_is_redone_cold(allegro, backend):
     assert sol.optimal and sol.backend == backend
     np.testing.assert_allclose(sol.tau, solve(moved, backend='daqp').tau, atol=AGREE[backend])
 
+
 def drifting_rotating(setup, steps):
     """
-    The load's force rotating once around base y while every joint drifts by up to 0.05 rad
-    (the sequence on which ProxSuite's warm start stopped off the optimum, saying solved).
+    Yield the load's force rotating once around base y, every joint drifting by up to 0.05 rad.
+
+    This is the sequence on which ProxSuite's warm start stopped off the optimum, saying
+    solved.
     """
     scale = np.linalg.norm(setup.external_wrench[:3])
     phase = np.random.default_rng(0).uniform(0, 2 * np.pi, setup.hand.m)
@@ -269,8 +285,9 @@ def drifting_rotating(setup, steps):
 
 def test_proxsuite_warm_answers_are_the_optimum_on_a_drifting_grasp(allegro):
     """
-    Every answer of the warm solver equals an independent solver's optimum (DAQP, cold):
-    a warm answer that stopped on a stale active set is caught by the KKT check and redone.
+    Every answer of the warm solver equals an independent solver's optimum (DAQP, cold).
+
+    A warm answer that stopped on a stale active set is caught by the KKT check and redone.
     """
     warm = make_solver('proxsuite', warm_start=True)
     for s in drifting_rotating(allegro, 500):
@@ -283,8 +300,10 @@ def test_proxsuite_warm_answers_are_the_optimum_on_a_drifting_grasp(allegro):
 
 def test_proxsuite_kkt_check_sees_a_suboptimal_point(allegro):
     """
-    The optimality check itself: ProxSuite's cold answer passes; the same point with a
-    multiplier of the wrong sign, or moved along the feasible set, does not.
+    The optimality check itself: ProxSuite's cold answer passes.
+
+    The same point with a multiplier of the wrong sign, or moved along the feasible set, does
+    not.
     """
     from grasp_torque_opt.backends.proxsuite import KKT_TOLERANCE, kkt_violation
 
@@ -307,8 +326,9 @@ def test_proxsuite_kkt_check_sees_a_suboptimal_point(allegro):
 
 def hard_qp(allegro, ratio=1e24):
     """
-    The Allegro's QP with weights 1e-12 and 1e12 alternating: ProxSuite runs to its caps
-    (the issue's freeze: over 11 minutes with caps 100000 x 100000).
+    Build the Allegro's QP with weights 1e-12 and 1e12 alternating: ProxSuite runs to its caps.
+
+    This is the issue's freeze: over 11 minutes with caps 100000 x 100000.
     """
     w = np.array([1.0 / np.sqrt(ratio), np.sqrt(ratio)] * (allegro.hand.m // 2))
     return build_tau_qp(allegro.maps(), allegro.friction, allegro.external_wrench,
@@ -330,6 +350,7 @@ def test_a_deadline_stops_proxsuite_whatever_its_caps(allegro):
 def test_a_deadline_leaves_an_ordinary_solve_alone(allegro):
     """
     A solve that fits in its budget is one ProxSuite call: bit for bit the same answer.
+
     Cut into the shortest slices (continued from each slice's result), it still converges to
     the same optimum.
     """
@@ -354,8 +375,9 @@ def test_no_active_set_solve_starts_past_its_deadline(allegro, backend):
 
 def test_solve_splits_its_deadline_and_skips_the_lp_when_spent(allegro):
     """
-    dispatch.solve under a deadline: the fallback still answers after a first backend
-    stopped by its share; past the deadline nothing more runs (no LP).
+    dispatch.solve under a deadline: the fallback still answers after the first backend stopped.
+
+    The first backend stopped by its share; past the deadline nothing more runs (no LP).
     """
     from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 
@@ -371,8 +393,10 @@ def test_solve_splits_its_deadline_and_skips_the_lp_when_spent(allegro):
 
 def test_a_deadline_caps_daqps_iterations(allegro):
     """
-    DAQP cycled for 1677 iterations (146 ms here) on a 32-contact grasp with weights at
-    the ratio bound: under a deadline its cap is the iterations that fit.
+    Under a deadline DAQP's iteration cap is the iterations that fit.
+
+    DAQP cycled for 1677 iterations (146 ms here) on a 32-contact grasp with weights at the
+    ratio bound.
     """
     from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
     from grasp_torque_opt.core.scenario import ContactSpec

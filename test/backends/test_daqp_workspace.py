@@ -1,6 +1,15 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-DaqpWorkspace (the adaptive method's rounds): same optimum as an independent solver, its
-multipliers a KKT point, warm and cold alike, bad data refused.
+DaqpWorkspace, the adaptive method's rounds: the same optimum as an independent solver.
+
+Its multipliers are a KKT point, warm and cold alike, and bad data is refused.
 """
 
 from grasp_torque_opt.backends.daqp import DaqpWorkspace, kkt_violation

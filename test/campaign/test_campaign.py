@@ -1,7 +1,17 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-The adversarial campaign, part 1: generated messages, parameter changes and failing
-solvers through a real node's own callbacks (no executor: every publish is seen), and
-generated scenario files through the CLI. Counts are printed at the end of the run.
+The adversarial campaign, part 1: a real node's own callbacks, and the CLI.
+
+Generated messages, parameter changes and failing solvers go through the node's own
+callbacks (no executor: every publish is seen), generated scenario files through the
+CLI. Counts are printed at the end of the run.
 """
 
 from __future__ import annotations
@@ -43,8 +53,10 @@ PUBLISH_MARGIN = 0.005
 
 class Recorder:
     """
-    Stands in front of the node's command publisher: publishes for real, and keeps
-    each command with the controller's decision it came from.
+    Stands in front of the node's command publisher.
+
+    It publishes for real, and keeps each command with the controller's decision it came
+    from.
     """
 
     def __init__(self, node: GraspTorqueNode):
@@ -105,7 +117,7 @@ class Rig:
 
 
 def operations(rig: Rig, size: int) -> st.SearchStrategy:
-    """What can happen to a running node: messages, time, parameter changes, solvers."""
+    """Return what can happen to a running node: messages, time, parameter changes, solvers."""
     js = mutated(rig.valid_js, rig.names)
     m = rig.setup.hand.m
     param = st.one_of(
@@ -278,8 +290,9 @@ def test_campaign_allegro_node(allegro_rig):
 
 def scenario_fields(doc: dict) -> list[tuple]:
     """
-    Paths of every field the schema allows, in a scenario document, in a fixed order:
-    the schema's sets iterate in an order that changes with each process's string hashes,
+    Return the paths of every field the schema allows in a scenario document, in a fixed order.
+
+    The schema's sets iterate in an order that changes with each process's string hashes,
     which made the derandomized examples differ from run to run (and, now and then, none
     of the 120 solve).
     """
@@ -371,8 +384,10 @@ FILE_STALL = 10.0
 @st.composite
 def hostile_texts(draw, text: str) -> bytes:
     """
-    A valid scenario's text made hostile: YAML aliases nested some levels deep, nesting,
-    bytes that are not UTF-8, many contacts, long strings, long integers, in some field.
+    Draw a valid scenario's text made hostile in some field.
+
+    The kinds: YAML aliases nested some levels deep, nesting, bytes that are not UTF-8,
+    many contacts, long strings, long integers.
     """
     lines = text.splitlines()
     fields = [i for i, line in enumerate(lines) if ': ' in line and not line.endswith(':')]

@@ -1,8 +1,17 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-The adversarial campaign, part 2: the node over real DDS. A 1 kHz burst of joint
-states, some malformed, with the service called throughout and flooded once (300 calls);
-an input publisher that dies and comes back. Every command received is checked, every
-service call must be answered.
+The adversarial campaign, part 2: the node over real DDS.
+
+A 1 kHz burst of joint states, some malformed, with the service called throughout and
+flooded once (300 calls); an input publisher that dies and comes back. Every command
+received is checked, every service call must be answered.
 """
 
 from __future__ import annotations
@@ -25,8 +34,10 @@ from std_srvs.srv import Trigger
 
 def variants(setup, n: int, seed: int):
     """
-    N configurations near the grasp's, their names and positions, and the certified
-    torques of each (computed here, independently of the node).
+    Return N configurations near the grasp's, their names and positions, and their torques.
+
+    The torques are each configuration's certified ones, computed here, independently of
+    the node.
     """
     rng = np.random.default_rng(seed)
     out = []
@@ -40,7 +51,7 @@ def variants(setup, n: int, seed: int):
 
 
 def malformed(names, pos, k: int):
-    """The k-th kind of bad joint state: each must be rejected, none may command."""
+    """Return the k-th kind of bad joint state: each must be rejected, none may command."""
     nan, inf = math.nan, math.inf
     kinds = [
         (names, [nan] + pos[1:]), (names, [inf] + pos[1:]), (names, pos[:-1]),

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The command line: its JSON contract, exit codes and one-line errors."""
 
 import json
@@ -101,8 +109,9 @@ def test_console_script_runs_as_installed():
                                         (('objective',), {'weights': [1.0, 2.0, 1.0, 2.0]})])
 def test_per_joint_lists_without_joints_exit_2(tmp_path, capsys, planar_doc, path, value):
     """
-    Without hand.joints, per-joint values would follow Pinocchio's joint order, not the
-    URDF file's (the Allegro's model order is 0-3, 12-15, 4-7, 8-11): they need the order.
+    Per-joint values need hand.joints: without it they would follow Pinocchio's joint order.
+
+    That order is not the URDF file's (the Allegro's model order is 0-3, 12-15, 4-7, 8-11).
     """
     doc = mutated(mutated(planar_doc, ('hand', 'joints'), None), path, value)
     doc['hand']['urdf'] = str(PLANAR.parent / doc['hand']['urdf'])
@@ -134,7 +143,8 @@ def test_fallback_answers_for_a_backend_that_cannot(planar, capsys):
     """Quadprog cannot take the planar grasp's internal force: DAQP answers, unless told not to."""
     code, out, _ = run(['solve', str(PLANAR), '--backend', 'quadprog', '--json'], capsys)
     d = json.loads(out)
-    assert code == 0 and d['certificate']['ok'] is True and 'fallback after quadprog' in d['message']
+    assert code == 0 and d['certificate']['ok'] is True
+    assert 'fallback after quadprog' in d['message']
     code, out, _ = run(['solve', str(PLANAR), '--backend', 'quadprog', '--fallback', 'none',
                         '--json'], capsys)
     assert code == 4 and json.loads(out)['tau'] is None
@@ -142,7 +152,7 @@ def test_fallback_answers_for_a_backend_that_cannot(planar, capsys):
 
 @pytest.mark.parametrize('urdf', ['a\nb.urdf', '\x85', 'x\u2028y.urdf', 'tab\there.urdf'])
 def test_line_breaks_in_the_input_stay_escaped_in_the_one_line(tmp_path, capsys, planar_doc,
-                                                                urdf):
+                                                               urdf):
     r"""str.splitlines() breaks at \\x85 and \\u2028 too: the quoted input must not."""
     doc = mutated(planar_doc, ('hand', 'urdf'), urdf)
     bad = tmp_path / 'bad.yaml'

@@ -1,6 +1,15 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-The planner's command line: --objective, --margin, --capacity, the infeasible explanation,
-and ``score`` on a generated batch (bad lines named, the rest scored, files written).
+The planner's command line: --objective, --margin, --capacity, the infeasible explanation.
+
+Also ``score`` on a generated batch: bad lines named, the rest scored, files written.
 """
 
 import copy

@@ -1,8 +1,17 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-Hostile scenario files through the CLI: exit 2 and one line naming the problem, in
-bounded time and memory, never a traceback (an alias bomb took over 4 GB, so did
-/dev/zero; 5000 levels of nesting raised RecursionError; a Latin-1 byte,
-UnicodeDecodeError; a directory as hand.urdf was "file not found").
+Hostile scenario files through the CLI: exit 2 and one line naming the problem.
+
+The answer comes in bounded time and memory, never as a traceback (an alias bomb took
+over 4 GB, so did /dev/zero; 5000 levels of nesting raised RecursionError; a Latin-1
+byte, UnicodeDecodeError; a directory as hand.urdf was "file not found").
 
 The files are run in one child process whose address space is capped at 1.5 GB, so a
 file that blows up kills the child, not the test run.
@@ -26,10 +35,11 @@ TIME_CAP = 60
 
 
 def chain_urdf(n: int) -> str:
-    """A URDF of n revolute joints in a chain (170 KB at 500)."""
+    """Build a URDF of n revolute joints in a chain (170 KB at 500)."""
     inertia = ('<inertial><mass value="0.01"/><inertia ixx="1e-6" iyy="1e-6" izz="1e-6" '
                'ixy="0" ixz="0" iyz="0"/></inertial>')
-    links = ['<link name="l0"/>'] + [f'<link name="l{i}">{inertia}</link>' for i in range(1, n + 1)]
+    links = ['<link name="l0"/>'] + [f'<link name="l{i}">{inertia}</link>'
+                                     for i in range(1, n + 1)]
     joints = [f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
               '<origin xyz="0 0.01 0"/><axis xyz="0 0 1"/>'
               '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The control cycle on plain arrays: inputs, gate, staleness, fault policy, gravity."""
 
 import dataclasses
@@ -237,6 +245,8 @@ def test_long_names_are_cut_in_messages(planar):
 
 def test_stamp_rule(planar):
     """
+    The stamp rule: zero, ahead of the clock, backwards from the mark.
+
     Zero: unstamped, accepted. Ahead of the clock beyond the tolerance: rejected.
     Backwards from the mark (the last accepted stamp, at most the clock when it was
     accepted): rejected while that message is fresh, accepted once it is stale.
@@ -264,6 +274,8 @@ def test_stamp_rule(planar):
 
 def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
     """
+    A source stamping ahead cannot lock out one on the clock.
+
     The issue: joint states stamped 0.4 s ahead (within the 0.5 s tolerance) at 25 Hz
     were followed exclusively, and the real 200 Hz driver rejected as out of order.
     """
@@ -273,7 +285,7 @@ def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
     for k in range(200):  # one second: the driver every 5 ms, the skewed source every 40 ms
         t = 100.0 + 0.005 * k
         for source, stamp in (('driver', t - 0.001),) + ((('skewed', t + 0.4),) if k % 8 == 0
-                                                          else ()):
+                                                         else ()):
             try:
                 ctrl.update_joint_state(*js, now=t, stamp=stamp, clock=t)
                 accepted[source] += 1
@@ -301,6 +313,8 @@ def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar)
 
 def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
     """
+    A cycle ends within its budget whatever the solver settings.
+
     The issue's freeze: caps 100000 x 100000 and weights 1e-12/1e12 kept one ProxSuite
     solve going for over 11 minutes. The cycle's solvers stop by its budget instead.
     """
@@ -321,6 +335,8 @@ def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
 
 def test_the_adaptive_method_keeps_the_budget_too(allegro):
     """
+    The adaptive method keeps the budget too.
+
     tau-qp-adaptive's rounds of DAQP QPs, at the caps' bounds on a 32-contact grasp with
     the weights' ratio at its bound: over 90 s per cycle without a budget here.
     """
@@ -345,15 +361,17 @@ def test_the_adaptive_method_keeps_the_budget_too(allegro):
 
 def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar):
     """
-    Staleness is checked when the command leaves: cycle_budget 10 s but joint states
-    stale after 50 ms (the issue's command 4.2 s late).
+    Staleness is checked when the command leaves.
+
+    Here cycle_budget is 10 s but joint states are stale after 50 ms (the issue's command
+    was 4.2 s late).
     """
     ctrl = fresh(planar, cycle_budget=10.0, joint_state_timeout=0.05, hold_time=1.0)
     ctrl.solver = Slow(0.08)
     ctrl.update_joint_state(*joint_state(planar), 0.0)
     r = ctrl.cycle(0.0)
     assert r.command is None and r.fault.startswith('inputs went stale during the cycle: '
-                                                     'joint_states stale')
+                                                    'joint_states stale')
     assert ctrl.counters.commands == 0 and ctrl.last_command is None
     ctrl.solver = Slow(0.0)
     ctrl.update_joint_state(*joint_state(planar), 1.0)
@@ -361,7 +379,7 @@ def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar)
 
 
 def with_limits(ctrl, limit):
-    """The controller after a torque_limits change (as the node applies one)."""
+    """Apply a torque_limits change to the controller, as the node applies one."""
     hand = dataclasses.replace(ctrl.setup.hand,
                                torque_limits=np.full(ctrl.setup.hand.m, float(limit)))
     ctrl.setup = dataclasses.replace(ctrl.setup, hand=hand)
@@ -370,6 +388,8 @@ def with_limits(ctrl, limit):
 @pytest.mark.parametrize('policy', ['hold', 'zero'])
 def test_lowered_limits_act_on_the_command_in_force_at_once(allegro, policy):
     """
+    Lowered limits act on the command in force at once.
+
     The issue: 0.63 N m in force, limits lowered to 0.2 N m (the grasp unholdable), hold
     policy: nothing new was published and the controller kept 0.63 N m forever.
     """

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Outer cones and the Lagrangian bound, against the exact cone and the independent SOCP."""
 
 import dataclasses
@@ -60,8 +68,9 @@ def test_outer_cones_contain_the_exact_cone_and_touch_it(N):
 
 def test_inflation_moves_every_facet_off_the_exact_cone():
     """
-    Inflated, no facet touches the exact cone any more (docs/adaptive.md: its dual
-    vectors lie strictly inside the dual cone).
+    Inflated, no facet touches the exact cone any more.
+
+    The facets' dual vectors lie strictly inside the dual cone (docs/adaptive.md).
     """
     u = np.array([[1.0, 0.0], [0.6, 0.8]])
     touch = np.column_stack((MU1 * u, np.ones(2), np.zeros(2)))  # fz = 1, on the cone
@@ -74,7 +83,9 @@ def test_inflation_moves_every_facet_off_the_exact_cone():
 
 def test_dual_cone_margin_is_the_dual_cone():
     """
-    S with margin >= 0 has s . f >= 0 on the whole exact cone; s with margin < 0 has
+    The margin's sign says whether s is in the dual cone.
+
+    An s with margin >= 0 has s . f >= 0 on the whole exact cone; an s with margin < 0 has
     an extreme ray of the cone with s . f < 0.
     """
     rng = np.random.default_rng(3)
@@ -109,8 +120,10 @@ def random_dual_points(rng, maps, friction, k):
 
 def test_any_dual_feasible_point_bounds_the_socp_from_below(allegro):
     """
-    The bound holds for any (eta, y) whose sigma is in K* + R+ e_z: random ones, against
-    Clarabel's optimum of the exact SOCP (reference.exact_socp, no polygon in it).
+    The bound holds for any (eta, y) whose sigma is in K* + R+ e_z.
+
+    Checked on random ones, against Clarabel's optimum of the exact SOCP
+    (reference.exact_socp, no polygon in it).
     """
     maps = allegro.maps()
     assert np.linalg.matrix_rank(maps.J) == maps.J.shape[0]

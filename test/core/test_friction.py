@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The linearized cone S against the paper's inequalities and the exact cone."""
 
 from grasp_torque_opt.core.friction import (
@@ -12,9 +20,9 @@ import pytest
 
 
 def paper_rows(mu1, mu2, N):
-    """The paper's 2N inequalities, written out term by term (Section 1)."""
-    s = lambda j: np.sin(2 * np.pi * j / N)  # noqa: E731
-    c = lambda j: np.cos(2 * np.pi * j / N)  # noqa: E731
+    """Write out the paper's 2N inequalities term by term (Section 1)."""
+    s = lambda j: np.sin(2 * np.pi * j / N)  # noqa: E731 -- the paper's s_j, as it writes it
+    c = lambda j: np.cos(2 * np.pi * j / N)  # noqa: E731 -- the paper's c_j, as it writes it
     sN = np.sin(2 * np.pi / N)
     rows = []
     for sign in (+1, -1):

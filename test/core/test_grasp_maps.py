@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """G and J from first principles: moments summed by hand, finite differences of kinematics."""
 
 from grasp_torque_opt.core.exceptions import FrameNotFound
@@ -68,6 +76,6 @@ def test_default_normal_points_to_the_object_origin(planar):
 
 def test_unknown_frame_is_named(planar):
     spec = ContactSpec(link='finger3_tip', position=np.zeros(3))
-    with pytest.raises(FrameNotFound, match=r"grasp\.contacts\[0\]\.link: unknown frame "
+    with pytest.raises(FrameNotFound, match=r'grasp\.contacts\[0\]\.link: unknown frame '
                                             r"'finger3_tip' \(model frames: .*finger1_tip"):
         compute_grasp_maps(planar.hand, planar.q, [spec], planar.object_origin)

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Loading hands: paths, example-robot-data, joints and limits."""
 
 from conftest import ALLEGRO_URDF, ROOT
@@ -30,7 +38,7 @@ def test_joint_order_is_command_order():
 
 
 def test_fixed_joint_is_not_actuated():
-    with pytest.raises(JointNotFound, match=r"hand.joints\[0\]: unknown joint "
+    with pytest.raises(JointNotFound, match=r'hand.joints\[0\]: unknown joint '
                                             r"'finger1_tip_joint' \(1-DoF joints: joint1"):
         Hand.from_urdf(ROOT / 'urdf/planar_two_finger.urdf', ['finger1_tip_joint'])
 
@@ -46,8 +54,8 @@ def test_urdf_string_is_parsed():
 def test_limits_above_the_urdf_effort_are_refused_unless_allowed():
     urdf = ROOT / 'urdf/planar_two_finger.urdf'  # effort limits 10, 5, 10, 5 N m
     with pytest.raises(InputError, match=r"^hand.torque_limits: 6 N m for joint 'joint2' "
-                       r"exceeds the URDF effort limit \(5 N m\); set "
-                       r"hand.torque_limits_above_urdf: true to allow it$"):
+                       r'exceeds the URDF effort limit \(5 N m\); set '
+                       r'hand.torque_limits_above_urdf: true to allow it$'):
         Hand.from_urdf(urdf, None, [10.0, 6.0, 10.0, 5.0])
     hand = Hand.from_urdf(urdf, None, [10.0, 6.0, 10.0, 5.0], above_urdf=True)
     np.testing.assert_array_equal(hand.torque_limits, [10.0, 6.0, 10.0, 5.0])
@@ -58,8 +66,9 @@ def test_limits_above_the_urdf_effort_are_refused_unless_allowed():
 
 def test_pinocchio_orders_joints_unlike_the_urdf_file():
     """
-    Why per-joint lists need hand.joints: the Allegro's model order is 0-3, 12-15, 4-7,
-    8-11, not the file's 0-15.
+    Pinocchio orders joints unlike the URDF file: why per-joint lists need hand.joints.
+
+    The Allegro's model order is 0-3, 12-15, 4-7, 8-11, not the file's 0-15.
     """
     hand = Hand.from_urdf(resolve_urdf(ALLEGRO_URDF, ROOT))
     assert [int(float(n.split('_')[1])) for n in hand.joints] == \

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The scenario's optional object and gravity: the load from the object's weight."""
 
 import copy
@@ -12,7 +20,7 @@ import pytest
 
 @pytest.fixture(scope='module')
 def weighed_doc():
-    """The planar scenario with a box of 0.2 kg under gravity along -y, off-centre."""
+    """Return the planar scenario with a box of 0.2 kg under gravity along -y, off-centre."""
     doc = scenario_doc(PLANAR)
     del doc['load']
     doc['gravity'] = [0.0, -9.81, 0.0]

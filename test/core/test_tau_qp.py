@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The tau-space QP: its pieces, and its optimum against independent formulations and solvers."""
 
 import dataclasses
@@ -139,7 +147,7 @@ def test_decomposition_against_numpy_pinv(name, request):
 
 
 def test_feasible_load_is_not_declared_infeasible(allegro):
-    """A load that ProxSuite called PRIMAL_INFEASIBLE with eps_primal_inf 1e-8 (the LP holds it)."""
+    """A load ProxSuite called PRIMAL_INFEASIBLE with eps_primal_inf 1e-8 (the LP holds it)."""
     th = 2 * np.pi * 3 / 500
     w = np.array([1.4715 * np.cos(th), 0.0, 1.4715 * np.sin(th), 0.0, 0.0, 0.0])
     setup = dataclasses.replace(allegro, external_wrench=w)
@@ -152,8 +160,10 @@ def test_feasible_load_is_not_declared_infeasible(allegro):
 
 def test_a_hessian_that_is_not_diagonal_is_solved_as_dense(allegro):
     """
-    The default Hessian type is Diagonal (build_tau_qp's H is); a coupled H must still
-    give its own optimum, the one DAQP finds for it, not the diagonal one.
+    A coupled H must still give its own optimum, though the default Hessian type is Diagonal.
+
+    build_tau_qp's H is diagonal; the optimum is the one DAQP finds for the coupled H, not
+    the diagonal one.
     """
     maps = allegro.maps()
     qp = build_tau_qp(maps, allegro.friction, allegro.external_wrench, *allegro.tau_bounds,

@@ -1,6 +1,16 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-tau-qp-adaptive: bounds bracket the independent SOCP, the answer is certified and within its
-gap of it, the planar excess is closed, a failed round falls back to the paper's polygon.
+tau-qp-adaptive: certified answers within bounds that bracket the independent SOCP.
+
+The bounds bracket the independent SOCP, the answer is certified and within its gap of
+it, the planar excess is closed, a failed round falls back to the paper's polygon.
 """
 
 import dataclasses
@@ -58,8 +68,9 @@ def test_bounds_bracket_the_socp_and_the_gap_is_met(name, request):
 
 def test_random_allegro_loads_one_refiner(allegro):
     """
-    Seeded loads, one Refiner reused (its workspace carries over): every answer is
-    certified, bracketed and within its gap; each equals a fresh Refiner's.
+    Seeded loads, one Refiner reused (its workspace carries over).
+
+    Every answer is certified, bracketed and within its gap; each equals a fresh Refiner's.
     """
     rng = np.random.default_rng(11)
     maps = allegro.maps()
@@ -94,8 +105,10 @@ def test_lower_bound_never_above_the_socp_for_any_polygon(planar, allegro):
 
 def test_planar_case_closes_the_excess_of_the_papers_triangle(planar):
     """
-    N = 3 (the paper's): the polygon's torque is about 80% above the exact optimum; the
-    adaptive one is within 0.1% of it, and its certified gap says so.
+    N = 3 (the paper's): the adaptive torque is within 0.1% of the exact optimum.
+
+    The polygon's torque is about 80% above the exact optimum; the adaptive one's certified
+    gap says so too.
     """
     maps = planar.maps()
     E = exact_norm(planar, maps)
@@ -109,8 +122,10 @@ def test_planar_case_closes_the_excess_of_the_papers_triangle(planar):
 
 def test_round_zero_bound_is_the_circumscribed_polygon_of_the_scenario(planar):
     """
-    max_rounds 0 with the scenario's N: the answer is the paper's N-gon (or the outer
-    polygon's own, if certified) and the lower bound comes from the same N scaled out.
+    max_rounds 0 with the scenario's N: the answer is the paper's N-gon's.
+
+    Or it is the outer polygon's own, if certified; the lower bound comes from the same N
+    scaled out.
     """
     maps = planar.maps()
     sol = solve(planar, 'tau-qp-adaptive', maps=maps,
@@ -125,8 +140,9 @@ def test_round_zero_bound_is_the_circumscribed_polygon_of_the_scenario(planar):
 
 def test_a_failing_solver_falls_back_to_the_papers_polygon(allegro):
     """
-    Real DAQP with a cap of one iteration fails every round: the answer is the paper's
-    N-gon's (certified), never nothing.
+    Real DAQP with a cap of one iteration fails every round.
+
+    The answer is then the paper's N-gon's (certified), never nothing.
     """
     maps = allegro.maps()
     refiner = Refiner(AdaptiveSettings(max_iter=1))
@@ -142,8 +158,10 @@ def test_a_failing_solver_falls_back_to_the_papers_polygon(allegro):
 
 class RaisesOnSecondSolve(DaqpWorkspace):
     """
-    DAQP itself, raising on its second QP of a grasp: the real solver cannot be made to
-    fail on demand in one round only (its settings apply to every round).
+    DAQP itself, raising on its second QP of a grasp.
+
+    The real solver cannot be made to fail on demand in one round only (its settings apply
+    to every round).
     """
 
     def load(self, *args, **kwargs):
@@ -180,8 +198,10 @@ def test_heavy_load_is_infeasible_even_for_the_outer_polygon(planar):
 
 def test_holds_a_load_the_papers_triangle_cannot(allegro):
     """
-    With N = 3 some loads are lost to the polygon but not to the exact cone; the adaptive
-    method, whose outer polygon contains the exact cone, still finds the exact optimum.
+    With N = 3 some loads are lost to the polygon but not to the exact cone.
+
+    The adaptive method, whose outer polygon contains the exact cone, still finds the exact
+    optimum.
     """
     rng = np.random.default_rng(5)
     tri = dataclasses.replace(allegro, friction=dataclasses.replace(allegro.friction, sides=3))
@@ -203,9 +223,11 @@ def test_holds_a_load_the_papers_triangle_cannot(allegro):
 
 def test_a_contact_in_pure_torsion_is_restored_in_the_first_round(allegro):
     """
-    A load for which one fingertip's optimum is pure torsion at f_min (f_t = 0, the
-    apex of ||f_t||, where the cone has no gradient): the first round's candidate is
-    already certified and inside the exact cone (without the apex rows it was not).
+    A contact in pure torsion is restored in the first round.
+
+    A load for which one fingertip's optimum is pure torsion at f_min (f_t = 0, the apex of
+    ||f_t||, where the cone has no gradient): the first round's candidate is already
+    certified and inside the exact cone (without the apex rows it was not).
     """
     th = 2 * np.pi * 58 / 400
     w = allegro.external_wrench.copy()
@@ -222,8 +244,10 @@ def test_a_contact_in_pure_torsion_is_restored_in_the_first_round(allegro):
 
 def test_warm_start_follows_a_moving_grasp(allegro):
     """
-    The node's case: a grasp moving by 1 mrad per cycle and a turning load. Warm, each
-    cycle starts at the last answer's directions: every answer certified and bracketed.
+    The node's case: a grasp moving by 1 mrad per cycle and a turning load.
+
+    Warm, each cycle starts at the last answer's directions: every answer certified and
+    bracketed.
     """
     rng = np.random.default_rng(3)
     refiner = Refiner(AdaptiveSettings(warm_start=True))
@@ -245,8 +269,9 @@ def test_warm_start_follows_a_moving_grasp(allegro):
 
 def test_without_daqp_the_papers_polygon_answers():
     """
-    A ROS distribution may lack DAQP (docs/ros2_control.md): the method then answers
-    with the paper's N-gon, certified, and says why; nothing raises.
+    Without DAQP the method answers with the paper's N-gon, certified, and says why.
+
+    A ROS distribution may lack DAQP (docs/ros2_control.md); nothing raises.
     """
     import subprocess
     import sys

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Load capacity: feasible at alpha, infeasible just above, by independent solvers."""
 
 import copy
@@ -12,20 +20,20 @@ import pytest
 
 
 def holds(setup, maps, load) -> bool:
-    """The tau-QP certifies torques for this load."""
+    """Return whether the tau-QP certifies torques for this load."""
     return solve(dataclasses.replace(setup, external_wrench=np.asarray(load, float)),
                  maps=maps, backend='daqp').optimal
 
 
 def reduced(setup):
-    """The setup with the cone of mu/(1+k) and no margin, written here."""
+    """Return the setup with the cone of mu/(1+k) and no margin, written here."""
     fr, k = setup.friction, setup.friction.margin
     return dataclasses.replace(setup, friction=dataclasses.replace(
         fr, mu1=fr.mu1 / (1 + k), mu2=fr.mu2 / (1 + k), margin=0.0))
 
 
 def above_is_infeasible(setup, maps, load) -> bool:
-    """HiGHS (test/independent.py) finds no wrench for this load in the planned cones."""
+    """Say if HiGHS (test/independent.py) finds no wrench for this load in the planned cones."""
     return not lp_feasible(dataclasses.replace(reduced(setup),
                                                external_wrench=np.asarray(load, float)), maps)
 

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Every method, certified; infeasible verdicts confirmed by an independent LP."""
 
 import dataclasses
@@ -71,7 +79,8 @@ def test_a_result_that_fails_its_certificate_is_not_returned(planar):
 
 
 def test_unknown_method_is_refused(planar):
-    with pytest.raises(ValueError, match='method must be one of tau-qp, tau-qp-adaptive, force-qp, socp, nlp'):
+    with pytest.raises(ValueError,
+                       match='method must be one of tau-qp, tau-qp-adaptive, force-qp, socp, nlp'):
         solve(planar, 'lp')
 
 
@@ -79,8 +88,10 @@ def test_unknown_method_is_refused(planar):
 @pytest.mark.parametrize('N', [3, 4, 6, 8, 16, 32])
 def test_polygon_optimum_is_sandwiched_by_exact_cones(name, N, request):
     """
+    The polygon's optimum lies between two exact (SOCP) optima.
+
     The inscribed N-gon contains the exact cone with mu1 cos(pi/N) and is inside the one
-    with mu1: its optimum lies between the two exact (SOCP) optima.
+    with mu1.
     """
     setup = request.getfixturevalue(name)
     fr = dataclasses.replace(setup.friction, sides=N)

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Why infeasible: the holdable fraction, and that what it names binds in an independent solve."""
 
 import dataclasses
@@ -11,8 +19,9 @@ import pytest
 
 def named_are_active(setup):
     """
-    The explanation's fraction equals an independent HiGHS LP's, and every constraint it
-    names is active at that LP's optimum.
+    Check that the explanation's fraction equals an independent HiGHS LP's.
+
+    Every constraint it names must also be active at that LP's optimum.
     """
     maps = setup.maps()
     assert solve(setup, maps=maps).status == 'infeasible'

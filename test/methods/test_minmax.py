@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """Min-max torque objective: certified, and no certified torque has a smaller max ratio."""
 
 import copy
@@ -100,9 +108,10 @@ def test_minmax_equals_an_independent_lp_on_random_grasps(allegro):
 
 def test_the_min_max_lp_keeps_a_deadline(allegro):
     """
-    The min-max objective's LP runs before the QP in the node's cycle: on a 32-contact
-    grasp it took up to 175 ms here, past a 50 ms budget. Under a deadline it stops by it,
-    and none starts past it.
+    The min-max objective's LP runs before the QP in the node's cycle, and keeps its deadline.
+
+    On a 32-contact grasp it took up to 175 ms here, past a 50 ms budget. Under a deadline
+    it stops by it, and none starts past it.
     """
     import time
 

@@ -1,6 +1,16 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-Batch scoring: the batch's scores equal single solves, bad lines are named and skipped,
-and the process pool and a local Dask cluster give the serial answers.
+Batch scoring: the batch's scores equal single solves.
+
+Bad lines are named and skipped, and the process pool and a local Dask cluster give the
+serial answers.
 """
 
 import copy
@@ -39,7 +49,7 @@ BAD = [  # (line text, what the error must name)
     ('{"grasp": {"joint_positions": {"joint_99": 0}}}', 'grasp.joint_positions.joint_99'),
     ('{"objective": {"weights": [1, 2]}}', 'objective.weights'),
     ('{"load": {"external_wrench": [NaN, 0, 0, 0, 0, 0]}}', 'load.external_wrench[0]: must be '
-                                                             'finite'),
+                                                            'finite'),
     ('[' * 100_000 + ']' * 100_000, 'nested too deeply'),
     ('{"grasp": {"contacts": []}}', 'grasp.contacts: must be a non-empty list'),
     ('{"object": {"mass": 1e400}}', 'object.mass'),
@@ -47,7 +57,7 @@ BAD = [  # (line text, what the error must name)
 
 
 def independent_merge(base, over):
-    """The documented merge rule, written again: mappings merge, null removes, else replace."""
+    """Merge by the documented rule, written again: mappings merge, null removes, else replace."""
     out = copy.deepcopy(base)
     for k, v in over.items():
         if v is None:

@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The certified torques hold the ball in MuJoCo; the same impedance without them drops it."""
 
 from conftest import ALLEGRO
@@ -46,7 +54,7 @@ def test_simulated_contact_forces_equal_the_certified_wrenches(held, scenario):
 
 
 def held_force(contact):
-    """The simulated contact force in base axes, from the contact-frame wrench."""
+    """Return the simulated contact force in base axes, from the contact-frame wrench."""
     return contact.rotation @ contact.simulated[:3]
 
 

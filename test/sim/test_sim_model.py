@@ -1,3 +1,11 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """The MuJoCo model of a scenario: what it keeps of the URDF, and what it refuses."""
 
 import copy
@@ -96,8 +104,10 @@ def test_refusals_name_the_field():
 
 def test_the_planned_contacts_touch_the_object_at_the_grasp(allegro_sim, allegro):
     """
-    The bundled grasp's tips are tangent to the ball: MuJoCo finds one contact on each,
-    within 0.1 mm of the planned point, normal within 1 degree.
+    The bundled grasp's tips are tangent to the ball.
+
+    MuJoCo finds one contact on each, within 0.1 mm of the planned point, normal within 1
+    degree.
     """
     m = allegro_sim.model
     d = mujoco.MjData(m)

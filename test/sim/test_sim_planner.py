@@ -1,6 +1,16 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
 """
-The planner's numbers on physics: a friction margin holds where the minimum-effort
-torques slip, and the ball falls just above the mass the capacity LP predicts.
+The planner's numbers on physics.
+
+A friction margin holds where the minimum-effort torques slip, and the ball falls just
+above the mass the capacity LP predicts.
 """
 
 import dataclasses
