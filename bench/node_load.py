@@ -93,7 +93,7 @@ def _executor(name: str):
 # -- the echo node ---------------------------------------------------------------------------
 
 def echo_main(args: argparse.Namespace) -> int:
-    """A minimal rclpy node: each joint state is answered with zero torques, stamped."""
+    """Run a minimal rclpy node that answers each joint state with zero torques, stamped."""
     from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME
     import rclpy
     from rclpy.executors import ExternalShutdownException
@@ -313,7 +313,7 @@ def _fmt(x: float | None, spec: str) -> str:
 
 
 def table(cases: list[dict]) -> str:
-    """The markdown tables: every case, then the node against the echo node."""
+    """Format the markdown tables: every case, then the node against the echo node."""
     lines = ['| hand | rate [Hz] | executor | answering node | published [Hz] | '
              'commands [Hz] | dropped | dropped [%] | p50 [ms] | p99 [ms] | max [ms] | '
              'other work [cores] |',
@@ -340,7 +340,7 @@ def table(cases: list[dict]) -> str:
 
 
 def ratios(cases: list[dict]) -> list[dict]:
-    """The node against the echo node at the same hand, rate and executor."""
+    """Compare the node with the echo node at the same hand, rate and executor."""
     by_key = {(c['hand'], c['rate_hz'], c['executor'], c['target']): c for c in cases}
     out = []
     for (hand, rate, executor, target), node in by_key.items():
@@ -381,7 +381,7 @@ def main_run(args: argparse.Namespace) -> int:
         if 'error' in c:
             print(f"  {hand} {target} {rate:g} Hz {executor}: {c['error']}", flush=True)
         else:
-            print(f"  {hand:8} {target:18} {rate:6g} Hz {executor:11} "
+            print(f'  {hand:8} {target:18} {rate:6g} Hz {executor:11} '
                   f"commands {c['command_rate_hz']:7.1f}/s  dropped {c['dropped_pct']:6.2f}%"
                   f"  p50 {_fmt(c['latency']['p50_ms'], '.3f')} ms"
                   f"  p99 {_fmt(c['latency']['p99_ms'], '.3f')} ms"

@@ -73,7 +73,7 @@ def single_threaded_math() -> None:
 def make_solver(backend: str = 'proxsuite', settings: ProxSuiteSettings | None = None,
                 warm_start: bool = False, max_slice_s: float | None = None):
     """
-    A tau-QP solver by backend name (one of :data:`BACKENDS`).
+    Make a tau-QP solver by backend name (one of :data:`BACKENDS`).
 
     ``warm_start`` applies to ProxSuite and DAQP (each verifies its warm answers
     and redoes a bad one cold); quadprog has none. ``max_slice_s`` bounds each

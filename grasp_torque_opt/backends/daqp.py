@@ -169,8 +169,9 @@ class DaqpSolver:
              A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray,
              cold: bool, limit: int):
         """
-        Set up or update the workspace and solve (warm if enabled and not ``cold``, verified),
-        with at most ``limit`` iterations per DAQP solve.
+        Set up or update the workspace and solve, with at most ``limit`` iterations per solve.
+
+        The solve is warm if enabled and not ``cold``, and verified.
 
         Returns:
             (x, flag, info with "kkt", iterations); x None if the setup failed.
@@ -271,6 +272,14 @@ class DaqpWorkspace:
         Set every datum of the QP; the next solve starts cold unless ``warm``.
 
         Args:
+            H: the Hessian, shape (n, n).
+            g: the linear cost, shape (n,).
+            A_eq: the equality rows, shape (n_eq, n).
+            b_eq: their right-hand side, shape (n_eq,).
+            C: the inequality rows (upper bounds only), shape (n_in, n).
+            u: their upper bounds, shape (n_in,).
+            l_box: lower bounds on x, shape (n,) (may be -inf).
+            u_box: upper bounds on x, shape (n,) (may be inf).
             semidefinite: H may be singular (DAQP's proximal-point iterations on).
             warm: a QP of the same size may start from the last one's active set.
         """

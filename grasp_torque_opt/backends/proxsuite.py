@@ -60,6 +60,8 @@ def kkt_violation(qp: TauQP, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> flo
                  float(np.abs(qp.A @ x - qp.b).max(initial=0.0)) if qp.A.shape[0] else 0.0)
     return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
                dual / scale, primal)
+
+
 #: Seconds per ProxSuite inner iteration assumed before a solve of a size has measured
 #: it, for the Allegro's tau-QP (7 to 25 us per inner iteration here, setup included);
 #: scaled by :func:`size_factor` for others (32 contacts: 150 to 420 us measured).
@@ -68,11 +70,15 @@ INNER_ITERATION_S = 25e-6
 
 def size_factor(qp: TauQP) -> float:
     """
-    How much more one iteration of a dense solver costs on ``qp`` than on the Allegro's
-    four-fingertip tau-QP (16 variables, 144 rows), as n (n + rows), at least 1.
+    Return how much more a dense solver's iteration costs on ``qp`` than on the Allegro's.
+
+    The Allegro's four-fingertip tau-QP has 16 variables and 144 rows; the factor is
+    n (n + rows) against that, at least 1.
     """
     n = qp.H.shape[0]
     return max(1.0, n * (n + qp.A.shape[0] + qp.C.shape[0]) / (16 * 144))
+
+
 #: Each solve's measured time per inner iteration replaces the estimate if larger; a
 #: smaller one lowers it by at most this factor per solve (a slow solve is remembered).
 ESTIMATE_DECAY = 0.9
@@ -131,7 +137,6 @@ class ProxSuiteSettings:
     preconditioner: str = 'first'
 
 
-
 class TauQPSolver:
     """
     ProxSuite dense solver for tau-QPs, allocated once per problem size.
@@ -184,7 +189,7 @@ class TauQPSolver:
         self._dims: tuple | None = None
 
     def _hessian_type(self, H: np.ndarray) -> str:
-        """The settings' Hessian type, unless H is not diagonal (then ``Dense``)."""
+        """Return the settings' Hessian type, unless H is not diagonal (then ``Dense``)."""
         if self.settings.hessian_type == 'Diagonal' and \
                 np.count_nonzero(H) != np.count_nonzero(np.diagonal(H)):
             return 'Dense'
@@ -216,8 +221,9 @@ class TauQPSolver:
         if why:
             return RawResult('error', None, 0, 0.0, why)
         n, n_eq, n_in = qp.H.shape[0], qp.A.shape[0], qp.C.shape[0]
-        data = {'H': qp.H, 'g': qp.g, 'A': qp.A if n_eq else None, 'b': qp.b if n_eq else None,
-                    'C': qp.C, 'l': np.full(n_in, -np.inf), 'u': qp.u, 'l_box': qp.l_box, 'u_box': qp.u_box}
+        data = {'H': qp.H, 'g': qp.g, 'A': qp.A if n_eq else None,
+                'b': qp.b if n_eq else None, 'C': qp.C, 'l': np.full(n_in, -np.inf),
+                'u': qp.u, 'l_box': qp.l_box, 'u_box': qp.u_box}
         dims = (n, n_eq, n_in, self._hessian_type(qp.H))
         guess = proxsuite.proxqp.InitialGuess
         t0 = time.perf_counter()
@@ -262,7 +268,7 @@ class TauQPSolver:
 
     def _solve_until(self, deadline: float | None) -> tuple[int, bool]:
         """
-        ProxSuite's solve from the initial guess set, within ``deadline`` if given.
+        Run ProxSuite's solve from the initial guess set, within ``deadline`` if given.
 
         Returns:
             (inner iterations, whether the deadline stopped it before ProxSuite did).
@@ -307,7 +313,7 @@ class TauQPSolver:
                 s.max_iter = cap
 
     def _init(self, dims: tuple, data: dict) -> None:
-        """A new ProxSuite QP for this problem size, set up with the settings and ``data``."""
+        """Make a new ProxSuite QP for this problem size, set up with the settings and ``data``."""
         dense = proxsuite.proxqp.dense
         self._qp = dense.QP(*dims[:3], True, hessian_type=getattr(dense.HessianType, dims[3]),
                             dense_backend=getattr(dense.DenseBackend,

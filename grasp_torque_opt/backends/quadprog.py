@@ -43,8 +43,10 @@ class QuadprogSolver:
 
     def solve(self, qp: TauQP, deadline: float | None = None) -> RawResult:
         """
-        Solve a built tau-QP (none starts past ``deadline``, a ``time.perf_counter()``
-        value [s]; a quadprog solve ends after finitely many active-set steps).
+        Solve a built tau-QP; none starts past ``deadline``.
+
+        ``deadline`` is a ``time.perf_counter()`` value [s]; a quadprog solve ends after
+        finitely many active-set steps.
         """
         if deadline is not None and time.perf_counter() >= deadline:
             return RawResult('error', None, 0, 0.0, 'time budget spent before quadprog started')

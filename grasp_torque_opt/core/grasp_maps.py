@@ -86,12 +86,12 @@ class GraspMaps:
 
     @property
     def p(self) -> int:
-        """Number of contacts."""
+        """Return the number of contacts."""
         return len(self.links)
 
     @cached_property
     def contacts(self) -> list[ContactFrame]:
-        """The contact frames, one object each (built when first asked: the cycle never is)."""
+        """Return the contact frames, one object each (built when first asked)."""
         return [ContactFrame(link=link, frame_id=fid, position=pos, rotation=R)
                 for link, fid, pos, R in zip(self.links, self.frame_ids, self.positions,
                                              self.rotations)]

@@ -85,7 +85,7 @@ class TauQP:
 
     @property
     def m(self) -> int:
-        """Number of joint torques."""
+        """Return the number of joint torques."""
         return self.M2.shape[1]
 
     def split(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
