@@ -92,10 +92,10 @@ class Spec:
 
 #: Every parameter, declared in this order. Defaults come from the scenario.
 PARAMETERS: dict[str, Spec] = {
-    'scenario': Spec("Scenario file (docs/design.md section 4): hand, default contacts and load. "
+    'scenario': Spec('Scenario file (docs/design.md section 4): hand, default contacts and load. '
                      "A path, or the name of a bundled file in the package's config/.",
                      read_only=True),
-    'robot_description': Spec("URDF document of the hand (the ROS convention) or a path to "
+    'robot_description': Spec('URDF document of the hand (the ROS convention) or a path to '
                               "one; empty: the scenario's hand.urdf.", read_only=True),
     'joints': Spec("Actuated joints in command order (default: the scenario's).",
                    read_only=True),
@@ -104,24 +104,24 @@ PARAMETERS: dict[str, Spec] = {
     'mu_torsional': Spec('Torsional friction coefficient mu2 [m].', 1e-9, 1.0),
     'polygon_sides': Spec('Sides N of the inscribed friction polygon [-].', 3, 64),
     'min_normal_force': Spec('Minimum normal force per contact [N].', 0.0, 1000.0),
-    'torque_limits': Spec("|command_i| <= torque_limits[i] [N m], per joint; each at most "
+    'torque_limits': Spec('|command_i| <= torque_limits[i] [N m], per joint; each at most '
                           "the joint's URDF effort limit (the scenario's limit if the URDF "
-                          "gives none) unless torque_limits_above_urdf.", length='joints'),
+                          'gives none) unless torque_limits_above_urdf.', length='joints'),
     'torque_limits_above_urdf': Spec("Allow torque_limits above the URDF's effort limits (up "
                                      "to 1e4 N m); default: the scenario's "
-                                     "hand.torque_limits_above_urdf.", read_only=True),
+                                     'hand.torque_limits_above_urdf.', read_only=True),
     'weights': Spec('Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the '
                     'largest at most 1e6 times the smallest [-].', length='joints'),
     'friction_margin': Spec('Friction margin k: plan inside the cone of mu/(1+k), so the '
                             'commanded wrenches hold with up to (1+k) times less friction '
                             '(docs/planner.md) [-].', 0.0, 100.0),
     'objective': Spec("'sum-of-squares' (the paper's, default: the scenario's) or 'min-max' "
-                      "(max |tau_i + g_i| / limit_i, an LP, then the sum of squares among its "
-                      "optima; docs/planner.md)."),
+                      '(max |tau_i + g_i| / limit_i, an LP, then the sum of squares among its '
+                      'optima; docs/planner.md).'),
     'gravity_compensation': Spec("Add the fingers' own gravity torques g(q); the torque "
-                                 "limits then bound the sum."),
+                                 'limits then bound the sum.'),
     'gravity': Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
-                    "gravity, else [0, 0, -9.81].", length='3'),
+                    'gravity, else [0, 0, -9.81].', length='3'),
     'joint_state_timeout': Spec('Joint states older than this stop commands [s].', 1e-4, 10.0),
     'contacts_timeout': Spec('Once contacts arrived, older than this stop commands [s]; '
                              '0: never stale.', 0.0, 60.0),
@@ -131,7 +131,7 @@ PARAMETERS: dict[str, Spec] = {
                       'fault policy applies [s].', 0.0, 60.0),
     'fault_policy': Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
                          "controller keeps the last certified command) or 'zero' (publish "
-                         "zero torques)."),
+                         'zero torques).'),
     'max_message_bytes': Spec('A message on joint_states, contacts or external_wrench whose '
                               'serialized form is longer than this is rejected before it is '
                               'deserialized [bytes].', 1024, 16777216),
@@ -144,25 +144,25 @@ PARAMETERS: dict[str, Spec] = {
     'max_contact_distance': Spec('A contact point farther than this from the base origin '
                                  'stops commands [m].', 1e-3, 100.0),
     'stamp_future_tolerance': Spec("A header stamp more than this ahead of the node's clock "
-                                   "is rejected [s].", 0.0, 3600.0),
+                                   'is rejected [s].', 0.0, 3600.0),
     'cycle_budget': Spec('A cycle that takes longer publishes nothing (overrun); its '
                          'solvers stop by it (or by joint_state_timeout if smaller) [s].',
                          1e-4, 1.0),
     'solver.method': Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
-                          "exact-cone optimum from QPs with a certified gap to it, "
+                          'exact-cone optimum from QPs with a certified gap to it, '
                           "docs/adaptive.md; needs DAQP; about 3 times tau-qp's cycle with "
-                          "DAQP, well within the default cycle_budget)."),
+                          'DAQP, well within the default cycle_budget).'),
     'solver.backend': Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
-                           "without internal-force variables only); every result is "
-                           "certified whichever solves it."),
-    'solver.fallback': Spec("Backend asked in the same cycle when solver.backend gives nothing "
+                           'without internal-force variables only); every result is '
+                           'certified whichever solves it.'),
+    'solver.fallback': Spec('Backend asked in the same cycle when solver.backend gives nothing '
                             "certifiable ('none': no second try); its answer is certified "
-                            "the same way and counted (diagnostics solver.fallback_solves)."),
+                            'the same way and counted (diagnostics solver.fallback_solves).'),
     'solver.warm_start': Spec("Start each solve from the previous cycle's (ProxSuite: its "
-                              "result, preconditioner kept; DAQP: its active set); an answer "
-                              "that is not solved, fails the KKT check or is not certified "
-                              "is redone cold in the same cycle and counted (diagnostics "
-                              "solver.warm_start_fallbacks). No effect on quadprog."),
+                              'result, preconditioner kept; DAQP: its active set); an answer '
+                              'that is not solved, fails the KKT check or is not certified '
+                              'is redone cold in the same cycle and counted (diagnostics '
+                              'solver.warm_start_fallbacks). No effect on quadprog.'),
     'solver.eps_abs': Spec('Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) '
                            '[-].', 1e-12, 1e-4),
     'solver.max_iter': Spec('Solver iteration cap (ProxSuite outer, DAQP) [-].', 1, 10000),
@@ -206,7 +206,7 @@ def received(info: dict | None) -> float:
 
 
 def descriptor(name: str) -> ParameterDescriptor:
-    """The ParameterDescriptor of a parameter of :data:`PARAMETERS`."""
+    """Build the ParameterDescriptor of a parameter of :data:`PARAMETERS`."""
     spec = PARAMETERS[name]
     d = ParameterDescriptor(name=name, description=spec.description, read_only=spec.read_only)
     if spec.low is not None and isinstance(spec.low, int) and isinstance(spec.high, int):
@@ -232,8 +232,10 @@ SERVICE_SLICE_S = 0.005
 
 def _fallback(backend: str, fallback: str) -> str | None:
     """
-    The fallback backend to build: None for 'none', the backend itself, or one not installed
-    (a ROS distribution may lack DAQP; the node then runs without a second try).
+    Name the fallback backend to build, or None.
+
+    None for 'none', the backend itself, or one not installed (a ROS distribution may
+    lack DAQP; the node then runs without a second try).
     """
     return None if fallback in ('none', backend) or not available(fallback) else fallback
 
@@ -256,7 +258,9 @@ def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None
     if name == 'solver.backend':
         if value not in BACKENDS:
             return f"{name}: must be one of {', '.join(BACKENDS)}"
-        return '' if available(value) else f'{name}: {value} is not installed (pip install {value})'
+        if not available(value):
+            return f'{name}: {value} is not installed (pip install {value})'
+        return ''
     if name == 'solver.fallback':
         return '' if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
     if name == 'solver.method':
@@ -301,11 +305,13 @@ class GraspTorqueNode(Node):
 
     def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
         """
+        Load the scenario and the hand, declare the parameters, start the interfaces.
+
         Args:
-        message_info: age inputs from the middleware's receipt time (rmw message
-            info); False: from the callback's time (rclpy 7.1's EventsExecutor
-            raises SystemError on subscriptions that take message info).
-        kwargs: for rclpy's Node (context, parameter_overrides, ...).
+            message_info: age inputs from the middleware's receipt time (rmw message
+                info); False: from the callback's time (rclpy 7.1's EventsExecutor
+                raises SystemError on subscriptions that take message info).
+            kwargs: for rclpy's Node (context, parameter_overrides, ...).
         """
         super().__init__(NODE_NAME, **kwargs)
         self._lock = threading.Lock()
@@ -417,8 +423,8 @@ class GraspTorqueNode(Node):
         self.create_timer(self.get_parameter('marker_period').value, self._on_markers)
         self.get_logger().info(
             f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
-            f"{len(setup.contacts)} default contacts; commands on "
-            f"{self._command_pub.topic_name}")
+            f'{len(setup.contacts)} default contacts; commands on '
+            f'{self._command_pub.topic_name}')
 
     # -- configuration --------------------------------------------------------------------
 
@@ -447,8 +453,10 @@ class GraspTorqueNode(Node):
     @staticmethod
     def _limit_bounds(hand: Hand, above_urdf: bool) -> np.ndarray:
         """
-        The largest torque limit per joint [N m]: the URDF's effort limit, the
-        scenario's limit where the URDF gives none; MAX_TORQUE_LIMIT if allowed above.
+        Give the largest torque limit per joint [N m].
+
+        The URDF's effort limit, the scenario's limit where the URDF gives none;
+        MAX_TORQUE_LIMIT if allowed above.
         """
         if above_urdf:
             return np.full(hand.m, MAX_TORQUE_LIMIT)
@@ -463,7 +471,7 @@ class GraspTorqueNode(Node):
 
     def _configure(self, setup: GraspSetup, p: dict[str, Any]
                    ) -> tuple[GraspSetup, CycleConfig, ProxSuiteSettings]:
-        """The controller's setup, cycle settings and solver settings from parameter values."""
+        """Make the controller's setup, cycle and solver settings from parameter values."""
         hand = setup.hand
         if not np.array_equal(hand.torque_limits, p['torque_limits']):
             hand = dataclasses.replace(hand, torque_limits=np.array(p['torque_limits']))
@@ -544,8 +552,9 @@ class GraspTorqueNode(Node):
     def _on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
                        info: dict | None) -> None:
         """
-        A message as the middleware delivered it: its length checked, then deserialized
-        and taken (``take(msg, receipt)``).
+        Take a message as the middleware delivered it.
+
+        Its length is checked, then it is deserialized and taken (``take(msg, receipt)``).
         """
         receipt = received(info) if info is not None else None
         with self._lock:
@@ -558,8 +567,11 @@ class GraspTorqueNode(Node):
 
     def _on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
         """
-        A joint state; ``receipt``: when the middleware received it (monotonic [s];
-        None: now).
+        Take a joint state and run one cycle on it.
+
+        Args:
+            msg: the joint state.
+            receipt: when the middleware received it (monotonic [s]; None: now).
         """
         now = time.monotonic()
         receipt = now if receipt is None else receipt
@@ -636,8 +648,10 @@ class GraspTorqueNode(Node):
 
     def wait_for_duplicates(self, seconds: float) -> int:
         """
-        Look for other nodes of this name for up to ``seconds`` (discovery took 0.2 to
-        2.8 s here), without spinning: nothing is taken or published meanwhile.
+        Look for other nodes of this name for up to ``seconds``.
+
+        Discovery took 0.2 to 2.8 s here. Nothing spins meanwhile: nothing is taken or
+        published.
 
         Returns:
             How many were seen (0 after ``seconds``).
@@ -712,9 +726,10 @@ class GraspTorqueNode(Node):
     async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
                         ) -> Trigger.Response:
         """
-        Queue one solve for the worker, or answer "busy" at once when
-        MAX_PENDING_SOLVES are queued: every request gets an answer, in bounded memory.
-        (Runs in the executor's thread only, as does the count.).
+        Queue one solve for the worker, or answer "busy" at once.
+
+        "busy" when MAX_PENDING_SOLVES are queued: every request gets an answer, in
+        bounded memory. Runs in the executor's thread only, as does the count.
         """
         if self._pending_solves >= MAX_PENDING_SOLVES:
             self._busy_answers += 1
@@ -737,8 +752,10 @@ class GraspTorqueNode(Node):
 
     def _solve_for_service(self, inputs: Any, now: float, done: Future) -> None:
         """
-        One solve on a snapshot of the inputs, with the service's own controller
-        (own Pinocchio data and ProxSuite workspace): (success, CLI JSON or reason).
+        Solve once on a snapshot of the inputs, with the service's own controller.
+
+        It has its own Pinocchio data and ProxSuite workspace. ``done`` gets
+        (success, the CLI's JSON or the reason).
         """
         ctrl = self._service_controller
         try:
@@ -761,7 +778,7 @@ class GraspTorqueNode(Node):
 
     def safe_stop(self) -> bool:
         """
-        The safe action when the node stops, per ``fault_policy``.
+        Take the safe action when the node stops, per ``fault_policy``.
 
         ``zero``: publish zero torques once and wait (up to 0.5 s) for the
         subscribers to acknowledge them, since the effort controller would keep
@@ -781,7 +798,7 @@ class GraspTorqueNode(Node):
         return True
 
     def destroy_node(self) -> None:
-        """The safe action, then stop the service worker and the node."""
+        """Take the safe action, then stop the service worker and the node."""
         self.safe_stop()
         self._worker.shutdown(wait=True, cancel_futures=True)
         super().destroy_node()
