@@ -1,5 +1,11 @@
 # Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
 # SPDX-License-Identifier: BSD-3-Clause
+
 """
 Start grasp_torque_node beside a ros2_control effort controller.
 
@@ -19,17 +25,16 @@ parameter; otherwise the scenario's ``hand.urdf`` is used.
 import os
 
 from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
-
-from launch import LaunchDescription
 
 PACKAGE = 'grasp_torque_opt'
 
 
 def _node(context):
-    """The node, with the arguments resolved."""
+    """Describe the node, with the arguments resolved."""
     params = LaunchConfiguration('params_file').perform(context)
     controller = LaunchConfiguration('controller').perform(context).strip('/')
     urdf = LaunchConfiguration('robot_description').perform(context)
