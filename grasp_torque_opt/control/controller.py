@@ -55,8 +55,9 @@ QUATERNION_TOLERANCE = 1e-3
 MAX_ABS_JOINT_POSITION = 1e3
 #: Names and frames in error messages are cut to this many characters.
 SHOWN_NAME_LENGTH = 64
-#: The input topics, as named in counters, stamps and messages.
-SOURCES = ('joint_states', 'contacts', 'external_wrench', 'gravity')
+#: The input topics, as named in counters, stamps and messages (and ``gravity``, counted
+#: from its first rejection: it is optional).
+SOURCES = ('joint_states', 'contacts', 'external_wrench')
 #: Largest accepted norm of a gravity input [m/s^2] (about 10 g).
 MAX_GRAVITY = 100.0
 
@@ -542,7 +543,7 @@ class TorqueController:
         self.inputs = dataclasses.replace(self.inputs, gravity=g, gravity_time=now)
 
     def _reject(self, source: str, error: InputError) -> None:
-        self.counters.rejected[source] += 1
+        self.counters.rejected[source] = self.counters.rejected.get(source, 0) + 1
         self.last_rejection = str(error)  # names the field, e.g. contacts.poses[0]...
 
     # -- the cycle ------------------------------------------------------------------------
