@@ -62,8 +62,6 @@ EXECUTABLE = 'grasp_torque_lifecycle_node'
 class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
     """The node, managed: it loads at configure and commands only while active."""
 
-    _managed = True
-
     def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
         """
         Declare every parameter; load nothing (unconfigured).

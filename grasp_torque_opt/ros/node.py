@@ -565,9 +565,6 @@ class GraspTorqueCore:
     while active. The subclass calls :meth:`_init_core` first.
     """
 
-    #: Whether parameters that are read-only in the plain node may change while unconfigured.
-    _managed = False
-
     def _init_core(self, message_info: bool) -> None:
         """Set the state every method relies on; nothing is loaded yet."""
         self._lock = threading.Lock()
