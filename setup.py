@@ -95,6 +95,7 @@ setup(
             'grasp-torque-sim = grasp_torque_opt.ros.sim_driver:main',
             # ROS executables (ros2 run grasp_torque_opt ...), installed into lib/<pkg>.
             'grasp_torque_node = grasp_torque_opt.ros.node:main',
+            'grasp_torque_lifecycle_node = grasp_torque_opt.ros.lifecycle_node:main',
             'grasp_demo_driver = grasp_torque_opt.ros.demo_driver:main',
             'grasp_sim_driver = grasp_torque_opt.ros.sim_driver:main',
         ],

@@ -19,7 +19,10 @@ remapped to ``/<controller>/commands``, the input of an
 ``effort_controllers/JointGroupEffortController`` whose ``joints`` are the
 node's, in the same order (docs/ros2_control.md). ``robot_description``, if
 given, is a URDF file whose text becomes the node's ``robot_description``
-parameter; otherwise the scenario's ``hand.urdf`` is used.
+parameter; otherwise the params file decides (``robot_description_topic``, or
+the scenario's ``hand.urdf``). ``managed:=true`` starts the managed (lifecycle)
+node ``grasp_torque_lifecycle_node`` instead: it waits unconfigured for a
+lifecycle manager (or ``ros2 lifecycle set``) to configure and activate it.
 """
 
 import os
@@ -28,7 +31,7 @@ from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
-from launch_ros.actions import Node
+from launch_ros.actions import LifecycleNode, Node
 
 PACKAGE = 'grasp_torque_opt'
 
@@ -43,9 +46,12 @@ def _node(context):
         with open(urdf) as f:
             parameters.append({'robot_description': f.read()})
     remaps = [('effort_commands', f'/{controller}/commands')] if controller else []
-    return [Node(package=PACKAGE, executable='grasp_torque_node', name='grasp_torque_node',
-                 namespace=LaunchConfiguration('namespace'), parameters=parameters,
-                 remappings=remaps, output='screen', emulate_tty=True)]
+    managed = LaunchConfiguration('managed').perform(context).lower() in ('true', '1')
+    action, executable = ((LifecycleNode, 'grasp_torque_lifecycle_node') if managed
+                          else (Node, 'grasp_torque_node'))
+    return [action(package=PACKAGE, executable=executable, name='grasp_torque_node',
+                   namespace=LaunchConfiguration('namespace'), parameters=parameters,
+                   remappings=remaps, output='screen', emulate_tty=True)]
 
 
 def generate_launch_description():
@@ -63,6 +69,12 @@ def generate_launch_description():
                               description='Namespace of the node'),
         DeclareLaunchArgument(
             'robot_description', default_value='',
-            description="URDF file of the hand; empty: the scenario's hand.urdf"),
+            description='URDF file of the hand; empty: as the params file says '
+                        "(robot_description_topic, else the scenario's hand.urdf)"),
+        DeclareLaunchArgument(
+            'managed', default_value='false',
+            description='true: the managed (lifecycle) node grasp_torque_lifecycle_node, '
+                        'which commands only once configured and activated; false: the '
+                        'plain grasp_torque_node, which commands from its start'),
         OpaqueFunction(function=_node),
     ])

@@ -13,9 +13,14 @@ from pathlib import Path
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+from geometry_msgs.msg import Pose, PoseArray, Vector3Stamped, WrenchStamped
+from grasp_torque_opt.ros.lifecycle_node import GraspTorqueLifecycleNode
 from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode, SERVICE_QOS
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState, GetState
 import numpy as np
+from rcl_interfaces.msg import Log
+from rcl_interfaces.srv import SetParameters
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
@@ -33,7 +38,7 @@ DOMAIN = 1 + os.getpid() % 100
 class Harness:
     """The node under test and a tester node on one executor."""
 
-    def __init__(self, scenario: Path, **params):
+    def __init__(self, scenario: Path | None, **params):
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=DOMAIN)
         # The most generous cycle budget unless a test is about it: other processes may
@@ -41,9 +46,9 @@ class Harness:
         params.setdefault('cycle_budget', 1.0)
         # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
         params.setdefault('diagnostics_period', 0.1)
-        overrides = [Parameter('scenario', value=str(scenario))]
+        overrides = [] if scenario is None else [Parameter('scenario', value=str(scenario))]
         overrides += [Parameter(k.replace('__', '.'), value=v) for k, v in params.items()]
-        self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
+        self.node = self.make_node(overrides)
         self.tester = rclpy.create_node('tester', context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
@@ -53,20 +58,30 @@ class Harness:
         self.contacts_pub = t.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
         self.wrench_pub = t.create_publisher(WrenchStamped, 'external_wrench',
                                              qos_profile_sensor_data)
+        self.gravity_pub = t.create_publisher(Vector3Stamped, 'gravity',
+                                              qos_profile_sensor_data)
         self.commands: list[tuple[float, np.ndarray]] = []
         self.diagnostics: list[dict] = []
         self.markers: list[MarkerArray] = []
+        self.logs: list[Log] = []
         t.create_subscription(Float64MultiArray, 'effort_commands',
                               lambda m: self.commands.append((time.monotonic(),
                                                               np.array(m.data))), COMMAND_QOS)
         t.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 10)
         t.create_subscription(MarkerArray, 'grasp_torque_node/contact_wrenches',
                               self.markers.append, 1)
+        t.create_subscription(Log, '/rosout', self._on_log, 100)
         self.solve_client = t.create_client(Trigger, 'grasp_torque_node/solve',
                                             qos_profile=SERVICE_QOS)
-        assert self.spin_until(lambda: self.js_pub.get_subscription_count() > 0
-                               and self.contacts_pub.get_subscription_count() > 0
-                               and self.solve_client.service_is_ready(), 10.0)
+        assert self.spin_until(self.ready, 10.0)
+
+    def make_node(self, overrides):
+        return GraspTorqueNode(context=self.context, parameter_overrides=overrides)
+
+    def ready(self) -> bool:
+        return (self.js_pub.get_subscription_count() > 0
+                and self.contacts_pub.get_subscription_count() > 0
+                and self.solve_client.service_is_ready())
 
     def _on_diag(self, msg):
         for s in msg.status:
@@ -74,6 +89,10 @@ class Harness:
                 self.diagnostics.append({**{kv.key: kv.value for kv in s.values},
                                          '_level': s.level[0], '_message': s.message,
                                          '_hardware_id': s.hardware_id})
+
+    def _on_log(self, msg):
+        if msg.name == self.node.get_logger().name:
+            self.logs.append(msg)
 
     def spin_until(self, predicate, timeout: float) -> bool:
         end = time.monotonic() + timeout
@@ -83,6 +102,13 @@ class Harness:
 
     def spin_for(self, seconds: float) -> None:
         self.spin_until(lambda: False, seconds)
+
+    def call(self, client, request, timeout: float = 10.0):
+        """Call a service of the node from the tester and wait for the answer."""
+        assert self.spin_until(client.service_is_ready, timeout)
+        future = client.call_async(request)
+        assert self.spin_until(future.done, timeout), f'no answer from {client.srv_name}'
+        return future.result()
 
     def send_joint_state(self, names, positions) -> None:
         self.js_pub.publish(JointState(name=list(names), position=[float(x) for x in positions],
@@ -104,8 +130,56 @@ class Harness:
             msg.poses.append(pose)
         self.contacts_pub.publish(msg)
 
+    def send_gravity(self, frame, vector) -> None:
+        msg = Vector3Stamped()
+        msg.header.frame_id = frame
+        msg.vector.x, msg.vector.y, msg.vector.z = (float(v) for v in vector)
+        self.gravity_pub.publish(msg)
+
     def close(self) -> None:
         self.node.destroy_node()
         self.tester.destroy_node()
         self.executor.shutdown()
         rclpy.try_shutdown(context=self.context)
+
+
+class LifecycleHarness(Harness):
+    """
+    The managed node, driven over its real lifecycle and parameter services.
+
+    It starts unconfigured: its topics appear at configure, its services at start.
+    """
+
+    def make_node(self, overrides):
+        return GraspTorqueLifecycleNode(context=self.context, parameter_overrides=overrides)
+
+    def ready(self) -> bool:
+        if not hasattr(self, 'change_state'):
+            t = self.tester
+            self.change_state = t.create_client(ChangeState, 'grasp_torque_node/change_state')
+            self.get_state = t.create_client(GetState, 'grasp_torque_node/get_state')
+            self.set_params = t.create_client(SetParameters,
+                                              'grasp_torque_node/set_parameters')
+        return (self.change_state.service_is_ready() and self.get_state.service_is_ready()
+                and self.set_params.service_is_ready() and self.solve_client.service_is_ready())
+
+    def transition(self, transition_id: int, timeout: float = 10.0) -> bool:
+        """Ask the node for a lifecycle transition by its id; say whether it succeeded."""
+        request = ChangeState.Request(transition=Transition(id=transition_id))
+        return self.call(self.change_state, request, timeout).success
+
+    def state(self) -> str:
+        """Read the label of the node's lifecycle state from its get_state service."""
+        return self.call(self.get_state, GetState.Request()).current_state.label
+
+    def set_parameters(self, **params) -> list:
+        """Set parameters over the node's set_parameters service: one result each."""
+        request = SetParameters.Request(parameters=[
+            Parameter(k.replace('__', '.'), value=v).to_parameter_msg()
+            for k, v in params.items()])
+        return list(self.call(self.set_params, request).results)
+
+    def subscribed(self) -> bool:
+        """Whether the node's input subscriptions exist and are matched (configured)."""
+        return (self.js_pub.get_subscription_count() > 0
+                and self.gravity_pub.get_subscription_count() > 0)

@@ -63,8 +63,11 @@ QUATERNION_TOLERANCE = 1e-3
 MAX_ABS_JOINT_POSITION = 1e3
 #: Names and frames in error messages are cut to this many characters.
 SHOWN_NAME_LENGTH = 64
-#: The input topics, as named in counters, stamps and messages.
+#: The input topics, as named in counters, stamps and messages (and ``gravity``, counted
+#: from its first rejection: it is optional).
 SOURCES = ('joint_states', 'contacts', 'external_wrench')
+#: Largest accepted norm of a gravity input [m/s^2] (about 10 g).
+MAX_GRAVITY = 100.0
 
 
 @dataclass(frozen=True)
@@ -97,6 +100,8 @@ class CycleConfig:
             Its solvers stop by the budget (with joint_state_timeout if smaller).
         method: ``tau-qp`` (the paper's polygon) or ``tau-qp-adaptive`` (the
             exact-cone optimum with certified bounds, docs/adaptive.md; DAQP).
+        gravity_timeout: once gravity has arrived on its input, older than this
+            stops commands [s]; 0 disables the check.
     """
 
     joint_state_timeout: float = 0.1
@@ -115,6 +120,7 @@ class CycleConfig:
     stamp_future_tolerance: float = 0.5
     cycle_budget: float = 0.05
     method: str = 'tau-qp'
+    gravity_timeout: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -140,7 +146,8 @@ class Inputs:
 
     ``contacts`` and ``wrench`` are None until one arrives (then the scenario's
     defaults are used); ``q`` is None until the first joint state. ``wrench`` is
-    (frame, [F, M]) in that frame's axes.
+    (frame, [F, M]) in that frame's axes. ``gravity`` is in base axes [m/s^2], None
+    until one arrives (then ``CycleConfig.gravity`` and the scenario's load are used).
     """
 
     q: np.ndarray | None = None
@@ -149,6 +156,8 @@ class Inputs:
     contacts_time: float | None = None
     wrench: tuple[str, np.ndarray] | None = None
     wrench_time: float | None = None
+    gravity: np.ndarray | None = None
+    gravity_time: float | None = None
 
 
 @dataclass
@@ -269,6 +278,9 @@ class TorqueController:
         self.fault = ''
         self.last_rejection = ''
         self._stamps: dict[str, tuple[float, float]] = {}  # source -> (stamp, receipt time)
+        #: The scenario's load for a gravity input [m/s^2] (the object's weight moves with
+        #: it), or None: the load does not depend on gravity.
+        self.load_of_gravity = None
         model = self.setup.hand.model
         self._model_joints = {model.names[j]: model.joints[j].idx_q
                               for j in range(1, model.njoints) if model.joints[j].nq == 1}
@@ -342,7 +354,7 @@ class TorqueController:
     def _timeout(self, source: str) -> float:
         c = self.config
         t = {'joint_states': c.joint_state_timeout, 'contacts': c.contacts_timeout,
-             'external_wrench': c.wrench_timeout}[source]
+             'external_wrench': c.wrench_timeout, 'gravity': c.gravity_timeout}[source]
         return t if t > 0 else c.joint_state_timeout
 
     def _keep_stamp(self, source: str, stamp: float, now: float, clock: float | None) -> None:
@@ -494,8 +506,52 @@ class TorqueController:
         # Kept in the given axes; turned into base axes at the cycle's configuration.
         self.inputs = dataclasses.replace(self.inputs, wrench=(frame, w), wrench_time=now)
 
+    def update_gravity(self, frame: str, vector: np.ndarray, now: float, stamp: float = 0.0,
+                       clock: float | None = None, rotation: np.ndarray | None = None,
+                       unresolved: str = 'tf2_ros is not installed') -> None:
+        """
+        Take gravity [m/s^2]: g(q) and the scenario's load (its object's weight) follow it.
+
+        Args:
+            frame: the frame of the vector: '' or the base frame, or any frame when
+                ``rotation`` is given.
+            vector: gravity in ``frame`` [m/s^2], shape (3,).
+            now: monotonic receipt time [s].
+            stamp: header stamp [s] (0: unstamped).
+            clock: the clock the stamps are on, now [s] (None: not checked ahead).
+            rotation: base-from-frame rotation, shape (3, 3), when the caller could
+                look ``frame`` up (tf2); None: ``frame`` must be the base frame.
+            unresolved: why ``frame`` could not be looked up (for the message).
+
+        Raises:
+            InputError: another frame without ``rotation``, not finite, a norm above
+                :data:`MAX_GRAVITY`, a bad stamp. The vector is not kept.
+        """
+        try:
+            base = self.setup.hand.base_frame
+            if frame not in ('', base) and rotation is None:
+                raise InputError('gravity.header.frame_id', f"'{show(frame)}' is not the "
+                                 f"hand's base frame '{base}' (nor empty), and cannot be "
+                                 f'transformed ({unresolved})')
+            g = _finite(vector, 'gravity.vector')
+            if g.shape != (3,):
+                raise InputError('gravity.vector', f'{g.size} values, expected 3')
+            if rotation is not None:
+                g = _finite(rotation, 'gravity.header.frame_id transform') @ g
+            with np.errstate(over='ignore'):
+                norm = float(np.linalg.norm(g))
+            if norm > MAX_GRAVITY:
+                raise InputError('gravity.vector', f'norm {norm:.6g} m/s^2 exceeds '
+                                 f'{MAX_GRAVITY:g} m/s^2')
+            self._check_stamp('gravity', stamp, clock, now)
+        except InputError as e:
+            self._reject('gravity', e)
+            raise
+        self._keep_stamp('gravity', stamp, now, clock)
+        self.inputs = dataclasses.replace(self.inputs, gravity=g, gravity_time=now)
+
     def _reject(self, source: str, error: InputError) -> None:
-        self.counters.rejected[source] += 1
+        self.counters.rejected[source] = self.counters.rejected.get(source, 0) + 1
         self.last_rejection = str(error)  # names the field, e.g. contacts.poses[0]...
 
     # -- the cycle ------------------------------------------------------------------------
@@ -514,6 +570,9 @@ class TorqueController:
         if i.wrench_time is not None and c.wrench_timeout > 0 and \
                 now - i.wrench_time > c.wrench_timeout:
             return f'external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)'
+        if i.gravity_time is not None and c.gravity_timeout > 0 and \
+                now - i.gravity_time > c.gravity_timeout:
+            return f'gravity stale ({now - i.gravity_time:.3f} s > {c.gravity_timeout} s)'
         return ''
 
     def grasp_at(self, inputs: Inputs) -> tuple[GraspSetup, np.ndarray | None]:
@@ -550,9 +609,12 @@ class TorqueController:
             frame, w = inputs.wrench
             R = data.oMf[model.getFrameId(frame)].rotation if frame else np.eye(3)
             wrench = np.concatenate((R @ w[:3], R @ w[3:]))
+        elif inputs.gravity is not None and self.load_of_gravity is not None:
+            wrench = self.load_of_gravity(inputs.gravity)
         g = None
         if self.config.gravity_compensation:
-            model.gravity.linear = np.asarray(self.config.gravity, dtype=float)
+            model.gravity.linear = np.asarray(
+                self.config.gravity if inputs.gravity is None else inputs.gravity, dtype=float)
             g = pin.computeGeneralizedGravity(model, data, q)[hand.idx_v].copy()
         return dataclasses.replace(setup, q=q, contacts=contacts, external_wrench=wrench,
                                    torque_offset=g), g

@@ -20,6 +20,11 @@ most :data:`MAX_SCENARIO_BYTES`, UTF-8, YAML without aliases and nested at most
 :data:`MAX_DEPTH` deep, at most :data:`MAX_CONTACTS` contacts and
 :data:`MAX_JOINTS` joints, so that a hostile file costs bounded time and memory
 (a 2.8 KB alias bomb took over 4 GB; so did /dev/zero).
+
+Names: a scenario may name its joints and links as another URDF of the same hand
+does; ``hand.name_map`` (and the node's ``name_map`` parameter, merged over it) maps
+them to the URDF's names before anything is checked against the model
+(:func:`parse_name_map`, docs/design.md section 4.1).
 """
 
 from __future__ import annotations
@@ -45,6 +50,8 @@ MAX_JOINTS = 64
 #: Most sides of the friction polygon (the node's parameter has the same range; the QP
 #: grows with it: 2N rows per contact).
 MAX_POLYGON_SIDES = 64
+#: Most entries of a name map (a URDF has at most 512 joints and 512 links).
+MAX_NAME_MAP = 1024
 
 
 @dataclass(frozen=True)
@@ -142,6 +149,10 @@ class Scenario:
         extra_wrench: ``load.external_wrench`` as written: the load besides the
             object's weight, shape (6,) [N, N m].
         torque_limits_above_urdf: allow torque limits above the URDF's effort limits.
+        name_map: the map applied to the scenario's joint and frame names (scenario
+            name -> URDF name; ``hand.name_map`` with the caller's entries over it):
+            ``joints``, ``joint_positions`` and the contacts' links are already the
+            URDF's names.
     """
 
     urdf: str
@@ -160,6 +171,7 @@ class Scenario:
     extra_wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
     objective: str = 'sum-of-squares'
     torque_limits_above_urdf: bool = False
+    name_map: dict[str, str] = field(default_factory=dict)
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
@@ -176,7 +188,7 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 
 
 _SECTIONS = {
-    'hand': {'urdf', 'joints', 'torque_limits', 'torque_limits_above_urdf'},
+    'hand': {'urdf', 'joints', 'torque_limits', 'torque_limits_above_urdf', 'name_map'},
     'grasp': {'joint_positions', 'object_origin', 'contacts'},
     'friction': {'mu_tangential', 'mu_torsional', 'polygon_sides', 'min_normal_force',
                  'margin'},
@@ -275,7 +287,59 @@ def _names(value: Any, name: str) -> list[str]:
     return out
 
 
-def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scenario:
+def parse_name_map(value: Any, name: str = 'hand.name_map') -> dict[str, str]:
+    """
+    Validate a name map: scenario name -> URDF name.
+
+    Args:
+        value: a mapping of names to names (None: no map).
+        name: the field, for messages.
+
+    Returns:
+        The map (empty for None).
+
+    Raises:
+        InputError: not a mapping of non-empty names, more than :data:`MAX_NAME_MAP`
+            entries, or two names mapped to one.
+    """
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise InputError(name, f'must be a mapping scenario name -> URDF name, got '
+                         f'{quote(value)}')
+    if len(value) > MAX_NAME_MAP:
+        raise InputError(name, f'{len(value)} entries, more than {MAX_NAME_MAP}')
+    out: dict[str, str] = {}
+    seen: dict[str, str] = {}
+    for key, target in value.items():
+        if not isinstance(key, str) or not key:
+            raise InputError(name, f'a key must be a name, got {quote(key)}')
+        if not isinstance(target, str) or not target:
+            raise InputError(f'{name}.{cut(key)}', f'must be a name, got {quote(target)}')
+        if target in seen:
+            raise InputError(f'{name}.{cut(key)}', f"maps to '{cut(target)}', as "
+                             f"'{cut(seen[target])}' does: two names cannot map to one")
+        seen[target] = key
+        out[key] = target
+    return out
+
+
+def _renamed(names: list[str], name_map: dict[str, str], field_name: str) -> list[str]:
+    """Map names through the name map; they must stay unique (two may not become one)."""
+    out = [name_map.get(n, n) for n in names]
+    if len(set(out)) != len(out):
+        j = next(j for j, n in enumerate(out) if out.index(n) != j)
+        i = out.index(out[j])
+        if names[i] == out[i]:  # name the entry the map renamed
+            i, j = j, i
+        other = 'is' if names[j] == out[j] else f"'{cut(names[j])}' becomes too"
+        raise InputError(f'{field_name}[{i}]', f"'{cut(names[i])}' becomes '{cut(out[i])}' "
+                         f'through the name map, which [{j}] {other}')
+    return out
+
+
+def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
+                   name_map: dict[str, str] | None = None) -> Scenario:
     """
     Validate a scenario given as plain data (as parsed from YAML).
 
@@ -283,6 +347,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
         data: the parsed document.
         base_dir: folder that relative URDF paths are relative to.
         source: where the data came from, for messages.
+        name_map: scenario name -> URDF name, over the file's ``hand.name_map``
+            (e.g. the node's ``name_map`` parameter), validated by the caller.
 
     Returns:
         The validated scenario.
@@ -306,7 +372,12 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
     urdf = _require(hand, 'urdf', 'hand')
     if not isinstance(urdf, str) or not urdf:
         raise InputError('hand.urdf', f'must be a path, got {quote(urdf)}')
+    names = {**parse_name_map(hand.get('name_map')), **(name_map or {})}
+    if name_map:  # the merged map must be one to one as well
+        names = parse_name_map(names, 'name_map')
     joints = _names(hand['joints'], 'hand.joints') if hand.get('joints') is not None else None
+    if joints is not None:
+        joints = _renamed(joints, names, 'hand.joints')
 
     limits = hand.get('torque_limits')
     if limits is not None:
@@ -330,6 +401,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
                          f'{len(positions_raw)} entries, more than {MAX_JOINTS}')
     positions = {str(k): _number(v, f'grasp.joint_positions.{cut(k)}')
                  for k, v in positions_raw.items()}
+    renamed = _renamed(list(positions), names, 'grasp.joint_positions')
+    positions = dict(zip(renamed, positions.values()))
 
     origin = _vector(_require(grasp, 'object_origin', 'grasp'), 'grasp.object_origin', 3)
 
@@ -364,7 +437,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
                 t = tangent / np.linalg.norm(tangent)
                 if np.linalg.norm(t - (t @ normal) * normal) < 1e-6:
                     raise InputError(f'{name}.tangent', 'is parallel to the normal')
-        contacts.append(ContactSpec(link=link, position=position, normal=normal, tangent=tangent))
+        contacts.append(ContactSpec(link=names.get(link, link), position=position,
+                                    normal=normal, tangent=tangent))
 
     sides = _require(friction, 'polygon_sides', 'friction')
     if isinstance(sides, bool) or not isinstance(sides, int):
@@ -414,7 +488,7 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>') -> Scena
                     joint_positions=positions, object_origin=origin, contacts=contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,
                     object=obj, gravity=gravity, extra_wrench=extra, objective=kind,
-                    torque_limits_above_urdf=above_urdf)
+                    torque_limits_above_urdf=above_urdf, name_map=names)
 
 
 class _BoundedLoader(yaml.SafeLoader):
@@ -443,9 +517,11 @@ class _BoundedLoader(yaml.SafeLoader):
             self._depth -= 1
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> Scenario:
     """
     Read and validate a scenario file, within the bounds of the module's docstring.
+
+    ``name_map`` (scenario name -> URDF name) goes over the file's ``hand.name_map``.
 
     Raises:
         InputError: the file cannot be read, is not a regular file, too large, not
@@ -460,4 +536,4 @@ def load_scenario(path: str | Path) -> Scenario:
         first = (str(e).splitlines() or [''])[0]
         raise InputError('scenario', f'{cut(path, PATH_LENGTH)} is not valid YAML: '
                          f'{cut(first)}') from e
-    return parse_scenario(data, path.resolve().parent, source=str(path))
+    return parse_scenario(data, path.resolve().parent, source=str(path), name_map=name_map)

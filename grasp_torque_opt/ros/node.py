@@ -12,14 +12,21 @@ ROS 2 node ``grasp_torque_node``: certified grasp torques every cycle, and a sol
 A thin adapter over :class:`grasp_torque_opt.control.controller.TorqueController`:
 messages in, plain arrays to the controller, its decisions out. Interface
 pinned in docs/design.md section 4; parameters, units and defaults in docs/design.md section 4.4.
+
+:class:`GraspTorqueCore` is what the plain node here and the managed (lifecycle) node
+of :mod:`grasp_torque_opt.ros.lifecycle_node` share: loading the grasp, the
+parameters, the inputs, the cycle, the outputs and the service. The plain node does
+all of it at construction and commands at once (docs/node.md, "Plain or managed").
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 import dataclasses
 from dataclasses import dataclass
+import importlib.util
 import json
 import math
 import signal
@@ -29,7 +36,7 @@ import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Point, PoseArray, WrenchStamped
+from geometry_msgs.msg import Point, PoseArray, Vector3Stamped, WrenchStamped
 from grasp_torque_opt.backends import (
     available,
     BACKENDS,
@@ -42,15 +49,30 @@ from grasp_torque_opt.control.controller import (
     CycleConfig,
     CycleResult,
     POLICIES,
+    quaternion_matrix,
     stamp_seconds,
     TorqueController,
 )
-from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.core.exceptions import (
+    cut,
+    FrameNotFound,
+    GraspTorqueError,
+    InputError,
+    JointNotFound,
+    quote,
+)
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import Hand, MAX_TORQUE_LIMIT, MAX_URDF_BYTES
 from grasp_torque_opt.core.report import solution_dict
 from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
-from grasp_torque_opt.core.scenario import load_scenario, OBJECTIVES
+from grasp_torque_opt.core.scenario import (
+    load_scenario,
+    MAX_NAME_MAP,
+    OBJECTIVES,
+    parse_name_map,
+    Scenario,
+    weight_wrench,
+)
 import numpy as np
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -61,17 +83,30 @@ from rcl_interfaces.msg import (
 import rclpy
 from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.duration import Duration
+from rclpy.exceptions import (
+    InvalidTopicNameException,
+    ParameterNotDeclaredException,
+    ParameterUninitializedException,
+)
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import HistoryPolicy, qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    qos_profile_sensor_data,
+    QoSProfile,
+    ReliabilityPolicy,
+)
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 from rclpy.task import Future
+from rclpy.time import Time
 from rclpy.utilities import remove_ros_args
+from rclpy.validate_topic_name import validate_topic_name
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -85,6 +120,11 @@ SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=Reliability
 #: Solves the service queues for its worker (each a snapshot of the inputs); a request
 #: beyond them is answered "busy" at once.
 MAX_PENDING_SOLVES = 100
+#: robot_description as robot_state_publisher publishes it: reliable, transient local.
+URDF_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
+#: Serialized std_msgs/String beyond the URDF's own bytes (CDR header, length, NUL).
+URDF_MESSAGE_OVERHEAD = 64
 
 
 @dataclass(frozen=True)
@@ -100,11 +140,25 @@ class Spec:
 
 #: Every parameter, declared in this order. Defaults come from the scenario.
 PARAMETERS: dict[str, Spec] = {
-    'scenario': Spec("Scenario file (docs/design.md section 4): hand, default contacts and load. "
+    'scenario': Spec('Scenario file (docs/design.md section 4): hand, default contacts and load. '
                      "A path, or the name of a bundled file in the package's config/.",
                      read_only=True),
-    'robot_description': Spec("URDF document of the hand (the ROS convention) or a path to "
-                              "one; empty: the scenario's hand.urdf.", read_only=True),
+    'robot_description': Spec('URDF document of the hand (the ROS convention) or a path to '
+                              'one; empty: the URDF from robot_description_topic if set, '
+                              "else the scenario's hand.urdf.", read_only=True),
+    'robot_description_topic': Spec('Topic to take the URDF from (std_msgs/String, reliable, '
+                                    'transient local, as robot_state_publisher publishes '
+                                    "it, e.g. 'robot_description') when robot_description "
+                                    "is empty; '': none. Waited for at start (the managed "
+                                    'node: at configure) up to robot_description_timeout.',
+                                    read_only=True),
+    'robot_description_timeout': Spec('How long the node waits for the URDF on '
+                                      'robot_description_topic before it gives up [s].',
+                                      0.1, 300.0, read_only=True),
+    'name_map': Spec("The scenario's joint and frame names to the URDF's, as "
+                     "'SCENARIO_NAME=URDF_NAME' entries, over the scenario's "
+                     'hand.name_map; applied before any name is checked. Unset: none.',
+                     read_only=True),
     'joints': Spec("Actuated joints in command order (default: the scenario's).",
                    read_only=True),
     'object_origin': Spec('Object origin c in the base frame [m].', length='3'),
@@ -112,37 +166,39 @@ PARAMETERS: dict[str, Spec] = {
     'mu_torsional': Spec('Torsional friction coefficient mu2 [m].', 1e-9, 1.0),
     'polygon_sides': Spec('Sides N of the inscribed friction polygon [-].', 3, 64),
     'min_normal_force': Spec('Minimum normal force per contact [N].', 0.0, 1000.0),
-    'torque_limits': Spec("|command_i| <= torque_limits[i] [N m], per joint; each at most "
+    'torque_limits': Spec('|command_i| <= torque_limits[i] [N m], per joint; each at most '
                           "the joint's URDF effort limit (the scenario's limit if the URDF "
-                          "gives none) unless torque_limits_above_urdf.", length='joints'),
+                          'gives none) unless torque_limits_above_urdf.', length='joints'),
     'torque_limits_above_urdf': Spec("Allow torque_limits above the URDF's effort limits (up "
                                      "to 1e4 N m); default: the scenario's "
-                                     "hand.torque_limits_above_urdf.", read_only=True),
+                                     'hand.torque_limits_above_urdf.', read_only=True),
     'weights': Spec('Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the '
                     'largest at most 1e6 times the smallest [-].', length='joints'),
     'friction_margin': Spec('Friction margin k: plan inside the cone of mu/(1+k), so the '
                             'commanded wrenches hold with up to (1+k) times less friction '
                             '(docs/planner.md) [-].', 0.0, 100.0),
     'objective': Spec("'sum-of-squares' (the paper's, default: the scenario's) or 'min-max' "
-                      "(max |tau_i + g_i| / limit_i, an LP, then the sum of squares among its "
-                      "optima; docs/planner.md)."),
+                      '(max |tau_i + g_i| / limit_i, an LP, then the sum of squares among its '
+                      'optima; docs/planner.md).'),
     'gravity_compensation': Spec("Add the fingers' own gravity torques g(q); the torque "
-                                 "limits then bound the sum."),
+                                 'limits then bound the sum.'),
     'gravity': Spec("Gravity in the base frame for g(q) [m/s^2]; default: the scenario's "
-                    "gravity, else [0, 0, -9.81].", length='3'),
+                    'gravity, else [0, 0, -9.81].', length='3'),
     'joint_state_timeout': Spec('Joint states older than this stop commands [s].', 1e-4, 10.0),
     'contacts_timeout': Spec('Once contacts arrived, older than this stop commands [s]; '
                              '0: never stale.', 0.0, 60.0),
     'wrench_timeout': Spec('Once a load arrived, older than this stops commands [s]; '
                            '0: never stale.', 0.0, 60.0),
+    'gravity_timeout': Spec('Once gravity arrived on the gravity topic, older than this '
+                            'stops commands [s]; 0: never stale.', 0.0, 60.0),
     'hold_time': Spec('How long a fault may hold the last certified command before the '
                       'fault policy applies [s].', 0.0, 60.0),
     'fault_policy': Spec("After hold_time in a fault: 'hold' (publish nothing, the effort "
                          "controller keeps the last certified command) or 'zero' (publish "
-                         "zero torques)."),
-    'max_message_bytes': Spec('A message on joint_states, contacts or external_wrench whose '
-                              'serialized form is longer than this is rejected before it is '
-                              'deserialized [bytes].', 1024, 16777216),
+                         'zero torques).'),
+    'max_message_bytes': Spec('A message on joint_states, contacts, external_wrench or '
+                              'gravity whose serialized form is longer than this is rejected '
+                              'before it is deserialized [bytes].', 1024, 16777216),
     'max_joint_state_entries': Spec('A joint state with more names or positions than this is '
                                     'rejected unread [-].', 1, 100000),
     'max_wrench_force': Spec('A load whose force norm exceeds this is rejected [N].',
@@ -152,25 +208,25 @@ PARAMETERS: dict[str, Spec] = {
     'max_contact_distance': Spec('A contact point farther than this from the base origin '
                                  'stops commands [m].', 1e-3, 100.0),
     'stamp_future_tolerance': Spec("A header stamp more than this ahead of the node's clock "
-                                   "is rejected [s].", 0.0, 3600.0),
+                                   'is rejected [s].', 0.0, 3600.0),
     'cycle_budget': Spec('A cycle that takes longer publishes nothing (overrun); its '
                          'solvers stop by it (or by joint_state_timeout if smaller) [s].',
                          1e-4, 1.0),
     'solver.method': Spec("'tau-qp' (default: the paper's N-gon) or 'tau-qp-adaptive' (the "
-                          "exact-cone optimum from QPs with a certified gap to it, "
+                          'exact-cone optimum from QPs with a certified gap to it, '
                           "docs/adaptive.md; needs DAQP; about 3 times tau-qp's cycle with "
-                          "DAQP, well within the default cycle_budget)."),
+                          'DAQP, well within the default cycle_budget).'),
     'solver.backend': Spec("QP backend: 'proxsuite' (default), 'daqp' or 'quadprog' (grasps "
-                           "without internal-force variables only); every result is "
-                           "certified whichever solves it."),
-    'solver.fallback': Spec("Backend asked in the same cycle when solver.backend gives nothing "
+                           'without internal-force variables only); every result is '
+                           'certified whichever solves it.'),
+    'solver.fallback': Spec('Backend asked in the same cycle when solver.backend gives nothing '
                             "certifiable ('none': no second try); its answer is certified "
-                            "the same way and counted (diagnostics solver.fallback_solves)."),
+                            'the same way and counted (diagnostics solver.fallback_solves).'),
     'solver.warm_start': Spec("Start each solve from the previous cycle's (ProxSuite: its "
-                              "result, preconditioner kept; DAQP: its active set); an answer "
-                              "that is not solved, fails the KKT check or is not certified "
-                              "is redone cold in the same cycle and counted (diagnostics "
-                              "solver.warm_start_fallbacks). No effect on quadprog."),
+                              'result, preconditioner kept; DAQP: its active set); an answer '
+                              'that is not solved, fails the KKT check or is not certified '
+                              'is redone cold in the same cycle and counted (diagnostics '
+                              'solver.warm_start_fallbacks). No effect on quadprog.'),
     'solver.eps_abs': Spec('Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) '
                            '[-].', 1e-12, 1e-4),
     'solver.max_iter': Spec('Solver iteration cap (ProxSuite outer, DAQP) [-].', 1, 10000),
@@ -213,10 +269,133 @@ def received(info: dict | None) -> float:
     return now - max(0.0, (time.time_ns() - ns) * 1e-9)
 
 
-def descriptor(name: str) -> ParameterDescriptor:
-    """The ParameterDescriptor of a parameter of :data:`PARAMETERS`."""
+#: Parameters whose defaults come from the scenario (and its hand), and their types:
+#: the managed node declares them without a value until configure fills them in.
+SCENARIO_PARAMETERS = {
+    'joints': Parameter.Type.STRING_ARRAY,
+    'torque_limits_above_urdf': Parameter.Type.BOOL,
+    'object_origin': Parameter.Type.DOUBLE_ARRAY,
+    'mu_tangential': Parameter.Type.DOUBLE,
+    'mu_torsional': Parameter.Type.DOUBLE,
+    'polygon_sides': Parameter.Type.INTEGER,
+    'min_normal_force': Parameter.Type.DOUBLE,
+    'torque_limits': Parameter.Type.DOUBLE_ARRAY,
+    'weights': Parameter.Type.DOUBLE_ARRAY,
+    'friction_margin': Parameter.Type.DOUBLE,
+    'objective': Parameter.Type.STRING,
+    'gravity': Parameter.Type.DOUBLE_ARRAY,
+}
+#: The constraint a read-only parameter of the plain node has in the managed node.
+FIXED_WHILE_CONFIGURED = 'fixed while configured: set it while unconfigured, then configure'
+
+
+def fixed_defaults() -> dict[str, Any]:
+    """
+    Give the defaults of the parameters that do not depend on the scenario.
+
+    ``name_map`` is not among them: it is declared without a value (unset: no map),
+    as ROS parameters cannot hold an empty list of a known type.
+    """
+    return {
+        'scenario': '',
+        'robot_description': '',
+        'robot_description_topic': '',
+        'robot_description_timeout': 10.0,
+        'gravity_compensation': False,
+        'joint_state_timeout': 0.1,
+        'contacts_timeout': 0.5,
+        'wrench_timeout': 0.5,
+        'gravity_timeout': CycleConfig.gravity_timeout,
+        'hold_time': 0.1,
+        'fault_policy': 'hold',
+        'max_message_bytes': CycleConfig.max_message_bytes,
+        'max_joint_state_entries': CycleConfig.max_joint_state_entries,
+        'max_wrench_force': CycleConfig.max_wrench_force,
+        'max_wrench_torque': CycleConfig.max_wrench_torque,
+        'max_contact_distance': CycleConfig.max_contact_distance,
+        'stamp_future_tolerance': CycleConfig.stamp_future_tolerance,
+        'cycle_budget': CycleConfig.cycle_budget,
+        'solver.method': 'tau-qp',
+        'solver.backend': BACKENDS[0],
+        'solver.fallback': 'daqp',
+        'solver.warm_start': True,
+        'solver.eps_abs': ProxSuiteSettings.eps_abs,
+        'solver.max_iter': ProxSuiteSettings.max_iter,
+        'solver.max_iter_in': ProxSuiteSettings.max_iter_in,
+        'certificate_tolerance': CycleConfig.certificate_tolerance,
+        'diagnostics_period': 1.0,
+        'marker_period': 0.1,
+        'watchdog_period': 0.01,
+        'startup_check_time': 2.0,
+        'marker_scale': 0.02,
+        'publish_stamped_command': False,
+    }
+
+
+def scenario_defaults(scenario: Scenario, setup: GraspSetup) -> dict[str, Any]:
+    """Give the defaults of :data:`SCENARIO_PARAMETERS` from a scenario bound to its hand."""
+    return {
+        'joints': list(setup.hand.joints),
+        'torque_limits_above_urdf': scenario.torque_limits_above_urdf,
+        'object_origin': [float(x) for x in setup.object_origin],
+        'mu_tangential': setup.friction.mu1,
+        'mu_torsional': setup.friction.mu2,
+        'polygon_sides': setup.friction.sides,
+        'min_normal_force': setup.friction.min_normal_force,
+        'torque_limits': [float(x) for x in setup.hand.torque_limits],
+        'weights': [float(x) for x in setup.weights],
+        'friction_margin': setup.friction.margin,
+        'objective': setup.objective,
+        # One place for gravity: the scenario's, which also gives its load.
+        'gravity': ([float(x) for x in scenario.gravity] if scenario.gravity is not None
+                    else [0.0, 0.0, -9.81]),
+    }
+
+
+def name_map_of(entries: list[str] | None) -> dict[str, str]:
+    """
+    Parse the ``name_map`` parameter: entries ``SCENARIO_NAME=URDF_NAME``.
+
+    Args:
+        entries: the parameter's value (None or empty: no map).
+
+    Returns:
+        scenario name -> URDF name.
+
+    Raises:
+        InputError: an entry without one ``=`` between two names, a name mapped
+            twice, two names mapped to one, more than MAX_NAME_MAP entries.
+    """
+    if not entries:
+        return {}
+    if len(entries) > MAX_NAME_MAP:
+        raise InputError('name_map', f'{len(entries)} entries, more than {MAX_NAME_MAP}')
+    out: dict[str, str] = {}
+    for i, entry in enumerate(entries):
+        key, sep, target = (part.strip() for part in str(entry).partition('='))
+        if not sep or not key or not target or '=' in target:
+            raise InputError(f'name_map[{i}]', f'must be SCENARIO_NAME=URDF_NAME, got '
+                             f'{quote(entry)}')
+        if key in out:
+            raise InputError(f'name_map[{i}]', f"maps '{cut(key)}' a second time")
+        out[key] = target
+    return parse_name_map(out, 'name_map')
+
+
+def descriptor(name: str, managed: bool = False) -> ParameterDescriptor:
+    """
+    Build the ParameterDescriptor of a parameter of :data:`PARAMETERS`.
+
+    Args:
+        name: the parameter.
+        managed: for the managed node, where a parameter that is read-only in the
+            plain node can be set while unconfigured (and is refused while configured).
+    """
     spec = PARAMETERS[name]
-    d = ParameterDescriptor(name=name, description=spec.description, read_only=spec.read_only)
+    d = ParameterDescriptor(name=name, description=spec.description,
+                            read_only=spec.read_only and not managed)
+    if managed and spec.read_only:
+        d.additional_constraints = FIXED_WHILE_CONFIGURED
     if spec.low is not None and isinstance(spec.low, int) and isinstance(spec.high, int):
         d.integer_range = [IntegerRange(from_value=spec.low, to_value=spec.high, step=1)]
     elif spec.low is not None:
@@ -240,31 +419,51 @@ SERVICE_SLICE_S = 0.005
 
 def _fallback(backend: str, fallback: str) -> str | None:
     """
-    The fallback backend to build: None for 'none', the backend itself, or one not installed
-    (a ROS distribution may lack DAQP; the node then runs without a second try).
+    Name the fallback backend to build, or None.
+
+    None for 'none', the backend itself, or one not installed (a ROS distribution may
+    lack DAQP; the node then runs without a second try).
     """
     return None if fallback in ('none', backend) or not available(fallback) else fallback
 
 
-def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None,
+def check(name: str, value: Any, m: int | None, torque_bounds: np.ndarray | None = None,
           joints: list[str] | None = None) -> str:
     """
-    Why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too.
+    Say why a parameter value is refused ('' if accepted). Ranges are checked by rclpy too.
 
     Args:
         name: the parameter.
         value: its new value.
-        m: number of joints.
+        m: number of joints (None: no hand loaded yet, the count is not checked).
         torque_bounds: the largest value of each torque limit [N m] (None: unchecked).
         joints: joint names, for messages.
     """
     spec = PARAMETERS[name]
+    if name == 'name_map':
+        try:
+            name_map_of(value)
+        except InputError as e:
+            return str(e)
+        return ''
+    if name == 'robot_description_topic':
+        if not value:
+            return ''
+        try:
+            validate_topic_name(value)
+        except InvalidTopicNameException as e:
+            return f'{name}: ' + str(e).splitlines()[0]
+        return ''
+    if name == 'scenario' or name == 'robot_description' or name == 'joints':
+        return ''
     if name == 'fault_policy':
         return '' if value in POLICIES else f"{name}: must be one of {', '.join(POLICIES)}"
     if name == 'solver.backend':
         if value not in BACKENDS:
             return f"{name}: must be one of {', '.join(BACKENDS)}"
-        return '' if available(value) else f'{name}: {value} is not installed (pip install {value})'
+        if not available(value):
+            return f'{name}: {value} is not installed (pip install {value})'
+        return ''
     if name == 'solver.fallback':
         return '' if value in FALLBACKS else f"{name}: must be one of {', '.join(FALLBACKS)}"
     if name == 'solver.method':
@@ -277,7 +476,7 @@ def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None
     if spec.length is not None:
         n = m if spec.length == 'joints' else int(spec.length)
         values = list(value)
-        if len(values) != n:
+        if n is not None and len(values) != n:
             return f'{name}: must have {n} entries, got {len(values)}'
         if not all(math.isfinite(v) for v in values):
             return f'{name}: must be finite'
@@ -289,7 +488,7 @@ def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None
                                   name, 'torque_limits_above_urdf (read-only: at start)')
             except InputError as e:
                 return str(e)
-        if name == 'weights':
+        if name == 'weights' and values:
             low, high = WEIGHT_RANGE
             if not all(low <= v <= high for v in values):
                 return f'{name}: every entry must be in [{low:g}, {high:g}]'
@@ -304,159 +503,368 @@ def check(name: str, value: Any, m: int, torque_bounds: np.ndarray | None = None
     return ''
 
 
-class GraspTorqueNode(Node):
-    """Publishes certified effort commands on each joint state; answers ``~/solve``."""
+def wait_for_urdf(node: Node, topic: str, timeout: float,
+                  stop: Callable[[], bool] = lambda: False) -> str:
+    """
+    Take the URDF from a robot_description topic, waiting for it up to ``timeout``.
 
-    def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
-        """
-        Args:
-        message_info: age inputs from the middleware's receipt time (rmw message
-            info); False: from the callback's time (rclpy 7.1's EventsExecutor
-            raises SystemError on subscriptions that take message info).
-        kwargs: for rclpy's Node (context, parameter_overrides, ...).
-        """
-        super().__init__(NODE_NAME, **kwargs)
+    The subscription is reliable and transient local, as robot_state_publisher
+    publishes it, so a URDF published before the node started arrives too. The
+    message is taken serialized and refused by its length before it is deserialized.
+    It polls (every 20 ms) instead of spinning, so it also works from inside a
+    callback of the node's executor (the managed node's configure), which it then
+    holds for at most ``timeout``.
+
+    Args:
+        node: the node that subscribes (for as long as this waits).
+        topic: the topic (relative names resolve in the node's namespace).
+        timeout: how long to wait [s].
+        stop: polled; True ends the wait (a stop signal).
+
+    Returns:
+        The URDF document.
+
+    Raises:
+        InputError: nothing arrived in time, or the message is larger than a URDF may be
+            (field ``robot_description_topic``).
+    """
+    sub = node.create_subscription(String, topic, lambda _: None, URDF_QOS, raw=True)
+    name = sub.topic_name
+    end = time.monotonic() + timeout
+    try:
+        while True:
+            with sub.handle:
+                taken = sub.handle.take_message(String, True)
+            if taken is not None:
+                data = taken[0]
+                if len(data) > MAX_URDF_BYTES + URDF_MESSAGE_OVERHEAD:
+                    raise InputError('robot_description_topic', f'the URDF on {name} is '
+                                     f'{len(data)} bytes serialized, larger than a URDF may '
+                                     f'be ({MAX_URDF_BYTES} bytes)')
+                return deserialize_message(data, String).data
+            if stop():
+                raise InputError('robot_description_topic', f'stopped while waiting for the '
+                                 f'URDF on {name}')
+            if time.monotonic() >= end:
+                raise InputError('robot_description_topic', f'no URDF on {name} within '
+                                 f'{timeout:g} s (robot_description_timeout); it is taken '
+                                 'reliable and transient local, as robot_state_publisher '
+                                 'publishes it')
+            time.sleep(0.02)
+    finally:
+        node.destroy_subscription(sub)
+
+
+class GraspTorqueCore:
+    """
+    What the plain and the managed node share: a mixin put before rclpy's node class.
+
+    The grasp (scenario, URDF, name map), the parameters' checks and their effect,
+    the inputs, the cycle, the outputs and the ``~/solve`` service. :attr:`commanding`
+    says whether the node commands now: the plain node always, the managed node
+    while active. The subclass calls :meth:`_init_core` first.
+    """
+
+    def _init_core(self, message_info: bool) -> None:
+        """Set the state every method relies on; nothing is loaded yet."""
         self._lock = threading.Lock()
         self._last_stamp = None  # header stamp of the last accepted joint state
-        setup = self._load_setup()
-        self._m = setup.hand.m
-        defaults = {
-            'torque_limits_above_urdf': self._scenario.torque_limits_above_urdf,
-            'object_origin': [float(x) for x in setup.object_origin],
-            'mu_tangential': setup.friction.mu1,
-            'mu_torsional': setup.friction.mu2,
-            'polygon_sides': setup.friction.sides,
-            'min_normal_force': setup.friction.min_normal_force,
-            'torque_limits': [float(x) for x in setup.hand.torque_limits],
-            'weights': [float(x) for x in setup.weights],
-            'friction_margin': setup.friction.margin,
-            'objective': setup.objective,
-            'gravity_compensation': False,
-            # One place for gravity: the scenario's, which also gives its load.
-            'gravity': ([float(x) for x in self._scenario_gravity]
-                        if self._scenario_gravity is not None else [0.0, 0.0, -9.81]),
-            'joint_state_timeout': 0.1,
-            'contacts_timeout': 0.5,
-            'wrench_timeout': 0.5,
-            'hold_time': 0.1,
-            'fault_policy': 'hold',
-            'max_message_bytes': CycleConfig.max_message_bytes,
-            'max_joint_state_entries': CycleConfig.max_joint_state_entries,
-            'max_wrench_force': CycleConfig.max_wrench_force,
-            'max_wrench_torque': CycleConfig.max_wrench_torque,
-            'max_contact_distance': CycleConfig.max_contact_distance,
-            'stamp_future_tolerance': CycleConfig.stamp_future_tolerance,
-            'cycle_budget': CycleConfig.cycle_budget,
-            'solver.method': 'tau-qp',
-            'solver.backend': BACKENDS[0],
-            'solver.fallback': 'daqp',
-            'solver.warm_start': True,
-            'solver.eps_abs': ProxSuiteSettings.eps_abs,
-            'solver.max_iter': ProxSuiteSettings.max_iter,
-            'solver.max_iter_in': ProxSuiteSettings.max_iter_in,
-            'certificate_tolerance': CycleConfig.certificate_tolerance,
-            'diagnostics_period': 1.0,
-            'marker_period': 0.1,
-            'watchdog_period': 0.01,
-            'startup_check_time': 2.0,
-            'marker_scale': 0.02,
-            'publish_stamped_command': False,
-        }
-        for name, value in defaults.items():
-            self.declare_parameter(name, value, descriptor(name))
-        self._torque_bounds = self._limit_bounds(
-            setup.hand, self.get_parameter('torque_limits_above_urdf').value)
-        for name in defaults:
-            reason = self._check(name, self.get_parameter(name).value)
-            if reason:
-                raise InputError(name, reason.split(': ', 1)[1])
-        self._base_setup = setup
-        backend = self.get_parameter('solver.backend').value
-        warm = self.get_parameter('solver.warm_start').value
-        fallback = _fallback(backend, self.get_parameter('solver.fallback').value)
-        self._warn_missing_fallback()
-        self.controller = TorqueController(*self._configure(setup, self._params()), backend,
-                                           warm, fallback)
-        # The service solves snapshots out of sequence: always cold.
-        self._service_controller = TorqueController(*self._configure(
-            dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), self._params()),
-            backend, False, fallback)
-        self._service_controller.solver = make_solver(
-            backend, self._service_controller.solver.settings, False, SERVICE_SLICE_S)
-        self.add_on_set_parameters_callback(self._validate_parameters)
-        self.add_post_set_parameters_callback(self._apply_parameters)
+        self._message_info = message_info
+        self.controller: TorqueController | None = None
+        self._service_controller: TorqueController | None = None
+        self._scenario: Scenario | None = None
+        self._base_setup: GraspSetup | None = None
+        self._m: int | None = None
+        self._torque_bounds: np.ndarray | None = None
+        self._base_joints: list[str] | None = None
+        self._filling = False  # the managed node fills in scenario defaults
+        self._made: list[tuple[str, Any]] = []  # (kind, entity) made by _start_interfaces
+        self._worker: ThreadPoolExecutor | None = None
+        self._command_pub = None
+        self._stamped_pub = None
+        self._tf: tuple[Any, ...] | None = None  # (buffer, listener, node, executor, thread)
+        self._pending_solves = 0
+        self._busy_answers = 0
+        self._duplicates = 0
 
+    @property
+    def commanding(self) -> bool:
+        """Whether the node publishes commands now."""
+        return self.controller is not None
+
+    def _value(self, name: str) -> Any:
+        """Give a parameter's value, None while it has none (declared by type only)."""
+        try:
+            return self.get_parameter(name).value
+        except (ParameterUninitializedException, ParameterNotDeclaredException):
+            return None  # (or, in the managed node's cleanup, being declared again)
+
+    # -- the grasp --------------------------------------------------------------------------
+
+    def _urdf(self, stop: Callable[[], bool] = lambda: False) -> str:
+        """
+        Give the URDF document to use: '' for the scenario's ``hand.urdf``.
+
+        ``robot_description`` (a document or a path) wins; else, with
+        ``robot_description_topic`` set, the URDF published there (waited for up to
+        ``robot_description_timeout``); else the scenario's.
+        """
+        urdf = self._value('robot_description') or ''
+        topic = self._value('robot_description_topic') or ''
+        if urdf:
+            if topic:
+                self.get_logger().info(f'robot_description is set: the URDF on {topic} is '
+                                       'not read')
+            if not urdf.lstrip().startswith('<'):
+                path = find_config(urdf, 'robot_description')
+                urdf = decode_utf8(read_bounded(path, 'robot_description', MAX_URDF_BYTES),
+                                   path, 'robot_description')
+            return urdf
+        if topic:
+            reason = self._check('robot_description_topic', topic)
+            if reason:
+                raise InputError('robot_description_topic', reason.partition(': ')[2])
+            timeout = self._value('robot_description_timeout')
+            self.get_logger().info(f'waiting for the URDF on {topic} (up to {timeout:g} s)')
+            return wait_for_urdf(self, topic, timeout, stop)
+        return ''
+
+    def _bind(self, urdf: str, joints: list[str] | None = None) -> GraspSetup:
+        """
+        Load the scenario, map its names (``name_map``) and bind it to the hand.
+
+        Args:
+            urdf: the URDF document ('' for the scenario's ``hand.urdf``).
+            joints: actuated joints in command order instead of the scenario's (URDF
+                names), or None.
+
+        Raises:
+            InputError: naming the parameter or the scenario's field.
+        """
+        name = self._value('scenario')
+        if not name:
+            raise InputError('scenario', 'parameter not set (a scenario file gives the '
+                             'default contacts and load)')
+        name_map = name_map_of(self._value('name_map'))
+        scenario = self._scenario = load_scenario(find_config(name), name_map)
+        if joints is not None:
+            scenario = dataclasses.replace(scenario, joints=list(joints))
+        try:
+            return GraspSetup.from_scenario(scenario, urdf or None)
+        except (JointNotFound, FrameNotFound) as e:
+            if not urdf:
+                raise
+            raise InputError(e.field, f'{e.problem}; if the scenario names them as another '
+                             "URDF of this hand does, map them to this URDF's names with the "
+                             'name_map parameter (SCENARIO_NAME=URDF_NAME) or the '
+                             "scenario's hand.name_map") from e
+
+    @staticmethod
+    def _load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | None:
+        """
+        Give the scenario's load as a function of gravity [m/s^2], or None.
+
+        Only when the scenario's load is its object's weight (``object`` and
+        ``gravity`` both given): then it is ``load.external_wrench`` plus the weight
+        under the gravity given, about the scenario's object origin, base axes.
+        Otherwise the load does not depend on gravity.
+        """
+        if scenario.object is None or scenario.gravity is None:
+            return None
+        obj, origin = scenario.object, scenario.object_origin.copy()
+        extra = scenario.extra_wrench.copy()
+        return lambda g: extra + weight_wrench(obj, np.asarray(g, dtype=float), origin)
+
+    def _build(self, setup: GraspSetup) -> None:
+        """
+        Check every parameter against the hand, then make the two controllers.
+
+        Raises:
+            InputError: the first parameter refused, named.
+        """
+        self._m = setup.hand.m
+        self._base_joints = list(setup.hand.joints)
+        self._torque_bounds = self._limit_bounds(
+            setup.hand, bool(self._value('torque_limits_above_urdf')))
+        for name in PARAMETERS:
+            reason = self._check(name, self._value(name))
+            if reason:
+                field, _, problem = reason.partition(': ')
+                raise InputError(field, problem)
+        self._base_setup = setup
+        p = self._params()
+        backend, warm = p['solver.backend'], p['solver.warm_start']
+        fallback = _fallback(backend, p['solver.fallback'])
+        self._warn_missing_fallback()
+        controller = TorqueController(*self._configure(setup, p), backend, warm, fallback)
+        # The service solves snapshots out of sequence: always cold.
+        service = TorqueController(*self._configure(
+            dataclasses.replace(setup, hand=dataclasses.replace(setup.hand)), p),
+            backend, False, fallback)
+        service.solver = make_solver(backend, service.solver.settings, False, SERVICE_SLICE_S)
+        controller.load_of_gravity = service.load_of_gravity = \
+            self._load_of_gravity(self._scenario)
+        self.controller, self._service_controller = controller, service
+
+    def _release(self) -> None:
+        """Drop the controllers and the model (the managed node's cleanup)."""
+        self.controller = self._service_controller = None
+        self._base_setup = self._scenario = None
+        self._m = self._torque_bounds = self._base_joints = None
+        self._last_stamp = None
+
+    # -- interfaces -------------------------------------------------------------------------
+
+    def _make_publisher(self, msg_type: type, topic: str, qos: QoSProfile) -> Any:
+        """Make a command publisher (the managed node's are lifecycle publishers)."""
+        return self.create_publisher(msg_type, topic, qos)
+
+    def _start_interfaces(self) -> None:
+        """Make the subscriptions, publishers, the service, the timers and the worker."""
+        made = self._made
         # Serialized (raw): a message is measured before it is deserialized. With message
         # info, inputs are aged from when the middleware received them.
         for msg_type, topic, take in ((JointState, 'joint_states', self._on_joint_state),
                                       (PoseArray, 'contacts', self._on_contacts),
-                                      (WrenchStamped, 'external_wrench', self._on_wrench)):
+                                      (WrenchStamped, 'external_wrench', self._on_wrench),
+                                      (Vector3Stamped, 'gravity', self._on_gravity)):
             def callback(data, info=None, msg_type=msg_type, topic=topic, take=take):
                 self._on_serialized(topic, msg_type, data, take, info)
-            if message_info:
+            if self._message_info:
                 sub_callback = (lambda cb: lambda data, info: cb(data, info))(callback)
             else:
                 sub_callback = (lambda cb: lambda data: cb(data))(callback)
             sub = self.create_subscription(msg_type, topic, sub_callback,
                                            qos_profile_sensor_data, raw=True)
+            made.append(('subscription', sub))
             if topic == 'joint_states':
                 self._joint_states_topic = sub.topic_name  # remapped and resolved
-        self._command_pub = self.create_publisher(Float64MultiArray, 'effort_commands',
-                                                  COMMAND_QOS)
+        self._command_pub = self._make_publisher(Float64MultiArray, 'effort_commands',
+                                                 COMMAND_QOS)
+        made.append(('command_publisher', self._command_pub))
         self._stamped_pub = None
         if self.get_parameter('publish_stamped_command').value:
-            self._stamped_pub = self.create_publisher(JointState, '~/effort_commands_stamped',
-                                                      COMMAND_QOS)
+            self._stamped_pub = self._make_publisher(JointState, '~/effort_commands_stamped',
+                                                     COMMAND_QOS)
+            made.append(('command_publisher', self._stamped_pub))
         self._marker_pub = self.create_publisher(MarkerArray, '~/contact_wrenches', 1)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        made += [('publisher', self._marker_pub), ('publisher', self._diag_pub)]
+        for period, callback in (('watchdog_period', self._on_watchdog),
+                                 ('diagnostics_period', self._on_diagnostics),
+                                 ('marker_period', self._on_markers)):
+            made.append(('timer', self.create_timer(self.get_parameter(period).value,
+                                                    callback)))
+        self._start_tf()
+
+    def _start_service(self) -> None:
+        """
+        Make ``~/solve`` and its worker thread, for the node's lifetime.
+
+        The managed node keeps them while unconfigured too (answering that it cannot
+        solve): a request still being solved at cleanup is answered on a service that
+        still exists (rclpy's executor raises out of spin when a coroutine answers on a
+        destroyed one).
+        """
         # The service solves in a worker thread while the executor goes on with the loop.
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solve_service')
         self._pending_solves = 0
-        self._busy_answers = 0
-        self._duplicates = 0
         # A group of its own: in the node's default (mutually exclusive) group, each call
         # held every callback of the node, the control loop's included, until its solve
         # was done; reentrant, so that requests are taken (and answered "busy") meanwhile.
         self.create_service(Trigger, '~/solve', self._on_solve, qos_profile=SERVICE_QOS,
                             callback_group=ReentrantCallbackGroup())
-        self.create_timer(self.get_parameter('watchdog_period').value, self._on_watchdog)
-        self.create_timer(self.get_parameter('diagnostics_period').value,
-                          self._on_diagnostics)
-        self.create_timer(self.get_parameter('marker_period').value, self._on_markers)
-        self.get_logger().info(
-            f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
-            f"{len(setup.contacts)} default contacts; commands on "
-            f"{self._command_pub.topic_name}")
+
+    def _stop_interfaces(self) -> None:
+        """Destroy what :meth:`_start_interfaces` made."""
+        self._stop_tf()
+        for kind, entity in reversed(self._made):
+            if kind == 'subscription':
+                self.destroy_subscription(entity)
+            elif kind == 'command_publisher':
+                self._destroy_command_publisher(entity)
+            elif kind == 'publisher':
+                self.destroy_publisher(entity)
+            else:
+                self.destroy_timer(entity)
+        self._made.clear()
+        self._command_pub = self._stamped_pub = None
+
+    def _destroy_command_publisher(self, publisher: Any) -> None:
+        self.destroy_publisher(publisher)
+
+    def _start_tf(self) -> None:
+        """
+        Listen to tf2 when tf2_ros is importable, to turn gravity into base axes.
+
+        Its listener has a node and an executor thread of its own, in this node's
+        context, so that /tf traffic never waits behind the control loop (nor holds
+        it). Not tested here: tf2_ros is not on the package registry.
+        """
+        if importlib.util.find_spec('tf2_ros') is None:
+            return
+        import tf2_ros
+
+        tf_node = rclpy.create_node(f'{self.get_name()}_tf_listener',
+                                    namespace=self.get_namespace(), context=self.context,
+                                    start_parameter_services=False)
+        buffer = tf2_ros.Buffer()
+        listener = tf2_ros.TransformListener(buffer, tf_node, spin_thread=False)
+        executor = SingleThreadedExecutor(context=self.context)
+        executor.add_node(tf_node)
+        thread = threading.Thread(target=self._spin_tf, args=(executor,), daemon=True,
+                                  name='tf_listener')
+        thread.start()
+        self._tf = (buffer, listener, tf_node, executor, thread)
+
+    @staticmethod
+    def _spin_tf(executor: SingleThreadedExecutor) -> None:
+        try:
+            executor.spin()
+        except ExternalShutdownException:
+            pass
+
+    def _stop_tf(self) -> None:
+        if self._tf is None:
+            return
+        _, listener, tf_node, executor, thread = self._tf
+        self._tf = None
+        executor.shutdown(timeout_sec=1.0)
+        thread.join(timeout=1.0)
+        listener.unregister()
+        tf_node.destroy_node()
+
+    def _gravity_rotation(self, frame: str) -> tuple[np.ndarray | None, str]:
+        """
+        Give the base-from-``frame`` rotation from tf2 (latest), or None and why not.
+
+        Not tested here: tf2_ros is not on the package registry.
+        """
+        if self._tf is None:
+            return None, 'tf2_ros is not installed'
+        import tf2_ros
+
+        base = self.controller.setup.hand.base_frame
+        try:
+            t = self._tf[0].lookup_transform(base, frame, Time())
+        except tf2_ros.TransformException as e:
+            return None, f'tf2: {cut(str(e))}'
+        r = t.transform.rotation
+        try:
+            return quaternion_matrix(np.array([r.x, r.y, r.z, r.w]),
+                                     'gravity.header.frame_id transform'), ''
+        except InputError as e:
+            return None, f'tf2: {e}'
 
     # -- configuration --------------------------------------------------------------------
-
-    def _load_setup(self) -> GraspSetup:
-        name = self.declare_parameter('scenario', '', descriptor('scenario')).value
-        urdf = self.declare_parameter('robot_description', '',
-                                      descriptor('robot_description')).value
-        if not name:
-            raise InputError('scenario', 'parameter not set (a scenario file gives the '
-                             'default contacts and load)')
-        scenario = self._scenario = load_scenario(find_config(name))
-        self._scenario_gravity = scenario.gravity
-        if urdf and not urdf.lstrip().startswith('<'):
-            path = find_config(urdf, 'robot_description')
-            urdf = decode_utf8(read_bounded(path, 'robot_description', MAX_URDF_BYTES), path,
-                               'robot_description')
-        setup = GraspSetup.from_scenario(scenario, urdf or None)
-        joints = self.declare_parameter('joints', list(setup.hand.joints),
-                                        descriptor('joints')).value
-        if list(joints) != list(setup.hand.joints):
-            setup = GraspSetup.from_scenario(dataclasses.replace(scenario, joints=list(joints)),
-                                             urdf or None)
-        self._base_joints = list(setup.hand.joints)
-        return setup
 
     @staticmethod
     def _limit_bounds(hand: Hand, above_urdf: bool) -> np.ndarray:
         """
-        The largest torque limit per joint [N m]: the URDF's effort limit, the
-        scenario's limit where the URDF gives none; MAX_TORQUE_LIMIT if allowed above.
+        Give the largest torque limit per joint [N m].
+
+        The URDF's effort limit, the scenario's limit where the URDF gives none;
+        MAX_TORQUE_LIMIT if allowed above.
         """
         if above_urdf:
             return np.full(hand.m, MAX_TORQUE_LIMIT)
@@ -467,11 +875,11 @@ class GraspTorqueNode(Node):
         return check(name, value, self._m, self._torque_bounds, self._base_joints)
 
     def _params(self) -> dict[str, Any]:
-        return {name: self.get_parameter(name).value for name in PARAMETERS}
+        return {name: self._value(name) for name in PARAMETERS}
 
     def _configure(self, setup: GraspSetup, p: dict[str, Any]
                    ) -> tuple[GraspSetup, CycleConfig, ProxSuiteSettings]:
-        """The controller's setup, cycle settings and solver settings from parameter values."""
+        """Make the controller's setup, cycle and solver settings from parameter values."""
         hand = setup.hand
         if not np.array_equal(hand.torque_limits, p['torque_limits']):
             hand = dataclasses.replace(hand, torque_limits=np.array(p['torque_limits']))
@@ -493,27 +901,36 @@ class GraspTorqueNode(Node):
             max_wrench_force=p['max_wrench_force'], max_wrench_torque=p['max_wrench_torque'],
             max_contact_distance=p['max_contact_distance'],
             stamp_future_tolerance=p['stamp_future_tolerance'],
-            cycle_budget=p['cycle_budget'], method=p['solver.method'])
+            cycle_budget=p['cycle_budget'], method=p['solver.method'],
+            gravity_timeout=p['gravity_timeout'])
         solver = ProxSuiteSettings(eps_abs=p['solver.eps_abs'], max_iter=p['solver.max_iter'],
                                    max_iter_in=p['solver.max_iter_in'])
         return setup, config, solver
 
+    def _fixed(self, name: str) -> str:
+        """Say why a parameter cannot change now ('' if it can): the managed node's rule."""
+        return ''
+
     def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
         for param in params:
             if param.name in PARAMETERS:
-                reason = self._check(param.name, param.value)
+                if param.value is None:  # declared by type only (the managed node)
+                    continue
+                reason = self._fixed(param.name) or self._check(param.name, param.value)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
         # min-max is the tau-QP's objective only (docs/planner.md): refuse the pair.
         new = {param.name: param.value for param in params}
-        objective = new.get('objective', self.get_parameter('objective').value)
-        method = new.get('solver.method', self.get_parameter('solver.method').value)
+        objective = new.get('objective', self._value('objective'))
+        method = new.get('solver.method', self._value('solver.method'))
         if objective == 'min-max' and method != 'tau-qp':
             return SetParametersResult(successful=False, reason=(
                 f'objective: min-max needs solver.method tau-qp, not {method}'))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list[Parameter]) -> None:
+        if self.controller is None or self._filling:
+            return  # nothing loaded yet: configure takes the values
         p = self._params()
         with self._lock:
             warm_loop = p['solver.warm_start'] and p['solver.backend'] != 'quadprog'
@@ -533,9 +950,12 @@ class GraspTorqueNode(Node):
                     ctrl.fallback = make_solver(fallback, solver) if fallback else None
             # The change acts on the command in force at once (a new certified command,
             # or zeros if the one in force is now over the limits), not at the next cycle.
-            result = self.controller.reconfigured(time.monotonic())
-            if result is not None:
-                self._publish(result, self._last_stamp)
+            # Not while the managed node is inactive: it commands nothing then, and its
+            # activation runs the same rule.
+            if self.commanding:
+                result = self.controller.reconfigured(time.monotonic())
+                if result is not None:
+                    self._publish(result, self._last_stamp)
 
     def _warn_missing_fallback(self) -> None:
         name = self.get_parameter('solver.fallback').value
@@ -552,11 +972,14 @@ class GraspTorqueNode(Node):
     def _on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
                        info: dict | None) -> None:
         """
-        A message as the middleware delivered it: its length checked, then deserialized
-        and taken (``take(msg, receipt)``).
+        Take a message as the middleware delivered it.
+
+        Its length is checked, then it is deserialized and taken (``take(msg, receipt)``).
         """
         receipt = received(info) if info is not None else None
         with self._lock:
+            if self.controller is None:
+                return  # released (the managed node's cleanup) while it waited
             try:
                 self.controller.check_bytes(topic, len(data))
             except InputError as e:
@@ -566,8 +989,11 @@ class GraspTorqueNode(Node):
 
     def _on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
         """
-        A joint state; ``receipt``: when the middleware received it (monotonic [s];
-        None: now).
+        Take a joint state and, while the node commands, run one cycle on it.
+
+        Args:
+            msg: the joint state.
+            receipt: when the middleware received it (monotonic [s]; None: now).
         """
         now = time.monotonic()
         receipt = now if receipt is None else receipt
@@ -583,7 +1009,8 @@ class GraspTorqueNode(Node):
                 self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
                 return
             self._last_stamp = msg.header.stamp
-            self._publish(self.controller.cycle(now), msg.header.stamp)
+            if self.commanding:
+                self._publish(self.controller.cycle(now), msg.header.stamp)
 
     def _on_contacts(self, msg: PoseArray, receipt: float | None = None) -> None:
         now = time.monotonic() if receipt is None else receipt
@@ -610,7 +1037,31 @@ class GraspTorqueNode(Node):
             except InputError as e:
                 self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
 
+    def _on_gravity(self, msg: Vector3Stamped, receipt: float | None = None) -> None:
+        """
+        Take gravity [m/s^2] in the hand's base frame (another frame only through tf2).
+
+        g(q) and the scenario's load (its object's weight) follow it; once one has
+        arrived, it goes stale after ``gravity_timeout``, as the other inputs do.
+        """
+        now = time.monotonic() if receipt is None else receipt
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        frame, v = msg.header.frame_id, msg.vector
+        with self._lock:
+            base = self.controller.setup.hand.base_frame
+        rotation, why = (None, 'tf2_ros is not installed')
+        if frame not in ('', base) and self._tf is not None:
+            rotation, why = self._gravity_rotation(frame)
+        with self._lock:
+            try:
+                self.controller.update_gravity(frame, [v.x, v.y, v.z], now, stamp,
+                                               self._clock_now(), rotation, why)
+            except InputError as e:
+                self.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
+
     def _on_watchdog(self) -> None:
+        if not self.commanding:
+            return
         with self._lock:
             result = self.controller.watchdog(time.monotonic())
             if result is not None:
@@ -638,14 +1089,16 @@ class GraspTorqueNode(Node):
     # -- other nodes of this name -------------------------------------------------------
 
     def duplicates(self) -> int:
-        """How many other nodes of this node's name and namespace the graph shows."""
+        """Count the other nodes of this node's name and namespace that the graph shows."""
         me = (self.get_name(), self.get_namespace())
         return sum(1 for n in self.get_node_names_and_namespaces() if tuple(n) == me) - 1
 
     def wait_for_duplicates(self, seconds: float) -> int:
         """
-        Look for other nodes of this name for up to ``seconds`` (discovery took 0.2 to
-        2.8 s here), without spinning: nothing is taken or published meanwhile.
+        Look for other nodes of this name for up to ``seconds``.
+
+        Discovery took 0.2 to 2.8 s here. Nothing spins meanwhile: nothing is taken or
+        published.
 
         Returns:
             How many were seen (0 after ``seconds``).
@@ -659,9 +1112,15 @@ class GraspTorqueNode(Node):
 
     # -- outputs between cycles -----------------------------------------------------------
 
+    def _state_note(self) -> str:
+        """Say why the node does not command although configured ('' when it does)."""
+        return ''
+
     def _on_diagnostics(self) -> None:
         with self._lock:
-            rep = diagnostics.report(self.controller, time.monotonic())
+            now = time.monotonic()
+            rep = diagnostics.report(self.controller, now)
+            gravity_time = self.controller.inputs.gravity_time
             # The hand's name from its URDF (e.g. allegro_hand_right), as hardware_id asks.
             hand = self.controller.setup.hand.model.name
         # Two sources of joint states are followed as one stream (the stamp rule keeps
@@ -671,8 +1130,15 @@ class GraspTorqueNode(Node):
             self.get_logger().warn(f'{publishers} publishers on {self._joint_states_topic}: '
                                    'their joint states are taken as one stream',
                                    throttle_duration_sec=10.0)
-        values = [*rep.values, ('joint_states.publishers', str(publishers))]
+        values = [*rep.values, ('joint_states.publishers', str(publishers)),
+                  ('age.gravity_s', 'never' if gravity_time is None
+                   else f'{now - gravity_time:.4f}')]
+        if not any(k == 'rejected.gravity' for k, _ in values):
+            values.append(('rejected.gravity', '0'))  # counted from its first rejection
         level, message = rep.level, rep.message
+        note = self._state_note()
+        if note:
+            level, message = diagnostics.STALE, f'{note}; {message}'
         self._duplicates = self.duplicates()  # about 1 us: rmw's graph cache
         if self._duplicates > 0:
             name = self.get_fully_qualified_name()
@@ -691,7 +1157,7 @@ class GraspTorqueNode(Node):
 
     def _on_markers(self) -> None:
         with self._lock:
-            last = self.controller.last
+            last = self.controller.last if self.commanding else None
             base = self.controller.setup.hand.base_frame
         self._marker_pub.publish(self._markers(last, base, self.get_clock().now().to_msg()))
 
@@ -720,9 +1186,10 @@ class GraspTorqueNode(Node):
     async def _on_solve(self, request: Trigger.Request, response: Trigger.Response
                         ) -> Trigger.Response:
         """
-        Queue one solve for the worker, or answer "busy" at once when
-        MAX_PENDING_SOLVES are queued: every request gets an answer, in bounded memory.
-        (Runs in the executor's thread only, as does the count.).
+        Queue one solve for the worker, or answer "busy" at once.
+
+        "busy" when MAX_PENDING_SOLVES are queued: every request gets an answer, in
+        bounded memory. Runs in the executor's thread only, as does the count.
         """
         if self._pending_solves >= MAX_PENDING_SOLVES:
             self._busy_answers += 1
@@ -731,24 +1198,33 @@ class GraspTorqueNode(Node):
                                 f'{MAX_PENDING_SOLVES}); call again later')
             return response
         with self._lock:
-            inputs = self.controller.inputs
+            worker, ctrl = self._worker, self._service_controller
+            inputs = self.controller.inputs if self.controller is not None else None
+        if worker is None or ctrl is None:
+            response.success = False
+            response.message = 'cannot solve: not configured (lifecycle state unconfigured)'
+            return response
         self._pending_solves += 1
         try:
             done = Future(executor=self.executor)
             done.add_done_callback(lambda _: None)  # completion wakes the executor
-            self._worker.submit(self._solve_for_service, inputs, time.monotonic(), done)
+            worker.submit(self._solve_for_service, inputs, time.monotonic(), done, ctrl)
             await done
         finally:
             self._pending_solves -= 1
         response.success, response.message = done.result()
         return response
 
-    def _solve_for_service(self, inputs: Any, now: float, done: Future) -> None:
+    def _solve_for_service(self, inputs: Any, now: float, done: Future,
+                           ctrl: TorqueController | None = None) -> None:
         """
-        One solve on a snapshot of the inputs, with the service's own controller
-        (own Pinocchio data and ProxSuite workspace): (success, CLI JSON or reason).
+        Solve once on a snapshot of the inputs, with the service's own controller.
+
+        It has its own Pinocchio data and ProxSuite workspace (``ctrl``, taken when the
+        request came: None for the node's current one). ``done`` gets (success, the
+        CLI's JSON or the reason).
         """
-        ctrl = self._service_controller
+        ctrl = self._service_controller if ctrl is None else ctrl
         try:
             stale = ctrl.stale(now, inputs)
             if stale:
@@ -769,29 +1245,84 @@ class GraspTorqueNode(Node):
 
     def safe_stop(self) -> bool:
         """
-        The safe action when the node stops, per ``fault_policy``.
+        Take the safe action when the node stops commanding, per ``fault_policy``.
 
         ``zero``: publish zero torques once and wait (up to 0.5 s) for the
         subscribers to acknowledge them, since the effort controller would keep
         the last command forever. ``hold``: nothing (the last certified command
-        stays, as during a fault). Nothing either before the first command.
+        stays, as during a fault). Nothing either before the first command, nor
+        while the node does not command (the managed node took it on deactivate).
 
         Returns:
             True if zero torques were published.
         """
         with self._lock:
-            if self.controller.config.fault_policy != 'zero' or \
+            if not self.commanding or self.controller.config.fault_policy != 'zero' or \
                     self.controller.counters.commands == 0 or not self.context.ok():
                 return False
             self._command_pub.publish(Float64MultiArray(data=[0.0] * self._m))
+            self.controller.in_force = np.zeros(self._m)  # what the effort controller holds
         self._command_pub.wait_for_all_acked(Duration(seconds=0.5))
         self.get_logger().info('stopped: zero torques published (fault_policy zero)')
         return True
 
+
+class GraspTorqueNode(GraspTorqueCore, Node):
+    """Publishes certified effort commands on each joint state; answers ``~/solve``."""
+
+    def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
+        """
+        Load the scenario and the hand, declare the parameters, start the interfaces.
+
+        Args:
+            message_info: age inputs from the middleware's receipt time (rmw message
+                info); False: from the callback's time (rclpy 7.1's EventsExecutor
+                raises SystemError on subscriptions that take message info).
+            kwargs: for rclpy's Node (context, parameter_overrides, ...).
+
+        Raises:
+            InputError: a parameter, the scenario or the URDF is refused (named).
+        """
+        super().__init__(NODE_NAME, **kwargs)
+        self._init_core(message_info)
+        fixed = fixed_defaults()
+        for name in ('scenario', 'robot_description', 'robot_description_topic',
+                     'robot_description_timeout'):
+            self.declare_parameter(name, fixed.pop(name), descriptor(name))
+        self.declare_parameter('name_map', Parameter.Type.STRING_ARRAY, descriptor('name_map'))
+        reason = self._check('name_map', self._value('name_map'))
+        if reason:
+            field, _, problem = reason.partition(': ')
+            raise InputError(field, problem)
+        urdf = self._urdf(stop_requested)
+        setup = self._bind(urdf)
+        defaults = scenario_defaults(self._scenario, setup)
+        joints = self.declare_parameter('joints', defaults.pop('joints'),
+                                        descriptor('joints')).value
+        if list(joints) != list(setup.hand.joints):
+            setup = self._bind(urdf, list(joints))
+            defaults = {k: v for k, v in scenario_defaults(self._scenario, setup).items()
+                        if k != 'joints'}
+        for name in PARAMETERS:
+            if name in defaults or name in fixed:
+                value = defaults[name] if name in defaults else fixed[name]
+                self.declare_parameter(name, value, descriptor(name))
+        self._build(setup)
+        self.add_on_set_parameters_callback(self._validate_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+        self._start_interfaces()
+        self._start_service()
+        self.get_logger().info(
+            f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
+            f'{len(setup.contacts)} default contacts; commands on '
+            f'{self._command_pub.topic_name}')
+
     def destroy_node(self) -> None:
-        """The safe action, then stop the service worker and the node."""
+        """Take the safe action, then stop the service worker and the node."""
         self.safe_stop()
-        self._worker.shutdown(wait=True, cancel_futures=True)
+        self._stop_tf()
+        if self._worker is not None:
+            self._worker.shutdown(wait=True, cancel_futures=True)
         super().destroy_node()
 
 
@@ -799,9 +1330,14 @@ class GraspTorqueNode(Node):
 _stop_signal: int | None = None
 
 
+def stop_requested() -> bool:
+    """Say whether a stop signal has arrived (polled by waits that may take long)."""
+    return _stop_signal is not None
+
+
 def _interrupt(signum: int, frame: Any) -> None:
     """
-    SIGINT/SIGTERM: ask ``main``'s spin loop to end; the node then stops cleanly.
+    Ask ``main``'s spin loop to end on SIGINT/SIGTERM; the node then stops cleanly.
 
     Only a flag: an exception raised here would surface at whatever bytecode the main
     thread runs next -- inside rclpy's executor (between a handle's ``__enter__`` and its
@@ -819,15 +1355,23 @@ def _interrupt(signum: int, frame: Any) -> None:
 EXECUTORS = {'single': SingleThreadedExecutor, 'events': EventsExecutor}
 
 
-def main(args: list[str] | None = None) -> int:
+def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None) -> int:
     """
-    Run the node (Jazzy pattern): spin, then destroy and shut down.
+    Run a node (Jazzy pattern): spin, then destroy and shut down.
 
     Besides the ROS arguments, ``--executor single|events`` picks the executor.
+
+    Args:
+        make_node: the node's class (or a factory taking ``message_info``).
+        prog: the executable's name, for messages.
+        args: the command line (None: ``sys.argv``).
+
+    Returns:
+        The exit code: 0, or 2 with one line on stderr when the node refuses to run.
     """
     global _stop_signal
     argv = sys.argv if args is None else args
-    parser = argparse.ArgumentParser(prog=NODE_NAME)
+    parser = argparse.ArgumentParser(prog=prog)
     parser.add_argument('--executor', choices=sorted(EXECUTORS), default='single',
                         help='rclpy executor to spin (default: single)')
     opts = parser.parse_args(remove_ros_args(argv)[1:])
@@ -842,7 +1386,7 @@ def main(args: list[str] | None = None) -> int:
     executor = None
     code = 0
     try:
-        node = GraspTorqueNode(message_info=opts.executor != 'events')
+        node = make_node(message_info=opts.executor != 'events')
         wait = node.get_parameter('startup_check_time').value
         if wait > 0.0:
             node.get_logger().info(f'looking for another {NODE_NAME} on this domain ({wait:g} s)')
@@ -865,7 +1409,7 @@ def main(args: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except GraspTorqueError as e:
-        print(f'{NODE_NAME}: error: {e}', file=sys.stderr)
+        print(f'{prog}: error: {e}', file=sys.stderr)
         code = 2
     finally:
         if executor is not None:
@@ -876,6 +1420,11 @@ def main(args: list[str] | None = None) -> int:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return code
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the plain node ``grasp_torque_node``, which commands from its start."""
+    return run(GraspTorqueNode, NODE_NAME, args)
 
 
 if __name__ == '__main__':

@@ -40,11 +40,27 @@ def launch_arguments() -> dict[str, str]:
 
 def test_the_launch_file_declares_its_arguments_and_the_docs_name_each():
     args = launch_arguments()
-    assert set(args) == {'params_file', 'controller', 'namespace', 'robot_description'}
+    assert set(args) == {'params_file', 'controller', 'namespace', 'robot_description',
+                         'managed'}
     assert all(args.values()), 'every argument has a description'
     doc = DOC.read_text()
     for name in args:
         assert f'`{name}`' in doc, name
+
+
+def test_the_executables_the_launch_file_starts_are_installed_by_setup_py():
+    """Name both node executables in the launch file as setup.py's entry points name them."""
+    source = LAUNCH.read_text()
+    scripts = {}
+    for node in ast.walk(ast.parse((ROOT / 'setup.py').read_text())):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and \
+                ' = grasp_torque_opt.' in node.value:
+            name, target = (part.strip() for part in node.value.split('='))
+            scripts[name] = target
+    assert scripts['grasp_torque_node'] == 'grasp_torque_opt.ros.node:main'
+    assert scripts['grasp_torque_lifecycle_node'] == 'grasp_torque_opt.ros.lifecycle_node:main'
+    for executable in ('grasp_torque_node', 'grasp_torque_lifecycle_node'):
+        assert f"'{executable}'" in source, executable
 
 
 @pytest.mark.skipif(importlib.util.find_spec('launch_ros') is None,

@@ -127,7 +127,7 @@ def test_service_says_why_without_inputs(planar_node):
     ('cycle_budget', 10.0, 'cycle_budget'),
     # Unbounded limits: 1e6 and 1e300 N m were accepted (URDF effort limits 10, 5, 10, 5).
     ('torque_limits', [1e6, 1.0, 1.0, 1.0], "torque_limits: 1e+06 N m for joint 'joint1' "
-     "exceeds the URDF effort limit (10 N m); set torque_limits_above_urdf"),
+     'exceeds the URDF effort limit (10 N m); set torque_limits_above_urdf'),
     ('torque_limits', [1.0, 1.0, 1.0, 1e300], 'exceeds the URDF effort limit (5 N m)'),
     ('torque_limits', [10.0, 5.0, 10.0, 5.1], "joint 'joint4'"),
 ])
@@ -174,7 +174,7 @@ def test_malformed_inputs_give_no_command_and_a_diagnostic(planar_node, planar):
     pos, quat = base_poses(planar)
     bad_contacts = [('palm', pos, quat * 1.1, 'contacts.poses[0].orientation: is not a unit '
                      'quaternion'),
-                    ('finger9', pos, quat, "contacts.header.frame_id: unknown frame "
+                    ('finger9', pos, quat, 'contacts.header.frame_id: unknown frame '
                      "'finger9'"),
                     ('palm', pos[:1], quat[:1], 'contacts: 1 poses for 2 contacts')]
     for frame, p, q, reason in bad_contacts:
@@ -340,6 +340,8 @@ def test_stopping_applies_the_policy_in_process(planar):
                                           (signal.SIGINT, 'events')])
 def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig, executor):
     """
+    Stop the process with a signal: with fault_policy zero, zero torques are left.
+
     grasp_torque_node as users run it (either executor): it answers joint states, a signal
     stops it, and with fault_policy zero the effort controller is left with zero torques.
     """
@@ -415,6 +417,8 @@ def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, ba
 
 def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegro):
     """
+    Lower the limits under the command in force: zeros are published at once.
+
     Hold policy, 0.63 N m in force, torque_limits lowered to 0.2 N m (unholdable): zeros
     reach the effort controller at once, without another joint state; before, nothing new
     was published and the controller kept 0.63 N m forever.
@@ -452,6 +456,8 @@ def test_limits_above_the_urdf_only_when_allowed_at_start(planar):
 
 def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothing(planar):
     """
+    Age inputs from the middleware's receipt: a message that waited is stale.
+
     Inputs are aged from the middleware's receipt, not from the callback: a joint state
     that waited 0.3 s for the executor (timeout 0.1 s) is stale when its callback runs. Before,
     a flood or a slow cycle let commands leave 165 ms after their joint state.
@@ -471,6 +477,8 @@ def test_a_joint_state_that_waited_in_the_queue_past_its_timeout_commands_nothin
 
 def test_an_oversized_message_is_rejected_before_it_is_deserialized(planar):
     """
+    Refuse an oversized message by its serialized length.
+
     20000 poses (1.1 MB) on contacts: refused by its serialized length. Deserializing
     10^5 poses took 0.8 s here, and a flood of them cut the command rate from 200 to 38 Hz.
     """
@@ -491,6 +499,8 @@ def test_an_oversized_message_is_rejected_before_it_is_deserialized(planar):
 
 def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
     """
+    Answer every one of a flood of ~/solve calls.
+
     300 concurrent ~/solve calls: each answered, solved or "busy" (before, beyond the 100
     queued requests the rest never were, silently: 872 to 900 of 1000). With solves slower
     than the calls come, at most MAX_PENDING_SOLVES are queued and the rest are "busy", and
@@ -537,6 +547,8 @@ def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
 
 def test_a_second_node_of_the_same_name_refuses_to_run(planar):
     """
+    Refuse to run beside a running node of the same name.
+
     Two grasp_torque_nodes on one domain both drove effort_commands, and parameter reads
     and writes went to either. One already running: a second one started exits with code 2
     and one line naming the other, before it takes any input; the first reports it.

@@ -7,8 +7,10 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-The node's planner parameters over ROS: friction_margin and objective change the command,
-and ~/solve reports the usage, the ratio, and why an infeasible load is infeasible.
+The node's planner parameters over ROS.
+
+friction_margin and objective change the command, and ~/solve reports the usage, the
+ratio, and why an infeasible load is infeasible.
 """
 
 import dataclasses

@@ -9,9 +9,11 @@
 """The bundled params files apply under any node name and namespace (keyed /**:)."""
 
 from conftest import CONFIG
+from grasp_torque_opt.ros.lifecycle_node import GraspTorqueLifecycleNode
 from grasp_torque_opt.ros.node import GraspTorqueNode
 import pytest
 import rclpy
+from rclpy.lifecycle import TransitionCallbackReturn
 from ros_harness import DOMAIN
 import yaml
 
@@ -21,14 +23,18 @@ FILES = sorted(CONFIG.glob('*_node.yaml'))
 @pytest.mark.parametrize('path', FILES, ids=[p.name for p in FILES])
 @pytest.mark.parametrize('remap', [[], ['-r', '__node:=right_hand_torques'],
                                    ['-r', '__ns:=/right_hand']])
-def test_every_parameter_of_the_file_applies_whatever_the_name(path, remap):
+@pytest.mark.parametrize('kind', [GraspTorqueNode, GraspTorqueLifecycleNode],
+                         ids=['plain', 'managed'])
+def test_every_parameter_of_the_file_applies_whatever_the_name(path, remap, kind):
     params = next(iter(yaml.safe_load(path.read_text()).values()))['ros__parameters']
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=DOMAIN)
     try:
-        node = GraspTorqueNode(context=context,
-                               cli_args=['--ros-args', '--params-file', str(path), *remap])
+        node = kind(context=context,
+                    cli_args=['--ros-args', '--params-file', str(path), *remap])
         try:
+            if kind is GraspTorqueLifecycleNode:  # it loads the file's scenario at configure
+                assert node.trigger_configure() == TransitionCallbackReturn.SUCCESS
             for name, value in params.items():
                 got = node.get_parameter(name).value
                 assert (list(got) if isinstance(value, list) else got) == value, name

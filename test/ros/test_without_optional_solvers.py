@@ -7,8 +7,10 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-The node runs with a ROS distribution's packages alone: no Clarabel, DAQP, quadprog,
-threadpoolctl, OSQP or MuJoCo (pip installs them; rosdep may not have them).
+The node runs with a ROS distribution's packages alone.
+
+No Clarabel, DAQP, quadprog, threadpoolctl, OSQP or MuJoCo (pip installs them; rosdep
+may not have them).
 """
 
 import subprocess
