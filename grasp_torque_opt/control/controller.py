@@ -210,12 +210,12 @@ class Counters:
 
 
 def show(name: str) -> str:
-    """A name as quoted in messages, cut to :data:`SHOWN_NAME_LENGTH` characters."""
+    """Quote a name in messages, cut to :data:`SHOWN_NAME_LENGTH` characters."""
     return name if len(name) <= SHOWN_NAME_LENGTH else name[:SHOWN_NAME_LENGTH] + '...'
 
 
 def stamp_seconds(sec: int, nanosec: int) -> float:
-    """A builtin_interfaces/Time as seconds (0.0 for an unstamped message)."""
+    """Return a builtin_interfaces/Time as seconds (0.0 for an unstamped message)."""
     return sec + 1e-9 * nanosec
 
 
@@ -289,8 +289,9 @@ class TorqueController:
 
     def check_bytes(self, source: str, n: int) -> None:
         """
-        Reject a message by the length of its serialized form, before it is deserialized
-        (5.6 MB of poses took 0.8 s to deserialize here, holding up the loop).
+        Reject a message by the length of its serialized form, before it is deserialized.
+
+        5.6 MB of poses took 0.8 s to deserialize here, holding up the loop.
 
         Raises:
             InputError: more than ``max_message_bytes`` (counted as a rejection).
@@ -315,8 +316,9 @@ class TorqueController:
         """
         try:
             if source == 'joint_states' and n > self.config.max_joint_state_entries:
+                limit = self.config.max_joint_state_entries
                 raise InputError('joint_states', f'{n} entries, more than '
-                                 f'max_joint_state_entries ({self.config.max_joint_state_entries})')
+                                 f'max_joint_state_entries ({limit})')
             p = len(self.setup.contacts)
             if source == 'contacts' and n != p:
                 raise InputError('contacts', f'{n} poses for {p} contacts')
@@ -326,7 +328,7 @@ class TorqueController:
 
     def _check_stamp(self, source: str, stamp: float, clock: float | None, now: float) -> None:
         """
-        The header stamp rule (docs/node.md, "Input checks").
+        Apply the header stamp rule (docs/node.md, "Input checks").
 
         0 is an unstamped message: accepted, not compared. A stamp more than
         ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)
@@ -397,7 +399,7 @@ class TorqueController:
             given = set(names)
             missing = [n for n in self.setup.hand.joints if n not in given]
             if missing:
-                raise InputError('joint_states', f"missing commanded joint(s) "
+                raise InputError('joint_states', 'missing commanded joint(s) '
                                  f"{', '.join(missing[:4])}")
             q = (self.setup.q if self.inputs.q is None else self.inputs.q).copy()
             for name, value in zip(names, positions):
@@ -408,7 +410,7 @@ class TorqueController:
                     raise InputError('joint_states', f"position of '{name}' is not finite")
                 if abs(value) > MAX_ABS_JOINT_POSITION:
                     raise InputError('joint_states', f"position of '{name}' is {value:.6g}, "
-                                     f"beyond +-{MAX_ABS_JOINT_POSITION:g}")
+                                     f'beyond +-{MAX_ABS_JOINT_POSITION:g}')
                 q[iq] = value
             self._check_stamp('joint_states', stamp, clock, now)
         except InputError as e:
@@ -577,7 +579,7 @@ class TorqueController:
 
     def grasp_at(self, inputs: Inputs) -> tuple[GraspSetup, np.ndarray | None]:
         """
-        The grasp of a snapshot of inputs, and g(q) if compensated.
+        Return the grasp of a snapshot of inputs, and g(q) if compensated.
 
         Raises:
             InputError: a contact point beyond ``max_contact_distance``, or the
@@ -621,9 +623,10 @@ class TorqueController:
 
     def budget(self) -> float:
         """
-        The time a cycle's solvers may take [s]: ``cycle_budget``, or
-        ``joint_state_timeout`` if smaller (a command later than that would answer a
-        stale joint state).
+        Return the time a cycle's solvers may take [s].
+
+        That is ``cycle_budget``, or ``joint_state_timeout`` if smaller (a command later
+        than that would answer a stale joint state).
         """
         return min(self.config.cycle_budget, self.config.joint_state_timeout)
 
@@ -663,7 +666,7 @@ class TorqueController:
         return self.refiner
 
     def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
-        """The last check before a command leaves: certified, finite, sized, within limits."""
+        """Check a command last before it leaves: certified, finite, sized, within limits."""
         if not solution.optimal:
             return None, f'no certified solution ({solution.status}: {solution.message})'
         cmd = solution.tau + (0.0 if g is None else g)
@@ -799,7 +802,8 @@ class TorqueController:
         if self.in_force.shape == lim.shape and np.all(np.abs(self.in_force) <= lim):
             return result if result is not None and result.command is not None else None
         why = result.fault if result is not None else self.stale(now)
-        reason = 'the command in force exceeds the new torque_limits' + (f' ({why})' if why else '')
+        reason = 'the command in force exceeds the new torque_limits' + (
+            f' ({why})' if why else '')
         if not self.fault:
             self.counters.faults += 1
         self.fault = reason

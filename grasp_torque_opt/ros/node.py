@@ -27,7 +27,6 @@ from concurrent.futures import ThreadPoolExecutor
 import dataclasses
 from dataclasses import dataclass
 import importlib.util
-import json
 import math
 import signal
 import sys
@@ -63,7 +62,7 @@ from grasp_torque_opt.core.exceptions import (
 )
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import Hand, MAX_TORQUE_LIMIT, MAX_URDF_BYTES
-from grasp_torque_opt.core.report import solution_dict
+from grasp_torque_opt.core.report import solution_dict, strict_json
 from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
 from grasp_torque_opt.core.scenario import (
     load_scenario,
@@ -1239,7 +1238,7 @@ class GraspTorqueCore:
             d = solution_dict(sol, maps)
             d['command'] = None if cmd is None else [float(x) for x in cmd]
             d['gravity_torque'] = None if g is None else [float(x) for x in g]
-            done.set_result((cmd is not None, json.dumps(d)))
+            done.set_result((cmd is not None, strict_json(d)))
         except Exception as e:  # noqa: BLE001 -- the caller gets the reason, the node lives on
             done.set_result((False, f'cannot solve: {type(e).__name__}: {e}'))
 
