@@ -84,6 +84,8 @@ from rclpy.callback_groups import ReentrantCallbackGroup
 from rclpy.duration import Duration
 from rclpy.exceptions import (
     InvalidTopicNameException,
+    NameValidationException,
+    ParameterException,
     ParameterNotDeclaredException,
     ParameterUninitializedException,
 )
@@ -1381,12 +1383,19 @@ def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None
     parser = argparse.ArgumentParser(prog=prog)
     parser.add_argument('--executor', choices=sorted(EXECUTORS), default='single',
                         help='rclpy executor to spin (default: single)')
-    opts = parser.parse_args(remove_ros_args(argv)[1:])
-    single_threaded_math()
-    # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the safe
-    # action could publish; here both end the spin loop and the context stays valid.
-    # SIGINT explicitly too: a process started from a background job inherits it ignored.
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        opts = parser.parse_args(remove_ros_args(argv)[1:])
+        single_threaded_math()
+        # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the
+        # safe action could publish; here both end the spin loop and the context stays
+        # valid. SIGINT explicitly too: a process started from a background job inherits
+        # it ignored.
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    except Exception as e:  # noqa: B902 -- rcl's argument errors are pybind types of rclpy's
+        # e.g. a --params-file that cannot be opened: rcl parses it before any node exists.
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        print(f'{prog}: error: ROS arguments: {first}', file=sys.stderr)
+        return 2
     _stop_signal = None
     previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     node = None
@@ -1416,6 +1425,11 @@ def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except GraspTorqueError as e:
+        print(f'{prog}: error: {e}', file=sys.stderr)
+        code = 2
+    except (ParameterException, NameValidationException) as e:
+        # rclpy refuses a -p value out of a parameter's declared range or of the wrong
+        # type while the node declares it, and a bad name or namespace (-r __node:=...).
         print(f'{prog}: error: {e}', file=sys.stderr)
         code = 2
     finally:
