@@ -36,7 +36,6 @@ from __future__ import annotations
 import argparse
 from datetime import datetime, timezone
 import json
-import os
 from pathlib import Path
 import sys
 import tempfile
@@ -51,6 +50,7 @@ from ros_load import (  # noqa: E402
     isolated_env,
     Pacer,
     private_domains,
+    process_cpu_s,
 )
 
 PARAMS = CONFIG / 'allegro_right_node.yaml'
@@ -124,18 +124,6 @@ def count_main(args: argparse.Namespace) -> int:
         'wrong_length': sum(n != len(names) for n in received),
         'target_cpu_s': None if cpu0 is None or cpu1 is None else cpu1 - cpu0}))
     return 0
-
-
-def process_cpu_s(pid: int | None) -> float | None:
-    """Return the CPU time a process used so far, user and system [s] (None: unknown)."""
-    if pid is None:
-        return None
-    try:
-        stat = Path(f'/proc/{pid}/stat').read_text()
-    except OSError:
-        return None
-    fields = stat.rsplit(')', 1)[1].split()  # after the command name, which may hold spaces
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
 def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) -> dict:

@@ -197,18 +197,39 @@ def percentiles_ms(values_s: list[float] | np.ndarray) -> dict[str, float | None
             'max_ms': float(v.max())}
 
 
+def process_cpu_s(pid: int | None) -> float | None:
+    """Return the CPU time a process used so far, user and system [s] (None: unknown)."""
+    if pid is None:
+        return None
+    try:
+        stat = Path(f'/proc/{pid}/stat').read_text()
+    except OSError:
+        return None
+    fields = stat.rsplit(')', 1)[1].split()  # after the command name, which may hold spaces
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
 class CpuShare:
     """
     CPU used by processes other than this one and its reaped children, over an interval.
 
     The machine may be shared: this says how much of it the benchmark had.
-    Start it before the children, call :meth:`others_cores` after they were reaped.
+    Start it before the children, call :meth:`others_cores` after they were reaped,
+    or name the children still running in ``exclude``: their CPU time is not "other".
+    "Other" is the machine's busy time (/proc/stat) that no process of the benchmark
+    was charged with: other processes, but also the kernel's interrupt work (the
+    benchmark's own DDS traffic on the loopback included) and, on a VM, the time the
+    hypervisor took (steal).
+
+    Args:
+        exclude: pids of running children that belong to the benchmark.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, exclude: tuple[int, ...] = ()) -> None:
         self._t = time.monotonic()
         self._busy = self._busy_s()
         self._own = self._own_s()
+        self._exclude = {pid: process_cpu_s(pid) or 0.0 for pid in exclude}
 
     @staticmethod
     def _busy_s() -> float:
@@ -222,13 +243,21 @@ class CpuShare:
         kids = resource.getrusage(resource.RUSAGE_CHILDREN)
         return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
+    def cores_of(self, pid: int) -> float | None:
+        """Return the mean cores an excluded child used since the start (None: unknown)."""
+        now = process_cpu_s(pid)
+        if now is None or pid not in self._exclude:
+            return None
+        return (now - self._exclude[pid]) / (time.monotonic() - self._t)
+
     def others_cores(self) -> float | None:
-        """Mean number of cores busy with other work since the start (None without /proc)."""
+        """Return the mean number of cores busy with other work since the start."""
         try:
             busy = self._busy_s() - self._busy
         except OSError:
             return None
-        return max(0.0, busy - (self._own_s() - self._own)) / (time.monotonic() - self._t)
+        kids = sum((process_cpu_s(pid) or start) - start for pid, start in self._exclude.items())
+        return max(0.0, busy - (self._own_s() - self._own) - kids) / (time.monotonic() - self._t)
 
 
 def vm_rss_kib(pid: int) -> int | None:

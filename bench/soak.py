@@ -525,7 +525,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     diag_start = dict(diag)
     commands_before, stamped_before = len(commands), stamped_ok
     memory = [(0.0, vm_rss_kib(node.pid))]
-    share = CpuShare()
+    share = CpuShare(exclude=(node.pid,))
 
     # -- the mix -----------------------------------------------------------------------------
     state['mixing'] = True
@@ -607,7 +607,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     pacer.spin_for(0.3)
     diag_end = dict(diag)
     memory.append((args.duration, vm_rss_kib(node.pid)))
-    others = share.others_cores()
+    others, node_cores = share.others_cores(), share.cores_of(node.pid)
     alive = node.alive()
     ros.destroy_node()
     rclpy.try_shutdown()
@@ -677,7 +677,8 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         'memory_kib': [{'t_s': t, 'vm_rss_kib': r} for t, r in memory],
         'memory_growth_kib': (memory[-1][1] - memory[0][1])
         if memory[0][1] is not None and memory[-1][1] is not None else None,
-        'other_processes_cores': others, 'node_alive_at_end': alive,
+        'other_processes_cores': others, 'node_cores': node_cores,
+        'node_alive_at_end': alive,
         'invariants_broken': sum(violations.values()) + (0 if alive else 1),
         'violations': violations if alive else {**violations, 'node_died': 1},
         'examples': examples,
@@ -749,6 +750,7 @@ def report(r: dict) -> str:
         f"{_mib(mem[-1]['vm_rss_kib'])} |",
         f'| node VmRSS samples [MiB] | '
         f"{', '.join(_mib(x['vm_rss_kib']) for x in mem)} |",
+        f"| the node's CPU [cores] | {_f(r.get('node_cores'), '.2f')} |",
         f"| other work on the machine [cores] | {_f(r['other_processes_cores'], '.2f')} |",
         f"| **invariants broken** | **{r['invariants_broken']}** |",
     ]

@@ -47,6 +47,7 @@ from grasp_torque_opt.control import diagnostics
 from grasp_torque_opt.control.controller import (
     CycleConfig,
     CycleResult,
+    MAX_GRAVITY,
     POLICIES,
     quaternion_matrix,
     stamp_seconds,
@@ -497,6 +498,8 @@ def check(name: str, value: Any, m: int | None, torque_bounds: np.ndarray | None
                                   name, 'torque_limits_above_urdf (read-only: at start)')
             except InputError as e:
                 return str(e)
+        if name == 'gravity' and math.sqrt(sum(v * v for v in values)) > MAX_GRAVITY:
+            return f'{name}: norm must be at most {MAX_GRAVITY:g} m/s^2 (as on the topic)'
         if name == 'weights' and values:
             low, high = WEIGHT_RANGE
             if not all(low <= v <= high for v in values):

@@ -28,6 +28,7 @@ from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
 import pinocchio as pin
 import pytest
+from rclpy.parameter import Parameter
 from ros_harness import Harness
 from std_srvs.srv import Trigger
 
@@ -44,6 +45,18 @@ def test_gravity_defaults_to_the_scenarios_and_drives_g_of_q(allegro):
         g = pin.computeGeneralizedGravity(model, model.createData(), q)[allegro.hand.idx_v]
         ref = solve(dataclasses.replace(GraspSetup.from_file(ALLEGRO), torque_offset=g))
         np.testing.assert_allclose(cmd, ref.tau + g, atol=1e-9)
+    finally:
+        h.close()
+
+
+def test_a_gravity_parameter_above_the_topics_bound_is_refused():
+    h = Harness(ALLEGRO, gravity_compensation=True)
+    try:
+        (result,) = h.node.set_parameters([Parameter('gravity', value=[0.0, 0.0, -101.0])])
+        assert not result.successful and 'gravity: norm must be at most 100' in result.reason
+        assert list(h.node.get_parameter('gravity').value) == [9.81, 0.0, 0.0]
+        (result,) = h.node.set_parameters([Parameter('gravity', value=[0.0, 0.0, -99.0])])
+        assert result.successful, result.reason
     finally:
         h.close()
 
