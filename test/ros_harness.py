@@ -10,6 +10,8 @@
 
 import os
 from pathlib import Path
+import subprocess
+import sys
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
@@ -183,3 +185,74 @@ class LifecycleHarness(Harness):
         """Whether the node's input subscriptions exist and are matched (configured)."""
         return (self.js_pub.get_subscription_count() > 0
                 and self.gravity_pub.get_subscription_count() > 0)
+
+
+class NodeProcess:
+    """
+    A node's executable as users run it (a child process on this run's domain), and a tester.
+
+    The tester node, in a context of its own, publishes joint states and records the
+    effort commands; services of the child are called through :meth:`call`.
+
+    Args:
+        module: the executable's module (``python -m module``).
+        args: its command line after the module.
+        tester_name: the tester node's name.
+    """
+
+    def __init__(self, module: str, args: list[str], tester_name: str) -> None:
+        env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN),
+                   ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+        self.child = subprocess.Popen([sys.executable, '-m', module, *args], env=env,
+                                      stderr=subprocess.PIPE, text=True)
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=DOMAIN)
+        self.tester = rclpy.create_node(tester_name, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.tester)
+        self.commands: list[np.ndarray] = []
+        self.tester.create_subscription(Float64MultiArray, 'effort_commands',
+                                        lambda m: self.commands.append(np.array(m.data)),
+                                        COMMAND_QOS)
+        self.pub = self.tester.create_publisher(JointState, 'joint_states',
+                                                qos_profile_sensor_data)
+
+    def spin_until(self, predicate, timeout: float) -> bool:
+        """Spin the tester until ``predicate()`` or ``timeout`` [s]; return predicate()."""
+        end = time.monotonic() + timeout
+        while not predicate() and time.monotonic() < end:
+            self.executor.spin_once(timeout_sec=0.01)
+        return predicate()
+
+    def call(self, client, request, timeout: float = 30.0):
+        """Call a service of the child and return its answer (asserted to come)."""
+        assert self.spin_until(client.service_is_ready, timeout)
+        future = client.call_async(request)
+        assert self.spin_until(future.done, timeout)
+        return future.result()
+
+    def first_command(self, names: list[str], positions: list[float],
+                      timeout: float = 10.0) -> bool:
+        """Publish a joint state until the child's first command arrives."""
+        assert self.spin_until(lambda: self.pub.get_subscription_count() > 0, 20.0)
+        end = time.monotonic() + timeout
+        while not self.commands and time.monotonic() < end:
+            self.pub.publish(JointState(name=names, position=positions))
+            self.spin_until(lambda: bool(self.commands), 0.1)
+        return bool(self.commands)
+
+    def finish(self, timeout: float = 10.0) -> tuple[int, str]:
+        """
+        Wait for the child to end; return its exit code and stderr.
+
+        stderr is read while waiting, so that a chatty child cannot block on a full pipe.
+        """
+        _, err = self.child.communicate(timeout=timeout)
+        return self.child.returncode, err
+
+    def close(self) -> None:
+        if self.child.poll() is None:
+            self.child.kill()
+        self.tester.destroy_node()
+        self.executor.shutdown()
+        rclpy.try_shutdown(context=self.context)

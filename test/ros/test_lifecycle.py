@@ -15,29 +15,20 @@ from ``/grasp_torque_node/get_state``; parameters are set through the node's
 """
 
 import json
-import os
 import signal
-import subprocess
-import sys
-import time
 
 from conftest import PLANAR, scenario_doc, setup_from_doc
 from cycle_inputs import joint_state
 from grasp_torque_opt.methods.dispatch import solve
-from grasp_torque_opt.ros.node import COMMAND_QOS, SERVICE_QOS
+from grasp_torque_opt.ros.node import SERVICE_QOS
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState, GetState
 import numpy as np
 import pytest
 from rcl_interfaces.msg import Log
 from rcl_interfaces.srv import GetParameters, SetParameters
-import rclpy
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
-from rclpy.qos import qos_profile_sensor_data
-from ros_harness import DOMAIN, LifecycleHarness
-from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
+from ros_harness import LifecycleHarness, NodeProcess
 from std_srvs.srv import Trigger
 
 CONFIGURE = Transition.TRANSITION_CONFIGURE
@@ -227,73 +218,40 @@ def test_the_executable_is_driven_over_the_domain_and_stops_with_the_safe_action
     parameter service, configure and activate succeed; commands flow; SIGINT takes the
     zero policy's safe action and the process ends cleanly.
     """
-    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-    child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.lifecycle_node',
-                              '--ros-args', '-p', f'scenario:={PLANAR}',
-                              '-p', 'fault_policy:=explode', '-p', 'polygon_sides:=2',
-                              '-p', 'joint_state_timeout:=5.0', '-p', 'hold_time:=5.0',
-                              '-p', 'startup_check_time:=0.0'],
-                             env=env, stderr=subprocess.PIPE, text=True)
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=DOMAIN)
-    tester = rclpy.create_node('lifecycle_tester', context=ctx)
-    executor = SingleThreadedExecutor(context=ctx)
-    executor.add_node(tester)
-    commands = []
-    tester.create_subscription(Float64MultiArray, 'effort_commands',
-                               lambda m: commands.append(np.array(m.data)), COMMAND_QOS)
-    pub = tester.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
-    change = tester.create_client(ChangeState, 'grasp_torque_node/change_state')
-    state = tester.create_client(GetState, 'grasp_torque_node/get_state')
-    params = tester.create_client(SetParameters, 'grasp_torque_node/set_parameters')
-    solve_client = tester.create_client(Trigger, 'grasp_torque_node/solve',
-                                        qos_profile=SERVICE_QOS)
-
-    def spin_until(pred, timeout):
-        end = time.monotonic() + timeout
-        while not pred() and time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.01)
-        return pred()
-
-    def call(client, request):
-        assert spin_until(client.service_is_ready, 30.0)
-        future = client.call_async(request)
-        assert spin_until(future.done, 30.0)
-        return future.result()
+    p = NodeProcess('grasp_torque_opt.ros.lifecycle_node',
+                    ['--ros-args', '-p', f'scenario:={PLANAR}',
+                     '-p', 'fault_policy:=explode', '-p', 'polygon_sides:=2',
+                     '-p', 'joint_state_timeout:=5.0', '-p', 'hold_time:=5.0',
+                     '-p', 'startup_check_time:=0.0'], 'lifecycle_tester')
+    change = p.tester.create_client(ChangeState, 'grasp_torque_node/change_state')
+    state = p.tester.create_client(GetState, 'grasp_torque_node/get_state')
+    params = p.tester.create_client(SetParameters, 'grasp_torque_node/set_parameters')
+    solve_client = p.tester.create_client(Trigger, 'grasp_torque_node/solve',
+                                          qos_profile=SERVICE_QOS)
 
     def transition(tid):
-        return call(change, ChangeState.Request(transition=Transition(id=tid))).success
+        return p.call(change, ChangeState.Request(transition=Transition(id=tid))).success
 
     try:
-        assert call(state, GetState.Request()).current_state.label == 'unconfigured'
+        assert p.call(state, GetState.Request()).current_state.label == 'unconfigured'
         assert not transition(CONFIGURE)
-        assert call(state, GetState.Request()).current_state.label == 'unconfigured'
-        results = call(params, SetParameters.Request(parameters=[
+        assert p.call(state, GetState.Request()).current_state.label == 'unconfigured'
+        results = p.call(params, SetParameters.Request(parameters=[
             Parameter('fault_policy', value='zero').to_parameter_msg(),
             Parameter('polygon_sides', value=3).to_parameter_msg()])).results
         assert [r.successful for r in results] == [True, True]
         assert transition(CONFIGURE) and transition(ACTIVATE)
-        names, pos = joint_state(planar)
-        assert spin_until(lambda: pub.get_subscription_count() > 0, 20.0)
-        end = time.monotonic() + 10.0
-        while not commands and time.monotonic() < end:
-            pub.publish(JointState(name=names, position=pos))
-            spin_until(lambda: bool(commands), 0.1)
-        assert commands
-        np.testing.assert_allclose(commands[-1], solve(planar).tau, atol=1e-9)
-        assert call(solve_client, Trigger.Request()).success
-        child.send_signal(signal.SIGINT)
-        assert spin_until(lambda: np.all(commands[-1] == 0.0), 4.0), commands[-3:]
-        _, err = child.communicate(timeout=10)
-        assert child.returncode == 0, err
+        assert p.first_command(*joint_state(planar))
+        np.testing.assert_allclose(p.commands[-1], solve(planar).tau, atol=1e-9)
+        assert p.call(solve_client, Trigger.Request()).success
+        p.child.send_signal(signal.SIGINT)
+        assert p.spin_until(lambda: np.all(p.commands[-1] == 0.0), 4.0), p.commands[-3:]
+        code, err = p.finish()
+        assert code == 0, err
         assert 'Traceback' not in err, err
         failed = [line for line in err.splitlines() if 'configure failed' in line]
         assert len(failed) == 1 and 'polygon_sides: the value given at start was refused' in \
             failed[0], err
         assert 'stopped: zero torques published' in err, err
     finally:
-        if child.poll() is None:
-            child.kill()
-        tester.destroy_node()
-        executor.shutdown()
-        rclpy.try_shutdown(context=ctx)
+        p.close()

@@ -30,12 +30,10 @@ import pinocchio as pin
 import pytest
 import rclpy
 from rclpy.duration import Duration
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
-from rclpy.qos import qos_profile_sensor_data, ReliabilityPolicy
-from ros_harness import DOMAIN, Harness
+from rclpy.qos import ReliabilityPolicy
+from ros_harness import DOMAIN, Harness, NodeProcess
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker
 
@@ -345,53 +343,25 @@ def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, si
     grasp_torque_node as users run it (either executor): it answers joint states, a signal
     stops it, and with fault_policy zero the effort controller is left with zero torques.
     """
-    env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
-    child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node', '--executor',
-                              executor, '--ros-args',
-                              '-p', f'scenario:={PLANAR}', '-p', 'fault_policy:=zero',
-                              '-p', 'joint_state_timeout:=5.0', '-p', 'hold_time:=5.0'],
-                             env=env, stderr=subprocess.PIPE, text=True)
-    ctx = rclpy.Context()
-    rclpy.init(context=ctx, domain_id=DOMAIN)
-    tester = rclpy.create_node('stop_tester', context=ctx)
-    executor = SingleThreadedExecutor(context=ctx)
-    executor.add_node(tester)
-    commands = []
-    tester.create_subscription(Float64MultiArray, 'effort_commands',
-                               lambda m: commands.append(np.array(m.data)), COMMAND_QOS)
-    pub = tester.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
-
-    def spin_until(pred, timeout):
-        end = time.monotonic() + timeout
-        while not pred() and time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.01)
-        return pred()
-
+    p = NodeProcess('grasp_torque_opt.ros.node',
+                    ['--executor', executor, '--ros-args', '-p', f'scenario:={PLANAR}',
+                     '-p', 'fault_policy:=zero', '-p', 'joint_state_timeout:=5.0',
+                     '-p', 'hold_time:=5.0'], 'stop_tester')
     try:
-        names, pos = joint_state(planar)
-        assert spin_until(lambda: pub.get_subscription_count() > 0, 20.0)
-        end = time.monotonic() + 10.0
-        while not commands and time.monotonic() < end:
-            pub.publish(JointState(name=names, position=pos))
-            spin_until(lambda: bool(commands), 0.1)
-        assert commands and np.linalg.norm(commands[-1]) > 0
-        child.send_signal(sig)
+        assert p.first_command(*joint_state(planar))
+        assert np.linalg.norm(p.commands[-1]) > 0
+        p.child.send_signal(sig)
         # Within 4 s: 5 s after the last joint state the stale policy would publish zeros
         # itself, and they would pass for the stop's (as they did while a SIGINT inherited
         # ignored, from a background job, left the node spinning).
-        assert spin_until(lambda: np.all(commands[-1] == 0.0), 4.0), commands[-3:]
-        # The zeros arrived (the safety promise); the process then ends cleanly. Read
-        # stderr while waiting, so a chatty child cannot block on a full pipe.
-        _, err = child.communicate(timeout=10)
-        assert child.returncode == 0, err
+        assert p.spin_until(lambda: np.all(p.commands[-1] == 0.0), 4.0), p.commands[-3:]
+        # The zeros arrived (the safety promise); the process then ends cleanly.
+        code, err = p.finish()
+        assert code == 0, err
         assert 'Traceback' not in err, err
         assert 'stopped: zero torques published' in err, err
     finally:
-        if child.poll() is None:
-            child.kill()
-        tester.destroy_node()
-        executor.shutdown()
-        rclpy.try_shutdown(context=ctx)
+        p.close()
 
 
 @pytest.mark.parametrize('backend', ['daqp', 'quadprog'])
