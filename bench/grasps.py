@@ -48,6 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, report, ROOT  # noqa: E402, I100
 from grasp_torque_opt.core.exceptions import GraspTorqueError  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
+from grasp_torque_opt.methods.score import THREAD_VARS  # noqa: E402
 from grasp_torque_opt.reference.feasibility import linearized_feasible  # noqa: E402
 
 SCENARIO = ROOT / 'config' / 'allegro_right.yaml'
@@ -55,10 +56,6 @@ SCENARIO = ROOT / 'config' / 'allegro_right.yaml'
 Q_NOISE = 0.08
 #: Cap on candidates per kept grasp, so a bad seed cannot loop forever.
 MAX_DRAWS_PER_GRASP = 50
-
-
-#: Environment variables that set the BLAS/LAPACK thread pools.
-THREAD_VARS = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')
 
 
 def blas_threads() -> dict:

@@ -42,7 +42,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import multiprocessing as mp
-import os
 from pathlib import Path
 import sys
 import time
@@ -56,7 +55,8 @@ from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
-from grasps import allegro_grasps, blas_threads, SCENARIO, THREAD_VARS  # noqa: E402
+from grasp_torque_opt.methods.score import thread_env  # noqa: E402
+from grasps import allegro_grasps, blas_threads, SCENARIO  # noqa: E402
 
 CHUNK = 25
 TARGET = 5000.0
@@ -111,18 +111,9 @@ def sequential(backend: str, work: list) -> dict:
 def pooled(backend: str, work: list, workers: int, worker_threads: str = '1') -> dict:
     ctx = mp.get_context('spawn')
     barrier = ctx.Barrier(workers)
-    saved = {k: os.environ.get(k) for k in THREAD_VARS}
     t0 = time.perf_counter()
-    try:
-        if worker_threads != 'default':  # spawned workers read these at import
-            os.environ.update(dict.fromkeys(THREAD_VARS, worker_threads))
+    with thread_env(None if worker_threads == 'default' else worker_threads):
         pool = ctx.Pool(workers, initializer=_init, initargs=(backend, barrier))
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
     with pool:
         warm_up = [work[i % len(work)] for i in range(workers)]  # one each, even if few
         pids = set(pool.map(_warm_up, warm_up, chunksize=1))

@@ -40,7 +40,8 @@ chunk function; each worker binds the base scenario once and reuses one solver.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 import hashlib
 import json
@@ -289,6 +290,27 @@ def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tup
 THREAD_VARS = ('OMP_NUM_THREADS', 'OPENBLAS_NUM_THREADS', 'MKL_NUM_THREADS')
 
 
+@contextmanager
+def thread_env(value: str | None) -> Iterator[None]:
+    """
+    Set every :data:`THREAD_VARS` to ``value`` in this process's environment, then restore.
+
+    Spawned workers read these at import, so a pool is created inside the block;
+    ``value`` None changes nothing (the library's default thread count).
+    """
+    saved = {k: os.environ.get(k) for k in THREAD_VARS}
+    if value is not None:
+        os.environ.update(dict.fromkeys(THREAD_VARS, value))
+    try:
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
 def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int | None = None,
                 engine: str = 'processes', scheduler: str | None = None,
                 progress: Callable[[int, int], None] | None = None,
@@ -341,16 +363,8 @@ def _pool_map(job: ScoreJob, tasks: list, workers: int, finished) -> None:
     import multiprocessing as mp
 
     ctx = mp.get_context('spawn')  # fork after Pinocchio and BLAS threads is not safe
-    saved = {k: os.environ.get(k) for k in THREAD_VARS}
-    os.environ.update(dict.fromkeys(THREAD_VARS, '1'))  # spawned workers read these at import
-    try:
+    with thread_env('1'):
         pool = ctx.Pool(min(workers, len(tasks)))
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
     with pool:
         pending = [(i, pool.apply_async(score_chunk, (job, t))) for i, t in enumerate(tasks)]
         for i, res in pending:
