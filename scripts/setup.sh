@@ -28,7 +28,10 @@ if [ ! -x .venv/bin/python ]; then
     fi
 fi
 stamp=.venv/.installed
-if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ]; then
+# Again when the build inputs change: setup.py, pyproject.toml, or the compiled cycle's
+# source (an editable install does not rebuild it by itself).
+if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ] || [ pyproject.toml -nt "$stamp" ] ||
+        [ src/fast_cycle.cpp -nt "$stamp" ]; then
     .venv/bin/python -m pip install -q --upgrade pip
     .venv/bin/python -m pip install -q -e '.[ros,test,bench,sim,distributed]'
     touch "$stamp"

@@ -98,6 +98,11 @@ def report(controller: TorqueController, now: float) -> Report:
                ('solver.warm_solves', str(getattr(solver, 'warm_solves', 0))),
                ('solver.warm_start_fallbacks', str(getattr(solver, 'fallbacks', 0))),
                ('solver.fallback_solves', str(n.fallback_solves))]
+    fast = c.compiled_cycle
+    values += [('solver.compiled', 'true' if fast is not None and not fast.gave_up else
+                f'false: {c.compiled_reason}' if c.compiled_reason else 'no cycle yet'),
+               ('solver.compiled_solves', str(fast.solves if fast is not None else 0)),
+               ('solver.compiled_handed_back', str(fast.handed_back if fast is not None else 0))]
     values += [(f'rejected.{k}', str(v)) for k, v in n.rejected.items()]
     values.append(('last_rejection', c.last_rejection or 'none'))
     values += [('age.joint_states_s', _ago(now, c.inputs.q_time)),

@@ -160,7 +160,7 @@ class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
         self.get_logger().info(
             f"inactive: {self._m} joints in command order ({', '.join(setup.hand.joints)}), "
             f'{len(setup.contacts)} default contacts; activate to command on '
-            f'{self._command_pub.topic_name}')
+            f'{self._command_pub.topic_name}; cycle: {self._cycle_kind()}')
         return TransitionCallbackReturn.SUCCESS
 
     def _configure_failed(self, reason: str) -> TransitionCallbackReturn:

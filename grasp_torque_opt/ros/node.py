@@ -43,7 +43,7 @@ from grasp_torque_opt.backends import (
     single_threaded_math,
 )
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-from grasp_torque_opt.control import diagnostics
+from grasp_torque_opt.control import compiled, diagnostics
 from grasp_torque_opt.control.controller import (
     CycleConfig,
     CycleResult,
@@ -237,6 +237,12 @@ PARAMETERS: dict[str, Spec] = {
                               'that is not solved, fails the KKT check or is not certified '
                               'is redone cold in the same cycle and counted (diagnostics '
                               'solver.warm_start_fallbacks). No effect on quadprog.'),
+    'solver.compiled': Spec('Run the cycle compiled (maps, build, ProxSuite solve and '
+                            'certificate in C++, src/fast_cycle.cpp) where it applies: '
+                            'tau-qp, sum-of-squares, ProxSuite, no internal-force variables. '
+                            'Elsewhere, and on any answer it cannot certify, the Python '
+                            'cycle answers (diagnostics solver.compiled). false: the Python '
+                            'cycle always.'),
     'solver.eps_abs': Spec('Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol) '
                            '[-].', 1e-12, 1e-4),
     'solver.max_iter': Spec('Solver iteration cap (ProxSuite outer, DAQP) [-].', 1, 10000),
@@ -329,6 +335,7 @@ def fixed_defaults() -> dict[str, Any]:
         'solver.backend': BACKENDS[0],
         'solver.fallback': 'daqp',
         'solver.warm_start': True,
+        'solver.compiled': True,
         'solver.eps_abs': ProxSuiteSettings.eps_abs,
         'solver.max_iter': ProxSuiteSettings.max_iter,
         'solver.max_iter_in': ProxSuiteSettings.max_iter_in,
@@ -718,6 +725,14 @@ class GraspTorqueCore:
             self._load_of_gravity(self._scenario)
         self.controller, self._service_controller = controller, service
 
+    def _cycle_kind(self) -> str:
+        """Say which cycle runs: compiled, or Python and why."""
+        ctrl = self.controller
+        if not ctrl.config.compiled:
+            return 'Python (solver.compiled false)'
+        why = compiled.unsupported(ctrl.setup, ctrl.config.method, ctrl.solver)
+        return f'Python ({why})' if why else 'compiled'
+
     def _release(self) -> None:
         """Drop the controllers and the model (the managed node's cleanup)."""
         self.controller = self._service_controller = None
@@ -914,7 +929,7 @@ class GraspTorqueCore:
             max_contact_distance=p['max_contact_distance'],
             stamp_future_tolerance=p['stamp_future_tolerance'],
             cycle_budget=p['cycle_budget'], method=p['solver.method'],
-            gravity_timeout=p['gravity_timeout'])
+            gravity_timeout=p['gravity_timeout'], compiled=p['solver.compiled'])
         solver = ProxSuiteSettings(eps_abs=p['solver.eps_abs'], max_iter=p['solver.max_iter'],
                                    max_iter_in=p['solver.max_iter_in'])
         return setup, config, solver
@@ -1327,7 +1342,7 @@ class GraspTorqueNode(GraspTorqueCore, Node):
         self.get_logger().info(
             f"{self._m} joints in command order ({', '.join(setup.hand.joints)}), "
             f'{len(setup.contacts)} default contacts; commands on '
-            f'{self._command_pub.topic_name}')
+            f'{self._command_pub.topic_name}; cycle: {self._cycle_kind()}')
 
     def destroy_node(self) -> None:
         """Take the safe action, then stop the service worker and the node."""

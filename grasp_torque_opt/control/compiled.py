@@ -1,0 +1,261 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The node's cycle compiled: maps, build, warm ProxSuite solve and certificate in C++.
+
+``grasp_torque_opt.control._fast_cycle`` (``src/fast_cycle.cpp``, built by ``setup.py`` with
+pybind11, Eigen and ProxSuite's C++ headers) is the Python cycle written again, rule
+for rule, for the case the node runs on every joint state (docs/design.md section 2.6):
+
+- the ``tau-qp`` method and the ``sum-of-squares`` objective;
+- the ProxSuite backend with the package's settings (Diagonal Hessian,
+  PrimalDualLDLT, the preconditioner of the first problem kept);
+- A = [G; J^T] of full column rank (the QR branch of
+  :func:`~grasp_torque_opt.core.tau_qp.decompose`: no internal-force variables, as
+  for the Allegro's four fingertips).
+
+Pinocchio's kinematics stay in Python (about 10 us). A warm answer that ProxSuite does
+not call solved, or that fails the KKT check or the certificate, is redone cold in the
+same call, as the Python solver does. What the compiled cycle cannot certify, it hands
+back: :meth:`CompiledCycle.solve` returns None with the reason, and the controller runs
+the Python cycle, which stays the reference and is what the tests hold the compiled
+one to.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from grasp_torque_opt.backends.proxsuite import (
+    ESTIMATE_DECAY,
+    INNER_ITERATION_S,
+    KKT_TOLERANCE,
+    TauQPSolver,
+)
+from grasp_torque_opt.core.certificate import Certificate
+from grasp_torque_opt.core.friction import contact_block
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.margin import planned_friction
+from grasp_torque_opt.core.solution import OPTIMAL, Solution
+from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
+import numpy as np
+import pinocchio as pin
+
+#: The interface of src/fast_cycle.cpp this module speaks (its ``API``).
+API = 1
+
+try:
+    from grasp_torque_opt.control import _fast_cycle
+    IMPORT_ERROR = ''
+    if getattr(_fast_cycle, 'API', None) != API:
+        IMPORT_ERROR = ('grasp_torque_opt.control._fast_cycle was built from another '
+                        'src/fast_cycle.cpp: run scripts/setup.sh again')
+        _fast_cycle = None
+except ImportError as e:  # not built (no compiler, or a colcon build without pybind11)
+    _fast_cycle = None
+    IMPORT_ERROR = f'grasp_torque_opt.control._fast_cycle is not built ({e})'
+
+#: Share of the time left that the compiled ProxSuite solve may use; the fallback gets
+#: the rest (as :data:`grasp_torque_opt.methods.dispatch.PRIMARY_SHARE`).
+PRIMARY_SHARE = 0.8
+#: Outcome codes after which ProxSuite was tried (warm, and cold if the warm answer
+#: failed): the controller asks its fallback backend next, not ProxSuite again.
+SOLVER_CODES = (3, 4, 5)  # NOT_SOLVED, NOT_CERTIFIED, TIMED_OUT (src/fast_cycle.cpp)
+#: After this many cycles in a row handed back as not of full column rank (a grasp
+#: with internal-force variables), the compiled cycle is not tried again for the grasp.
+RANK_GIVE_UP = 10
+
+
+def available() -> bool:
+    """Tell whether the compiled cycle was built and imports."""
+    return _fast_cycle is not None
+
+
+def unsupported(setup: GraspSetup, method: str, solver) -> str:
+    """
+    Say why the compiled cycle does not take this grasp and solver ('' if it does).
+
+    Only what is known before a cycle: a grasp whose A turns out rank-deficient at some
+    configuration is handed back by :meth:`CompiledCycle.solve` instead.
+    """
+    if _fast_cycle is None:
+        return IMPORT_ERROR
+    if method != 'tau-qp':
+        return f'method {method} (the compiled cycle solves tau-qp)'
+    if setup.objective != 'sum-of-squares':
+        return f'objective {setup.objective} (the compiled cycle solves sum-of-squares)'
+    if not isinstance(solver, TauQPSolver):
+        return f"backend {getattr(solver, 'name', type(solver).__name__)} (the compiled " \
+               'cycle solves with ProxSuite)'
+    s = solver.settings
+    if (s.hessian_type, s.dense_backend, s.preconditioner) != \
+            ('Diagonal', 'PrimalDualLDLT', 'first'):
+        return 'ProxSuite settings other than Diagonal, PrimalDualLDLT, preconditioner first'
+    if solver.max_slice_s is not None:
+        return 'a solver with max_slice_s'
+    return ''
+
+
+@dataclass
+class _Contacts:
+    """A contact list as arrays for the compiled cycle (remade when the list changes)."""
+
+    specs: list
+    frame_ids: tuple[int, ...]
+    links: tuple[str, ...]
+    points: np.ndarray
+    normals: np.ndarray
+    has_normal: np.ndarray
+    tangents: np.ndarray
+    has_tangent: np.ndarray
+
+
+class CompiledCycle:
+    """
+    The compiled cycle bound to one grasp's friction, weights, limits and one solver.
+
+    Args:
+        setup: the grasp (its friction, weights and limits are taken here).
+        solver: the Python ProxSuite solver it stands in for: its settings are used,
+            and its counters (``warm_solves``, ``fallbacks``, ``timeouts``) count the
+            compiled solves too.
+        tolerance: certificate tolerance.
+    """
+
+    def __init__(self, setup: GraspSetup, solver: TauQPSolver, tolerance: float) -> None:
+        self.solver = solver
+        self.tolerance = tolerance
+        self._key = self.key(setup, solver, tolerance)
+        hand = setup.hand
+        friction = planned_friction(setup.friction)
+        S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
+                                 friction.min_normal_force)
+        st = solver.settings
+        s = _fast_cycle.Settings()
+        s.eps_abs, s.eps_rel, s.eps_primal_inf = st.eps_abs, st.eps_rel, st.eps_primal_inf
+        s.max_iter, s.max_iter_in = st.max_iter, st.max_iter_in
+        s.kkt_tolerance, s.certificate_tolerance = KKT_TOLERANCE, tolerance
+        s.qr_rtol, s.box_margin = QR_RTOL, BOX_MARGIN
+        s.inner_iteration_s, s.estimate_decay = INNER_ITERATION_S, ESTIMATE_DECAY
+        s.primary_share = PRIMARY_SHARE
+        self._cycle = _fast_cycle.FastCycle(
+            np.asarray(hand.idx_v, dtype=np.int64), S_i, b_i,
+            np.asarray(setup.weights, dtype=float), np.asarray(hand.torque_limits, dtype=float),
+            friction.mu1, friction.mu2, setup.friction.mu1, setup.friction.mu2,
+            friction.min_normal_force, solver.warm_start, s)
+        self._joints = list(hand.joints)
+        self._contacts: _Contacts | None = None
+        self._no_offset = np.zeros(0)
+        #: Cycles answered here, and handed back to the Python cycle (by reason code).
+        self.solves = 0
+        self.handed_back = 0
+        #: Why the last cycle was handed back ('' if it was not).
+        self.last_reason = ''
+        #: The last cycle's outcome code (``_fast_cycle.CERTIFIED`` ... ``TIMED_OUT``).
+        self.last_code = 0
+        #: Cycles in a row handed back for A's rank; at :data:`RANK_GIVE_UP`, ``gave_up``
+        #: says why the compiled cycle is no longer tried for this grasp.
+        self._rank_misses = 0
+        self.gave_up = ''
+
+    @staticmethod
+    def key(setup: GraspSetup, solver, tolerance: float) -> tuple:
+        """Return what the compiled cycle was made for; another key needs a new one."""
+        return (id(setup.hand), setup.friction, id(setup.weights), setup.objective,
+                id(solver), solver.settings, solver.warm_start, tolerance)
+
+    def fits(self, setup: GraspSetup, solver, tolerance: float) -> bool:
+        """Tell whether this compiled cycle was made for this grasp's constants and solver."""
+        k = self._key
+        return (k[0] == id(setup.hand) and k[2] == id(setup.weights) and k[4] == id(solver)
+                and k[1] == setup.friction and k[3] == setup.objective
+                and k[5] == solver.settings and k[6] == solver.warm_start
+                and k[7] == tolerance)
+
+    def _arrays(self, setup: GraspSetup) -> _Contacts:
+        """Return the contact list as arrays, remade only when the list object changes."""
+        c = self._contacts
+        if c is not None and c.specs is setup.contacts:
+            return c
+        hand, specs = setup.hand, setup.contacts
+        p = len(specs)
+        normals, tangents = np.zeros((p, 3)), np.zeros((p, 3))
+        has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+        for i, spec in enumerate(specs):
+            if spec.normal is not None:
+                normals[i], has_n[i] = spec.normal, True
+            if spec.tangent is not None:
+                tangents[i], has_t[i] = spec.tangent, True
+        self._contacts = c = _Contacts(
+            specs=specs,
+            frame_ids=tuple(hand.frame_index(s.link, f'grasp.contacts[{i}].link')
+                            for i, s in enumerate(specs)),
+            links=tuple(s.link for s in specs),
+            points=np.array([s.position for s in specs], dtype=float).reshape(p, 3),
+            normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t)
+        return c
+
+    def solve(self, setup: GraspSetup, time_left: float | None
+              ) -> tuple[Solution, GraspMaps] | tuple[None, str]:
+        """
+        One cycle on the grasp at its configuration (contacts, load, torque offset set).
+
+        Args:
+            setup: the grasp of this cycle (``TorqueController.grasp_at``).
+            time_left: seconds the solver may still take (None: only its caps).
+
+        Returns:
+            (certified solution, maps), or (None, why) when the Python cycle must answer.
+        """
+        c = self._arrays(setup)
+        hand = setup.hand
+        model, data = hand.model, hand.data
+        pin.computeJointJacobians(model, data, setup.q)
+        pin.updateFramePlacements(model, data)
+        oMf = np.array([data.oMf[fid].homogeneous for fid in c.frame_ids])
+        J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+                       for fid in c.frame_ids])
+        offset = self._no_offset if setup.torque_offset is None else setup.torque_offset
+        a = self._cycle.solve(oMf, J6, c.points, c.normals, c.has_normal, c.tangents,
+                              c.has_tangent, setup.object_origin, setup.external_wrench,
+                              offset, -1.0 if time_left is None else time_left)
+        solver = self.solver
+        solver.warm_solves += a.warm_solves
+        solver.fallbacks += a.redone_cold
+        solver.last_warm = a.warm
+        self.last_code = a.code
+        if a.code != _fast_cycle.CERTIFIED:
+            solver.timeouts += a.code == _fast_cycle.TIMED_OUT
+            self.handed_back += 1
+            self.last_reason = f'compiled cycle: {a.message}'
+            self._rank_misses = self._rank_misses + 1 if a.message.startswith('A = ') else 0
+            if self._rank_misses >= RANK_GIVE_UP:
+                self.gave_up = f'{a.message} in {RANK_GIVE_UP} cycles in a row'
+            return None, self.last_reason
+        self._rank_misses = 0
+        self.solves += 1
+        self.last_reason = ''
+        maps = GraspMaps(G=a.G, J=a.J, links=c.links, frame_ids=c.frame_ids,
+                         positions=a.positions, rotations=a.rotations,
+                         object_origin=np.asarray(setup.object_origin, dtype=float))
+        t_maps, t_build, t_solve, t_certify = a.timings
+        eq, torque, cone, normal, limit, finite = a.certificate
+        sol = Solution(status=OPTIMAL, method='tau-qp', joints=list(self._joints),
+                       tau=a.tau, wrenches=a.f.reshape(-1, 4), iterations=a.iterations,
+                       solve_time_s=a.solve_time_s,
+                       certificate=Certificate(eq, torque, cone, normal, limit, finite,
+                                               self.tolerance),
+                       message=f'certified (solver: {a.message})',
+                       timings={'maps': t_maps, 'build': t_build, 'solve': t_solve,
+                                'certify': t_certify},
+                       backend=solver.name, objective=setup.objective,
+                       friction_margin=setup.friction.margin, friction_usage=a.usage,
+                       max_torque_ratio=a.max_torque_ratio)
+        return sol, maps
