@@ -6,7 +6,7 @@
 #
 # SPDX-License-Identifier: BSD-3-Clause
 
-"""Every Python file opens with the copyright and BSD-3-Clause header (the ROS template's)."""
+"""Every Python and C++ file opens with the copyright and BSD-3-Clause header (ROS template)."""
 
 from pathlib import Path
 import re
@@ -31,22 +31,23 @@ SPDX = 'SPDX-License-Identifier: BSD-3-Clause'
 
 def header_problem(path: Path) -> str | None:
     """
-    Say what is wrong with the header of a Python file, None if nothing.
+    Say what is wrong with the header of a Python or C++ file, None if nothing.
 
     As ament_copyright reads a header: past a shebang or coding line and blank lines, the
     first block of comment lines, a copyright line first, then the licence text. An
     empty file needs none.
     """
     lines = path.read_text(encoding='utf-8').splitlines()
+    mark = '#' if path.suffix == '.py' else '//'
     i = 0
-    while i < len(lines) and lines[i].startswith('#') and (
+    while i < len(lines) and mark == '#' and lines[i].startswith('#') and (
             lines[i].startswith('#!') or 'coding=' in lines[i] or 'coding:' in lines[i]):
         i += 1
     while i < len(lines) and not lines[i].strip():
         i += 1
     block = []
-    while i < len(lines) and lines[i].startswith('#'):
-        block.append(lines[i][1:].strip())
+    while i < len(lines) and lines[i].startswith(mark):
+        block.append(lines[i][len(mark):].strip())
         i += 1
     if not lines:
         return None
@@ -62,8 +63,9 @@ def header_problem(path: Path) -> str | None:
 @pytest.mark.copyright
 @pytest.mark.linter
 def test_copyright():
-    files = own_files('.py')
+    files = own_files('.py', '.cpp', '.hpp', '.h')
     assert ROOT / 'setup.py' in files and ROOT / 'test' / 'test_copyright.py' in files
+    assert ROOT / 'src' / 'fast_cycle.cpp' in files
     problems = [f'{p.relative_to(ROOT)}: {why}' for p in files if (why := header_problem(p))]
     assert not problems, 'Files without the copyright header:\n' + '\n'.join(problems)
     if ament_copyright is not None:
