@@ -174,10 +174,12 @@ class CompiledCycle:
     def fits(self, setup: GraspSetup, solver, tolerance: float) -> bool:
         """Tell whether this compiled cycle was made for this grasp's constants and solver."""
         k = self._key
+        # Identity first: a cycle's grasp shares its constants with the controller's.
         return (k[0] == id(setup.hand) and k[2] == id(setup.weights) and k[4] == id(solver)
-                and k[1] == setup.friction and k[3] == setup.objective
-                and k[5] == solver.settings and k[6] == solver.warm_start
-                and k[7] == tolerance)
+                and (k[1] is setup.friction or k[1] == setup.friction)
+                and k[3] == setup.objective
+                and (k[5] is solver.settings or k[5] == solver.settings)
+                and k[6] == solver.warm_start and k[7] == tolerance)
 
     def _arrays(self, setup: GraspSetup) -> _Contacts:
         """Return the contact list as arrays, remade only when the list object changes."""
@@ -202,7 +204,7 @@ class CompiledCycle:
             normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t)
         return c
 
-    def solve(self, setup: GraspSetup, time_left: float | None
+    def solve(self, setup: GraspSetup, time_left: float | None, kinematics: bool = True
               ) -> tuple[Solution, GraspMaps] | tuple[None, str]:
         """
         One cycle on the grasp at its configuration (contacts, load, torque offset set).
@@ -210,6 +212,9 @@ class CompiledCycle:
         Args:
             setup: the grasp of this cycle (``TorqueController.grasp_at``).
             time_left: seconds the solver may still take (None: only its caps).
+            kinematics: compute the joint Jacobians and frame placements at
+                ``setup.q`` here; False: the hand's data already holds them
+                (``grasp_at(..., jacobians=True)``).
 
         Returns:
             (certified solution, maps), or (None, why) when the Python cycle must answer.
@@ -217,9 +222,11 @@ class CompiledCycle:
         c = self._arrays(setup)
         hand = setup.hand
         model, data = hand.model, hand.data
-        pin.computeJointJacobians(model, data, setup.q)
-        pin.updateFramePlacements(model, data)
-        oMf = np.array([data.oMf[fid].homogeneous for fid in c.frame_ids])
+        if kinematics:
+            pin.computeJointJacobians(model, data, setup.q)
+            pin.updateFramePlacements(model, data)
+        placements = data.oMf
+        oMf = np.array([placements[fid].homogeneous for fid in c.frame_ids])
         J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
                        for fid in c.frame_ids])
         offset = self._no_offset if setup.torque_offset is None else setup.torque_offset

@@ -624,9 +624,13 @@ class TorqueController:
             return f'gravity stale ({now - i.gravity_time:.3f} s > {c.gravity_timeout} s)'
         return ''
 
-    def grasp_at(self, inputs: Inputs) -> tuple[GraspSetup, np.ndarray | None]:
+    def grasp_at(self, inputs: Inputs, jacobians: bool = False
+                 ) -> tuple[GraspSetup, np.ndarray | None]:
         """
         Return the grasp of a snapshot of inputs, and g(q) if compensated.
+
+        With ``jacobians``, the joint Jacobians are computed with the placements (the
+        compiled cycle reads both from the hand's Pinocchio data).
 
         Raises:
             InputError: a contact point beyond ``max_contact_distance``, or the
@@ -636,7 +640,11 @@ class TorqueController:
         hand = setup.hand
         q = inputs.q
         model, data = hand.model, hand.data
-        pin.framesForwardKinematics(model, data, q)
+        if jacobians:
+            pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacements(model, data)
+        else:
+            pin.framesForwardKinematics(model, data, q)
         contacts = setup.contacts
         if inputs.contacts is not None:
             cp = inputs.contacts
@@ -691,12 +699,12 @@ class TorqueController:
             InputError: the inputs do not make a grasp (e.g. a tangent parallel to
                 its normal).
         """
-        setup, g = self.grasp_at(inputs)
-        fast = self._compiled(setup)
+        fast = self._compiled(self.setup)
+        setup, g = self.grasp_at(inputs, jacobians=fast is not None)
         solver, fallback, handed_back = self.solver, self.fallback, ''
         if fast is not None:
             sol, maps = fast.solve(setup, None if deadline is None else
-                                   deadline - time.perf_counter())
+                                   deadline - time.perf_counter(), kinematics=False)
             if sol is not None:
                 return sol, maps, g
             handed_back = maps
