@@ -11,6 +11,7 @@
 from glob import glob
 import os
 from pathlib import Path
+import platform
 import site
 import sys
 import sysconfig
@@ -41,7 +42,7 @@ def _header_dir(relative: str) -> str | None:
 
 def fast_cycle_extensions() -> list[Extension]:
     """
-    Return the compiled cycle (src/fast_cycle.cpp) as an extension, if it can be built.
+    Return the compiled cycle (src/fast_cycle.hpp) as extensions, if they can be built.
 
     It needs pybind11, Eigen and ProxSuite's headers and a C++17 compiler. Without them,
     or if it fails to compile (``optional``), the package installs without it and the
@@ -61,11 +62,22 @@ def fast_cycle_extensions() -> list[Extension]:
         print("setup.py: Eigen's or ProxSuite's headers not found: not building the "
               'compiled cycle')
         return []
-    return [Extension(
-        'grasp_torque_opt.control._fast_cycle', ['src/fast_cycle.cpp'],
-        include_dirs=[pybind11.get_include(), eigen, proxsuite], language='c++',
-        extra_compile_args=['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden'],
-        optional=True)]
+    # No debug information (Python's own flags ask for -g: 58 MB instead of 1 MB); the
+    # libraries' headers as system headers (their own warnings are theirs).
+    common = ['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden', '-g0',
+              '-isystem', eigen, '-isystem', proxsuite]
+    out = [Extension('grasp_torque_opt.control._fast_cycle', ['src/fast_cycle.cpp'],
+                     include_dirs=[pybind11.get_include()], language='c++',
+                     extra_compile_args=common, depends=['src/fast_cycle.hpp'], optional=True)]
+    if platform.machine().lower() in ('x86_64', 'amd64'):
+        # As ProxSuite's own wheel does: a second build with AVX2 and FMA, loaded only on
+        # a CPU that has them (grasp_torque_opt/control/compiled.py). About 15% faster.
+        out.append(Extension(
+            'grasp_torque_opt.control._fast_cycle_avx2', ['src/fast_cycle_avx2.cpp'],
+            include_dirs=[pybind11.get_include()], language='c++',
+            extra_compile_args=[*common, '-mavx2', '-mfma'], depends=['src/fast_cycle.hpp'],
+            optional=True))
+    return out
 
 
 package_name = 'grasp_torque_opt'

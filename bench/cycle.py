@@ -27,7 +27,10 @@ The paths:
   a solver reused across cycles), with each stage's share of the total;
 - ``controller``: what the node runs on each joint state, without ROS: the joint
   state checked and taken, then ``TorqueController.cycle`` (kinematics, gravity
-  torques when compensated, maps, build, solve, certificate, gate).
+  torques when compensated, maps, build, solve, certificate, gate), twice: as the
+  node runs it by default (compiled where it applies, docs/design.md section 2.6;
+  "compiled answered" counts its certified cycles) and with ``compiled=False``
+  (the Python cycle everywhere).
 
 Speed is measured here, never asserted in a test.
 """
@@ -161,11 +164,12 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jit
     return out
 
 
-def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jitter'
-                     ) -> dict:
+def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jitter',
+                     compiled: bool = True) -> dict:
     """Time the node's cycle without ROS: take a joint state, then run the cycle."""
     backend = variant.partition('+')[0]
-    ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True), backend=backend,
+    ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True, compiled=compiled),
+                            backend=backend,
                             warm_start=variant.endswith('+warm'),
                             fallback=None if backend == 'daqp' else 'daqp')
     names = list(setup.hand.joints)
@@ -182,9 +186,13 @@ def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str 
             samples.append(elapsed)
             published += result.kind == 'solution'
     solver = ctrl.solver
+    fast = ctrl.compiled_cycle
     return {'total': summary(samples), 'certified_commands': published, 'cycles': repeats,
             'warm_solves': getattr(solver, 'warm_solves', 0),
-            'warm_start_fallbacks': getattr(solver, 'fallbacks', 0)}
+            'warm_start_fallbacks': getattr(solver, 'fallbacks', 0),
+            'compiled_solves': fast.solves if fast is not None else 0,
+            'compiled_handed_back': fast.handed_back if fast is not None else 0,
+            'python_because': ctrl.compiled_reason if fast is None or fast.gave_up else ''}
 
 
 #: What is timed: each backend, and DAQP with its verified warm start.
@@ -204,6 +212,8 @@ def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS,
                 r = res[f'{b} {motion}'] = {'core': core}
                 if 'skipped' not in core:
                     r['controller'] = bench_controller(setup, b, repeats, motion)
+                    r['controller_python'] = bench_controller(setup, b, repeats, motion,
+                                                              compiled=False)
     return out
 
 
@@ -211,25 +221,30 @@ def table(results: dict) -> str:
     """Format a markdown table: per scenario and backend, stage medians [us], totals."""
     head = ('| scenario | backend, motion | maps | build | solve | certify | core median '
             '| core p99 | fallbacks / failed | node cycle median | node cycle p99 '
-            '| warm redone cold |')
-    lines = [head, '|' + '---|' * 12]
+            '| warm redone cold | compiled answered | Python cycle median | Python cycle p99 |')
+    lines = [head, '|' + '---|' * 15]
     for name, res in results['scenarios'].items():
         for b, r in res.items():
             core = r['core']
             if 'skipped' in core:
                 lines.append(f"| {name} | {b} | - | - | - | - | skipped: {core['skipped']} "
-                             '| | | | | |')
+                             '| | | | | | | | |')
                 continue
             stages = ' | '.join(f"{1e6 * core[k]['median_s']:.0f} ({100 * core[k]['share']:.0f}%)"
                                 for k in STAGES)
-            ctl = r['controller']['total']
-            redone = (f"{r['controller']['warm_start_fallbacks']} of "
-                      f"{r['controller']['warm_solves']}" if '+warm' in b else '-')
+            c = r['controller']
+            ctl, py = c['total'], r['controller_python']['total']
+            redone = (f"{c['warm_start_fallbacks']} of {c['warm_solves']}" if '+warm' in b
+                      else '-')
+            answered = (f"{c['compiled_solves']} of {c['cycles'] + 50}" if c['compiled_solves']
+                        else f"0 ({c['python_because'].split(' (')[0]})")
             lines.append(f"| {name} | {b} | {stages} | {1e6 * core['total']['median_s']:.0f} | "
                          f"{1e6 * core['total']['p99_s']:.0f} | {core['fallbacks']} / "
                          f"{core['failed']} | {1e6 * ctl['median_s']:.0f} | "
-                         f"{1e6 * ctl['p99_s']:.0f} | {redone} |")
-    return '\n'.join(lines) + '\n\n(times in us; share of the core cycle in parentheses)'
+                         f"{1e6 * ctl['p99_s']:.0f} | {redone} | {answered} | "
+                         f"{1e6 * py['median_s']:.0f} | {1e6 * py['p99_s']:.0f} |")
+    return '\n'.join(lines) + ('\n\n(times in us; share of the core cycle in parentheses; '
+                               "the core cycle is the library's Python solve)")
 
 
 def main() -> None:

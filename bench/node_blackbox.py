@@ -14,8 +14,10 @@ Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000]
 Each case starts one answering process exactly as a user would, with nothing
 added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
 (the default executor; the default backend, ProxSuite with its verified warm
-start), then the same with ``-p solver.warm_start:=false`` (the cold ProxSuite
-default before the warm start), with ``-p solver.backend:=daqp``, and the trivial
+start, in the compiled cycle), then the same with ``-p solver.compiled:=false``
+(the Python cycle, the default before the compiled one), with that and
+``-p solver.warm_start:=false`` as well (the cold ProxSuite default before the
+warm start), with ``-p solver.backend:=daqp``, and the trivial
 echo node of ``bench/node_load.py`` (one zero command per joint state). A
 separate process publishes Allegro joint states at the rate with sensor-data
 QoS for ``--duration`` seconds once the answering node is discovered and has
@@ -57,7 +59,9 @@ PARAMS = CONFIG / 'allegro_right_node.yaml'
 SCENARIO = CONFIG / 'allegro_right.yaml'
 #: Answering processes: name -> extra node arguments (None: the echo node).
 TARGETS = {'echo': None, 'grasp_torque_node (default)': [],
-           'grasp_torque_node warm_start:=false': ['-p', 'solver.warm_start:=false'],
+           'grasp_torque_node compiled:=false': ['-p', 'solver.compiled:=false'],
+           'grasp_torque_node warm_start:=false compiled:=false':
+               ['-p', 'solver.warm_start:=false', '-p', 'solver.compiled:=false'],
            'grasp_torque_node backend:=daqp': ['-p', 'solver.backend:=daqp']}
 DRAIN_S = 0.5
 READY_TIMEOUT_S = 15.0

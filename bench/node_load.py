@@ -12,12 +12,14 @@ The node under load: latency and dropped cycles of grasp_torque_node beside a tr
 Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
        [--hands allegro planar] [--executors single events] [--out FILE]
 
-For each hand, joint-state rate and rclpy executor, three answering processes
+For each hand, joint-state rate and rclpy executor, four answering processes
 are measured in turn with the same load process:
 
 - ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
-  ``publish_stamped_command:=true``), as configured (ProxSuite) and with
-  ``solver.backend:=daqp`` (target ``grasp_torque_node/daqp``);
+  ``publish_stamped_command:=true``), as configured (ProxSuite, the compiled cycle
+  where it applies), with ``solver.compiled:=false`` (the Python cycle, target
+  ``grasp_torque_node/python``) and with ``solver.backend:=daqp`` (target
+  ``grasp_torque_node/daqp``);
 - an echo node written here, named ``grasp_torque_node`` too, that answers each
   joint state with zero torques on ``effort_commands`` and the stamped copy on
   ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
@@ -71,7 +73,10 @@ from ros_load import (  # noqa: E402
 HANDS = {'allegro': ('allegro_right.yaml', 'allegro_right_node.yaml'),
          'planar': ('planar_two_finger.yaml', 'planar_two_finger_node.yaml')}
 #: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
-TARGETS = ('echo', 'grasp_torque_node', 'grasp_torque_node/daqp')
+TARGETS = ('echo', 'grasp_torque_node', 'grasp_torque_node/python', 'grasp_torque_node/daqp')
+#: The node's arguments added per target (the default: none).
+TARGET_ARGS = {'grasp_torque_node/python': ['-p', 'solver.compiled:=false'],
+               'grasp_torque_node/daqp': ['-p', 'solver.backend:=daqp']}
 WARMUP_S = 1.0
 #: After the last joint state, how long commands in flight are still awaited [s].
 DRAIN_S = 0.5
@@ -271,8 +276,7 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
         cmd = me + ['--role', 'echo', '--executor', executor, '--joints', ','.join(joints)]
     else:
         extra = ['--log-level', 'error']
-        if '/' in target:
-            extra += ['-p', f"solver.backend:={target.split('/', 1)[1]}"]
+        extra += TARGET_ARGS.get(target, [])
         cmd = node_command(CONFIG / HANDS[hand][1], executor, extra)
     result_file = tmp / f'{tag}.json'
     load_cmd = me + ['--role', 'load', '--hand', hand, '--rate', str(rate),

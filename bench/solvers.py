@@ -88,7 +88,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, report, ROOT, SCENARIOS  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings  # noqa: E402
-from grasp_torque_opt.core.certificate import certify  # noqa: E402
+from grasp_torque_opt.control import compiled  # noqa: E402
+from grasp_torque_opt.core.certificate import certify, DEFAULT_TOLERANCE  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.core.solution import RawResult  # noqa: E402
 from grasp_torque_opt.core.tau_qp import build_tau_qp, TauQP  # noqa: E402
@@ -426,6 +427,49 @@ def warm_pair(grasps: list[Grasp], refs: list[np.ndarray | None], cold, warm) ->
             'warm_iterations_median': float(np.median(it_warm))}
 
 
+def warm_compiled(grasps: list[Grasp], refs: list[np.ndarray | None]) -> dict:
+    """
+    Run the node's default, the compiled cycle (docs/design.md section 2.6), on the steps.
+
+    Timed per step is its whole call (maps, build, warm solve, KKT check, certificate);
+    a step it hands back (the node's Python cycle or fallback answers it) is counted,
+    and its answers are held to the cold ProxSuite optimum and the force QP.
+    """
+    if not compiled.available():
+        return {'skipped': compiled.IMPORT_ERROR}
+    solver = make_solver('proxsuite', warm_start=True)
+    cycle = compiled.CompiledCycle(grasps[0].setup, solver, DEFAULT_TOLERANCE)
+    cold = make_solver('proxsuite')
+    times, handed, off, worst = [], 0, 0, 0.0
+    off_ref = {'cold': 0, 'warm': 0}
+    cold_bad, verdict = 0, 0
+    for g, ref in zip(grasps, refs):
+        t0 = time.perf_counter()
+        sol, _ = cycle.solve(g.setup, None)
+        times.append(time.perf_counter() - t0)
+        ok_c, tau_c, _ = outcome(g, cold.solve(g.qp), 'qp')
+        cold_bad += not ok_c
+        if ok_c and ref is not None:
+            off_ref['cold'] += float(np.max(np.abs(tau_c - ref))) > AGREE_TOL
+        verdict += (sol is not None) != ok_c
+        if sol is None:
+            handed += 1
+            continue
+        if ref is not None:
+            off_ref['warm'] += float(np.max(np.abs(sol.tau - ref))) > AGREE_TOL
+        if ok_c:
+            d = float(np.max(np.abs(sol.tau - tau_c)))
+            worst = max(worst, d)
+            off += d > AGREE_TOL
+    return {'steps': len(grasps), 'module': cycle.module.__name__.rsplit('.', 1)[-1],
+            'handed_back': handed, 'warm_solves': solver.warm_solves,
+            'warm_redone_cold': solver.fallbacks, 'verdict_differs': verdict,
+            'cold_not_certified': cold_bad, 'off_cold_optimum': off,
+            'max_abs_tau_dev_from_cold': worst, 'cold_off_reference': off_ref['cold'],
+            'off_reference': off_ref['warm'], 'median_s': pct(times, 50),
+            'p99_s': pct(times, 99)}
+
+
 def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
     base = GraspSetup.from_file(SCENARIO)
     out = {}
@@ -443,6 +487,7 @@ def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
                                          make_solver('proxsuite', variant, warm_start=True)),
             'daqp': warm_pair(grasps, refs, make_solver('daqp'),
                               make_solver('daqp', warm_start=True)),
+            'compiled': warm_compiled(grasps, refs),
         }
     return out
 
@@ -511,7 +556,7 @@ def table(results: dict) -> str:
               '|---|---|---|---|---|---:|---|---|---:|---|']
     for seq, res in results['warm_starts'].items():
         for solver, w in res.items():
-            if not isinstance(w, dict):
+            if not isinstance(w, dict) or solver == 'compiled':
                 continue
             lines.append(
                 f"| {seq} ({w['steps']}) | {solver} | {_us(w['cold_median_s'])} / "
@@ -522,6 +567,24 @@ def table(results: dict) -> str:
                 f"{w['warm_off_cold_optimum']} | "
                 f"{w['warm_max_abs_tau_dev_from_cold']:.1e} | {w['cold_off_reference']} / "
                 f"{w['warm_off_reference']} |")
+    lines += ['', "**the compiled cycle** (the node's default: maps, build, warm ProxSuite "
+              'solve, KKT check and certificate in one call; handed back: left to the '
+              'Python cycle and the fallback, as the infeasible steps must be)', '',
+              '| sequence | module | median / p99 [us] | handed back | warm redone cold '
+              '| verdict differs from cold | off the cold optimum / max abs [N m] '
+              '| off ref |', '|---|---|---|---:|---|---:|---|---:|']
+    for seq, res in results['warm_starts'].items():
+        w = res.get('compiled')
+        if not w:
+            continue
+        if 'skipped' in w:
+            lines.append(f"| {seq} | skipped: {w['skipped']} | | | | | | |")
+            continue
+        lines.append(
+            f"| {seq} ({w['steps']}) | {w['module']} | {_us(w['median_s'])} / "
+            f"{_us(w['p99_s'])} | {w['handed_back']} | {w['warm_redone_cold']} of "
+            f"{w['warm_solves']} | {w['verdict_differs']} | {w['off_cold_optimum']} / "
+            f"{w['max_abs_tau_dev_from_cold']:.1e} | {w['off_reference']} |")
     return '\n'.join(lines)
 
 

@@ -31,7 +31,7 @@ stamp=.venv/.installed
 # Again when the build inputs change: setup.py, pyproject.toml, or the compiled cycle's
 # source (an editable install does not rebuild it by itself).
 if [ ! -f "$stamp" ] || [ setup.py -nt "$stamp" ] || [ pyproject.toml -nt "$stamp" ] ||
-        [ src/fast_cycle.cpp -nt "$stamp" ]; then
+        [ -n "$(find src -newer "$stamp" -print -quit)" ]; then
     .venv/bin/python -m pip install -q --upgrade pip
     .venv/bin/python -m pip install -q -e '.[ros,test,bench,sim,distributed]'
     touch "$stamp"

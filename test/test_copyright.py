@@ -65,7 +65,7 @@ def header_problem(path: Path) -> str | None:
 def test_copyright():
     files = own_files('.py', '.cpp', '.hpp', '.h')
     assert ROOT / 'setup.py' in files and ROOT / 'test' / 'test_copyright.py' in files
-    assert ROOT / 'src' / 'fast_cycle.cpp' in files
+    assert ROOT / 'src' / 'fast_cycle.hpp' in files
     problems = [f'{p.relative_to(ROOT)}: {why}' for p in files if (why := header_problem(p))]
     assert not problems, 'Files without the copyright header:\n' + '\n'.join(problems)
     if ament_copyright is not None:

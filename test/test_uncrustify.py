@@ -28,6 +28,6 @@ def test_uncrustify(monkeypatch):
         monkeypatch.setenv('PATH', f"{vendored}{os.pathsep}{os.environ.get('PATH', '')}")
     assert shutil.which('uncrustify'), 'no uncrustify program (pip install .[test])'
     files = own_files('.cpp', '.hpp', '.h')
-    assert ROOT / 'src' / 'fast_cycle.cpp' in files
+    assert ROOT / 'src' / 'fast_cycle.hpp' in files
     rc = main(argv=[str(p) for p in files])
     assert rc == 0, 'Found code style errors (ament_uncrustify --reformat fixes them)'

@@ -9,9 +9,10 @@
 """
 The node's cycle compiled: maps, build, warm ProxSuite solve and certificate in C++.
 
-``grasp_torque_opt.control._fast_cycle`` (``src/fast_cycle.cpp``, built by ``setup.py`` with
-pybind11, Eigen and ProxSuite's C++ headers) is the Python cycle written again, rule
-for rule, for the case the node runs on every joint state (docs/design.md section 2.6):
+``grasp_torque_opt.control._fast_cycle`` (``src/fast_cycle.hpp``, built by ``setup.py`` with
+pybind11, Eigen and ProxSuite's C++ headers; on x86-64 also ``_fast_cycle_avx2``, used
+where the CPU runs AVX2 and FMA) is the Python cycle written again, rule for rule, for
+the case the node runs on every joint state (docs/design.md section 2.6):
 
 - the ``tau-qp`` method and the ``sum-of-squares`` objective;
 - the ProxSuite backend with the package's settings (Diagonal Hessian,
@@ -31,6 +32,8 @@ one to.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import importlib
+import platform
 
 from grasp_torque_opt.backends.proxsuite import (
     ESTIMATE_DECAY,
@@ -48,26 +51,50 @@ from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
 import numpy as np
 import pinocchio as pin
 
-#: The interface of src/fast_cycle.cpp this module speaks (its ``API``).
+#: The interface of src/fast_cycle.hpp this module speaks (its ``API``).
 API = 1
 
-try:
-    from grasp_torque_opt.control import _fast_cycle
-    IMPORT_ERROR = ''
-    if getattr(_fast_cycle, 'API', None) != API:
-        IMPORT_ERROR = ('grasp_torque_opt.control._fast_cycle was built from another '
-                        'src/fast_cycle.cpp: run scripts/setup.sh again')
-        _fast_cycle = None
-except ImportError as e:  # not built (no compiler, or a colcon build without pybind11)
-    _fast_cycle = None
-    IMPORT_ERROR = f'grasp_torque_opt.control._fast_cycle is not built ({e})'
+
+def cpu_has_avx2() -> bool:
+    """Tell whether this CPU and its OS run AVX2 and FMA code (ProxSuite's own cpuid check)."""
+    if platform.machine().lower() not in ('x86_64', 'amd64'):
+        return False
+    try:
+        from proxsuite import instructionset
+        return bool(instructionset.has_AVX2() and instructionset.has_FMA()
+                    and instructionset.has_OSXSAVE())
+    except (ImportError, AttributeError):
+        return False
+
+
+def load(name: str):
+    """Return the module ``name`` of the compiled cycle and '', or None and why not."""
+    try:
+        module = importlib.import_module(f'grasp_torque_opt.control.{name}')
+    except ImportError as e:  # not built (no compiler, or a colcon build without pybind11)
+        return None, f'grasp_torque_opt.control.{name} is not built ({e})'
+    if getattr(module, 'API', None) != API:
+        return None, (f'grasp_torque_opt.control.{name} was built from another '
+                      'src/fast_cycle.hpp: run scripts/setup.sh again')
+    return module, ''
+
+
+#: The modules built (``_fast_cycle_avx2`` only where this CPU runs it), best first.
+MODULES = ('_fast_cycle_avx2', '_fast_cycle') if cpu_has_avx2() else ('_fast_cycle',)
+_fast_cycle, IMPORT_ERROR = None, ''
+for _name in MODULES:
+    _fast_cycle, _why = load(_name)
+    if _fast_cycle is not None:
+        IMPORT_ERROR = ''
+        break
+    IMPORT_ERROR = IMPORT_ERROR or _why
 
 #: Share of the time left that the compiled ProxSuite solve may use; the fallback gets
 #: the rest (as :data:`grasp_torque_opt.methods.dispatch.PRIMARY_SHARE`).
 PRIMARY_SHARE = 0.8
 #: Outcome codes after which ProxSuite was tried (warm, and cold if the warm answer
 #: failed): the controller asks its fallback backend next, not ProxSuite again.
-SOLVER_CODES = (3, 4, 5)  # NOT_SOLVED, NOT_CERTIFIED, TIMED_OUT (src/fast_cycle.cpp)
+SOLVER_CODES = (3, 4, 5)  # NOT_SOLVED, NOT_CERTIFIED, TIMED_OUT (src/fast_cycle.hpp)
 #: After this many cycles in a row handed back as not of full column rank (a grasp
 #: with internal-force variables), the compiled cycle is not tried again for the grasp.
 RANK_GIVE_UP = 10
@@ -127,9 +154,11 @@ class CompiledCycle:
             and its counters (``warm_solves``, ``fallbacks``, ``timeouts``) count the
             compiled solves too.
         tolerance: certificate tolerance.
+        module: the compiled module to use (default: the best one built for this CPU).
     """
 
-    def __init__(self, setup: GraspSetup, solver: TauQPSolver, tolerance: float) -> None:
+    def __init__(self, setup: GraspSetup, solver: TauQPSolver, tolerance: float,
+                 module=None) -> None:
         self.solver = solver
         self.tolerance = tolerance
         self._key = self.key(setup, solver, tolerance)
@@ -138,14 +167,16 @@ class CompiledCycle:
         S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
                                  friction.min_normal_force)
         st = solver.settings
-        s = _fast_cycle.Settings()
+        s = (module or _fast_cycle).Settings()
         s.eps_abs, s.eps_rel, s.eps_primal_inf = st.eps_abs, st.eps_rel, st.eps_primal_inf
         s.max_iter, s.max_iter_in = st.max_iter, st.max_iter_in
         s.kkt_tolerance, s.certificate_tolerance = KKT_TOLERANCE, tolerance
         s.qr_rtol, s.box_margin = QR_RTOL, BOX_MARGIN
         s.inner_iteration_s, s.estimate_decay = INNER_ITERATION_S, ESTIMATE_DECAY
         s.primary_share = PRIMARY_SHARE
-        self._cycle = _fast_cycle.FastCycle(
+        #: The compiled module in use (``_fast_cycle`` or ``_fast_cycle_avx2``).
+        self.module = module or _fast_cycle
+        self._cycle = self.module.FastCycle(
             np.asarray(hand.idx_v, dtype=np.int64), S_i, b_i,
             np.asarray(setup.weights, dtype=float), np.asarray(hand.torque_limits, dtype=float),
             friction.mu1, friction.mu2, setup.friction.mu1, setup.friction.mu2,
@@ -238,8 +269,8 @@ class CompiledCycle:
         solver.fallbacks += a.redone_cold
         solver.last_warm = a.warm
         self.last_code = a.code
-        if a.code != _fast_cycle.CERTIFIED:
-            solver.timeouts += a.code == _fast_cycle.TIMED_OUT
+        if a.code != self.module.CERTIFIED:
+            solver.timeouts += a.code == self.module.TIMED_OUT
             self.handed_back += 1
             self.last_reason = f'compiled cycle: {a.message}'
             self._rank_misses = self._rank_misses + 1 if a.message.startswith('A = ') else 0

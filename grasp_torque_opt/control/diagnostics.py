@@ -101,6 +101,8 @@ def report(controller: TorqueController, now: float) -> Report:
     fast = c.compiled_cycle
     values += [('solver.compiled', 'true' if fast is not None and not fast.gave_up else
                 f'false: {c.compiled_reason}' if c.compiled_reason else 'no cycle yet'),
+               ('solver.compiled_module', fast.module.__name__.rsplit('.', 1)[-1]
+                if fast is not None else 'none'),
                ('solver.compiled_solves', str(fast.solves if fast is not None else 0)),
                ('solver.compiled_handed_back', str(fast.handed_back if fast is not None else 0))]
     values += [(f'rejected.{k}', str(v)) for k, v in n.rejected.items()]

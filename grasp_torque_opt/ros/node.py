@@ -238,7 +238,7 @@ PARAMETERS: dict[str, Spec] = {
                               'is redone cold in the same cycle and counted (diagnostics '
                               'solver.warm_start_fallbacks). No effect on quadprog.'),
     'solver.compiled': Spec('Run the cycle compiled (maps, build, ProxSuite solve and '
-                            'certificate in C++, src/fast_cycle.cpp) where it applies: '
+                            'certificate in C++, src/fast_cycle.hpp) where it applies: '
                             'tau-qp, sum-of-squares, ProxSuite, no internal-force variables. '
                             'Elsewhere, and on any answer it cannot certify, the Python '
                             'cycle answers (diagnostics solver.compiled). false: the Python '

@@ -7,7 +7,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-The compiled cycle (src/fast_cycle.cpp) against the Python cycle and independent solvers.
+The compiled cycle (src/fast_cycle.hpp) against the Python cycle and independent solvers.
 
 The Python cycle is the reference; the optimum of each compiled command is checked
 against DAQP (a dual active-set method, not ProxSuite) on the QP the Python builder
@@ -70,6 +70,9 @@ def reference(setup, q, g):
 def test_the_compiled_cycle_is_built():
     # The README's setup builds it; without it the node runs 3 to 4 times slower.
     assert compiled.available(), compiled.IMPORT_ERROR
+    for name in compiled.MODULES:  # and the AVX2 build where this CPU runs it
+        assert compiled.load(name)[0] is not None, compiled.load(name)[1]
+    assert compiled._fast_cycle.__name__.endswith(compiled.MODULES[0])
 
 
 @pytest.mark.parametrize('gravity', [False, True])
@@ -245,14 +248,47 @@ def test_a_new_friction_or_weights_make_a_new_compiled_cycle(allegro):
         b.solution.tau @ (qp.H @ b.solution.tau), rel=1e-7)
 
 
-def test_a_contact_list_of_another_size_is_taken(allegro_doc):
+def test_a_contact_list_of_another_size_is_taken_cold(allegro_doc, allegro):
+    # Four fingertips, then three (a finger lifted), then four again: the same compiled
+    # cycle (same hand, friction, weights) meets a QP of another size and starts cold.
     three = setup_from_doc(with_contacts(allegro_doc, allegro_doc['grasp']['contacts'][:3]))
-    fast, slow = fresh(three), fresh(three, compiled=False)
-    names, pos = joint_state(three)
-    for ctrl in (fast, slow):
-        ctrl.update_joint_state(names, pos, 1.0)
-    a, b = fast.cycle(1.0), slow.cycle(1.0)
-    assert a.kind == b.kind
-    if a.kind == 'solution':
-        np.testing.assert_allclose(a.command, b.command, atol=1e-6)
-    assert a.solution.status == b.solution.status
+    fast, slow = fresh(allegro), fresh(allegro, compiled=False)
+    names, pos = joint_state(allegro)
+    certified = 0
+    for k, contacts in enumerate([allegro.contacts, three.contacts, allegro.contacts]):
+        results = []
+        for ctrl in (fast, slow):
+            ctrl.setup = dataclasses.replace(ctrl.setup, contacts=contacts)
+            ctrl.update_joint_state(names, pos, 1.0 + k)
+            results.append(ctrl.cycle(1.0 + k))
+        a, b = results
+        assert a.kind == b.kind and a.solution.status == b.solution.status
+        if a.kind == 'solution':
+            certified += 1
+            np.testing.assert_allclose(a.command, b.command, atol=1e-6)
+        assert a.maps.G.shape == (6, 4 * len(contacts))
+    assert certified >= 2  # four fingertips hold it; three may not
+    assert fast.compiled_cycle.solves == certified and fast.compiled_cycle._cycle.inits == 3
+
+
+@pytest.mark.parametrize('name', compiled.MODULES)
+def test_every_module_built_for_this_cpu_gives_the_python_optimum(allegro, name):
+    # The node loads the best of them; the other must be right as well (another CPU).
+    module, why = compiled.load(name)
+    assert module is not None, why
+    cycle = compiled.CompiledCycle(allegro, TauQPSolver(warm_start=True), 1e-6, module=module)
+    assert cycle.module is module
+    python = TauQPSolver()
+    for q in moving_states(allegro, 60, seed=5):
+        full = allegro.q.copy()
+        full[allegro.hand.idx_q] = q
+        at = dataclasses.replace(allegro, q=full)
+        sol, maps = cycle.solve(at, None)
+        ref = solve(at, solver=python)
+        assert sol.optimal and ref.optimal
+        np.testing.assert_allclose(sol.tau, ref.tau, atol=1e-6)
+        np.testing.assert_allclose(sol.wrenches, ref.wrenches, atol=1e-6)
+        # Within the certificate's tolerance (a warm answer sits up to ~1e-8 N outside the
+        # polygon where the cold one is on it; both are solver-tolerance deep).
+        assert sol.certificate.ok and sol.certificate.worst <= 1e-7
+    assert cycle.solves == 60 and cycle.solver.warm_solves == 59

@@ -1,0 +1,702 @@
+// Copyright 2026 grasp_torque_opt developers
+//
+// Use of this source code is governed by a BSD-style
+// license that can be found in the LICENSE file or at
+// https://developers.google.com/open-source/licenses/bsd
+//
+// SPDX-License-Identifier: BSD-3-Clause
+
+// The node's default cycle compiled: grasp maps, tau-QP build, warm ProxSuite solve,
+// KKT check and certificate in one call (grasp_torque_opt.control._fast_cycle and
+// _fast_cycle_avx2, from fast_cycle.cpp and fast_cycle_avx2.cpp).
+//
+// It is the Python cycle (core/grasp_maps.py, core/tau_qp.py, backends/proxsuite.py,
+// core/certificate.py, methods/dispatch.py) written again, rule for rule, for the case
+// the node runs on every joint state: the tau-QP, the sum of squares, A = [G; J^T] of
+// full column rank (a QR, no internal-force variables). Anything else, and any answer
+// it cannot certify, it hands back to the Python cycle, which stays the reference
+// (docs/design.md section 2.6). Pinocchio's kinematics stay in Python: this file
+// takes the link placements and Jacobians that Pinocchio computed.
+
+#ifndef FAST_CYCLE_HPP_
+#define FAST_CYCLE_HPP_
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <proxsuite/proxqp/dense/dense.hpp>
+
+namespace py = pybind11;
+namespace dense = proxsuite::proxqp::dense;
+
+using Mat = Eigen::MatrixXd;
+using Vec = Eigen::VectorXd;
+using RowMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using Clock = std::chrono::steady_clock;
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+namespace
+{
+
+// Outcome codes (mirrored in grasp_torque_opt/control/compiled.py).
+constexpr int CERTIFIED = 0;     // certified optimum
+constexpr int NOT_HANDLED = 1;   // inputs this path does not take (rank, normals): Python
+constexpr int BAD_DATA = 2;      // QP data not finite or bounds inverted
+constexpr int NOT_SOLVED = 3;    // ProxSuite did not call it solved
+constexpr int NOT_CERTIFIED = 4;  // solved, but the certificate failed
+constexpr int TIMED_OUT = 5;     // the time budget stopped the solver
+
+double seconds_since(Clock::time_point t0)
+{
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+Eigen::Matrix3d skew(const Eigen::Vector3d & v)
+{
+  Eigen::Matrix3d s;
+  s << 0.0, -v(2), v(1), v(2), 0.0, -v(0), -v(1), v(0), 0.0;
+  return s;
+}
+
+// contact_frame.contact_rotations for one contact; false where Python raises.
+bool contact_rotation(
+  const Eigen::Vector3d & normal, const double * tangent,
+  Eigen::Matrix3d & R)
+{
+  const double nx = normal(0), ny = normal(1), nz = normal(2);
+  const double norm = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (!std::isfinite(norm) || norm < 1e-9) {
+    return false;
+  }
+  const double zx = nx / norm, zy = ny / norm, zz = nz / norm;
+  double xx, xy, xz;
+  if (tangent == nullptr) {
+    const double ax = std::abs(zx), ay = std::abs(zy), az = std::abs(zz);
+    if (ax <= ay && ax <= az) {
+      xx = 0.0, xy = -zz, xz = zy;
+    } else if (ay <= az) {
+      xx = zz, xy = 0.0, xz = -zx;
+    } else {
+      xx = -zy, xy = zx, xz = 0.0;
+    }
+  } else {
+    double tx = tangent[0], ty = tangent[1], tz = tangent[2];
+    const double tn = std::sqrt(tx * tx + ty * ty + tz * tz);
+    if (!std::isfinite(tn) || tn < 1e-9) {
+      return false;
+    }
+    tx /= tn, ty /= tn, tz /= tn;
+    const double d = tx * zx + ty * zy + tz * zz;
+    xx = tx - d * zx, xy = ty - d * zy, xz = tz - d * zz;
+    if (std::sqrt(xx * xx + xy * xy + xz * xz) < 1e-6) {
+      return false;
+    }
+  }
+  const double k = 1.0 / std::sqrt(xx * xx + xy * xy + xz * xz);
+  xx *= k, xy *= k, xz *= k;
+  const double yx = zy * xz - zz * xy, yy = zz * xx - zx * xz, yz = zx * xy - zy * xx;
+  R << xx, yx, zx, xy, yy, zy, xz, yz, zz;
+  return true;
+}
+
+template<typename Derived>
+double max_abs(const Eigen::MatrixBase<Derived> & a)
+{
+  return a.size() ? a.cwiseAbs().maxCoeff() : 0.0;
+}
+
+struct Settings
+{
+  double eps_abs, eps_rel, eps_primal_inf;
+  int max_iter, max_iter_in;
+  double kkt_tolerance, certificate_tolerance, qr_rtol, box_margin;
+  double inner_iteration_s, estimate_decay, primary_share;
+};
+
+// One cycle's answer, read by compiled.py.
+struct Answer
+{
+  int code = NOT_HANDLED;
+  std::string message;
+  Vec tau, f;
+  RowMat G, J, positions, rotations;  // rotations: p rows of 9 (row-major R_i)
+  int iterations = 0;
+  bool warm = false;        // the answer came from a warm start
+  int warm_solves = 0;      // warm starts tried in this call (0 or 1)
+  int redone_cold = 0;      // warm answers redone cold in this call
+  double cert[5] = {0, 0, 0, 0, 0};    // equilibrium, torque, cone, normal_force, limit
+  bool finite = false;
+  Vec usage;
+  double max_torque_ratio = 0.0;
+  double solve_time_s = 0.0;
+  double t_maps = 0.0, t_build = 0.0, t_solve = 0.0, t_certify = 0.0;
+};
+
+class FastCycle
+{
+public:
+  FastCycle(
+    py::array_t<int64_t> idx_v, Array S_i, Array b_i, Array weights, Array limits,
+    double mu1, double mu2, double mu1_usage, double mu2_usage,
+    double min_normal_force, bool warm_start, const Settings & settings)
+  : mu1_(mu1), mu2_(mu2), mu1_usage_(mu1_usage), mu2_usage_(mu2_usage),
+    fmin_(min_normal_force), warm_start_(warm_start), s_(settings)
+  {
+    auto iv = idx_v.unchecked<1>();
+    for (py::ssize_t i = 0; i < iv.shape(0); ++i) {
+      idx_v_.push_back(iv(i));
+    }
+    m_ = static_cast<int>(idx_v_.size());
+    if (S_i.ndim() != 2 || S_i.shape(1) != 4 || b_i.ndim() != 1 ||
+      b_i.shape(0) != S_i.shape(0))
+    {
+      throw std::invalid_argument("S_i must be (rows, 4) and b_i (rows,)");
+    }
+    S_i_ = Eigen::Map<const RowMat>(S_i.data(), S_i.shape(0), 4);
+    b_i_ = Eigen::Map<const Vec>(b_i.data(), b_i.shape(0));
+    if (weights.size() != m_ || limits.size() != m_) {
+      throw std::invalid_argument("weights and limits need one entry per actuated joint");
+    }
+    weights_ = Eigen::Map<const Vec>(weights.data(), m_);
+    limits_ = Eigen::Map<const Vec>(limits.data(), m_);
+  }
+
+  // One cycle. oMf: (p, 4, 4) link placements; J6: (p, 6, nv) LOCAL_WORLD_ALIGNED
+  // link Jacobians; points: (p, 3) contact points in their link frames; normals and
+  // tangents (p, 3) in base axes, used where has_normal / has_tangent; c (3); w_ext (6);
+  // offset (m) added to tau before commanding (g(q)) or empty; time_left [s] (< 0:
+  // none).
+  Answer solve(
+    Array oMf, Array J6, Array points, Array normals, py::array_t<bool> has_normal,
+    Array tangents, py::array_t<bool> has_tangent, Array c, Array w_ext,
+    Array offset, double time_left)
+  {
+    Answer a;
+    const auto t0 = Clock::now();
+    const int p = static_cast<int>(oMf.shape(0));
+    if (oMf.ndim() != 3 || oMf.shape(1) != 4 || oMf.shape(2) != 4 || J6.ndim() != 3 ||
+      J6.shape(0) != p || J6.shape(1) != 6 || points.shape(0) != p ||
+      normals.shape(0) != p || tangents.shape(0) != p || has_normal.size() != p ||
+      has_tangent.size() != p || c.size() != 3 || w_ext.size() != 6 ||
+      (offset.size() != 0 && offset.size() != m_) || p == 0)
+    {
+      a.message = "inputs of the wrong shape";
+      return a;
+    }
+    const int nv = static_cast<int>(J6.shape(2));
+    for (int64_t j : idx_v_) {
+      if (j < 0 || j >= nv) {
+        a.message = "joint index out of range";
+        return a;
+      }
+    }
+    Eigen::Map<const Eigen::Vector3d> cc(c.data());
+    Eigen::Map<const Eigen::Matrix<double, 6, 1>> w_ext_v(w_ext.data());
+    Vec off = offset.size() ? Vec(Eigen::Map<const Vec>(offset.data(), m_)) :
+      Vec::Zero(m_);
+    {
+      // The GIL is released from here on: nothing below touches a Python object.
+      py::gil_scoped_release release;
+      run(a, p, nv, oMf.data(), J6.data(), points.data(), normals.data(),
+          has_normal.data(), tangents.data(), has_tangent.data(), cc, w_ext_v, off,
+          time_left, t0);
+    }
+    return a;
+  }
+
+  int dims_changes() const {return inits_;}
+
+private:
+  void run(
+    Answer & a, int p, int nv, const double * oMf, const double * J6,
+    const double * pts, const double * nrm, const bool * has_n, const double * tng,
+    const bool * has_t, const Eigen::Vector3d & c,
+    const Eigen::Matrix<double, 6, 1> & w_ext, const Vec & off, double time_left,
+    Clock::time_point t0)
+  {
+    const int m = m_, cols = 4 * p;
+    // -- maps (core/grasp_maps.compute_grasp_maps) -------------------------------------
+    a.G.setZero(6, cols);
+    a.J.resize(cols, m);
+    a.positions.resize(p, 3);
+    a.rotations.resize(p, 9);
+    for (int i = 0; i < p; ++i) {
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf + 16 * i);
+      const Eigen::Matrix3d Rl = M.topLeftCorner<3, 3>();
+      const Eigen::Vector3d o = M.topRightCorner<3, 1>();
+      const Eigen::Vector3d point = Rl * Eigen::Map<const Eigen::Vector3d>(pts + 3 * i) + o;
+      Eigen::Vector3d n;
+      if (has_n[i]) {
+        n = Eigen::Map<const Eigen::Vector3d>(nrm + 3 * i);
+      } else {
+        n = c - point;
+        if (n.dot(n) < 1e-18) {
+          a.message = "a normal cannot be defaulted";
+          return;
+        }
+      }
+      Eigen::Matrix3d R;
+      if (!contact_rotation(n, has_t[i] ? tng + 3 * i : nullptr, R)) {
+        a.message = "a contact frame cannot be made";
+        return;
+      }
+      for (int k = 0; k < 3; ++k) {
+        a.positions(i, k) = point(k);
+      }
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.rotations.row(i).data()) = R;
+      a.G.block<3, 3>(0, 4 * i) = R;
+      a.G.block<3, 3>(3, 4 * i) = skew(point - c) * R;
+      a.G.block<3, 1>(3, 4 * i + 3) = R.col(2);
+      Eigen::Map<const RowMat> Jl(J6 + 6 * nv * i, 6, nv);
+      Eigen::Matrix<double, 6, Eigen::Dynamic> Ja(6, m);
+      for (int j = 0; j < m; ++j) {
+        Ja.col(j) = Jl.col(idx_v_[j]);
+      }
+      const auto Jv = Ja.topRows<3>();
+      const auto Jw = Ja.bottomRows<3>();
+      a.J.block(4 * i, 0, 3, m) = R.transpose() * (Jv - skew(point - o) * Jw);
+      a.J.row(4 * i + 3) = R.col(2).transpose() * Jw;
+    }
+    const auto t1 = Clock::now();
+    a.t_maps = std::chrono::duration<double>(t1 - t0).count();
+
+    // -- build (core/tau_qp.build_tau_qp, the QR branch of decompose) ----------------
+    const int rows = 6 + m;
+    if (rows < cols) {
+      a.message = "A = [G; J^T] has more columns than rows";
+      return;
+    }
+    Mat A_full(rows, cols);
+    A_full.topRows(6) = a.G;
+    A_full.bottomRows(m) = a.J.transpose();
+    if (!A_full.allFinite()) {
+      a.message = "maps not finite";
+      return;
+    }
+    Eigen::HouseholderQR<Mat> qr(A_full);
+    const Mat & packed = qr.matrixQR();
+    const Vec d = packed.diagonal().head(cols).cwiseAbs();
+    if (!(d.minCoeff() > s_.qr_rtol * d.maxCoeff())) {
+      a.message = "A = [G; J^T] is not of full column rank";
+      return;
+    }
+    const Mat Q = qr.householderQ();  // rows x rows
+    const auto Rup = packed.topRows(cols).triangularView<Eigen::Upper>();
+    const Mat pinv = Rup.solve(Q.leftCols(cols).transpose());  // cols x rows
+    const auto U_perp = Q.rightCols(rows - cols);
+    const int n_eq = rows - cols;
+    const auto M1 = pinv.leftCols(6);
+    const auto M2 = pinv.rightCols(m);
+    const Vec w = -w_ext;
+    const int block = static_cast<int>(S_i_.rows()), n_in = block * p;
+    Mat C(n_in, m);
+    Vec u(n_in);
+    const Vec f_w = M1 * w;  // M1 w
+    for (int i = 0; i < p; ++i) {
+      C.middleRows(block * i, block) = S_i_ * M2.middleRows(4 * i, 4);
+      u.segment(block * i, block) = b_i_ - S_i_ * f_w.segment<4>(4 * i);
+    }
+    Mat H = Mat::Zero(m, m);
+    H.diagonal() = 2.0 * weights_;
+    const Vec g = Vec::Zero(m);
+    const Mat A = U_perp.bottomRows(m).transpose();
+    const Vec b = -U_perp.topRows(6).transpose() * w;
+    const Vec tau_min = -limits_ - off, tau_max = limits_ - off;
+    const Vec l_box = tau_min.array() + s_.box_margin;
+    const Vec u_box = tau_max.array() - s_.box_margin;
+    const Vec l = Vec::Constant(n_in, -std::numeric_limits<double>::infinity());
+    const auto t2 = Clock::now();
+    a.t_build = std::chrono::duration<double>(t2 - t1).count();
+
+    // -- solve (backends/proxsuite.TauQPSolver.solve) ---------------------------------
+    // tau_qp.check_data: one sum per array, then the bounds.
+    const double total = H.sum() + g.sum() + A.sum() + b.sum() + C.sum() + u.sum();
+    if (!std::isfinite(total)) {
+      a.code = BAD_DATA;
+      a.message = "QP data not finite";
+      return;
+    }
+    if (!(l_box.array() <= u_box.array()).all()) {
+      a.code = BAD_DATA;
+      a.message = "QP bounds NaN or inverted (lower > upper)";
+      return;
+    }
+    Clock::time_point deadline = Clock::time_point::max();
+    if (time_left >= 0.0) {
+      // dispatch.PRIMARY_SHARE of the time left after the build, as the Python cycle.
+      const double left = time_left - std::chrono::duration<double>(t2 - t0).count();
+      deadline = t2 + std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::duration<double>(s_.primary_share * std::max(0.0, left)));
+    }
+    const bool has_deadline = time_left >= 0.0;
+    bool stopped = false;
+    bool warm = false;
+    try {
+      const std::tuple<int, int, int> dims(m, n_eq, n_in);
+      if (!qp_ || dims != dims_) {
+        inner_s_ = s_.inner_iteration_s *
+          std::max(1.0, static_cast<double>(m) * (m + n_eq + n_in) / (16.0 * 144.0));
+        init(m, n_eq, n_in, H, g, A, b, C, l, u, l_box, u_box);
+        dims_ = dims;
+      } else {
+        warm = warm_start_;
+        qp_->settings.initial_guess =
+          warm ? proxsuite::proxqp::InitialGuessStatus::WARM_START_WITH_PREVIOUS_RESULT :
+          proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
+        update(n_eq, H, g, A, b, C, l, u, l_box, u_box);
+      }
+      a.iterations = solve_until(has_deadline, deadline, stopped);
+      if (warm) {
+        a.warm_solves = 1;
+        const auto & r = qp_->results;
+        bool ok = r.info.status == proxsuite::proxqp::QPSolverOutput::PROXQP_SOLVED &&
+          kkt_violation(H, g, A, b, C, u, l_box, u_box, r.x, r.y, r.z) <=
+          s_.kkt_tolerance;
+        if (!ok && !stopped) {  // the same data, cold
+          a.redone_cold = 1;
+          qp_->settings.initial_guess = proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
+          a.iterations += solve_until(has_deadline, deadline, stopped);
+          warm = false;
+        }
+      }
+      const auto t3 = Clock::now();
+      a.solve_time_s = std::chrono::duration<double>(t3 - t2).count();
+      if (stopped) {
+        a.code = TIMED_OUT;
+        a.message = "time budget spent after " + std::to_string(a.iterations) + " iterations";
+        a.t_solve = a.solve_time_s;
+        return;
+      }
+      certify_answer(a, M1, M2, w, w_ext, tau_min, tau_max);
+      if (a.code == NOT_CERTIFIED && warm) {
+        // dispatch.solve: a warm start that lands off the certificate is redone cold.
+        a.redone_cold += 1;
+        qp_->settings.initial_guess = proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
+        update(n_eq, H, g, A, b, C, l, u, l_box, u_box);
+        a.iterations += solve_until(has_deadline, deadline, stopped);
+        warm = false;
+        if (stopped) {
+          a.code = TIMED_OUT;
+          a.message = "time budget spent after " + std::to_string(a.iterations) +
+            " iterations";
+          a.t_solve = seconds_since(t2);
+          return;
+        }
+        certify_answer(a, M1, M2, w, w_ext, tau_min, tau_max);
+      }
+      a.warm = warm;
+      a.t_solve = std::chrono::duration<double>(t3 - t2).count();
+      a.t_certify = seconds_since(t3);
+    } catch (const std::exception & e) {
+      qp_.reset();
+      a.code = NOT_SOLVED;
+      a.message = std::string("ProxSuite failed: ") + e.what();
+      return;
+    }
+    if (a.code != CERTIFIED) {
+      return;
+    }
+    // dispatch.planner_metrics: usage on the unreduced cone, max |tau + offset| / limit.
+    a.usage.resize(p);
+    for (int i = 0; i < p; ++i) {
+      const double fx = a.f(4 * i), fy = a.f(4 * i + 1), fz = a.f(4 * i + 2),
+        mz = a.f(4 * i + 3);
+      const double demand = std::hypot(fx, fy) / mu1_usage_ + std::abs(mz) / mu2_usage_;
+      a.usage(i) = fz > 0.0 ? demand / fz : std::numeric_limits<double>::infinity();
+    }
+    a.max_torque_ratio = ((a.tau + off).cwiseAbs().array() / limits_.array()).maxCoeff();
+  }
+
+  template<typename M1T, typename M2T>
+  void certify_answer(
+    Answer & a, const M1T & M1, const M2T & M2, const Vec & w,
+    const Eigen::Matrix<double, 6, 1> & w_ext, const Vec & tau_min,
+    const Vec & tau_max)
+  {
+    const auto & r = qp_->results;
+    const std::string status = solver_status(r.info.status);
+    a.message = status;
+    if (r.info.status != proxsuite::proxqp::QPSolverOutput::PROXQP_SOLVED) {
+      a.code = NOT_SOLVED;
+      return;
+    }
+    a.tau = r.x.head(m_);
+    a.f = M1 * w + M2 * a.tau;
+    // core/certificate.certify
+    const int p = static_cast<int>(a.f.size() / 4);
+    if (!std::isfinite(a.tau.sum() + a.f.sum())) {
+      a.finite = false;
+      std::fill(a.cert, a.cert + 5, std::numeric_limits<double>::infinity());
+      a.code = NOT_CERTIFIED;
+      return;
+    }
+    a.finite = true;
+    double worst_margin = std::numeric_limits<double>::infinity();
+    double min_fz = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < p; ++i) {
+      const double fx = a.f(4 * i), fy = a.f(4 * i + 1), fz = a.f(4 * i + 2),
+        mz = a.f(4 * i + 3);
+      worst_margin = std::min(worst_margin, fz - std::hypot(fx, fy) / mu1_ - std::abs(mz) / mu2_);
+      min_fz = std::min(min_fz, fz);
+    }
+    a.cert[0] = max_abs(a.G * a.f + w_ext);
+    a.cert[1] = max_abs(a.J.transpose() * a.f - a.tau);
+    a.cert[2] = std::max(0.0, -worst_margin);
+    a.cert[3] = std::max(0.0, fmin_ - min_fz);
+    a.cert[4] = std::max(0.0, std::max((tau_min - a.tau).maxCoeff(), (a.tau - tau_max).maxCoeff()));
+    const double worst = *std::max_element(a.cert, a.cert + 5);
+    a.code = worst <= s_.certificate_tolerance ? CERTIFIED : NOT_CERTIFIED;
+    (void)w;
+  }
+
+  static std::string solver_status(proxsuite::proxqp::QPSolverOutput s)
+  {
+    using O = proxsuite::proxqp::QPSolverOutput;
+    switch (s) {
+      case O::PROXQP_SOLVED: return "PROXQP_SOLVED";
+      case O::PROXQP_MAX_ITER_REACHED: return "PROXQP_MAX_ITER_REACHED";
+      case O::PROXQP_PRIMAL_INFEASIBLE: return "PROXQP_PRIMAL_INFEASIBLE";
+      case O::PROXQP_DUAL_INFEASIBLE: return "PROXQP_DUAL_INFEASIBLE";
+      case O::PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE: return "PROXQP_SOLVED_CLOSEST_PRIMAL_FEASIBLE";
+      case O::PROXQP_NOT_RUN: return "PROXQP_NOT_RUN";
+    }
+    return "PROXQP_UNKNOWN";
+  }
+
+  // backends/proxsuite.kkt_violation
+  double kkt_violation(
+    const Mat & H, const Vec & g, const Mat & A, const Vec & b, const Mat & C,
+    const Vec & u, const Vec & l_box, const Vec & u_box, const Vec & x,
+    const Vec & y, const Vec & z) const
+  {
+    const int n_in = static_cast<int>(C.rows());
+    const auto z_C = z.head(n_in);
+    const auto z_box = z.tail(x.size());
+    const Vec grad = H * x + g;
+    Vec residual = grad + C.transpose() * z_C + z_box;
+    if (A.rows()) {
+      residual += A.transpose() * y;
+    }
+    const Vec slack = u - C * x;
+    const Vec to_upper = u_box - x, to_lower = x - l_box;
+    const double scale = std::max(1.0, max_abs(z));
+    double dual = std::max(0.0, z_C.size() ? -z_C.minCoeff() : 0.0);
+    for (int i = 0; i < x.size(); ++i) {
+      const bool fu = std::isfinite(to_upper(i)), fl = std::isfinite(to_lower(i));
+      if (!(fu && fl)) {
+        dual = std::max(dual, std::abs(z_box(i)));
+      }
+      dual = std::max(dual, std::max(z_box(i), 0.0) * (fu ? to_upper(i) : 0.0));
+      dual = std::max(dual, std::max(-z_box(i), 0.0) * (fl ? to_lower(i) : 0.0));
+    }
+    for (int i = 0; i < n_in; ++i) {
+      dual = std::max(dual, std::abs(z_C(i) * slack(i)));
+    }
+    double primal = std::max({0.0, slack.size() ? -slack.minCoeff() : 0.0,
+          -to_upper.minCoeff(), -to_lower.minCoeff()});
+    if (A.rows()) {
+      primal = std::max(primal, max_abs(A * x - b));
+    }
+    return std::max({max_abs(residual) / std::max(1.0, max_abs(grad)), dual / scale, primal});
+  }
+
+  void init(
+    int n, int n_eq, int n_in, const Mat & H, const Vec & g, const Mat & A, const Vec & b,
+    const Mat & C, const Vec & l, const Vec & u, const Vec & l_box, const Vec & u_box)
+  {
+    ++inits_;
+    qp_ = std::make_unique<dense::QP<double>>(n, n_eq, n_in, true,
+                                               proxsuite::proxqp::HessianType::Diagonal,
+                                               proxsuite::proxqp::DenseBackend::PrimalDualLDLT);
+    auto & st = qp_->settings;
+    st.eps_abs = s_.eps_abs;
+    st.eps_rel = s_.eps_rel;
+    st.max_iter = s_.max_iter;
+    st.max_iter_in = s_.max_iter_in;
+    st.eps_primal_inf = s_.eps_primal_inf;
+    st.check_duality_gap = true;
+    st.eps_duality_gap_abs = s_.eps_abs;
+    st.eps_duality_gap_rel = 0.0;
+    st.initial_guess = proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
+    if (n_eq) {
+      qp_->init(H, g, A, b, C, l, u, l_box, u_box, true);
+    } else {
+      qp_->init(H, g, proxsuite::nullopt, proxsuite::nullopt, C, l, u, l_box, u_box, true);
+    }
+  }
+
+  void update(
+    int n_eq, const Mat & H, const Vec & g, const Mat & A, const Vec & b, const Mat & C,
+    const Vec & l, const Vec & u, const Vec & l_box, const Vec & u_box)
+  {
+    if (n_eq) {
+      qp_->update(H, g, A, b, C, l, u, l_box, u_box, false);
+    } else {
+      qp_->update(H, g, proxsuite::nullopt, proxsuite::nullopt, C, l, u, l_box, u_box, false);
+    }
+  }
+
+  // backends/proxsuite.TauQPSolver._solve_until: slices of outer iterations sized so
+  // that even at max_iter_in inner iterations each ends by the deadline.
+  int solve_until(bool has_deadline, Clock::time_point deadline, bool & stopped)
+  {
+    stopped = false;
+    auto & st = qp_->settings;
+    if (!has_deadline) {
+      qp_->solve();
+      return static_cast<int>(qp_->results.info.iter);
+    }
+    const int cap = s_.max_iter;
+    int inner = 0, outer = 0;
+    bool capped = false;
+    for (;; ) {
+      const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+      if (left <= 0.0) {
+        stopped = true;
+        break;
+      }
+      const double per_outer = s_.max_iter_in * inner_s_;
+      int k = static_cast<int>(std::max(1.0, std::floor(left / per_outer)));
+      k = std::min(cap - outer, k);
+      if (k != cap || capped) {
+        st.max_iter = k;
+        capped = true;
+      }
+      const auto ts = Clock::now();
+      qp_->solve();
+      const auto & info = qp_->results.info;
+      const int iters = static_cast<int>(info.iter);
+      inner += iters;
+      outer += static_cast<int>(info.iter_ext);
+      const double per_inner = seconds_since(ts) / std::max(1, iters);
+      inner_s_ = std::max(per_inner, s_.estimate_decay * inner_s_);
+      if (info.status != proxsuite::proxqp::QPSolverOutput::PROXQP_MAX_ITER_REACHED ||
+        outer >= cap)
+      {
+        break;
+      }
+      st.initial_guess = proxsuite::proxqp::InitialGuessStatus::WARM_START_WITH_PREVIOUS_RESULT;
+    }
+    if (capped) {
+      st.max_iter = cap;
+    }
+    return inner;
+  }
+
+  std::vector<int64_t> idx_v_;
+  int m_ = 0;
+  RowMat S_i_;
+  Vec b_i_, weights_, limits_;
+  double mu1_, mu2_, mu1_usage_, mu2_usage_, fmin_;
+  bool warm_start_;
+  Settings s_;
+  std::unique_ptr<dense::QP<double>> qp_;
+  std::tuple<int, int, int> dims_{-1, -1, -1};
+  double inner_s_ = 0.0;
+  int inits_ = 0;
+};
+
+py::array_t<double> to_array(const Vec & v)
+{
+  py::array_t<double> out(v.size());
+  std::copy(v.data(), v.data() + v.size(), out.mutable_data());
+  return out;
+}
+
+py::array_t<double> to_array(const RowMat & m)
+{
+  py::array_t<double> out({m.rows(), m.cols()});
+  std::copy(m.data(), m.data() + m.size(), out.mutable_data());
+  return out;
+}
+
+
+}  // namespace
+
+// The module's name comes from the file that includes this one: fast_cycle.cpp
+// (_fast_cycle, for any CPU) or fast_cycle_avx2.cpp (_fast_cycle_avx2, built with AVX2
+// and FMA; compiled.py loads it only where the CPU has them).
+PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
+{
+  mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
+  // What compiled.py expects; a module built from an older source is not used.
+  mod.attr("API") = 1;
+  mod.attr("CERTIFIED") = CERTIFIED;
+  mod.attr("NOT_HANDLED") = NOT_HANDLED;
+  mod.attr("BAD_DATA") = BAD_DATA;
+  mod.attr("NOT_SOLVED") = NOT_SOLVED;
+  mod.attr("NOT_CERTIFIED") = NOT_CERTIFIED;
+  mod.attr("TIMED_OUT") = TIMED_OUT;
+  mod.attr("PROXSUITE_VERSION") = PROXSUITE_VERSION;
+
+  py::class_<Settings>(mod, "Settings")
+  .def(py::init<>())
+  .def_readwrite("eps_abs", &Settings::eps_abs)
+  .def_readwrite("eps_rel", &Settings::eps_rel)
+  .def_readwrite("eps_primal_inf", &Settings::eps_primal_inf)
+  .def_readwrite("max_iter", &Settings::max_iter)
+  .def_readwrite("max_iter_in", &Settings::max_iter_in)
+  .def_readwrite("kkt_tolerance", &Settings::kkt_tolerance)
+  .def_readwrite("certificate_tolerance", &Settings::certificate_tolerance)
+  .def_readwrite("qr_rtol", &Settings::qr_rtol)
+  .def_readwrite("box_margin", &Settings::box_margin)
+  .def_readwrite("inner_iteration_s", &Settings::inner_iteration_s)
+  .def_readwrite("estimate_decay", &Settings::estimate_decay)
+  .def_readwrite("primary_share", &Settings::primary_share);
+
+  py::class_<Answer>(mod, "Answer")
+  .def_readonly("code", &Answer::code)
+  .def_readonly("message", &Answer::message)
+  .def_property_readonly("tau", [](const Answer & a) {return to_array(a.tau);})
+  .def_property_readonly("f", [](const Answer & a) {return to_array(a.f);})
+  .def_property_readonly("G", [](const Answer & a) {return to_array(a.G);})
+  .def_property_readonly("J", [](const Answer & a) {return to_array(a.J);})
+  .def_property_readonly("positions", [](const Answer & a) {return to_array(a.positions);})
+  .def_property_readonly("rotations", [](const Answer & a) {
+      py::array_t<double> out({a.rotations.rows(), py::ssize_t(3), py::ssize_t(3)});
+      std::copy(a.rotations.data(), a.rotations.data() + a.rotations.size(),
+                out.mutable_data());
+      return out;
+    })
+  .def_property_readonly("usage", [](const Answer & a) {return to_array(a.usage);})
+  .def_readonly("iterations", &Answer::iterations)
+  .def_readonly("warm", &Answer::warm)
+  .def_readonly("warm_solves", &Answer::warm_solves)
+  .def_readonly("redone_cold", &Answer::redone_cold)
+  .def_property_readonly("certificate", [](const Answer & a) {
+      return py::make_tuple(a.cert[0], a.cert[1], a.cert[2], a.cert[3], a.cert[4], a.finite);
+    })
+  .def_readonly("max_torque_ratio", &Answer::max_torque_ratio)
+  .def_readonly("solve_time_s", &Answer::solve_time_s)
+  .def_property_readonly("timings", [](const Answer & a) {
+      return py::make_tuple(a.t_maps, a.t_build, a.t_solve, a.t_certify);
+    });
+
+  py::class_<FastCycle>(mod, "FastCycle")
+  .def(py::init<py::array_t<int64_t>, Array, Array, Array, Array, double, double, double,
+    double, double, bool, const Settings &>(),
+         py::arg("idx_v"), py::arg("S_i"), py::arg("b_i"), py::arg("weights"),
+         py::arg("limits"), py::arg("mu1"), py::arg("mu2"), py::arg("mu1_usage"),
+         py::arg("mu2_usage"), py::arg("min_normal_force"), py::arg("warm_start"),
+         py::arg("settings"))
+  .def("solve", &FastCycle::solve, py::arg("oMf"), py::arg("J6"), py::arg("points"),
+         py::arg("normals"), py::arg("has_normal"), py::arg("tangents"),
+         py::arg("has_tangent"), py::arg("c"), py::arg("w_ext"), py::arg("offset"),
+         py::arg("time_left"))
+  .def_property_readonly("inits", &FastCycle::dims_changes);
+}
+
+#endif  // FAST_CYCLE_HPP_
