@@ -10,7 +10,7 @@
 QP solvers side by side on the tau-QP, the exact-cone references, and warm starts.
 
 Usage: .venv/bin/python bench/solvers.py [--grasps 200] [--seed 0] [--repeats 5]
-       [--scenario-repeats 200] [--steps 500] [--out bench/results/solvers.json]
+       [--scenario-repeats 200] [--steps 500] [--warm-only] [--out bench/results/solvers.json]
 
 The thread pools of BLAS/LAPACK are the environment's (recorded in the
 output). OpenBLAS's default threads make the numpy/SciPy parts (SLSQP, the
@@ -496,8 +496,13 @@ def warm_starts(steps: int, variant: ProxSuiteSettings) -> dict:
 
 
 def run(grasps: int = 200, seed: int = 0, repeats: int = 5, scenario_repeats: int = 200,
-        steps: int = 500) -> dict:
+        steps: int = 500, warm_only: bool = False) -> dict:
     """Run the whole benchmark (JSON-able): tuning, the three problem sets, warm starts."""
+    if warm_only:  # the sequences alone, with the package's settings as the tuned row
+        return {'machine': machine(), 'osqp': osqp.__version__, 'blas_threads': blas_threads(),
+                'grasps': 0, 'seed': seed, 'repeats': repeats, 'tuning': None,
+                'tuned_variant': 'not tuned (--warm-only)', 'sets': {},
+                'warm_starts': warm_starts(steps, ProxSuiteSettings())}
     tuning = tune_proxsuite(allegro_grasps(TUNING_GRASPS, seed + TUNING_SEED_OFFSET),
                             max(1, min(repeats, 3)))
     variant = ProxSuiteSettings(**tuning['best']['variant']) if tuning['best'] else \
@@ -595,9 +600,12 @@ def main() -> None:
     parser.add_argument('--repeats', type=int, default=5, help='calls per grasp (median taken)')
     parser.add_argument('--scenario-repeats', type=int, default=200)
     parser.add_argument('--steps', type=int, default=500, help='warm-start sequence length')
+    parser.add_argument('--warm-only', action='store_true',
+                        help='only the warm-start sequences (no tuning, no problem sets)')
     parser.add_argument('--out', type=Path, help='write the results as JSON here')
     args = parser.parse_args()
-    res = run(args.grasps, args.seed, args.repeats, args.scenario_repeats, args.steps)
+    res = run(args.grasps, args.seed, args.repeats, args.scenario_repeats, args.steps,
+              args.warm_only)
     report(res, table(res), args.out,
            f'{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp; '
            f"threads: {res['blas_threads']}")
