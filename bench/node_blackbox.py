@@ -10,6 +10,7 @@
 The node measured as a user measures it: joint states in, effort commands counted, from outside.
 
 Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000] [--runs 1]
+       [--targets TARGET ...]
 
 Each case starts one answering process exactly as a user would, with nothing
 added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
@@ -18,7 +19,10 @@ start, in the compiled cycle), then the same with ``-p solver.compiled:=false``
 (the Python cycle, the default before the compiled one), with that and
 ``-p solver.warm_start:=false`` as well (the cold ProxSuite default before the
 warm start), with ``-p solver.backend:=daqp``, and the trivial
-echo node of ``bench/node_load.py`` (one zero command per joint state). A
+echo node of ``bench/node_load.py`` (one zero command per joint state), taking
+joint states with sensor-data QoS (keep last 5) and, as ``echo, joint_states depth
+1``, with the node's own QoS (keep last 1); and the node with ``--executor events``
+(rclpy's experimental events executor, its main's flag, not a parameter). A
 separate process publishes Allegro joint states at the rate with sensor-data
 QoS for ``--duration`` seconds once the answering node is discovered and has
 answered once, and counts the ``effort_commands`` that arrive (a plain
@@ -58,7 +62,9 @@ from ros_load import (  # noqa: E402
 PARAMS = CONFIG / 'allegro_right_node.yaml'
 SCENARIO = CONFIG / 'allegro_right.yaml'
 #: Answering processes: name -> extra node arguments (None: the echo node).
-TARGETS = {'echo': None, 'grasp_torque_node (default)': [],
+TARGETS = {'echo': None, 'echo, joint_states depth 1': None,
+           'grasp_torque_node (default)': [],
+           'grasp_torque_node --executor events': ['--executor', 'events'],
            'grasp_torque_node compiled:=false': ['-p', 'solver.compiled:=false'],
            'grasp_torque_node warm_start:=false compiled:=false':
                ['-p', 'solver.warm_start:=false', '-p', 'solver.compiled:=false'],
@@ -139,11 +145,13 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
 
         joints = GraspSetup.from_file(SCENARIO).hand.joints
         cmd = [sys.executable, str(bench / 'node_load.py'), '--role', 'echo',
-               '--executor', 'single', '--joints', ','.join(joints)]
+               '--executor', 'single', '--joints', ','.join(joints),
+               '--echo-qos', 'node' if 'depth 1' in target else 'sensor']
     else:
         exe = Path(sys.executable).parent / 'grasp_torque_node'
-        cmd = [str(exe), '--ros-args', '--params-file', str(PARAMS)] + extra
-    tag = f"{target.split()[0]}-{len(extra or [])}-{extra[-1] if extra else ''}-{rate:g}"
+        pre = extra[:2] if extra[:1] == ['--executor'] else []  # the node's own flag
+        cmd = [str(exe), *pre, '--ros-args', '--params-file', str(PARAMS)] + extra[len(pre):]
+    tag = f'{target}-{rate:g}'
     tag = ''.join(c if c.isalnum() or c in '-.' else '_' for c in tag)
     result = tmp / f'{tag}.json'
     user = [sys.executable, str(Path(__file__).resolve()), '--role', 'user', '--rate',
@@ -191,6 +199,9 @@ def main() -> int:
     parser.add_argument('--duration', type=float, default=8.0, help='seconds published [s]')
     parser.add_argument('--rates', type=float, nargs='+', default=[500.0, 1000.0])
     parser.add_argument('--runs', type=int, default=1, help='runs of every case')
+    parser.add_argument('--targets', nargs='+', choices=list(TARGETS), default=list(TARGETS),
+                        metavar='TARGET', help='answering processes (default: all of: '
+                        + '; '.join(TARGETS) + ')')
     parser.add_argument('--out', type=Path,
                         default=Path(__file__).resolve().parent / 'results' / 'node_blackbox.json')
     parser.add_argument('--role', choices=['run', 'user'], default='run', help=argparse.SUPPRESS)
@@ -207,7 +218,7 @@ def main() -> int:
     print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}",
           flush=True)
     keys = [(rate, target, run) for run in range(1, args.runs + 1) for rate in args.rates
-            for target in TARGETS]
+            for target in args.targets]
     tmp = Path(tempfile.mkdtemp(prefix='node_blackbox_'))
     cases = []
     for (rate, target, run), domain in zip(keys, private_domains(len(keys))):

@@ -98,8 +98,14 @@ def _executor(name: str):
 # -- the echo node ---------------------------------------------------------------------------
 
 def echo_main(args: argparse.Namespace) -> int:
-    """Run a minimal rclpy node that answers each joint state with zero torques, stamped."""
-    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME
+    """
+    Run a minimal rclpy node that answers each joint state with zero torques, stamped.
+
+    It takes joint states with sensor-data QoS (keep last 5), or with ``--echo-qos node``
+    the node's own ``JOINT_STATE_QOS`` (keep last 1: a state that a newer one overtakes
+    before it is taken is dropped, as in the node).
+    """
+    from grasp_torque_opt.ros.node import COMMAND_QOS, JOINT_STATE_QOS, NODE_NAME
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.node import Node
@@ -124,7 +130,8 @@ def echo_main(args: argparse.Namespace) -> int:
             stamped_pub.publish(out)
 
         node.create_subscription(JointState, 'joint_states', on_joint_state,
-                                 qos_profile_sensor_data)
+                                 JOINT_STATE_QOS if args.echo_qos == 'node'
+                                 else qos_profile_sensor_data)
         executor = _executor(args.executor)
         executor.add_node(node)
         if args.executor == 'events':  # as grasp_torque_node's main does
@@ -422,6 +429,8 @@ def main() -> int:
     parser.add_argument('--executor', choices=EXECUTORS, default='single',
                         help=argparse.SUPPRESS)
     parser.add_argument('--joints', help=argparse.SUPPRESS)
+    parser.add_argument('--echo-qos', choices=['sensor', 'node'], default='sensor',
+                        help=argparse.SUPPRESS)
     parser.add_argument('--hand', choices=sorted(HANDS), help=argparse.SUPPRESS)
     parser.add_argument('--rate', type=float, help=argparse.SUPPRESS)
     parser.add_argument('--result', help=argparse.SUPPRESS)
