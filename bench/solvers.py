@@ -606,9 +606,9 @@ def main() -> None:
     args = parser.parse_args()
     res = run(args.grasps, args.seed, args.repeats, args.scenario_repeats, args.steps,
               args.warm_only)
-    report(res, table(res), args.out,
-           f'{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp; '
-           f"threads: {res['blas_threads']}")
+    detail = ('warm-start sequences only' if args.warm_only else
+              f'{args.grasps} grasps, seed {args.seed}, {args.repeats} calls per grasp')
+    report(res, table(res), args.out, f"{detail}; threads: {res['blas_threads']}")
 
 
 if __name__ == '__main__':
