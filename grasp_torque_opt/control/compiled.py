@@ -94,7 +94,8 @@ for _name in MODULES:
 PRIMARY_SHARE = 0.8
 #: Outcome codes after which ProxSuite was tried (warm, and cold if the warm answer
 #: failed): the controller asks its fallback backend next, not ProxSuite again.
-SOLVER_CODES = (3, 4, 5)  # NOT_SOLVED, NOT_CERTIFIED, TIMED_OUT (src/fast_cycle.hpp)
+SOLVER_CODES = () if _fast_cycle is None else (
+    _fast_cycle.NOT_SOLVED, _fast_cycle.NOT_CERTIFIED, _fast_cycle.TIMED_OUT)
 #: After this many cycles in a row handed back as not of full column rank (a grasp
 #: with internal-force variables), the compiled cycle is not tried again for the grasp.
 RANK_GIVE_UP = 10
@@ -161,7 +162,10 @@ class CompiledCycle:
                  module=None) -> None:
         self.solver = solver
         self.tolerance = tolerance
-        self._key = self.key(setup, solver, tolerance)
+        #: What it was made for (held, so that an identity check cannot meet a new
+        #: object at a freed one's address).
+        self._made_for = (setup.hand, setup.friction, setup.weights, setup.objective, solver,
+                          solver.settings, solver.warm_start, tolerance)
         hand = setup.hand
         friction = planned_friction(setup.friction)
         S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
@@ -196,21 +200,17 @@ class CompiledCycle:
         self._rank_misses = 0
         self.gave_up = ''
 
-    @staticmethod
-    def key(setup: GraspSetup, solver, tolerance: float) -> tuple:
-        """Return what the compiled cycle was made for; another key needs a new one."""
-        return (id(setup.hand), setup.friction, id(setup.weights), setup.objective,
-                id(solver), solver.settings, solver.warm_start, tolerance)
-
     def fits(self, setup: GraspSetup, solver, tolerance: float) -> bool:
         """Tell whether this compiled cycle was made for this grasp's constants and solver."""
-        k = self._key
-        # Identity first: a cycle's grasp shares its constants with the controller's.
-        return (k[0] == id(setup.hand) and k[2] == id(setup.weights) and k[4] == id(solver)
-                and (k[1] is setup.friction or k[1] == setup.friction)
-                and k[3] == setup.objective
-                and (k[5] is solver.settings or k[5] == solver.settings)
-                and k[6] == solver.warm_start and k[7] == tolerance)
+        hand, friction, weights, objective, made_solver, settings, warm, tol = self._made_for
+        # The objects themselves, not equal copies (the hand, the weights and the solver
+        # are the controller's until a parameter change replaces them); the frozen
+        # friction and settings compare equal when they are copies.
+        return (hand is setup.hand and weights is setup.weights and made_solver is solver
+                and (friction is setup.friction or friction == setup.friction)
+                and objective == setup.objective
+                and (settings is solver.settings or settings == solver.settings)
+                and warm == solver.warm_start and tol == tolerance)
 
     def _arrays(self, setup: GraspSetup) -> _Contacts:
         """Return the contact list as arrays, remade only when the list object changes."""
