@@ -40,6 +40,17 @@ def _header_dir(relative: str) -> str | None:
     return None
 
 
+def _source(relative: str) -> str:
+    """
+    Return a source file's path for the compiler, relative where setup.py runs from its folder.
+
+    colcon runs setup.py from its build folder, where only setup.py is linked: there
+    the path is absolute (the linked setup.py's real folder).
+    """
+    here = Path(__file__).resolve().parent
+    return relative if Path.cwd().resolve() == here else str(here / relative)
+
+
 def fast_cycle_extensions() -> list[Extension]:
     """
     Return the compiled cycle (src/fast_cycle.hpp) as extensions, if they can be built.
@@ -66,16 +77,17 @@ def fast_cycle_extensions() -> list[Extension]:
     # libraries' headers as system headers (their own warnings are theirs).
     common = ['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden', '-g0',
               '-isystem', eigen, '-isystem', proxsuite]
-    out = [Extension('grasp_torque_opt.control._fast_cycle', ['src/fast_cycle.cpp'],
+    header = [_source('src/fast_cycle.hpp')]
+    out = [Extension('grasp_torque_opt.control._fast_cycle', [_source('src/fast_cycle.cpp')],
                      include_dirs=[pybind11.get_include()], language='c++',
-                     extra_compile_args=common, depends=['src/fast_cycle.hpp'], optional=True)]
+                     extra_compile_args=common, depends=header, optional=True)]
     if platform.machine().lower() in ('x86_64', 'amd64'):
         # As ProxSuite's own wheel does: a second build with AVX2 and FMA, loaded only on
         # a CPU that has them (grasp_torque_opt/control/compiled.py). About 15% faster.
         out.append(Extension(
-            'grasp_torque_opt.control._fast_cycle_avx2', ['src/fast_cycle_avx2.cpp'],
+            'grasp_torque_opt.control._fast_cycle_avx2', [_source('src/fast_cycle_avx2.cpp')],
             include_dirs=[pybind11.get_include()], language='c++',
-            extra_compile_args=[*common, '-mavx2', '-mfma'], depends=['src/fast_cycle.hpp'],
+            extra_compile_args=[*common, '-mavx2', '-mfma'], depends=header,
             optional=True))
     return out
 
