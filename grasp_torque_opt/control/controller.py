@@ -723,7 +723,8 @@ class TorqueController:
     def _compiled(self, setup: GraspSetup) -> compiled.CompiledCycle | None:
         """Return the compiled cycle for this grasp and solver, or None (the reason kept)."""
         if not self.config.compiled:
-            self.compiled_reason = 'off (compiled: false)'
+            # Dropped, not kept aside: turned on again, it starts anew (cold).
+            self.compiled_cycle, self.compiled_reason = None, 'off (compiled: false)'
             return None
         fast, tol = self.compiled_cycle, self.config.certificate_tolerance
         if fast is not None and fast.fits(setup, self.solver, tol):

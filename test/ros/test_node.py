@@ -385,6 +385,31 @@ def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, ba
         h.close()
 
 
+def test_the_compiled_cycle_answers_over_ros_and_the_parameter_turns_it_off(allegro):
+    # The Allegro node runs the compiled cycle (design.md section 2.6); solver.compiled
+    # false, set over ROS, gives the Python cycle's command for the same state.
+    h = Harness(ALLEGRO)
+    try:
+        names = list(allegro.hand.joints)
+        positions = allegro.q[allegro.hand.idx_q]
+        h.send_joint_state(names, positions)
+        compiled = h.next_command(5.0)
+        assert compiled is not None
+        assert h.node.controller.compiled_cycle is not None
+        assert h.node.controller.compiled_cycle.solves >= 1
+        assert h.spin_until(lambda: h.diagnostics and
+                            h.diagnostics[-1].get('solver.compiled') == 'true', 3.0)
+        assert h.node.set_parameters([Parameter('solver.compiled', value=False)])[0].successful
+        h.send_joint_state(names, positions)
+        python = h.next_command(5.0)
+        assert python is not None
+        np.testing.assert_allclose(python, compiled, atol=1e-6)
+        assert h.spin_until(lambda: h.diagnostics and h.diagnostics[-1].get(
+            'solver.compiled') == 'false: off (compiled: false)', 3.0)
+    finally:
+        h.close()
+
+
 def test_lowering_the_limits_below_the_command_in_force_zeroes_it_at_once(allegro):
     """
     Lower the limits under the command in force: zeros are published at once.
