@@ -414,57 +414,69 @@ class TorqueController:
         """
         self.check_size('joint_states', max(len(names), len(positions)))
         q = (self.setup.q if self.inputs.q is None else self.inputs.q).copy()
-        known = self._names
-        if known is not None and known[3] is self.setup.hand.joints and \
-                len(positions) == len(names) and names == known[0]:
-            # The same names as the last accepted state (a driver's every message): its
-            # checks hold; one array comparison checks the positions (NaN fails it).
-            values = np.asarray(positions, dtype=float)[known[1]]
-            if (np.abs(values) <= MAX_ABS_JOINT_POSITION).all():
-                try:
-                    self._check_stamp('joint_states', stamp, clock, now)
-                except InputError as e:
-                    self._reject('joint_states', e)
-                    raise
-                q[known[2]] = values
-                self._keep_stamp('joint_states', stamp, now, clock)
-                self.inputs = _replaced(self.inputs, q=q, q_time=now)
-                return
+        known, checked = self._names, None
         try:
-            if len(names) != len(positions):
-                raise InputError('joint_states', f'{len(names)} names but '
-                                 f'{len(positions)} positions')
-            if len(set(names)) != len(names):
-                dup = next(n for n, k in Counter(names).items() if k > 1)
-                raise InputError('joint_states', f"duplicate joint name '{show(dup)}'")
-            if any(not n for n in names):
-                raise InputError('joint_states', 'empty joint name')
-            given = set(names)
-            missing = [n for n in self.setup.hand.joints if n not in given]
-            if missing:
-                raise InputError('joint_states', 'missing commanded joint(s) '
-                                 f"{', '.join(missing[:4])}")
-            used, to = [], []
-            for k, (name, value) in enumerate(zip(names, positions)):
-                iq = self._model_joints.get(name)
-                if iq is None:
-                    continue
-                if not math.isfinite(value):
-                    raise InputError('joint_states', f"position of '{name}' is not finite")
-                if abs(value) > MAX_ABS_JOINT_POSITION:
-                    raise InputError('joint_states', f"position of '{name}' is {value:.6g}, "
-                                     f'beyond +-{MAX_ABS_JOINT_POSITION:g}')
-                q[iq] = value
-                used.append(k)
-                to.append(iq)
+            values = None
+            if known is not None and known[3] is self.setup.hand.joints and \
+                    len(positions) == len(names) and names == known[0]:
+                # The same names as the last accepted state (a driver's every message):
+                # their checks hold; one array comparison checks the positions (NaN fails
+                # it, and then the loop below names the position).
+                values = np.asarray(positions, dtype=float)[known[1]]
+                if not (np.abs(values) <= MAX_ABS_JOINT_POSITION).all():
+                    values = None
+            if values is not None:
+                q[known[2]] = values
+            else:
+                checked = self._checked_names(names, positions, q)
             self._check_stamp('joint_states', stamp, clock, now)
         except InputError as e:
             self._reject('joint_states', e)
             raise
-        self._names = (list(names), np.array(used, dtype=np.intp), np.array(to, dtype=np.intp),
-                       self.setup.hand.joints)
+        if checked is not None:
+            self._names = checked
         self._keep_stamp('joint_states', stamp, now, clock)
         self.inputs = _replaced(self.inputs, q=q, q_time=now)
+
+    def _checked_names(self, names: list[str], positions: list[float], q: np.ndarray
+                       ) -> tuple:
+        """
+        Check a joint state's names and used positions and write them into q.
+
+        Returns:
+            What :meth:`update_joint_state` keeps to skip the name checks next time.
+
+        Raises:
+            InputError: as :meth:`update_joint_state` says.
+        """
+        if len(names) != len(positions):
+            raise InputError('joint_states', f'{len(names)} names but '
+                             f'{len(positions)} positions')
+        if len(set(names)) != len(names):
+            dup = next(n for n, k in Counter(names).items() if k > 1)
+            raise InputError('joint_states', f"duplicate joint name '{show(dup)}'")
+        if any(not n for n in names):
+            raise InputError('joint_states', 'empty joint name')
+        given = set(names)
+        missing = [n for n in self.setup.hand.joints if n not in given]
+        if missing:
+            raise InputError('joint_states', 'missing commanded joint(s) '
+                             f"{', '.join(missing[:4])}")
+        used, to = [], []
+        for k, (name, value) in enumerate(zip(names, positions)):
+            iq = self._model_joints.get(name)
+            if iq is None:
+                continue
+            if not math.isfinite(value):
+                raise InputError('joint_states', f"position of '{name}' is not finite")
+            if abs(value) > MAX_ABS_JOINT_POSITION:
+                raise InputError('joint_states', f"position of '{name}' is {value:.6g}, "
+                                 f'beyond +-{MAX_ABS_JOINT_POSITION:g}')
+            q[iq] = value
+            used.append(k)
+            to.append(iq)
+        return (list(names), np.array(used, dtype=np.intp), np.array(to, dtype=np.intp),
+                self.setup.hand.joints)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
                         now: float, stamp: float = 0.0, clock: float | None = None) -> None:
