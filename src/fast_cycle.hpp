@@ -459,7 +459,6 @@ private:
     a.cert[4] = std::max(0.0, std::max((tau_min - a.tau).maxCoeff(), (a.tau - tau_max).maxCoeff()));
     const double worst = *std::max_element(a.cert, a.cert + 5);
     a.code = worst <= s_.certificate_tolerance ? CERTIFIED : NOT_CERTIFIED;
-    (void)w;
   }
 
   static std::string solver_status(proxsuite::proxqp::QPSolverOutput s)
