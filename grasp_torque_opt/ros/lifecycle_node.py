@@ -51,6 +51,7 @@ from grasp_torque_opt.ros.node import (
     SCENARIO_PARAMETERS,
     stop_requested,
 )
+from grasp_torque_opt.ros.peers import quiet_publisher
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
@@ -126,7 +127,8 @@ class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
 
     def _make_publisher(self, msg_type: type, topic: str, qos: Any) -> Any:
         """Make a command publisher: a lifecycle one, silent unless active."""
-        return self.create_lifecycle_publisher(msg_type, topic, qos)
+        return self.create_lifecycle_publisher(msg_type, topic, qos,
+                                               event_callbacks=quiet_publisher())
 
     def _destroy_command_publisher(self, publisher: Any) -> None:
         self.destroy_lifecycle_publisher(publisher)

@@ -73,6 +73,7 @@ from grasp_torque_opt.core.scenario import (
     Scenario,
     weight_wrench,
 )
+from grasp_torque_opt.ros.peers import PeerWatch, quiet_publisher, quiet_subscription, summary
 import numpy as np
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -605,6 +606,7 @@ class GraspTorqueCore:
         self._pending_solves = 0
         self._busy_answers = 0
         self._duplicates = 0
+        self._peers = PeerWatch()  # what _start_interfaces made, checked against the graph
 
     @property
     def commanding(self) -> bool:
@@ -744,7 +746,7 @@ class GraspTorqueCore:
 
     def _make_publisher(self, msg_type: type, topic: str, qos: QoSProfile) -> Any:
         """Make a command publisher (the managed node's are lifecycle publishers)."""
-        return self.create_publisher(msg_type, topic, qos)
+        return self.create_publisher(msg_type, topic, qos, event_callbacks=quiet_publisher())
 
     def _start_interfaces(self) -> None:
         """Make the subscriptions, publishers, the service, the timers and the worker."""
@@ -762,21 +764,29 @@ class GraspTorqueCore:
             else:
                 sub_callback = (lambda cb: lambda data: cb(data))(callback)
             qos = JOINT_STATE_QOS if topic == 'joint_states' else qos_profile_sensor_data
-            sub = self.create_subscription(msg_type, topic, sub_callback, qos, raw=True)
+            sub = self.create_subscription(msg_type, topic, sub_callback, qos, raw=True,
+                                           event_callbacks=quiet_subscription())
             made.append(('subscription', sub))
+            self._peers.watch(sub, msg_type)
             if topic == 'joint_states':
                 self._joint_states_topic = sub.topic_name  # remapped and resolved
         self._command_pub = self._make_publisher(Float64MultiArray, 'effort_commands',
                                                  COMMAND_QOS)
         made.append(('command_publisher', self._command_pub))
+        self._peers.watch(self._command_pub, Float64MultiArray)
         self._stamped_pub = None
         if self.get_parameter('publish_stamped_command').value:
             self._stamped_pub = self._make_publisher(JointState, '~/effort_commands_stamped',
                                                      COMMAND_QOS)
             made.append(('command_publisher', self._stamped_pub))
-        self._marker_pub = self.create_publisher(MarkerArray, '~/contact_wrenches', 1)
-        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+            self._peers.watch(self._stamped_pub, JointState)
+        self._marker_pub = self.create_publisher(MarkerArray, '~/contact_wrenches', 1,
+                                                 event_callbacks=quiet_publisher())
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10,
+                                               event_callbacks=quiet_publisher())
         made += [('publisher', self._marker_pub), ('publisher', self._diag_pub)]
+        self._peers.watch(self._marker_pub, MarkerArray)
+        self._peers.watch(self._diag_pub, DiagnosticArray)
         for period, callback in (('watchdog_period', self._on_watchdog),
                                  ('diagnostics_period', self._on_diagnostics),
                                  ('marker_period', self._on_markers)):
@@ -815,6 +825,7 @@ class GraspTorqueCore:
             else:
                 self.destroy_timer(entity)
         self._made.clear()
+        self._peers.clear()
         self._command_pub = self._stamped_pub = None
 
     def _destroy_command_publisher(self, publisher: Any) -> None:
@@ -1175,6 +1186,15 @@ class GraspTorqueCore:
             level = diagnostics.ERROR
             message = f'another node named {name} is on this domain; {message}'
         values.append(('duplicate_nodes', str(self._duplicates)))
+        # What rclpy's default QoS event handlers would have logged, found from the graph.
+        peers, new = self._peers.check(self)
+        for peer in new:
+            self.get_logger().warn(f'{peer.describe()}: no messages will pass between it '
+                                   'and this node')
+        values.append(('incompatible_peers', summary(peers)))
+        if peers:
+            level = max(level, diagnostics.WARN)  # at least WARN (STALE and ERROR stay)
+            message = f'{len(peers)} incompatible peer(s) on its topics; {message}'
         status = DiagnosticStatus(level=bytes([level]), name=f'{self.get_name()}: grasp '
                                   'torques', message=message, hardware_id=hand,
                                   values=[KeyValue(key=k, value=v) for k, v in values])

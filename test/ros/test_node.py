@@ -31,9 +31,10 @@ import pytest
 import rclpy
 from rclpy.duration import Duration
 from rclpy.parameter import Parameter
-from rclpy.qos import ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from ros_harness import DOMAIN, Harness, NodeProcess
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker
 
@@ -587,3 +588,47 @@ def test_a_running_node_reports_another_of_its_name(planar):
     finally:
         other.destroy_node()
         h.close()
+
+
+def test_incompatible_peers_are_found_from_the_graph_and_told_once(planar_node):
+    h = planar_node
+    # No QoS event handlers of the node's own topics wait in its executor.
+    ours = [h.node._command_pub, h.node._marker_pub, h.node._diag_pub,
+            *h.node.subscriptions]
+    assert all(e.event_handlers == [] for e in ours)
+    assert h.spin_until(lambda: h.diagnostics and
+                        h.diagnostics[-1].get('incompatible_peers') == 'none', 5.0)
+    # Another process's peers, as a user's would be (one participant refuses two types
+    # on one topic): a latched effort controller, and a publisher of another type.
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=DOMAIN)
+    other = rclpy.create_node('other_peer', context=context)
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    try:
+        bad_sub = other.create_subscription(Float64MultiArray, 'effort_commands',
+                                            lambda _: None, latched)
+        bad_pub = other.create_publisher(String, 'contacts', 1)
+
+        def both():
+            d = h.diagnostics[-1] if h.diagnostics else {}
+            text = d.get('incompatible_peers', '')
+            return ('/effort_commands: subscription of /other_peer' in text
+                    and '/contacts: publisher of /other_peer' in text)
+
+        assert h.spin_until(both, 10.0), h.diagnostics[-1]
+        d = h.diagnostics[-1]
+        assert 'Volatile publisher and transient local subscription' in d['incompatible_peers']
+        assert ('type std_msgs/msg/String, not geometry_msgs/msg/PoseArray'
+                in d['incompatible_peers'])
+        assert d['_level'] >= 1 and '2 incompatible peer(s)' in d['_message']
+        h.spin_for(0.5)  # several diagnostics periods: each peer is told once
+        told = [m.msg for m in h.logs if 'no messages will pass' in m.msg]
+        assert len(told) == 2 and told[0] != told[1], told
+        other.destroy_subscription(bad_sub)
+        other.destroy_publisher(bad_pub)
+        assert h.spin_until(lambda: h.diagnostics[-1].get('incompatible_peers') == 'none',
+                            10.0), h.diagnostics[-1]
+    finally:
+        other.destroy_node()
+        rclpy.shutdown(context=context)
