@@ -73,6 +73,7 @@ from grasp_torque_opt.core.scenario import (
     Scenario,
     weight_wrench,
 )
+from grasp_torque_opt.ros import realtime
 from grasp_torque_opt.ros.peers import PeerWatch, quiet_publisher, quiet_subscription, summary
 import numpy as np
 from rcl_interfaces.msg import (
@@ -262,6 +263,11 @@ PARAMETERS: dict[str, Spec] = {
                                'of its name on the domain before it takes any input; one '
                                'found: it exits with an error (code 2). Later, one is '
                                'reported (diagnostics ERROR) [s].', 0.0, 30.0, read_only=True),
+    'thread_priority': Spec('At start, the SCHED_FIFO priority the executables ask for the '
+                            "thread that spins the node, as ros2_control's controller_manager "
+                            'does (its default, 50); where the system refuses, a warning and '
+                            'normal scheduling; 0: the scheduling is left as it is [-].', 0, 99,
+                            read_only=True),
     'marker_scale': Spec('Arrow length per newton in ~/contact_wrenches [m/N].', 0.0, 10.0),
     'publish_stamped_command': Spec('Also publish each command on ~/effort_commands_stamped '
                                     '(sensor_msgs/JointState: joints, effort, and the stamp of '
@@ -345,6 +351,7 @@ def fixed_defaults() -> dict[str, Any]:
         'marker_period': 0.1,
         'watchdog_period': 0.01,
         'startup_check_time': 2.0,
+        'thread_priority': 50,
         'marker_scale': 0.02,
         'publish_stamped_command': False,
     }
@@ -804,7 +811,9 @@ class GraspTorqueCore:
         destroyed one).
         """
         # The service solves in a worker thread while the executor goes on with the loop.
-        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solve_service')
+        # Its thread starts from the executor's, maybe SCHED_FIFO: it goes back to normal.
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solve_service',
+                                          initializer=realtime.normal_scheduling)
         self._pending_solves = 0
         # A group of its own: in the node's default (mutually exclusive) group, each call
         # held every callback of the node, the control loop's included, until its solve
@@ -857,6 +866,7 @@ class GraspTorqueCore:
 
     @staticmethod
     def _spin_tf(executor: SingleThreadedExecutor) -> None:
+        realtime.normal_scheduling()  # started by the managed node's (maybe SCHED_FIFO) thread
         try:
             executor.spin()
         except ExternalShutdownException:
@@ -1186,6 +1196,7 @@ class GraspTorqueCore:
             level = diagnostics.ERROR
             message = f'another node named {name} is on this domain; {message}'
         values.append(('duplicate_nodes', str(self._duplicates)))
+        values.append(('executor_thread', realtime.describe()))  # this callback's thread
         # What rclpy's default QoS event handlers would have logged, found from the graph.
         peers, new = self._peers.check(self)
         for peer in new:
@@ -1454,6 +1465,10 @@ def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None
         # the single-threaded one keeps up (the service runs in its own worker).
         executor = EXECUTORS[opts.executor]()
         executor.add_node(node)
+        # After the executor and the node made their threads: only this one is raised.
+        fifo, what = realtime.set_fifo(node.get_parameter('thread_priority').value)
+        log = node.get_logger()
+        (log.info if fifo or what.startswith('left') else log.warn)(f'executor thread: {what}')
         # A spin_once loop, so that the stop flag is seen: each wait ends by the next
         # watchdog tick at the latest. (EventsExecutor.spin() also delivered no subscription
         # callback with these wheels, rclpy 7.1.6 and Fast DDS, while keeping a core busy.)

@@ -632,3 +632,72 @@ def test_incompatible_peers_are_found_from_the_graph_and_told_once(planar_node):
     finally:
         other.destroy_node()
         rclpy.shutdown(context=context)
+
+
+def _fifo_threads(pid: int) -> dict[int, int]:
+    """Give {thread id: SCHED_FIFO priority} of a process's SCHED_FIFO threads, from /proc."""
+    out = {}
+    for task in Path(f'/proc/{pid}/task').iterdir():
+        fields = (task / 'stat').read_text().rsplit(')', 1)[1].split()
+        priority, policy = int(fields[37]), int(fields[38])  # rt_priority, policy (41st)
+        if policy == os.SCHED_FIFO:
+            out[int(task.name)] = priority
+    return out
+
+
+def _fifo_allowed() -> bool:
+    """Whether this process may ask SCHED_FIFO (asked from a thread that then goes back)."""
+    from grasp_torque_opt.ros import realtime
+    import threading
+
+    answer = []
+
+    def probe():
+        answer.append(realtime.set_fifo(1)[0])
+        realtime.normal_scheduling()
+
+    t = threading.Thread(target=probe)
+    t.start()
+    t.join()
+    return answer[0]
+
+
+@pytest.mark.parametrize('priority', [50, 0])
+def test_the_executor_thread_alone_asks_sched_fifo(planar, priority):
+    """
+    The executable's spinning thread asks SCHED_FIFO at thread_priority, as controller_manager.
+
+    Only that thread: the solve worker it starts and the middleware's threads stay normal.
+    Where the system refuses, the node says so and runs on.
+    """
+    from diagnostic_msgs.msg import DiagnosticArray
+
+    p = NodeProcess('grasp_torque_opt.ros.node',
+                    ['--ros-args', '-p', f'scenario:={PLANAR}', '-p', 'diagnostics_period:=0.1',
+                     '-p', 'joint_state_timeout:=5.0', '-p', f'thread_priority:={priority}'],
+                    'fifo_tester')
+    seen = []
+    p.tester.create_subscription(
+        DiagnosticArray, '/diagnostics',
+        lambda m: seen.extend(kv.value for s in m.status for kv in s.values
+                              if kv.key == 'executor_thread'), 10)
+    try:
+        assert p.first_command(*joint_state(planar))
+        client = p.tester.create_client(Trigger, 'grasp_torque_node/solve')
+        assert p.call(client, Trigger.Request()).success  # the worker thread exists now
+        assert p.spin_until(lambda: bool(seen), 5.0)
+        fifo = _fifo_threads(p.child.pid)
+        if priority and _fifo_allowed():
+            assert fifo == {p.child.pid: priority}, fifo  # the main thread, and it alone
+            assert seen[-1] == f'SCHED_FIFO {priority}'
+        else:
+            assert fifo == {}, fifo
+            assert seen[-1] == 'SCHED_OTHER'
+        p.child.send_signal(signal.SIGINT)
+        code, err = p.finish()
+        assert code == 0 and 'Traceback' not in err, err
+        said = ('executor thread: SCHED_FIFO 50' if priority and _fifo_allowed()
+                else 'refused' if priority else 'executor thread: left as it is')
+        assert said in err, err
+    finally:
+        p.close()
