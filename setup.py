@@ -96,7 +96,7 @@ package_name = 'grasp_torque_opt'
 
 setup(
     name=package_name,
-    version='0.3.0',
+    version='0.4.0',
     packages=find_packages(exclude=['test', 'bench']),
     ext_modules=fast_cycle_extensions(),
     data_files=[

@@ -15,13 +15,16 @@ Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000]
 Each case starts one answering process exactly as a user would, with nothing
 added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
 (the default executor; the default backend, ProxSuite with its verified warm
-start, in the compiled cycle), then the same with ``-p solver.compiled:=false``
+start, in the compiled cycle; the spinning thread SCHED_FIFO 50 where the
+system allows), then with ``-p thread_priority:=0`` (normal scheduling, the
+default before 0.4.0), the same with ``-p solver.compiled:=false``
 (the Python cycle, the default before the compiled one), with that and
 ``-p solver.warm_start:=false`` as well (the cold ProxSuite default before the
 warm start), with ``-p solver.backend:=daqp``, and the trivial
 echo node of ``bench/node_load.py`` (one zero command per joint state), taking
 joint states with sensor-data QoS (keep last 5) and, as ``echo, joint_states depth
-1``, with the node's own QoS (keep last 1); and the node with ``--executor events``
+1``, with the node's own QoS (keep last 1), and as ``echo, SCHED_FIFO 50`` with the
+thread priority the node asks; and the node with ``--executor events``
 (rclpy's experimental events executor, its main's flag, not a parameter). A
 separate process publishes Allegro joint states at the rate with sensor-data
 QoS for ``--duration`` seconds once the answering node is discovered and has
@@ -62,8 +65,9 @@ from ros_load import (  # noqa: E402
 PARAMS = CONFIG / 'allegro_right_node.yaml'
 SCENARIO = CONFIG / 'allegro_right.yaml'
 #: Answering processes: name -> extra node arguments (None: the echo node).
-TARGETS = {'echo': None, 'echo, joint_states depth 1': None,
+TARGETS = {'echo': None, 'echo, joint_states depth 1': None, 'echo, SCHED_FIFO 50': None,
            'grasp_torque_node (default)': [],
+           'grasp_torque_node thread_priority:=0': ['-p', 'thread_priority:=0'],
            'grasp_torque_node --executor events': ['--executor', 'events'],
            'grasp_torque_node compiled:=false': ['-p', 'solver.compiled:=false'],
            'grasp_torque_node warm_start:=false compiled:=false':
@@ -146,7 +150,8 @@ def run_case(target: str, rate: float, duration: float, domain: int, tmp: Path) 
         joints = GraspSetup.from_file(SCENARIO).hand.joints
         cmd = [sys.executable, str(bench / 'node_load.py'), '--role', 'echo',
                '--executor', 'single', '--joints', ','.join(joints),
-               '--echo-qos', 'node' if 'depth 1' in target else 'sensor']
+               '--echo-qos', 'node' if 'depth 1' in target else 'sensor',
+               '--echo-priority', '50' if 'FIFO' in target else '0']
     else:
         exe = Path(sys.executable).parent / 'grasp_torque_node'
         pre = extra[:2] if extra[:1] == ['--executor'] else []  # the node's own flag

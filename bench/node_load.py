@@ -17,13 +17,16 @@ are measured in turn with the same load process:
 
 - ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
   ``publish_stamped_command:=true``), as configured (ProxSuite, the compiled cycle
-  where it applies), with ``solver.compiled:=false`` (the Python cycle, target
-  ``grasp_torque_node/python``) and with ``solver.backend:=daqp`` (target
+  where it applies, its spinning thread SCHED_FIFO 50 where the system allows),
+  with ``thread_priority:=0`` (normal scheduling, the default before 0.4.0; target
+  ``grasp_torque_node/normal``), with ``solver.compiled:=false`` (the Python cycle,
+  target ``grasp_torque_node/python``) and with ``solver.backend:=daqp`` (target
   ``grasp_torque_node/daqp``);
 - an echo node written here, named ``grasp_torque_node`` too, that answers each
   joint state with zero torques on ``effort_commands`` and the stamped copy on
   ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
-  its executor as the node's main does (``events``: a ``spin_once`` loop).
+  its executor as the node's main does (``events``: a ``spin_once`` loop), with
+  normal scheduling (``--echo-priority N``: SCHED_FIFO N, as the node asks).
 
 The load process (a separate process, the same for every case) publishes joint
 states with sensor-data QoS on absolute deadlines (the scenario's grasp with a
@@ -73,9 +76,11 @@ from ros_load import (  # noqa: E402
 HANDS = {'allegro': ('allegro_right.yaml', 'allegro_right_node.yaml'),
          'planar': ('planar_two_finger.yaml', 'planar_two_finger_node.yaml')}
 #: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
-TARGETS = ('echo', 'grasp_torque_node', 'grasp_torque_node/python', 'grasp_torque_node/daqp')
+TARGETS = ('echo', 'grasp_torque_node', 'grasp_torque_node/normal', 'grasp_torque_node/python',
+           'grasp_torque_node/daqp')
 #: The node's arguments added per target (the default: none).
-TARGET_ARGS = {'grasp_torque_node/python': ['-p', 'solver.compiled:=false'],
+TARGET_ARGS = {'grasp_torque_node/normal': ['-p', 'thread_priority:=0'],
+               'grasp_torque_node/python': ['-p', 'solver.compiled:=false'],
                'grasp_torque_node/daqp': ['-p', 'solver.backend:=daqp']}
 WARMUP_S = 1.0
 #: After the last joint state, how long commands in flight are still awaited [s].
@@ -134,6 +139,11 @@ def echo_main(args: argparse.Namespace) -> int:
                                  else qos_profile_sensor_data)
         executor = _executor(args.executor)
         executor.add_node(node)
+        if args.echo_priority:
+            from grasp_torque_opt.ros.realtime import set_fifo
+
+            fifo, what = set_fifo(args.echo_priority)
+            print(f'echo executor thread: {what}', file=sys.stderr)
         if args.executor == 'events':  # as grasp_torque_node's main does
             while rclpy.ok():
                 executor.spin_once(timeout_sec=1.0)
@@ -431,6 +441,7 @@ def main() -> int:
     parser.add_argument('--joints', help=argparse.SUPPRESS)
     parser.add_argument('--echo-qos', choices=['sensor', 'node'], default='sensor',
                         help=argparse.SUPPRESS)
+    parser.add_argument('--echo-priority', type=int, default=0, help=argparse.SUPPRESS)
     parser.add_argument('--hand', choices=sorted(HANDS), help=argparse.SUPPRESS)
     parser.add_argument('--rate', type=float, help=argparse.SUPPRESS)
     parser.add_argument('--result', help=argparse.SUPPRESS)
