@@ -9,7 +9,8 @@
 """
 The soak run: grasp_torque_node at 1 kHz for minutes under valid, invalid and infeasible inputs.
 
-Usage: .venv/bin/python bench/soak.py [--duration 600] [--rate 1000] [--seed 0] [--out FILE]
+Usage: .venv/bin/python bench/soak.py [--duration 600] [--rate 1000] [--seed 0]
+       [--node-param NAME:=VALUE ...] [--out FILE]
 
 The node runs as a child process on the Allegro hand (``config/allegro_right_node.yaml``,
 ``publish_stamped_command:=true``) on a private ROS domain, localhost only. This
@@ -151,6 +152,8 @@ def main() -> int:
     parser.add_argument('--duration', type=float, default=600.0, help='seconds of the mix [s]')
     parser.add_argument('--rate', type=float, default=1000.0, help='joint-state rate [Hz]')
     parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--node-param', action='append', default=[], metavar='NAME:=VALUE',
+                        help="a -p for the node beside the params file (e.g. 'thread_priority:=0')")
     parser.add_argument('--out', type=Path,
                         default=Path(__file__).resolve().parent / 'results' / 'soak.json')
     args = parser.parse_args()
@@ -164,7 +167,8 @@ def main() -> int:
     result = None
     with open(logs / 'node.log', 'w') as log:
         try:
-            node = Child(node_command(PARAMS, 'single'), env, log)
+            extra = [a for p in args.node_param for a in ('-p', p)]
+            node = Child(node_command(PARAMS, 'single', extra), env, log)
             result = drive(args, node, domain, logs)
         except KeyboardInterrupt:
             print('soak: interrupted, node stopped', file=sys.stderr)
