@@ -12,7 +12,7 @@ The node under load: latency and dropped cycles of grasp_torque_node beside a tr
 Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
        [--hands allegro planar] [--executors single events] [--out FILE]
 
-For each hand, joint-state rate and rclpy executor, four answering processes
+For each hand, joint-state rate and rclpy executor, these answering processes
 are measured in turn with the same load process:
 
 - ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
@@ -26,7 +26,8 @@ are measured in turn with the same load process:
   joint state with zero torques on ``effort_commands`` and the stamped copy on
   ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
   its executor as the node's main does (``events``: a ``spin_once`` loop), with
-  normal scheduling (``--echo-priority N``: SCHED_FIFO N, as the node asks).
+  normal scheduling (target ``echo``) and with SCHED_FIFO 50, the priority the
+  node asks (target ``echo/fifo``).
 
 The load process (a separate process, the same for every case) publishes joint
 states with sensor-data QoS on absolute deadlines (the scenario's grasp with a
@@ -76,8 +77,8 @@ from ros_load import (  # noqa: E402
 HANDS = {'allegro': ('allegro_right.yaml', 'allegro_right_node.yaml'),
          'planar': ('planar_two_finger.yaml', 'planar_two_finger_node.yaml')}
 #: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
-TARGETS = ('echo', 'grasp_torque_node', 'grasp_torque_node/normal', 'grasp_torque_node/python',
-           'grasp_torque_node/daqp')
+TARGETS = ('echo', 'echo/fifo', 'grasp_torque_node', 'grasp_torque_node/normal',
+           'grasp_torque_node/python', 'grasp_torque_node/daqp')
 #: The node's arguments added per target (the default: none).
 TARGET_ARGS = {'grasp_torque_node/normal': ['-p', 'thread_priority:=0'],
                'grasp_torque_node/python': ['-p', 'solver.compiled:=false'],
@@ -288,9 +289,10 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
     env = isolated_env(domain)
     tag = f"{hand}-{target.replace('/', '-')}-{int(rate)}-{executor}"
     me = [sys.executable, str(Path(__file__).resolve())]
-    if target == 'echo':
+    if target.startswith('echo'):
         joints = GraspSetup.from_file(CONFIG / HANDS[hand][0]).hand.joints
-        cmd = me + ['--role', 'echo', '--executor', executor, '--joints', ','.join(joints)]
+        cmd = me + ['--role', 'echo', '--executor', executor, '--joints', ','.join(joints),
+                    '--echo-priority', '50' if target == 'echo/fifo' else '0']
     else:
         extra = ['--log-level', 'error']
         extra += TARGET_ARGS.get(target, [])
