@@ -10,7 +10,8 @@
 The node under load: latency and dropped cycles of grasp_torque_node beside a trivial echo node.
 
 Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
-       [--hands allegro planar] [--executors single events] [--out FILE]
+       [--hands allegro planar] [--executors single events] [--load-priority 0]
+       [--out FILE]
 
 For each hand, joint-state rate and rclpy executor, these answering processes
 are measured in turn with the same load process:
@@ -36,6 +37,9 @@ topics (reliable, depth ``RECEIVER_DEPTH``: deeper than the node's 1, so that
 the receiver never drops). A command is matched to its joint state by stamp;
 a joint state of the measured window without a stamped command within the
 drain time is a dropped cycle. Latency is stamp-to-receipt on the system clock.
+With ``--load-priority 50`` the load process's spinning thread is SCHED_FIFO 50,
+as the controller_manager loop that would send joint states and take the
+commands on a ros2_control hand (the default: normal scheduling, as any process).
 Every process runs on its own private ROS domain, localhost only; discovery,
 the first command and 1 s of warm-up come before the measured window.
 
@@ -203,6 +207,10 @@ def load_main(args: argparse.Namespace) -> int:
     node.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
     executor = _executor(args.load_executor)
     executor.add_node(node)
+    if args.load_priority:  # as ros2_control's controller_manager loop, which sends and takes
+        from grasp_torque_opt.ros.realtime import set_fifo
+
+        print(f'load executor thread: {set_fifo(args.load_priority)[1]}', file=sys.stderr)
     pacer = Pacer(executor, args.rate)
 
     def ready() -> bool:
@@ -282,7 +290,7 @@ def load_main(args: argparse.Namespace) -> int:
 # -- the run ---------------------------------------------------------------------------------
 
 def run_case(hand: str, target: str, rate: float, executor: str, duration: float,
-             load_executor: str, domain: int, tmp: Path) -> dict:
+             load_executor: str, domain: int, tmp: Path, load_priority: int = 0) -> dict:
     """One case: start the answering node, run the load process against it, stop both."""
     from grasp_torque_opt.core.grasp_setup import GraspSetup
 
@@ -300,6 +308,7 @@ def run_case(hand: str, target: str, rate: float, executor: str, duration: float
     result_file = tmp / f'{tag}.json'
     load_cmd = me + ['--role', 'load', '--hand', hand, '--rate', str(rate),
                      '--duration', str(duration), '--load-executor', load_executor,
+                     '--load-priority', str(load_priority),
                      '--result', str(result_file)]
     children: list[Child] = []
     with open(tmp / f'{tag}.target.log', 'w') as tlog, open(tmp / f'{tag}.load.log', 'w') as llog:
@@ -392,14 +401,15 @@ def main_run(args: argparse.Namespace) -> int:
     m = machine()
     print(f"machine: {m['cpu']}, {m['cores']} cores, Python {m['python']}; {m['date']}")
     print(f'{len(keys)} cases, {args.duration:g} s each after {WARMUP_S:g} s of warm-up; '
-          f'load process executor: {args.load_executor}; receiver depth {RECEIVER_DEPTH}',
+          f'load process executor: {args.load_executor}, SCHED_FIFO '
+          f"{args.load_priority or 'no'}; receiver depth {RECEIVER_DEPTH}",
           flush=True)
     cases = []
     logs = Path(tempfile.mkdtemp(prefix='node_load_'))
     print(f'logs of the child processes: {logs}')
     for (hand, rate, executor, target), domain in zip(keys, domains):
         c = run_case(hand, target, rate, executor, args.duration, args.load_executor,
-                     domain, logs)
+                     domain, logs, args.load_priority)
         cases.append(c)
         if 'error' in c:
             print(f"  {hand} {target} {rate:g} Hz {executor}: {c['error']}", flush=True)
@@ -414,7 +424,8 @@ def main_run(args: argparse.Namespace) -> int:
     print(table(cases))
     out = {'machine': m, 'date_utc': datetime.now(timezone.utc).isoformat(timespec='seconds'),
            'duration_s': args.duration, 'warmup_s': WARMUP_S, 'drain_s': DRAIN_S,
-           'load_executor': args.load_executor, 'receiver_depth': RECEIVER_DEPTH,
+           'load_executor': args.load_executor, 'load_priority': args.load_priority,
+           'receiver_depth': RECEIVER_DEPTH,
            'cases': cases, 'node_vs_echo': ratios(cases)}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(out, indent=2))
@@ -433,6 +444,9 @@ def main() -> int:
                         help='executors of the answering nodes')
     parser.add_argument('--load-executor', choices=['single', 'events'], default='events',
                         help='executor of the load process itself (the same in every case)')
+    parser.add_argument('--load-priority', type=int, default=0,
+                        help='SCHED_FIFO priority of the load process (0: normal); 50 sends and '
+                             "takes as ros2_control's controller_manager loop would")
     parser.add_argument('--out', type=Path,
                         default=Path(__file__).resolve().parent / 'results' / 'node_load.json')
     # Roles of the child processes.
