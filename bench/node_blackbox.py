@@ -15,9 +15,9 @@ Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000]
 Each case starts one answering process exactly as a user would, with nothing
 added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
 (the default executor; the default backend, ProxSuite with its verified warm
-start, in the compiled cycle; the spinning thread SCHED_FIFO 50 where the
-system allows), then with ``-p thread_priority:=0`` (normal scheduling, the
-default before 0.4.0), the same with ``-p solver.compiled:=false``
+start, in the compiled cycle; normal scheduling), then with ``-p
+thread_priority:=50`` (the spinning thread SCHED_FIFO 50, as ros2_control's
+controller_manager asks for its loop), with ``-p solver.compiled:=false``
 (the Python cycle, the default before the compiled one), with that and
 ``-p solver.warm_start:=false`` as well (the cold ProxSuite default before the
 warm start), with ``-p solver.backend:=daqp``, and the trivial
@@ -67,7 +67,7 @@ SCENARIO = CONFIG / 'allegro_right.yaml'
 #: Answering processes: name -> extra node arguments (None: the echo node).
 TARGETS = {'echo': None, 'echo, joint_states depth 1': None, 'echo, SCHED_FIFO 50': None,
            'grasp_torque_node (default)': [],
-           'grasp_torque_node thread_priority:=0': ['-p', 'thread_priority:=0'],
+           'grasp_torque_node thread_priority:=50': ['-p', 'thread_priority:=50'],
            'grasp_torque_node --executor events': ['--executor', 'events'],
            'grasp_torque_node compiled:=false': ['-p', 'solver.compiled:=false'],
            'grasp_torque_node warm_start:=false compiled:=false':

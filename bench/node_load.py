@@ -18,9 +18,9 @@ are measured in turn with the same load process:
 
 - ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
   ``publish_stamped_command:=true``), as configured (ProxSuite, the compiled cycle
-  where it applies, its spinning thread SCHED_FIFO 50 where the system allows),
-  with ``thread_priority:=0`` (normal scheduling, the default before 0.4.0; target
-  ``grasp_torque_node/normal``), with ``solver.compiled:=false`` (the Python cycle,
+  where it applies, normal scheduling), with ``thread_priority:=50`` (the spinning
+  thread SCHED_FIFO 50 where the system allows; target ``grasp_torque_node/fifo``),
+  with ``solver.compiled:=false`` (the Python cycle,
   target ``grasp_torque_node/python``) and with ``solver.backend:=daqp`` (target
   ``grasp_torque_node/daqp``);
 - an echo node written here, named ``grasp_torque_node`` too, that answers each
@@ -81,10 +81,10 @@ from ros_load import (  # noqa: E402
 HANDS = {'allegro': ('allegro_right.yaml', 'allegro_right_node.yaml'),
          'planar': ('planar_two_finger.yaml', 'planar_two_finger_node.yaml')}
 #: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
-TARGETS = ('echo', 'echo/fifo', 'grasp_torque_node', 'grasp_torque_node/normal',
+TARGETS = ('echo', 'echo/fifo', 'grasp_torque_node', 'grasp_torque_node/fifo',
            'grasp_torque_node/python', 'grasp_torque_node/daqp')
 #: The node's arguments added per target (the default: none).
-TARGET_ARGS = {'grasp_torque_node/normal': ['-p', 'thread_priority:=0'],
+TARGET_ARGS = {'grasp_torque_node/fifo': ['-p', 'thread_priority:=50'],
                'grasp_torque_node/python': ['-p', 'solver.compiled:=false'],
                'grasp_torque_node/daqp': ['-p', 'solver.backend:=daqp']}
 WARMUP_S = 1.0

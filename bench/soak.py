@@ -153,7 +153,7 @@ def main() -> int:
     parser.add_argument('--rate', type=float, default=1000.0, help='joint-state rate [Hz]')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--node-param', action='append', default=[], metavar='NAME:=VALUE',
-                        help="a -p for the node beside the params file ('thread_priority:=0')")
+                        help="a -p for the node beside the params file ('thread_priority:=50')")
     parser.add_argument('--out', type=Path,
                         default=Path(__file__).resolve().parent / 'results' / 'soak.json')
     args = parser.parse_args()

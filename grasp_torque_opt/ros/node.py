@@ -264,10 +264,10 @@ PARAMETERS: dict[str, Spec] = {
                                'found: it exits with an error (code 2). Later, one is '
                                'reported (diagnostics ERROR) [s].', 0.0, 30.0, read_only=True),
     'thread_priority': Spec('At start, the SCHED_FIFO priority the executables ask for the '
-                            "thread that spins the node, as ros2_control's controller_manager "
-                            'does (its default, 50); where the system refuses, a warning and '
-                            'normal scheduling; 0: the scheduling is left as it is [-].', 0, 99,
-                            read_only=True),
+                            "thread that spins the node (ros2_control's controller_manager asks "
+                            '50 for its loop); where the system refuses, a warning and normal '
+                            'scheduling; 0 (the default): the scheduling is left as it is [-].',
+                            0, 99, read_only=True),
     'marker_scale': Spec('Arrow length per newton in ~/contact_wrenches [m/N].', 0.0, 10.0),
     'publish_stamped_command': Spec('Also publish each command on ~/effort_commands_stamped '
                                     '(sensor_msgs/JointState: joints, effort, and the stamp of '
@@ -351,7 +351,7 @@ def fixed_defaults() -> dict[str, Any]:
         'marker_period': 0.1,
         'watchdog_period': 0.01,
         'startup_check_time': 2.0,
-        'thread_priority': 50,
+        'thread_priority': 0,  # opt-in: docs/node.md, "The executor thread's priority"
         'marker_scale': 0.02,
         'publish_stamped_command': False,
     }
