@@ -365,20 +365,22 @@ def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, si
         p.close()
 
 
+def _command_at(h: Harness, state: tuple) -> np.ndarray:
+    """Send a joint state (names, positions) and give the command it brings (asserted)."""
+    h.send_joint_state(*state)
+    command = h.next_command(5.0)
+    assert command is not None
+    return command
+
+
 @pytest.mark.parametrize('backend', ['daqp', 'quadprog'])
 def test_backend_parameter_switches_the_solver_and_keeps_the_optimum(allegro, backend):
     h = Harness(ALLEGRO)
     try:
-        names = list(allegro.hand.joints)
-        positions = allegro.q[allegro.hand.idx_q]
-        h.send_joint_state(names, positions)
-        before = h.next_command(5.0)
-        assert before is not None
+        before = _command_at(h, joint_state(allegro))
         assert h.node.set_parameters([Parameter('solver.backend', value=backend)])[0].successful
         assert h.node.controller.solver.name == backend
-        h.send_joint_state(names, positions)
-        after = h.next_command(5.0)
-        assert after is not None
+        after = _command_at(h, joint_state(allegro))
         np.testing.assert_allclose(after, before, atol=1e-6)
         refused = h.node.set_parameters([Parameter('solver.backend', value='osqp')])[0]
         assert not refused.successful and 'solver.backend' in refused.reason
@@ -391,19 +393,13 @@ def test_the_compiled_cycle_answers_over_ros_and_the_parameter_turns_it_off(alle
     # false, set over ROS, gives the Python cycle's command for the same state.
     h = Harness(ALLEGRO)
     try:
-        names = list(allegro.hand.joints)
-        positions = allegro.q[allegro.hand.idx_q]
-        h.send_joint_state(names, positions)
-        compiled = h.next_command(5.0)
-        assert compiled is not None
+        compiled = _command_at(h, joint_state(allegro))
         assert h.node.controller.compiled_cycle is not None
         assert h.node.controller.compiled_cycle.solves >= 1
         assert h.spin_until(lambda: h.diagnostics and
                             h.diagnostics[-1].get('solver.compiled') == 'true', 3.0)
         assert h.node.set_parameters([Parameter('solver.compiled', value=False)])[0].successful
-        h.send_joint_state(names, positions)
-        python = h.next_command(5.0)
-        assert python is not None
+        python = _command_at(h, joint_state(allegro))
         np.testing.assert_allclose(python, compiled, atol=1e-6)
         assert h.spin_until(lambda: h.diagnostics and h.diagnostics[-1].get(
             'solver.compiled') == 'false: off (compiled: false)', 3.0)
@@ -691,7 +687,8 @@ def test_the_executor_thread_alone_asks_sched_fifo(planar, priority):
         assert p.call(client, Trigger.Request()).success  # the worker thread exists now
         assert p.spin_until(lambda: bool(seen), 5.0)
         fifo = _fifo_threads(p.child.pid)
-        if priority and _fifo_allowed():
+        granted = bool(priority) and _fifo_allowed()
+        if granted:
             assert fifo == {p.child.pid: priority}, fifo  # the main thread, and it alone
             assert seen[-1] == f'SCHED_FIFO {priority}'
         else:
@@ -700,8 +697,7 @@ def test_the_executor_thread_alone_asks_sched_fifo(planar, priority):
         p.child.send_signal(signal.SIGINT)
         code, err = p.finish()
         assert code == 0 and 'Traceback' not in err, err
-        said = ('executor thread: SCHED_FIFO 50, switch interval 0.5 ms'
-                if priority and _fifo_allowed()
+        said = ('executor thread: SCHED_FIFO 50, switch interval 0.5 ms' if granted
                 else 'refused' if priority else 'executor thread: left as it is')
         assert said in err, err
     finally:
