@@ -147,8 +147,7 @@ def echo_main(args: argparse.Namespace) -> int:
         if args.echo_priority:
             from grasp_torque_opt.ros.realtime import set_fifo
 
-            fifo, what = set_fifo(args.echo_priority)
-            print(f'echo executor thread: {what}', file=sys.stderr)
+            print(f'echo executor thread: {set_fifo(args.echo_priority)[1]}', file=sys.stderr)
         if args.executor == 'events':  # as grasp_torque_node's main does
             while rclpy.ok():
                 executor.spin_once(timeout_sec=1.0)

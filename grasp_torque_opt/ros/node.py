@@ -1466,9 +1466,10 @@ def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None
         executor = EXECUTORS[opts.executor]()
         executor.add_node(node)
         # After the executor and the node made their threads: only this one is raised.
-        fifo, what = realtime.set_fifo(node.get_parameter('thread_priority').value)
+        priority = node.get_parameter('thread_priority').value
+        fifo, what = realtime.set_fifo(priority)
         log = node.get_logger()
-        (log.info if fifo or what.startswith('left') else log.warn)(f'executor thread: {what}')
+        (log.info if fifo or priority == 0 else log.warn)(f'executor thread: {what}')
         # A spin_once loop, so that the stop flag is seen: each wait ends by the next
         # watchdog tick at the latest. (EventsExecutor.spin() also delivered no subscription
         # callback with these wheels, rclpy 7.1.6 and Fast DDS, while keeping a core busy.)
