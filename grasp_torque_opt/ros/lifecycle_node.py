@@ -35,32 +35,21 @@ parameters, service, fault policy), driven by the standard lifecycle services
 from __future__ import annotations
 
 import sys
-import time
 from typing import Any
 
-from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
-from grasp_torque_opt.ros.node import (
-    descriptor,
-    fixed_defaults,
-    FIXED_WHILE_CONFIGURED,
-    GraspTorqueCore,
-    NODE_NAME,
-    PARAMETERS,
-    run,
-    scenario_defaults,
-    SCENARIO_PARAMETERS,
-    stop_requested,
-)
-from grasp_torque_opt.ros.peers import quiet_publisher
-from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.core.exceptions import GraspTorqueError
+from grasp_torque_opt.ros.node.qos import NODE_NAME
+from grasp_torque_opt.ros.node.root import GraspTorque
+from grasp_torque_opt.ros.node.runner import run
+from grasp_torque_opt.ros.node.signals import stop_requested
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
-from rclpy.parameter import Parameter
 
 #: The executable's name.
 EXECUTABLE = 'grasp_torque_lifecycle_node'
 
 
-class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
+class GraspTorqueLifecycleNode(LifecycleNode):
     """The node, managed: it loads at configure and commands only while active."""
 
     def __init__(self, message_info: bool = True, **kwargs: Any) -> None:
@@ -77,64 +66,20 @@ class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
             kwargs: for rclpy's LifecycleNode (context, parameter_overrides, ...).
         """
         super().__init__(NODE_NAME, **kwargs)
-        self._init_core(message_info)
-        self._active = False
-        #: Parameters whose value given at start was refused -> the reason.
-        self._refused: dict[str, str] = {}
-        #: Parameters that configure filled in from the scenario (emptied at cleanup).
-        self._filled: set[str] = set()
-        fixed = fixed_defaults()
-        for name in PARAMETERS:
-            if name == 'name_map':
-                self._declare(name, Parameter.Type.STRING_ARRAY)
-            elif name in SCENARIO_PARAMETERS:
-                self._declare(name, SCENARIO_PARAMETERS[name])
-            else:
-                self._declare(name, fixed[name])
-        self.add_on_set_parameters_callback(self._validate_parameters)
-        self.add_post_set_parameters_callback(self._apply_parameters)
-        self._start_service()
+        self.root = GraspTorque(self, managed=True, message_info=message_info)
+        self.root.parameters.declare_all_managed()
+        self.root.parameters.watch(self.root.apply)
+        self.root.service.start()
         self.get_logger().info('unconfigured: configure to load the hand, activate to command')
 
-    def _declare(self, name: str, value: Any) -> None:
-        """Declare a parameter; a refused value given at start is kept as a reason."""
-        try:
-            self.declare_parameter(name, value, descriptor(name, managed=True))
-        except (InvalidParameterValueException, InvalidParameterTypeException) as e:
-            why = str(e).splitlines()[0].split('Reason: ', 1)[-1]  # rclpy's words
-            if why.endswith(f': {name}'):
-                why = why[:-len(name) - 2]
-            self._refused[name] = f'the value given at start was refused ({why})'
-            self.declare_parameter(name, value, descriptor(name, managed=True),
-                                   ignore_override=True)
-
     @property
-    def commanding(self) -> bool:
-        """Whether the node publishes commands now: only while active."""
-        return self._active and self.controller is not None
+    def controller(self) -> TorqueController | None:
+        """Give the loop's TorqueController, or None while unconfigured."""
+        return self.root.controller
 
-    def _fixed(self, name: str) -> str:
-        if PARAMETERS[name].read_only and self.controller is not None and not self._filling:
-            return f'{name}: {FIXED_WHILE_CONFIGURED}'
-        return ''
-
-    def _apply_parameters(self, params: list[Parameter]) -> None:
-        if not self._filling:
-            for param in params:  # set by the user: no longer refused, nor the scenario's
-                self._refused.pop(param.name, None)
-                self._filled.discard(param.name)
-        super()._apply_parameters(params)
-
-    def _make_publisher(self, msg_type: type, topic: str, qos: Any) -> Any:
-        """Make a command publisher: a lifecycle one, silent unless active."""
-        return self.create_lifecycle_publisher(msg_type, topic, qos,
-                                               event_callbacks=quiet_publisher())
-
-    def _destroy_command_publisher(self, publisher: Any) -> None:
-        self.destroy_lifecycle_publisher(publisher)
-
-    def _state_note(self) -> str:
-        return '' if self._active else 'inactive (lifecycle): no commands'
+    def safe_stop(self) -> bool:
+        """Take the safe action of ``fault_policy`` (:meth:`GraspTorque.safe_stop`)."""
+        return self.root.safe_stop()
 
     # -- transitions ----------------------------------------------------------------------
 
@@ -146,23 +91,20 @@ class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
             SUCCESS (inactive), or FAILURE with one logged line naming what was
             refused (unconfigured again, nothing kept).
         """
+        root = self.root
         try:
-            if self._refused:
-                name, why = next(iter(self._refused.items()))
-                raise InputError(name, f'{why}; set it, then configure again')
-            urdf = self._urdf(stop_requested)
-            setup = self._bind(urdf, self._value('joints'))
-            self._fill(scenario_defaults(self._scenario, setup))
-            self._build(setup)
-            self._start_interfaces()
+            root.parameters.first_refused()
+            grasp = root.load(stop_requested, root.parameters.value('joints'))
+            root.parameters.fill(root.defaults(grasp))
+            root.build(grasp)
+            root.start_interfaces()
         except GraspTorqueError as e:
             return self._configure_failed(str(e))
         except Exception as e:  # noqa: BLE001 -- a transition fails, it does not raise
             return self._configure_failed(f'{type(e).__name__}: {e}')
         self.get_logger().info(
-            f"inactive: {self._m} joints in command order ({', '.join(setup.hand.joints)}), "
-            f'{len(setup.contacts)} default contacts; activate to command on '
-            f'{self._command_pub.topic_name}; cycle: {self._cycle_kind()}')
+            f'inactive: {root.describe()}; activate to command on '
+            f'{root.outputs.command_pub.topic_name}; cycle: {root.cycle_kind()}')
         return TransitionCallbackReturn.SUCCESS
 
     def _configure_failed(self, reason: str) -> TransitionCallbackReturn:
@@ -170,69 +112,31 @@ class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
         self._unconfigure()
         return TransitionCallbackReturn.FAILURE
 
-    def _fill(self, defaults: dict[str, Any]) -> None:
-        """
-        Give the parameters still without a value the scenario's.
-
-        Raises:
-            InputError: a value refused (it names the parameter).
-        """
-        self._filling = True
-        try:
-            for name, value in defaults.items():
-                if self._value(name) is not None:
-                    continue
-                result = self.set_parameters([Parameter(name, value=value)])[0]
-                if not result.successful:
-                    field, _, problem = result.reason.partition(': ')
-                    raise InputError(field, problem)
-                self._filled.add(name)
-        finally:
-            self._filling = False
-
     def _unconfigure(self) -> None:
         """Release the interfaces and the model; empty what configure filled in."""
-        with self._lock:
-            self._active = False
-        self._stop_interfaces()
-        with self._lock:
-            self._release()
-        self._filling = True
-        try:
-            for name in sorted(self._filled):
-                self.undeclare_parameter(name)
-                self.declare_parameter(name, SCENARIO_PARAMETERS[name],
-                                       descriptor(name, managed=True), ignore_override=True)
-        finally:
-            self._filling = False
-            self._filled.clear()
+        root = self.root
+        with root.lock:
+            root.active = False
+        root.stop_interfaces()
+        root.release()
+        root.parameters.empty_filled()
 
     def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Start commanding: the command publishers are enabled, then the loop commands."""
         result = super().on_activate(state)  # enables the lifecycle publishers
         if result != TransitionCallbackReturn.SUCCESS:
             return result
-        with self._lock:
-            self._active = True
-            # As after a parameter change: fresh inputs command at once, and a command in
-            # force over the limits (set while inactive) is zeroed.
-            decision = self.controller.reconfigured(time.monotonic())
-            if decision is not None:
-                self._publish(decision, self._last_stamp)
+        # As after a parameter change: fresh inputs command at once, and a command in
+        # force over the limits (set while inactive) is zeroed.
+        self.root.activate()
         self.get_logger().info('active: commanding on each joint state')
         return TransitionCallbackReturn.SUCCESS
 
     def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Take the safe action of ``fault_policy``, then stop commanding."""
-        self._stop_commanding()
+        self.root.deactivate()
         self.get_logger().info('inactive: no commands')
         return super().on_deactivate(state)  # disables the lifecycle publishers
-
-    def _stop_commanding(self) -> None:
-        if self._active:
-            self.safe_stop()  # while the publishers are still enabled
-        with self._lock:
-            self._active = False
 
     def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Release the model and the interfaces; unconfigured again."""
@@ -242,24 +146,23 @@ class GraspTorqueLifecycleNode(GraspTorqueCore, LifecycleNode):
 
     def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
         """From any state: the safe action if active, then release everything."""
-        self._stop_commanding()
+        self.root.deactivate()
         self._unconfigure()
         self.get_logger().info('finalized')
         return super().on_shutdown(state)
 
     def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
         """After an error in a transition: release everything, unconfigured again."""
-        self._stop_commanding()
+        self.root.deactivate()
         self._unconfigure()
         self.get_logger().error('a transition raised: the hand is released (unconfigured)')
         return TransitionCallbackReturn.SUCCESS
 
     def destroy_node(self) -> None:
         """Take the safe action if active, then release everything and stop the node."""
-        self._stop_commanding()
-        self._stop_interfaces()
-        if self._worker is not None:
-            self._worker.shutdown(wait=True, cancel_futures=True)
+        self.root.deactivate()
+        self.root.stop_interfaces()
+        self.root.service.shutdown()
         super().destroy_node()
         # rclpy 7.1's LifecycleNode leaves its state machine, which holds the node's
         # handle: the node stayed on the domain's graph after destroy_node() (and a

@@ -30,8 +30,9 @@ from cycle_inputs import base_poses, FAULT_MODES, Injected, joint_state
 from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
 from grasp_torque_opt.cli import main as cli_main
 from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.parameters import cycle_config
 from grasp_torque_opt.core import scenario as schema
-from grasp_torque_opt.ros.node import GraspTorqueNode, PARAMETERS
+from grasp_torque_opt.ros.node import controllers, GraspTorqueNode, PARAMETERS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from independent import assert_holds
@@ -60,8 +61,8 @@ class Recorder:
     """
 
     def __init__(self, node: GraspTorqueNode):
-        self.node, self.real, self.seen = node, node._command_pub, []
-        node._command_pub = self
+        self.node, self.real, self.seen = node, node.root.outputs.command_pub, []
+        node.root.outputs.command_pub = self
 
     def publish(self, msg) -> None:
         self.real.publish(msg)
@@ -84,7 +85,8 @@ class Rig:
         overrides = [Parameter('scenario', value=str(scenario))]
         overrides += [Parameter(k, value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
-        self.defaults = [Parameter(n, value=v) for n, v in self.node._params().items()
+        values = self.node.root.parameters.values()
+        self.defaults = [Parameter(n, value=v) for n, v in values.items()
                          if not PARAMETERS[n].read_only]
         self.recorder = Recorder(self.node)
         self.setup = setup
@@ -106,9 +108,11 @@ class Rig:
 
     def reset(self) -> None:
         assert all(r.successful for r in self.node.set_parameters(self.defaults))
-        n = self.node
-        with n._lock:
-            n.controller = TorqueController(*n._configure(n._base_setup, n._params()))
+        root = self.node.root
+        with root.lock:
+            p = root.params
+            root.controller = TorqueController(controllers.setup_of(root.grasp.setup, p),
+                                               cycle_config(p), controllers.solver_settings(p))
         self.recorder.seen.clear()
 
     def close(self) -> None:
@@ -164,15 +168,15 @@ def run(rig: Rig, ops) -> None:
         COUNTS['inputs'] += 1
         t0 = time.perf_counter()
         if kind == 'joint_states':
-            node._on_joint_state(arg)
+            node.root.inputs.on_joint_state(arg)
         elif kind == 'contacts':
-            node._on_contacts(arg)
+            node.root.inputs.on_contacts(arg)
         elif kind == 'external_wrench':
-            node._on_wrench(arg)
+            node.root.inputs.on_wrench(arg)
         elif kind == 'sleep':
             time.sleep(arg)
         elif kind == 'watchdog':
-            node._on_watchdog()
+            node.root.on_watchdog()
         elif kind == 'solver':
             solver = Injected(arg if arg != 'healthy' else FAULT_MODES[0])
             solver.healthy = arg == 'healthy'
@@ -184,10 +188,10 @@ def run(rig: Rig, ops) -> None:
             node.set_parameters([Parameter('torque_limits', value=[float(x) for x in limits])])
         elif kind in ('skewed_joint_state', 'joint_state_on_clock'):
             msg = copy.deepcopy(rig.valid_js)
-            t = node._clock_now() + (arg or 0.0)
+            t = node.root.inputs.clock_now() + (arg or 0.0)
             msg.header.stamp.sec, msg.header.stamp.nanosec = int(t), int((t % 1.0) * 1e9)
             before = node.controller.counters.rejected['joint_states']
-            node._on_joint_state(msg)
+            node.root.inputs.on_joint_state(msg)
             refused = node.controller.counters.rejected['joint_states'] > before
             if kind == 'joint_state_on_clock' and refused and \
                     'header.stamp' in node.controller.last_rejection:
@@ -237,7 +241,7 @@ def run(rig: Rig, ops) -> None:
             broken(f'a command fails the independent check: {e}')
     # The service still answers, with a certified command or a reason.
     done = Future()
-    node._solve_for_service(ctrl.inputs, time.monotonic(), done)
+    node.root.service.solve(ctrl.inputs, time.monotonic(), done)
     success, message = done.result()
     if success:
         d = json.loads(message)

@@ -498,7 +498,7 @@ def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
     than the calls come, at most MAX_PENDING_SOLVES are queued and the rest are "busy", and
     the control loop goes on meanwhile.
     """
-    from grasp_torque_opt.ros import node as node_module
+    from grasp_torque_opt.ros.node import service as service_module
     from rclpy.qos import HistoryPolicy, QoSProfile
 
     h = Harness(PLANAR, joint_state_timeout=10.0)
@@ -520,9 +520,9 @@ def test_a_flood_of_service_calls_is_answered_every_one(planar, monkeypatch):
             return len(answers) - len(busy), len(busy)
 
         solved, _ = flood(300)
-        assert solved >= node_module.MAX_PENDING_SOLVES
-        monkeypatch.setattr(node_module, 'MAX_PENDING_SOLVES', 4)
-        h.node._service_controller.solver = Slow(0.05)
+        assert solved >= service_module.MAX_PENDING_SOLVES
+        monkeypatch.setattr(service_module, 'MAX_PENDING_SOLVES', 4)
+        h.node.root.service.controller.solver = Slow(0.05)
         n = len(h.commands)
         futures = [client.call_async(Trigger.Request()) for _ in range(20)]
         for _ in range(10):  # the loop answers joint states while the service solves
@@ -589,7 +589,8 @@ def test_a_running_node_reports_another_of_its_name(planar):
 def test_incompatible_peers_are_found_from_the_graph_and_told_once(planar_node):
     h = planar_node
     # No QoS event handlers of the node's own topics wait in its executor.
-    ours = [h.node._command_pub, h.node._marker_pub, h.node._diag_pub,
+    root = h.node.root
+    ours = [root.outputs.command_pub, root.outputs.marker_pub, root.status.pub,
             *h.node.subscriptions]
     assert all(e.event_handlers == [] for e in ours)
     assert h.spin_until(lambda: h.diagnostics and

@@ -146,7 +146,7 @@ def test_configure_waits_for_the_urdf_then_cleanup_takes_the_next_one(planar, al
         # next configure takes them, with that hand's defaults (16 joints, renamed).
         assert h.transition(Transition.TRANSITION_DEACTIVATE)
         assert h.transition(Transition.TRANSITION_CLEANUP)
-        assert h.node.controller is None and h.node._value('torque_limits') is None
+        assert h.node.controller is None and h.node.root.parameters.value('torque_limits') is None
         urdf = write_renamed_urdf(tmp_path).read_text()
         publisher.publish(urdf)
         results = h.set_parameters(scenario=str(ALLEGRO), name_map=NAME_MAP)

@@ -1,0 +1,500 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The node's parameters from one schema file, without ROS.
+
+``grasp_torque_node_parameters.yaml`` beside this module is written in
+generate_parameter_library's format (ros2_controllers' ``*_parameters.yaml``): one
+entry per parameter with its type, default, description, read-only flag and
+validation. generate_parameter_library is a C++/Python code generator of the ROS
+build that is not on the package registry, so this module reads the same format
+itself; a colcon build could switch to the generated module later. From the file
+come:
+
+- :data:`SCHEMA`, the parameters in order (:class:`ParamSpec`), with
+  :meth:`Schema.check` (the validation that names the parameter) and the docs table
+  (:meth:`Schema.markdown_table`, docs/design.md section 4.4);
+- :class:`CycleConfig`, the frozen settings of the cycle, whose fields are the
+  entries with a ``cycle`` key, with their types and defaults;
+- :meth:`Schema.params`, a frozen snapshot of every value (``p.solver.backend``).
+
+The ROS side (declarations, descriptors, topic-name checks) is
+:mod:`grasp_torque_opt.ros.node.parameters`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+import dataclasses
+from dataclasses import dataclass
+import math
+from pathlib import Path
+from typing import Any
+
+from grasp_torque_opt.backends import available
+from grasp_torque_opt.core.exceptions import cut, InputError, quote
+from grasp_torque_opt.core.hand import Hand
+from grasp_torque_opt.core.scenario import MAX_NAME_MAP, parse_name_map
+import numpy as np
+import yaml
+
+#: The schema file.
+SCHEMA_FILE = Path(__file__).with_name('grasp_torque_node_parameters.yaml')
+#: Largest accepted norm of a gravity input [m/s^2] (about 10 g).
+MAX_GRAVITY = 100.0
+#: Each weight's range, and the largest ratio of two weights: W's condition number
+#: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
+WEIGHT_RANGE = (1e-6, 1e6)
+MAX_WEIGHT_RATIO = 1e6
+#: Python types of the schema's types.
+PYTHON_TYPES = {'string': str, 'double': float, 'int': int, 'bool': bool,
+                'string_array': tuple, 'double_array': tuple}
+#: Validators that fix an array's length: run first, as the others index it.
+SIZE_VALIDATORS = ('fixed_size<>', 'size_of_joints')
+
+
+@dataclass(frozen=True)
+class Context:
+    """
+    What some checks need beyond the value: the hand, once loaded.
+
+    Attributes:
+        m: number of actuated joints (None: no hand yet, lengths are not checked).
+        joints: their names, for messages.
+        torque_bounds: the largest accepted torque limit per joint [N m] (None:
+            unchecked).
+    """
+
+    m: int | None = None
+    joints: tuple[str, ...] = ()
+    torque_bounds: np.ndarray | None = None
+
+
+#: A custom validator: (parameter, value, context) -> the problem, '' if none.
+Validator = Callable[[str, Any, Context], str]
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """
+    One parameter of the schema.
+
+    Attributes:
+        name: dotted name (``solver.backend``).
+        type: ``string``, ``double``, ``int``, ``bool``, ``string_array`` or
+            ``double_array``.
+        description: what it does.
+        unit: its SI unit ('-' for none).
+        default: the default value (None: none: from the scenario, or unset).
+        read_only: fixed after start (the managed node: while configured).
+        from_scenario: where the scenario gives the default, in words (None: not).
+        unset: the words for a parameter without a default that may stay unset.
+        cycle: the :class:`CycleConfig` field that takes it (None: none).
+        validation: (validator, arguments) in the file's order.
+    """
+
+    name: str
+    type: str  # noqa: A003 -- generate_parameter_library's word
+    description: str
+    unit: str
+    default: Any = None
+    read_only: bool = False
+    from_scenario: str | None = None
+    unset: str | None = None
+    cycle: str | None = None
+    validation: tuple[tuple[str, tuple], ...] = ()
+
+    def argument(self, validator: str) -> tuple | None:
+        """Give a validator's arguments, or None when the entry does not use it."""
+        return next((args for v, args in self.validation if v == validator), None)
+
+    @property
+    def bounds(self) -> tuple[Any, Any] | None:
+        """Give (low, high), inclusive, or None."""
+        args = self.argument('bounds<>')
+        return (args[0], args[1]) if args else None
+
+    @property
+    def choices(self) -> tuple[str, ...] | None:
+        """Give the values allowed, or None."""
+        args = self.argument('one_of<>')
+        return tuple(args[0]) if args else None
+
+
+def _check_size(name: str, value: Any, n: int | None) -> str:
+    if n is not None and len(value) != n:
+        return f'must have {n} entries, got {len(value)}'
+    return ''
+
+
+def _bounds(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    low, high = args
+    return '' if low <= value <= high else f'must be in [{low}, {high}], got {value}'
+
+
+def _one_of(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    return '' if value in args[0] else f"must be one of {', '.join(args[0])}"
+
+
+def _fixed_size(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    return _check_size(name, value, int(args[0]))
+
+
+def _element_bounds(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    low, high = args
+    return '' if all(low <= v <= high for v in value) else \
+        f'every entry must be in [{low:g}, {high:g}]'
+
+
+#: generate_parameter_library's validators that this schema uses.
+BUILT_IN: dict[str, Callable[[str, Any, tuple, Context], str]] = {
+    'bounds<>': _bounds, 'one_of<>': _one_of, 'fixed_size<>': _fixed_size,
+    'element_bounds<>': _element_bounds,
+}
+
+
+def name_map_of(entries: list[str] | None) -> dict[str, str]:
+    """
+    Parse the ``name_map`` parameter: entries ``SCENARIO_NAME=URDF_NAME``.
+
+    Args:
+        entries: the parameter's value (None or empty: no map).
+
+    Returns:
+        scenario name -> URDF name.
+
+    Raises:
+        InputError: an entry without one ``=`` between two names, a name mapped
+            twice, two names mapped to one, more than MAX_NAME_MAP entries.
+    """
+    if not entries:
+        return {}
+    if len(entries) > MAX_NAME_MAP:
+        raise InputError('name_map', f'{len(entries)} entries, more than {MAX_NAME_MAP}')
+    out: dict[str, str] = {}
+    for i, entry in enumerate(entries):
+        key, sep, target = (part.strip() for part in str(entry).partition('='))
+        if not sep or not key or not target or '=' in target:
+            raise InputError(f'name_map[{i}]', f'must be SCENARIO_NAME=URDF_NAME, got '
+                             f'{quote(entry)}')
+        if key in out:
+            raise InputError(f'name_map[{i}]', f"maps '{cut(key)}' a second time")
+        out[key] = target
+    return parse_name_map(out, 'name_map')
+
+
+# -- custom validators: small pure functions, named in the schema ---------------------------
+
+def validate_name_map(name: str, value: Any, ctx: Context) -> str:
+    """Each entry ``SCENARIO_NAME=URDF_NAME``, one to one."""
+    name_map_of(value)  # raises with its own field (name_map[i]) naming the entry
+    return ''
+
+
+def validate_size_of_joints(name: str, value: Any, ctx: Context) -> str:
+    """One entry per actuated joint (unchecked before the hand is loaded)."""
+    return _check_size(name, value, ctx.m)
+
+
+def validate_positive_entries(name: str, value: Any, ctx: Context) -> str:
+    """Every entry > 0."""
+    return '' if all(v > 0 for v in value) else 'every entry must be > 0'
+
+
+def validate_within_urdf_limits(name: str, value: Any, ctx: Context) -> str:
+    """Each torque limit at most its joint's bound (the URDF's effort limit)."""
+    if ctx.torque_bounds is None:
+        return ''
+    Hand.check_limits(np.array(value, dtype=float), list(ctx.joints), ctx.torque_bounds,
+                      name, 'torque_limits_above_urdf (read-only: at start)')
+    return ''
+
+
+def validate_weight_range(name: str, value: Any, ctx: Context) -> str:
+    """Refuse a weight outside WEIGHT_RANGE, or a ratio above MAX_WEIGHT_RATIO."""
+    if not value:
+        return ''
+    low, high = WEIGHT_RANGE
+    if not all(low <= v <= high for v in value):
+        return f'every entry must be in [{low:g}, {high:g}]'
+    if max(value) > MAX_WEIGHT_RATIO * min(value):
+        return (f'the largest entry may be at most {MAX_WEIGHT_RATIO:g} times the smallest, '
+                f'got {max(value) / min(value):.3g}')
+    return ''
+
+
+def validate_gravity_norm(name: str, value: Any, ctx: Context) -> str:
+    """Refuse a norm above MAX_GRAVITY, as on the gravity topic."""
+    if math.sqrt(sum(v * v for v in value)) > MAX_GRAVITY:
+        return f'norm must be at most {MAX_GRAVITY:g} m/s^2 (as on the topic)'
+    return ''
+
+
+def validate_backend_installed(name: str, value: Any, ctx: Context) -> str:
+    """Refuse a backend whose Python module cannot be imported here."""
+    return '' if available(value) else f'{value} is not installed (pip install {value})'
+
+
+def validate_method_available(name: str, value: Any, ctx: Context) -> str:
+    """tau-qp-adaptive needs DAQP."""
+    if value == 'tau-qp' or available('daqp'):
+        return ''
+    return f'{value} needs daqp, which is not installed (pip install daqp)'
+
+
+#: The custom validators that need no ROS, by the names the schema gives them.
+VALIDATORS: dict[str, Validator] = {
+    'name_map': validate_name_map,
+    'size_of_joints': validate_size_of_joints,
+    'positive_entries': validate_positive_entries,
+    'within_urdf_limits': validate_within_urdf_limits,
+    'weight_range': validate_weight_range,
+    'gravity_norm': validate_gravity_norm,
+    'backend_installed': validate_backend_installed,
+    'method_available': validate_method_available,
+}
+
+
+def _entries(tree: Mapping[str, Any], prefix: str = '') -> list[ParamSpec]:
+    """Flatten the file's nested maps into specs, in the file's order."""
+    out = []
+    for key, entry in tree.items():
+        name = f'{prefix}{key}'
+        if 'type' not in entry:  # a namespace (solver.*)
+            out += _entries(entry, f'{name}.')
+            continue
+        if entry['type'] not in PYTHON_TYPES:
+            raise ValueError(f'{SCHEMA_FILE.name}: {name}: unknown type {entry["type"]!r}')
+        cycle = entry.get('cycle')
+        default = entry.get('default_value')
+        out.append(ParamSpec(
+            name=name, type=entry['type'], description=' '.join(entry['description'].split()),
+            unit=str(entry.get('unit', '-')),
+            default=tuple(default) if isinstance(default, list) else default,
+            read_only=bool(entry.get('read_only', False)),
+            from_scenario=entry.get('from_scenario'), unset=entry.get('unset'),
+            cycle=(key if cycle is True else cycle) or None,
+            validation=tuple((v, tuple(args or ())) for v, args in
+                             (entry.get('validation') or {}).items())))
+    return out
+
+
+class Schema:
+    """The parameters of one node, in declaration order, and their checks."""
+
+    def __init__(self, specs: list[ParamSpec], validators: Mapping[str, Validator]) -> None:
+        """Hold the specs and the custom validators they may name."""
+        self.specs: dict[str, ParamSpec] = {s.name: s for s in specs}
+        self.validators = dict(validators)
+
+    @classmethod
+    def load(cls, path: Path = SCHEMA_FILE, node: str = 'grasp_torque_node') -> Schema:
+        """Read a generate_parameter_library file (the top key is the node's)."""
+        with open(path, encoding='utf-8') as f:
+            doc = yaml.safe_load(f)
+        return cls(_entries(doc[node]), VALIDATORS)
+
+    def with_validators(self, **validators: Validator) -> Schema:
+        """Give the same schema with more custom validators (the ROS side's)."""
+        return Schema(list(self.specs.values()), {**self.validators, **validators})
+
+    def __iter__(self):
+        """Iterate over the parameters' names, in declaration order."""
+        return iter(self.specs)
+
+    def __getitem__(self, name: str) -> ParamSpec:
+        """Give a parameter's spec."""
+        return self.specs[name]
+
+    def __contains__(self, name: object) -> bool:
+        """Say whether the schema has the parameter."""
+        return name in self.specs
+
+    def defaults(self) -> dict[str, Any]:
+        """Give the defaults of the parameters that have one, not from the scenario."""
+        return {s.name: list(s.default) if isinstance(s.default, tuple) else s.default
+                for s in self.specs.values()
+                if s.default is not None and s.from_scenario is None}
+
+    def reason(self, name: str, value: Any, ctx: Context = Context()) -> str:
+        """Say why a value is refused, 'NAME: PROBLEM' ('' if it is accepted)."""
+        try:
+            self.check(name, value, ctx)
+        except InputError as e:
+            return str(e)
+        return ''
+
+    def check(self, name: str, value: Any, ctx: Context = Context()) -> None:
+        """
+        Check one value against its entry.
+
+        Sizes first, then finiteness (doubles), then the entry's validators in order.
+
+        Raises:
+            InputError: naming the parameter (or its entry) and the problem.
+        """
+        spec = self.specs[name]
+        order = sorted(spec.validation, key=lambda v: v[0] not in SIZE_VALIDATORS)
+        sized = [v for v in order if v[0] in SIZE_VALIDATORS]
+        for validator, args in sized:
+            self._run(spec, validator, args, value, ctx)
+        if spec.type == 'double' and not math.isfinite(value):
+            raise InputError(name, 'must be finite')
+        if spec.type == 'double_array' and not all(math.isfinite(v) for v in value):
+            raise InputError(name, 'must be finite')
+        for validator, args in order[len(sized):]:
+            self._run(spec, validator, args, value, ctx)
+
+    def _run(self, spec: ParamSpec, validator: str, args: tuple, value: Any,
+             ctx: Context) -> None:
+        if validator in BUILT_IN:
+            problem = BUILT_IN[validator](spec.name, value, args, ctx)
+        elif validator in self.validators:
+            problem = self.validators[validator](spec.name, value, ctx)
+        else:
+            return  # a ROS validator, checked where ROS is (ros.node.parameters)
+        if problem:
+            raise InputError(spec.name, problem)
+
+    def params(self, values: Mapping[str, Any]) -> Any:
+        """Make a frozen snapshot of every value (``p.solver.backend``, ...)."""
+        return _snapshot(PARAMS_CLASSES, values)
+
+    def markdown_table(self) -> str:
+        """Write the parameter table of docs/design.md section 4.4."""
+        rows = ['| parameter | type | unit | default | range, meaning |',
+                '|---|---|---|---|---|']
+        for s in self.specs.values():
+            rows.append(f'| `{s.name}` | {_type_words(s)} | {s.unit} | {_default_words(s)} '
+                        f'| {_meaning(s)} |')
+        return '\n'.join(rows) + '\n'
+
+
+def check_pairs(values: Mapping[str, Any]) -> None:
+    """
+    Check the rules between parameters (after each one's own check).
+
+    Raises:
+        InputError: min-max with a method other than tau-qp (docs/planner.md).
+    """
+    if values.get('objective') == 'min-max' and values.get('solver.method') != 'tau-qp':
+        raise InputError('objective', 'min-max needs solver.method tau-qp, not '
+                         f"{values.get('solver.method')}")
+
+
+def _type_words(s: ParamSpec) -> str:
+    if not s.type.endswith('_array'):
+        return s.type
+    size = s.argument('fixed_size<>')
+    n = size[0] if size else 'm' if s.argument('size_of_joints') is not None else ''
+    return f"{s.type.partition('_')[0]}[{n}]"
+
+
+def _value_words(v: Any) -> str:
+    if isinstance(v, bool):
+        return str(v).lower()
+    if isinstance(v, str):
+        return f'"{v}"' if v == '' else v
+    if isinstance(v, tuple):
+        return '[' + ', '.join(_value_words(x) for x in v) + ']'
+    return f'{v:g}' if isinstance(v, float) else str(v)
+
+
+def _default_words(s: ParamSpec) -> str:
+    if s.name == 'scenario':
+        return '(required)'
+    if s.from_scenario is not None:
+        return s.from_scenario
+    if s.unset is not None:
+        return s.unset
+    return _value_words(s.default)
+
+
+def _meaning(s: ParamSpec) -> str:
+    parts = []
+    if s.bounds is not None:
+        low, high = s.bounds
+        parts.append(f'[{_value_words(low)}, {_value_words(high)}]')
+    if s.choices is not None:
+        parts.append('one of ' + ', '.join(f'`{c}`' for c in s.choices))
+    text = s.description.replace('|', '\\|')
+    parts.append(text + (' Read-only.' if s.read_only else ''))
+    return '; '.join(parts)
+
+
+def _tree(specs: list[ParamSpec]) -> dict[str, Any]:
+    tree: dict[str, Any] = {}
+    for s in specs:
+        *path, leaf = s.name.split('.')
+        node = tree
+        for part in path:
+            node = node.setdefault(part, {})
+        node[leaf] = s
+    return tree
+
+
+def _classes(name: str, tree: dict[str, Any]) -> tuple[type, dict[str, Any]]:
+    """Make a frozen dataclass per namespace of the schema."""
+    fields, subs = [], {}
+    for key, sub in tree.items():
+        if isinstance(sub, ParamSpec):
+            fields.append((key, PYTHON_TYPES[sub.type] | None))
+        else:
+            subs[key] = _classes(name + key.title(), sub)
+            fields.append((key, subs[key][0]))
+    cls = dataclasses.make_dataclass(name, fields, frozen=True)
+    cls.__module__ = __name__
+    return cls, subs
+
+
+def _snapshot(classes: tuple[type, dict[str, Any]], values: Mapping[str, Any],
+              prefix: str = '') -> Any:
+    cls, subs = classes
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name in subs:
+            kwargs[f.name] = _snapshot(subs[f.name], values, f'{prefix}{f.name}.')
+        else:
+            v = values.get(f'{prefix}{f.name}')
+            kwargs[f.name] = tuple(v) if isinstance(v, list) else v
+    return cls(**kwargs)
+
+
+def _cycle_config(specs: list[ParamSpec]) -> type:
+    """Make :class:`CycleConfig` from the entries with a ``cycle`` key."""
+    fields = [(s.cycle, PYTHON_TYPES[s.type], dataclasses.field(default=s.default))
+              for s in specs if s.cycle]
+    cls = dataclasses.make_dataclass('CycleConfig', fields, frozen=True)
+    cls.__module__ = __name__
+    cls.__doc__ = (
+        'Timing and safety settings of the cycle: the schema entries with a ``cycle`` key '
+        '(grasp_torque_node_parameters.yaml), with their types, defaults and units there. '
+        + ' '.join(f'{s.cycle}: {s.description} [{s.unit}].' for s in specs if s.cycle))
+    return cls
+
+
+#: The node's parameters.
+SCHEMA = Schema.load()
+#: The frozen classes of :meth:`Schema.params` (``Params``, ``ParamsSolver``).
+PARAMS_CLASSES = _classes('Params', _tree(list(SCHEMA.specs.values())))
+#: The cycle's settings: one field per schema entry with a ``cycle`` key.
+CycleConfig = _cycle_config(list(SCHEMA.specs.values()))
+
+
+def value_of(params: Any, name: str) -> Any:
+    """Give one value of a :meth:`Schema.params` snapshot by its dotted name."""
+    for part in name.split('.'):
+        params = getattr(params, part)
+    return params
+
+
+def cycle_config(params: Any) -> Any:
+    """Make the :class:`CycleConfig` of a :meth:`Schema.params` snapshot."""
+    return CycleConfig(**{s.cycle: value_of(params, n) for n, s in SCHEMA.specs.items()
+                          if s.cycle})

@@ -1,0 +1,186 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+
+"""
+Where the node's grasp comes from: the URDF, the scenario and the name map.
+
+The URDF is ``robot_description`` (a document or a path), else the one published on
+``robot_description_topic`` (waited for a bounded time), else the scenario's
+``hand.urdf``. The scenario's names are mapped by ``name_map`` before they are checked
+against the URDF.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+import dataclasses
+from dataclasses import dataclass
+import time
+
+from grasp_torque_opt.control.parameters import name_map_of
+from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import MAX_URDF_BYTES
+from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
+from grasp_torque_opt.core.scenario import load_scenario, Scenario, weight_wrench
+from grasp_torque_opt.ros.node.parameters import PARAMETERS
+from grasp_torque_opt.ros.node.qos import URDF_QOS
+import numpy as np
+from rclpy.node import Node
+from rclpy.serialization import deserialize_message
+from std_msgs.msg import String
+
+#: Serialized std_msgs/String beyond the URDF's own bytes (CDR header, length, NUL).
+URDF_MESSAGE_OVERHEAD = 64
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """
+    A scenario bound to its hand, as the node loaded it.
+
+    Attributes:
+        scenario: the scenario file, its names mapped.
+        setup: bound to the hand's model.
+    """
+
+    scenario: Scenario
+    setup: GraspSetup
+
+
+def wait_for_urdf(node: Node, topic: str, timeout: float,
+                  stop: Callable[[], bool] = lambda: False) -> str:
+    """
+    Take the URDF from a robot_description topic, waiting for it up to ``timeout``.
+
+    The subscription is reliable and transient local, as robot_state_publisher
+    publishes it, so a URDF published before the node started arrives too. The
+    message is taken serialized and refused by its length before it is deserialized.
+    It polls (every 20 ms) instead of spinning, so it also works from inside a
+    callback of the node's executor (the managed node's configure), which it then
+    holds for at most ``timeout``.
+
+    Args:
+        node: the node that subscribes (for as long as this waits).
+        topic: the topic (relative names resolve in the node's namespace).
+        timeout: how long to wait [s].
+        stop: polled; True ends the wait (a stop signal).
+
+    Returns:
+        The URDF document.
+
+    Raises:
+        InputError: nothing arrived in time, or the message is larger than a URDF may be
+            (field ``robot_description_topic``).
+    """
+    sub = node.create_subscription(String, topic, lambda _: None, URDF_QOS, raw=True)
+    name = sub.topic_name
+    end = time.monotonic() + timeout
+    try:
+        while True:
+            with sub.handle:
+                taken = sub.handle.take_message(String, True)
+            if taken is not None:
+                data = taken[0]
+                if len(data) > MAX_URDF_BYTES + URDF_MESSAGE_OVERHEAD:
+                    raise InputError('robot_description_topic', f'the URDF on {name} is '
+                                     f'{len(data)} bytes serialized, larger than a URDF may '
+                                     f'be ({MAX_URDF_BYTES} bytes)')
+                return deserialize_message(data, String).data
+            if stop():
+                raise InputError('robot_description_topic', f'stopped while waiting for the '
+                                 f'URDF on {name}')
+            if time.monotonic() >= end:
+                raise InputError('robot_description_topic', f'no URDF on {name} within '
+                                 f'{timeout:g} s (robot_description_timeout); it is taken '
+                                 'reliable and transient local, as robot_state_publisher '
+                                 'publishes it')
+            time.sleep(0.02)
+    finally:
+        node.destroy_subscription(sub)
+
+
+def urdf_document(node: Node, value: Callable[[str], object],
+                  stop: Callable[[], bool] = lambda: False) -> str:
+    """
+    Give the URDF document to use: '' for the scenario's ``hand.urdf``.
+
+    ``robot_description`` (a document or a path) wins; else, with
+    ``robot_description_topic`` set, the URDF published there (waited for up to
+    ``robot_description_timeout``); else the scenario's.
+
+    Args:
+        node: the node (its logger; it subscribes to the topic while it waits).
+        value: a parameter's value by name (None while it has none).
+        stop: polled while waiting; True ends the wait.
+    """
+    urdf = value('robot_description') or ''
+    topic = value('robot_description_topic') or ''
+    if urdf:
+        if topic:
+            node.get_logger().info(f'robot_description is set: the URDF on {topic} is '
+                                   'not read')
+        if not urdf.lstrip().startswith('<'):
+            path = find_config(urdf, 'robot_description')
+            urdf = decode_utf8(read_bounded(path, 'robot_description', MAX_URDF_BYTES),
+                               path, 'robot_description')
+        return urdf
+    if topic:
+        PARAMETERS.check('robot_description_topic', topic)
+        timeout = value('robot_description_timeout')
+        node.get_logger().info(f'waiting for the URDF on {topic} (up to {timeout:g} s)')
+        return wait_for_urdf(node, topic, timeout, stop)
+    return ''
+
+
+def bind(scenario_name: str | None, name_map: list[str] | None, urdf: str,
+         joints: list[str] | None = None) -> Grasp:
+    """
+    Load the scenario, map its names (``name_map``) and bind it to the hand.
+
+    Args:
+        scenario_name: the ``scenario`` parameter (a path or a bundled name).
+        name_map: the ``name_map`` parameter (None: none).
+        urdf: the URDF document ('' for the scenario's ``hand.urdf``).
+        joints: actuated joints in command order instead of the scenario's (URDF
+            names), or None.
+
+    Raises:
+        InputError: naming the parameter or the scenario's field.
+    """
+    if not scenario_name:
+        raise InputError('scenario', 'parameter not set (a scenario file gives the '
+                         'default contacts and load)')
+    scenario = load_scenario(find_config(scenario_name), name_map_of(name_map))
+    bound = scenario if joints is None else dataclasses.replace(scenario, joints=list(joints))
+    try:
+        return Grasp(scenario, GraspSetup.from_scenario(bound, urdf or None))
+    except (JointNotFound, FrameNotFound) as e:
+        if not urdf:
+            raise
+        raise InputError(e.field, f'{e.problem}; if the scenario names them as another '
+                         "URDF of this hand does, map them to this URDF's names with the "
+                         'name_map parameter (SCENARIO_NAME=URDF_NAME) or the '
+                         "scenario's hand.name_map") from e
+
+
+def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | None:
+    """
+    Give the scenario's load as a function of gravity [m/s^2], or None.
+
+    Only when the scenario's load is its object's weight (``object`` and ``gravity``
+    both given): then it is ``load.external_wrench`` plus the weight under the gravity
+    given, about the scenario's object origin, base axes. Otherwise the load does not
+    depend on gravity.
+    """
+    if scenario.object is None or scenario.gravity is None:
+        return None
+    obj, origin = scenario.object, scenario.object_origin.copy()
+    extra = scenario.extra_wrench.copy()
+    return lambda g: extra + weight_wrench(obj, np.asarray(g, dtype=float), origin)

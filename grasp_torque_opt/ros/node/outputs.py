@@ -1,0 +1,155 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+
+"""
+The node's outputs: effort commands, the stamped copy, and the RViz arrows.
+
+A command leaves only through :meth:`Outputs.publish`, which keeps the node's own
+promise whatever the controller decided: the right length, finite, within the
+limits. The managed node's command publishers are lifecycle publishers (silent
+unless active): the root's configuration says which kind to make.
+"""
+
+from __future__ import annotations
+
+from array import array
+from typing import Any, TYPE_CHECKING
+
+from geometry_msgs.msg import Point
+from grasp_torque_opt.control.controller import CycleResult
+from grasp_torque_opt.ros.node.qos import COMMAND_QOS
+from grasp_torque_opt.ros.peers import quiet_publisher
+import numpy as np
+from rclpy.duration import Duration
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from visualization_msgs.msg import Marker, MarkerArray
+
+if TYPE_CHECKING:
+    from grasp_torque_opt.ros.node.root import GraspTorque
+
+
+class Outputs:
+    """The command publishers and the marker publisher."""
+
+    def __init__(self, root: GraspTorque) -> None:
+        """Belong to ``root``: its node, its controller and its configuration."""
+        self.root = root
+        self.node = root.node
+        self.command_pub: Any = None
+        self.stamped_pub: Any = None
+        self.marker_pub: Any = None
+
+    def start(self) -> list[tuple[str, Any]]:
+        """Make the publishers; give them as (kind, publisher) for :meth:`stop`."""
+        node, peers = self.node, self.root.peers
+        self.command_pub = self._command_publisher(Float64MultiArray, 'effort_commands')
+        made = [('command_publisher', self.command_pub)]
+        peers.watch(self.command_pub, Float64MultiArray)
+        self.stamped_pub = None
+        if self.root.params.publish_stamped_command:
+            self.stamped_pub = self._command_publisher(JointState, '~/effort_commands_stamped')
+            made.append(('command_publisher', self.stamped_pub))
+            peers.watch(self.stamped_pub, JointState)
+        self.marker_pub = node.create_publisher(MarkerArray, '~/contact_wrenches', 1,
+                                                event_callbacks=quiet_publisher())
+        made.append(('publisher', self.marker_pub))
+        peers.watch(self.marker_pub, MarkerArray)
+        return made
+
+    def _command_publisher(self, msg_type: type, topic: str) -> Any:
+        if self.root.managed:
+            return self.node.create_lifecycle_publisher(msg_type, topic, COMMAND_QOS,
+                                                        event_callbacks=quiet_publisher())
+        return self.node.create_publisher(msg_type, topic, COMMAND_QOS,
+                                          event_callbacks=quiet_publisher())
+
+    def destroy(self, kind: str, publisher: Any) -> None:
+        """Destroy a publisher made by :meth:`start`."""
+        if kind == 'command_publisher' and self.root.managed:
+            self.node.destroy_lifecycle_publisher(publisher)
+        else:
+            self.node.destroy_publisher(publisher)
+
+    def stop(self) -> None:
+        """Forget the publishers (destroyed by the root)."""
+        self.command_pub = self.stamped_pub = self.marker_pub = None
+
+    def publish(self, result: CycleResult, stamp: Any = None) -> None:
+        """
+        Publish a cycle's command, if it has one and keeps the node's promise.
+
+        Args:
+            result: the controller's decision.
+            stamp: the header stamp of the joint state it answers (None: now).
+        """
+        if result.fault:
+            self.node.get_logger().warn(f'no command: {result.fault}', throttle_duration_sec=1.0)
+        cmd = result.command
+        if cmd is None:
+            return
+        hand = self.root.controller.setup.hand
+        # The node's own promise, whatever the controller decided.
+        if cmd.shape != (hand.m,) or not np.isfinite(cmd).all() or \
+                (np.abs(cmd) > hand.torque_limits).any():
+            self.node.get_logger().error('refused to publish a malformed command')
+            return
+        data = array('d', cmd.tobytes())
+        self.command_pub.publish(Float64MultiArray(data=data))
+        if self.stamped_pub is not None:
+            msg = JointState(name=list(hand.joints), effort=data)
+            msg.header.stamp = stamp if stamp is not None else \
+                self.node.get_clock().now().to_msg()
+            msg.header.frame_id = hand.base_frame
+            self.stamped_pub.publish(msg)
+
+    def publish_zeros(self, m: int) -> None:
+        """Publish zero torques (the safe stop of ``fault_policy: zero``)."""
+        self.command_pub.publish(Float64MultiArray(data=[0.0] * m))
+
+    def on_markers(self) -> None:
+        """Publish the last solution's contact forces as arrows (none when it has none)."""
+        root = self.root
+        with root.lock:
+            last = root.controller.last if root.commanding else None
+            base = root.controller.setup.hand.base_frame
+        self.marker_pub.publish(markers(last, base, self.node.get_clock().now().to_msg(),
+                                        root.params.marker_scale, root.params.marker_period))
+
+
+def markers(last: CycleResult | None, base: str, stamp: Any, scale: float,
+            period: float) -> MarkerArray:
+    """
+    Draw a cycle's contact forces as arrows, in the hand's base frame.
+
+    Args:
+        last: the cycle (None, or one without a solution: only the clearing marker).
+        base: the base frame.
+        stamp: their header stamp.
+        scale: arrow length per newton [m/N].
+        period: the marker period [s]; each arrow lives three.
+    """
+    clear = Marker(action=Marker.DELETEALL)
+    if last is None or last.kind != 'solution':
+        return MarkerArray(markers=[clear])
+    out = [clear]
+    lifetime = Duration(seconds=3 * period).to_msg()
+    for i, (frame, w) in enumerate(zip(last.maps.contacts, last.solution.wrenches)):
+        force = frame.rotation @ w[:3]
+        start, end = frame.position, frame.position + scale * force
+        m = Marker(type=Marker.ARROW, action=Marker.ADD, ns='contact_force', id=i)
+        m.header.frame_id, m.header.stamp = base, stamp
+        m.points = [Point(x=float(start[0]), y=float(start[1]), z=float(start[2])),
+                    Point(x=float(end[0]), y=float(end[1]), z=float(end[2]))]
+        m.pose.orientation.w = 1.0
+        m.scale.x, m.scale.y, m.scale.z = 0.002, 0.004, 0.004
+        m.color.g, m.color.a = 0.8, 1.0
+        m.lifetime = lifetime
+        out.append(m)
+    return MarkerArray(markers=out)

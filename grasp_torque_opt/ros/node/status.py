@@ -1,0 +1,123 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+
+"""
+The node's /diagnostics: the controller's report, and what only the ROS graph tells.
+
+The controller's part is a pure function of it (:func:`grasp_torque_opt.control.
+diagnostics.report`); here it gets the graph's: publishers on joint_states, other
+nodes of this name, incompatible peers, the executor thread, the lifecycle state.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from grasp_torque_opt.control import diagnostics
+from grasp_torque_opt.ros import realtime
+from grasp_torque_opt.ros.peers import quiet_publisher, summary
+
+if TYPE_CHECKING:
+    from grasp_torque_opt.ros.node.root import GraspTorque
+
+
+class Status:
+    """The /diagnostics publisher and the graph checks it reports."""
+
+    def __init__(self, root: GraspTorque) -> None:
+        """Belong to ``root``."""
+        self.root = root
+        self.node = root.node
+        self.pub = None
+        self.duplicates = 0  # other nodes of this name, at the last report
+
+    def start(self) -> list:
+        """Make the publisher; give it for the root to destroy."""
+        self.pub = self.node.create_publisher(DiagnosticArray, '/diagnostics', 10,
+                                              event_callbacks=quiet_publisher())
+        self.root.peers.watch(self.pub, DiagnosticArray)
+        return [self.pub]
+
+    def stop(self) -> None:
+        """Forget the publisher (destroyed by the root)."""
+        self.pub = None
+
+    def count_duplicates(self) -> int:
+        """Count the other nodes of this node's name and namespace that the graph shows."""
+        node = self.node
+        me = (node.get_name(), node.get_namespace())
+        return sum(1 for n in node.get_node_names_and_namespaces() if tuple(n) == me) - 1
+
+    def wait_for_duplicates(self, seconds: float) -> int:
+        """
+        Look for other nodes of this name for up to ``seconds``.
+
+        Discovery took 0.2 to 2.8 s here. Nothing spins meanwhile: nothing is taken or
+        published.
+
+        Returns:
+            How many were seen (0 after ``seconds``).
+        """
+        end = time.monotonic() + seconds
+        while True:
+            n = self.count_duplicates()
+            if n > 0 or time.monotonic() >= end:
+                return n
+            time.sleep(0.05)
+
+    def on_diagnostics(self) -> None:
+        """Publish one diagnostic status (the diagnostics timer)."""
+        root, node = self.root, self.node
+        log = node.get_logger()
+        with root.lock:
+            now = time.monotonic()
+            rep = diagnostics.report(root.controller, now)
+            gravity_time = root.controller.inputs.gravity_time
+            # The hand's name from its URDF (e.g. allegro_hand_right), as hardware_id asks.
+            hand = root.controller.setup.hand.model.name
+        # Two sources of joint states are followed as one stream (the stamp rule keeps
+        # either from locking the other out); say so, as the node cannot tell them apart.
+        topic = root.inputs.joint_states_topic
+        publishers = node.count_publishers(topic)
+        if publishers > 1:
+            log.warn(f'{publishers} publishers on {topic}: their joint states are taken as '
+                     'one stream', throttle_duration_sec=10.0)
+        values = [*rep.values, ('joint_states.publishers', str(publishers)),
+                  ('age.gravity_s', 'never' if gravity_time is None
+                   else f'{now - gravity_time:.4f}')]
+        if not any(k == 'rejected.gravity' for k, _ in values):
+            values.append(('rejected.gravity', '0'))  # counted from its first rejection
+        level, message = rep.level, rep.message
+        if not root.commanding:
+            level, message = diagnostics.STALE, f'inactive (lifecycle): no commands; {message}'
+        self.duplicates = self.count_duplicates()  # about 1 us: rmw's graph cache
+        if self.duplicates > 0:
+            name = node.get_fully_qualified_name()
+            log.error(f'another node named {name} is on this domain: both may drive '
+                      'effort_commands and take parameters', throttle_duration_sec=10.0)
+            level = diagnostics.ERROR
+            message = f'another node named {name} is on this domain; {message}'
+        values.append(('duplicate_nodes', str(self.duplicates)))
+        values.append(('executor_thread', realtime.describe()))  # this callback's thread
+        # What rclpy's default QoS event handlers would have logged, found from the graph.
+        peers, new = root.peers.check(node)
+        for peer in new:
+            log.warn(f'{peer.describe()}: no messages will pass between it and this node')
+        values.append(('incompatible_peers', summary(peers)))
+        if peers:
+            level = max(level, diagnostics.WARN)  # at least WARN (STALE and ERROR stay)
+            message = f'{len(peers)} incompatible peer(s) on its topics; {message}'
+        status = DiagnosticStatus(level=bytes([level]), name=f'{node.get_name()}: grasp '
+                                  'torques', message=message, hardware_id=hand,
+                                  values=[KeyValue(key=k, value=v) for k, v in values])
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = node.get_clock().now().to_msg()
+        self.pub.publish(msg)
