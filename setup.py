@@ -98,6 +98,8 @@ setup(
     name=package_name,
     version='0.4.0',
     packages=find_packages(exclude=['test', 'bench']),
+    # The node's parameter schema, read at import (grasp_torque_opt.control.parameters).
+    package_data={'grasp_torque_opt.control': ['grasp_torque_node_parameters.yaml']},
     ext_modules=fast_cycle_extensions(),
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),

@@ -498,3 +498,7 @@ def cycle_config(params: Any) -> Any:
     """Make the :class:`CycleConfig` of a :meth:`Schema.params` snapshot."""
     return CycleConfig(**{s.cycle: value_of(params, n) for n, s in SCHEMA.specs.items()
                           if s.cycle})
+
+
+if __name__ == '__main__':  # the table of docs/design.md section 4.4
+    print(SCHEMA.markdown_table(), end='')
