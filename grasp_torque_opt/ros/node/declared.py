@@ -52,6 +52,7 @@ class DeclaredParameters:
         self.managed = managed
         self.context = Context()  # the hand's, once loaded
         self.configured = False  # read-only parameters are fixed while configured
+        self.started = False  # use_sim_time is fixed once the node runs
         self.filling = False  # the managed node fills in scenario defaults
         #: Parameters whose value given at start was refused -> the reason (managed).
         self.refused: dict[str, str] = {}
@@ -106,12 +107,17 @@ class DeclaredParameters:
     def watch(self, apply: Callable[[list[Parameter]], None]) -> None:
         """Check every change before it is taken; ``apply`` it after."""
         self.node.add_on_set_parameters_callback(self.validate)
+        self.started = True
         self.node.add_post_set_parameters_callback(
             lambda params: self._applied(params, apply))
 
     def validate(self, params: list[Parameter]) -> SetParametersResult:
         """Refuse a change with a reason naming the parameter (on-set-parameters callback)."""
         for param in params:
+            if param.name == 'use_sim_time' and self.started:
+                return SetParametersResult(successful=False, reason=(
+                    'use_sim_time: fixed after start (give it at start: the node judges '
+                    'staleness on the steady clock either way, docs/node.md)'))
             if param.name not in PARAMETERS or param.value is None:
                 continue  # not ours, or declared by type only (the managed node)
             if PARAMETERS[param.name].read_only and self.configured and not self.filling:

@@ -36,6 +36,7 @@ from grasp_torque_opt.ros.node.status import Status
 from grasp_torque_opt.ros.node.tf_gravity import TfGravity
 from grasp_torque_opt.ros.peers import PeerWatch
 import numpy as np
+from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -176,10 +177,15 @@ class GraspTorque:
         made += self.outputs.start()
         made += [('publisher', p) for p in self.status.start()]
         p = self.params
+        # On the steady clock: with use_sim_time and a /clock that stops (or never
+        # comes), timers on the ROS clock never fire, and a dead driver's joint states
+        # would never be found stale (the staleness itself is judged on the monotonic
+        # clock, in the controller).
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
         for period, callback in ((p.watchdog_period, self.on_watchdog),
                                  (p.diagnostics_period, self.status.on_diagnostics),
                                  (p.marker_period, self.outputs.on_markers)):
-            made.append(('timer', self.node.create_timer(period, callback)))
+            made.append(('timer', self.node.create_timer(period, callback, clock=steady)))
         self.tf.start(self.node)
 
     def stop_interfaces(self) -> None:

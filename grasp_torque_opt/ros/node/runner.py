@@ -34,6 +34,9 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 
+#: Longest wait of the spin loop without any callback [s]: how late a stop signal may be
+#: seen when nothing else wakes the executor.
+STOP_POLL_S = 0.1
 #: Executors the runner can spin: rclpy's default and its experimental events executor.
 EXECUTORS = {'single': SingleThreadedExecutor, 'events': EventsExecutor}
 
@@ -106,9 +109,11 @@ def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None
         log = node.get_logger()
         (log.info if fifo or priority == 0 else log.warn)(f'executor thread: {what}')
         # A spin_once loop, so that the stop flag is seen: each wait ends by the next
-        # watchdog tick at the latest. (EventsExecutor.spin() also delivered no subscription
-        # callback with these wheels, rclpy 7.1.6 and Fast DDS, while keeping a core busy.)
-        timeout = 1.0 if opts.executor == 'events' else None
+        # watchdog tick (a steady timer) or after STOP_POLL_S, also while the managed node
+        # is unconfigured and has no timer. (EventsExecutor.spin() also delivered no
+        # subscription callback with these wheels, rclpy 7.1.6 and Fast DDS, while
+        # keeping a core busy.)
+        timeout = 1.0 if opts.executor == 'events' else STOP_POLL_S
         while not signals.stop_requested() and rclpy.ok():
             executor.spin_once(timeout_sec=timeout)
     except (KeyboardInterrupt, ExternalShutdownException):
