@@ -43,6 +43,7 @@ this module has always exported are exported from here still.
 
 from __future__ import annotations
 
+import copy
 from operator import attrgetter
 import time
 
@@ -166,6 +167,18 @@ class TorqueController:
         self.store = InputStore(setup, config, counters)
         self.solving = Cycle(setup, config, counters, solver, second)
         self.policy = FaultPolicy(setup, config, counters)
+
+    def __copy__(self) -> TorqueController:
+        """
+        Return a shallow copy that keeps the setup, settings and state of now.
+
+        Its parts are shallow copies of these: a later parameter change (a new setup or
+        config set on this controller) does not reach the copy, as for any shallow copy.
+        """
+        new = object.__new__(type(self))
+        new.store, new.solving, new.policy = (copy.copy(part) for part in (
+            self.store, self.solving, self.policy))
+        return new
 
     # -- inputs: the store's ---------------------------------------------------------------
 
