@@ -9,13 +9,15 @@
 """
 QP backends for the tau-QP: ProxSuite (the default), DAQP and quadprog.
 
-Every backend takes a built :class:`~grasp_torque_opt.core.tau_qp.TauQP` and returns
+Every backend implements :class:`~grasp_torque_opt.backends.base.Backend` and is
+registered by name in :mod:`~grasp_torque_opt.backends.registry`, with its own settings
+type. Every backend takes a built :class:`~grasp_torque_opt.core.tau_qp.TauQP` and returns
 a :class:`~grasp_torque_opt.core.solution.RawResult`; none is trusted: the caller
 certifies whatever comes back (:func:`grasp_torque_opt.methods.dispatch.solve`). Each
 refuses non-finite data and inverted bounds before calling its solver, and each
 has its iterations capped, so one cycle can never stall.
 
-- ``proxsuite``: :class:`~grasp_torque_opt.core.tau_qp.TauQPSolver`, dense ProxQP,
+- ``proxsuite``: :class:`~grasp_torque_opt.backends.proxsuite.TauQPSolver`, dense ProxQP,
   the design's choice.
 - ``daqp``: DAQP, a dual active-set method, exact to its tolerances on small
   dense QPs. A positive semidefinite Hessian (the internal-force variables z
@@ -27,28 +29,25 @@ has its iterations capped, so one cycle can never stall.
 
 from __future__ import annotations
 
-import importlib.util
 import warnings
 
-from grasp_torque_opt.backends.daqp import DaqpSolver
+from grasp_torque_opt.backends.base import Backend
+from grasp_torque_opt.backends.daqp import DaqpSettings, DaqpSolver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings, TauQPSolver
-from grasp_torque_opt.backends.quadprog import QuadprogSolver
+from grasp_torque_opt.backends.quadprog import QuadprogSettings, QuadprogSolver
+from grasp_torque_opt.backends.registry import (
+    as_backend,
+    available,
+    BACKENDS,
+    is_backend,
+    make_solver,
+    REGISTRY,
+    settings_for,
+)
 
-#: Selectable backends; the first is the default.
-BACKENDS = ('proxsuite', 'daqp', 'quadprog')
-
-
-def available(backend: str) -> bool:
-    """
-    Whether the Python module of a backend can be imported here.
-
-    ProxSuite is a dependency; DAQP and quadprog are optional (pip installs them, a
-    ROS distribution may not have them).
-    """
-    try:
-        return importlib.util.find_spec(backend) is not None
-    except (ValueError, ImportError):  # e.g. blocked as sys.modules[name] = None
-        return False
+__all__ = ['as_backend', 'available', 'Backend', 'BACKENDS', 'DaqpSettings', 'DaqpSolver',
+           'is_backend', 'make_solver', 'ProxSuiteSettings', 'QuadprogSettings', 'QuadprogSolver',
+           'REGISTRY', 'settings_for', 'single_threaded_math', 'TauQPSolver']
 
 
 def single_threaded_math() -> None:
@@ -68,27 +67,3 @@ def single_threaded_math() -> None:
                       '(pip install threadpoolctl, or set OPENBLAS_NUM_THREADS=1)', stacklevel=2)
         return
     threadpool_limits(1)
-
-
-def make_solver(backend: str = 'proxsuite', settings: ProxSuiteSettings | None = None,
-                warm_start: bool = False, max_slice_s: float | None = None):
-    """
-    Make a tau-QP solver by backend name (one of :data:`BACKENDS`).
-
-    ``warm_start`` applies to ProxSuite and DAQP (each verifies its warm answers
-    and redoes a bad one cold); quadprog has none. ``max_slice_s`` bounds each
-    ProxSuite call under a deadline (:class:`~grasp_torque_opt.backends.proxsuite.TauQPSolver`).
-
-    Raises:
-        ValueError: an unknown backend, naming the known ones, or one whose
-            module is not installed, saying how to install it.
-    """
-    if backend in BACKENDS and not available(backend):
-        raise ValueError(f'backend {backend!r} is not installed (pip install {backend})')
-    if backend == 'proxsuite':
-        return TauQPSolver(settings, warm_start, max_slice_s)
-    if backend == 'daqp':
-        return DaqpSolver(settings, warm_start)
-    if backend == 'quadprog':
-        return QuadprogSolver(settings)
-    raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")

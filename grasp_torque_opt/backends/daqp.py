@@ -16,6 +16,7 @@ proximal-point iterations.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 import time
 
@@ -67,6 +68,26 @@ def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray
                -float(np.minimum(to_upper, to_lower).min()), float(complementarity.max()))
 
 
+@dataclass(frozen=True)
+class DaqpSettings:
+    """
+    DAQP's settings used for the tau-QP.
+
+    Attributes:
+        primal_tol: DAQP's primal feasibility tolerance (``primal_tol``).
+        iter_limit: cap on DAQP's iterations per solve (``iter_limit``; one cycle can
+            never stall).
+    """
+
+    primal_tol: float = ProxSuiteSettings.eps_abs
+    iter_limit: int = ProxSuiteSettings.max_iter
+
+    @classmethod
+    def from_proxsuite(cls, settings: ProxSuiteSettings) -> DaqpSettings:
+        """Return DAQP's settings for a ProxSuiteSettings: its eps_abs and max_iter only."""
+        return cls(primal_tol=settings.eps_abs, iter_limit=settings.max_iter)
+
+
 class DaqpSolver:
     """
     DAQP on the tau-QP: bounds on x, then the equalities, then the cone rows.
@@ -84,19 +105,18 @@ class DaqpSolver:
     ``warm_solves`` and ``fallbacks`` count them.
 
     Args:
-        settings: ``eps_abs`` is DAQP's primal tolerance, ``max_iter`` its
-            iteration cap; the rest does not apply.
+        settings: DAQP's tolerance and iteration cap.
         warm_start: start from the previous active set.
     """
 
     name = 'daqp'
 
-    def __init__(self, settings: ProxSuiteSettings | None = None,
+    def __init__(self, settings: DaqpSettings | None = None,
                  warm_start: bool = False) -> None:
         import daqp  # imported here: the core runs without the optional backends
 
         self._daqp = daqp
-        self.settings = settings or ProxSuiteSettings()
+        self.settings = settings or DaqpSettings()
         self.warm_start = warm_start
         self.warm_solves = 0
         self.fallbacks = 0
@@ -104,7 +124,7 @@ class DaqpSolver:
         self.last_warm = False
         self._model = None
         self._dims: tuple[int, int, int] | None = None
-        self._limit = self.settings.max_iter
+        self._limit = self.settings.iter_limit
         self._iter_s = ITERATION_S
         self._keep: tuple = ()
 
@@ -140,7 +160,7 @@ class DaqpSolver:
         H = qp.H.copy()  # DAQP wants writable buffers; H is shared read-only
         if self._dims != (n, n_eq, n_in):
             self._iter_s = ITERATION_S * size_factor(qp)  # a new size: a guess
-        limit = self.settings.max_iter
+        limit = self.settings.iter_limit
         if deadline is not None:
             limit = min(limit, max(1, int((deadline - time.perf_counter()) / self._iter_s)))
         t0 = time.perf_counter()
@@ -182,7 +202,7 @@ class DaqpSolver:
             if flag < 0:
                 return None, flag, {}, 0
             s = self._model.settings
-            s.update(primal_tol=self.settings.eps_abs, iter_limit=limit,
+            s.update(primal_tol=self.settings.primal_tol, iter_limit=limit,
                      eps_prox=0.0 if n == qp.m else -1e-6)
             self._model.settings = s
             self._dims = dims
@@ -210,7 +230,7 @@ class DaqpSolver:
             if not self.last_warm:
                 self.fallbacks += 1
                 # Under a deadline the two solves share the cap fitted to it.
-                rest = max(1, limit - iterations) if limit < self.settings.max_iter else limit
+                rest = max(1, limit - iterations) if limit < self.settings.iter_limit else limit
                 if rest != self._limit:
                     s = self._model.settings
                     s.update(iter_limit=rest)
@@ -251,8 +271,8 @@ class DaqpWorkspace:
 
     name = 'daqp'
 
-    def __init__(self, eps_abs: float = ProxSuiteSettings.eps_abs,
-                 max_iter: int = ProxSuiteSettings.max_iter) -> None:
+    def __init__(self, eps_abs: float = DaqpSettings.primal_tol,
+                 max_iter: int = DaqpSettings.iter_limit) -> None:
         import daqp  # imported here: the core runs without the optional backends
 
         self._daqp = daqp

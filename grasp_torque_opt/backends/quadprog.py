@@ -16,6 +16,7 @@ error, never a regularized answer.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import time
 
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
@@ -24,29 +25,51 @@ from grasp_torque_opt.core.tau_qp import check_data, TauQP
 import numpy as np
 
 
+@dataclass(frozen=True)
+class QuadprogSettings:
+    """
+    quadprog's settings: none (no tolerances; its active set ends after finitely many steps).
+
+    A type of its own all the same, as every backend has (the registry maps a
+    :class:`~grasp_torque_opt.backends.proxsuite.ProxSuiteSettings` to it).
+    """
+
+    @classmethod
+    def from_proxsuite(cls, settings: ProxSuiteSettings) -> QuadprogSettings:
+        """Return quadprog's settings for a ProxSuiteSettings: nothing of it applies."""
+        return cls()
+
+
 class QuadprogSolver:
     """
     quadprog (Goldfarb-Idnani) on the tau-QP; grasps with k = 0 only.
 
+    It has no warm start (``warm_start`` and ``last_warm`` are always False).
+
     Args:
-        settings: unused (quadprog has no tolerances; its active-set method
-            ends after finitely many steps).
+        settings: its settings (there are none to set).
     """
 
     name = 'quadprog'
+    warm_start = False
+    last_warm = False
 
-    def __init__(self, settings: ProxSuiteSettings | None = None) -> None:
+    def __init__(self, settings: QuadprogSettings | None = None) -> None:
         import quadprog
 
         self._quadprog = quadprog
-        self.settings = settings or ProxSuiteSettings()
+        self.settings = settings or QuadprogSettings()
 
-    def solve(self, qp: TauQP, deadline: float | None = None) -> RawResult:
+    def solve(self, qp: TauQP, cold: bool = False, deadline: float | None = None
+              ) -> RawResult:
         """
         Solve a built tau-QP; none starts past ``deadline``.
 
-        ``deadline`` is a ``time.perf_counter()`` value [s]; a quadprog solve ends after
-        finitely many active-set steps.
+        Args:
+            qp: the QP.
+            cold: every quadprog solve is cold (no warm start to skip).
+            deadline: ``time.perf_counter()`` value [s]; a quadprog solve ends after
+                finitely many active-set steps.
         """
         if deadline is not None and time.perf_counter() >= deadline:
             return RawResult('error', None, 0, 0.0, 'time budget spent before quadprog started')

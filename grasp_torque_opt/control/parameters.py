@@ -44,10 +44,10 @@ from grasp_torque_opt.core.scenario import MAX_NAME_MAP, parse_name_map
 import numpy as np
 import yaml
 
+#: Largest accepted norm of a gravity input [m/s^2] (about 10 g), parameter or message.
+MAX_GRAVITY = 100.0
 #: The schema file.
 SCHEMA_FILE = Path(__file__).with_name('grasp_torque_node_parameters.yaml')
-#: Largest accepted norm of a gravity input [m/s^2] (about 10 g).
-MAX_GRAVITY = 100.0
 #: Each weight's range, and the largest ratio of two weights: W's condition number
 #: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
 WEIGHT_RANGE = (1e-6, 1e6)

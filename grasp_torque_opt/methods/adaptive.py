@@ -50,8 +50,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 import math
 
-from grasp_torque_opt.backends.daqp import DaqpWorkspace
-from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.backends.daqp import DaqpSettings, DaqpWorkspace
 from grasp_torque_opt.core.bounds import dual_bound, relaxation_duals
 from grasp_torque_opt.core.certificate import Certificate, certify, DEFAULT_TOLERANCE
 from grasp_torque_opt.core.exceptions import SolverError
@@ -111,8 +110,8 @@ class AdaptiveSettings:
     max_rounds: int = 4
     first_sides: int | None = None
     warm_start: bool = False
-    eps_abs: float = ProxSuiteSettings.eps_abs
-    max_iter: int = ProxSuiteSettings.max_iter
+    eps_abs: float = DaqpSettings.primal_tol
+    max_iter: int = DaqpSettings.iter_limit
 
 
 @dataclass

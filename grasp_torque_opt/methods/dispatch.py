@@ -19,17 +19,18 @@ the load even with the exact cone).
 from __future__ import annotations
 
 import dataclasses
-import inspect
+from dataclasses import dataclass
 import time
 
-from grasp_torque_opt.backends import available, make_solver
-from grasp_torque_opt.backends.proxsuite import TauQPSolver
+from grasp_torque_opt.backends.base import Backend
+from grasp_torque_opt.backends.registry import as_backend, available, make_solver
 from grasp_torque_opt.core.bounds import make_bounds
 from grasp_torque_opt.core.certificate import Certificate, certify, DEFAULT_TOLERANCE
 from grasp_torque_opt.core.exceptions import InputError, SolverError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import cone_usage, planned_friction, torque_ratio
+from grasp_torque_opt.core.scenario import Friction
 from grasp_torque_opt.core.solution import (
     FAILED,
     INFEASIBLE,
@@ -53,25 +54,18 @@ LINEARIZED = ('tau-qp', 'force-qp')
 PRIMARY_SHARE = 0.8
 
 
-_TAKES_DEADLINE: dict[type, bool] = {}
-
-
-def _timed(solver, qp: TauQP, deadline: float | None, **kwargs) -> RawResult:
+def _ask(solver: Backend, qp: TauQP, deadline: float | None, cold: bool = False
+         ) -> RawResult:
     """
-    Call ``solver.solve(qp)``, passing the deadline when there is one and the solver takes it.
+    Call a backend's ``solve``, passing only what differs from the protocol's defaults.
 
-    Every backend takes it; a solver of the caller's own that does not runs on its
-    iteration caps alone.
+    A subclass of a backend that narrowed ``solve`` (a test's fault injection) is still
+    called as it can be when there is no deadline and no redo.
     """
-    if deadline is not None:
-        takes = _TAKES_DEADLINE.get(type(solver))
-        if takes is None:
-            params = inspect.signature(solver.solve).parameters
-            takes = _TAKES_DEADLINE[type(solver)] = 'deadline' in params or any(
-                p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
-        if takes:
-            kwargs['deadline'] = deadline
-    return solver.solve(qp, **kwargs)
+    options = {} if deadline is None else {'deadline': deadline}
+    if cold:
+        options['cold'] = True
+    return solver.solve(qp, **options)
 
 
 def qp_answer(qp: TauQP, raw: RawResult
@@ -106,21 +100,77 @@ def planner_metrics(out: Solution, setup: GraspSetup) -> Solution:
     return out
 
 
+@dataclass
+class _Grasp:
+    """What every method of one grasp shares: its maps and the planned problem's data."""
+
+    setup: GraspSetup
+    maps: GraspMaps
+    friction: Friction  # the margin's reduced cone, or the scenario's own
+    tau_min: np.ndarray
+    tau_max: np.ndarray
+    tolerance: float
+
+    @property
+    def args(self) -> tuple:
+        """Return the arguments of every builder and reference method."""
+        return (self.maps, self.friction, self.setup.external_wrench, self.tau_min,
+                self.tau_max, self.setup.weights)
+
+    def certify(self, tau: np.ndarray | None, f: np.ndarray | None) -> Certificate | None:
+        """Certify (tau, f) against the exact problem; None without an answer."""
+        return None if f is None else certify(self.maps.G, self.maps.J,
+                                              self.setup.external_wrench, self.friction,
+                                              self.tau_min, self.tau_max, tau, f,
+                                              self.tolerance)
+
+
+@dataclass
+class _Answer:
+    """
+    A method's answer as it goes through the steps: who answered, what, and its certificate.
+
+    ``qp``, ``solver``, ``fallback`` and ``first`` (the first backend's deadline) are the
+    tau-QP's; None for a reference method.
+    """
+
+    raw: RawResult
+    tau: np.ndarray | None
+    f: np.ndarray | None
+    used: str
+    qp: TauQP | None = None
+    solver: Backend | None = None
+    fallback: Backend | None = None
+    first: float | None = None
+    cert: Certificate | None = None
+
+    @property
+    def certified(self) -> bool:
+        """Whether the solver says solved and the certificate holds."""
+        return self.raw.status == 'solved' and self.cert is not None and self.cert.ok
+
+
 def solve(setup: GraspSetup, method: str = 'tau-qp', *, maps: GraspMaps | None = None,
-          solver: TauQPSolver | None = None, backend: str = 'proxsuite',
-          fallback: TauQPSolver | None = None,
+          solver: Backend | None = None, backend: str = 'proxsuite',
+          fallback: Backend | None = None,
           tolerance: float = DEFAULT_TOLERANCE, refiner: Refiner | None = None,
           deadline: float | None = None) -> Solution:
     """
     Solve one grasp with one method and certify the result.
+
+    The steps: the grasp's maps (:func:`_grasp`); the first answer (:func:`_tau_qp`,
+    with the min-max stage, or :func:`_reference`); its certificate, a warm answer
+    that fails it redone cold (:func:`_redo_cold`); the fallback backend
+    (:func:`_fallback`); the status (:func:`_decide`).
 
     Args:
         setup: the grasp.
         method: one of :data:`METHODS`.
         maps: G and J if already computed (else computed here).
         solver: a tau-QP solver to reuse across calls (tau-qp; for
-            tau-qp-adaptive, the paper's N-gon it falls back to), any backend
-            of :mod:`grasp_torque_opt.backends`.
+            tau-qp-adaptive, the paper's N-gon it falls back to): a backend of
+            :mod:`grasp_torque_opt.backends`, or a solver of the caller's own
+            (``solve(qp) -> RawResult``; it gets no deadline and no cold redo).
         backend: the backend to use when no solver is given (as ``solver``).
         fallback: a second tau-QP solver, asked only when the first gives nothing
             certifiable (ProxSuite called some holdable Allegro loads
@@ -144,11 +194,7 @@ def solve(setup: GraspSetup, method: str = 'tau-qp', *, maps: GraspMaps | None =
     Returns:
         A solution whose status is ``optimal`` only if certified.
     """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    if setup.objective == 'min-max' and method != 'tau-qp':
-        raise InputError('objective.type', f'min-max is solved by the tau-qp method only, '
-                         f'not {method}')
+    _check_method(setup, method)
     if method == 'tau-qp-adaptive':
         # The adaptive refinement plans in the margin's reduced cone; the usage and the
         # ratio are then measured as for tau-qp.
@@ -157,98 +203,159 @@ def solve(setup: GraspSetup, method: str = 'tau-qp', *, maps: GraspMaps | None =
                                                tolerance, refiner, deadline), setup)
     timings = {}
     t0 = time.perf_counter()
-    if maps is None:
-        maps = setup.maps()
+    grasp = _grasp(setup, maps, tolerance)
     t1 = time.perf_counter()
     timings['maps'] = t1 - t0
-    tau_min, tau_max = setup.tau_bounds
-    friction = planned_friction(setup.friction)  # the margin's reduced cone, or itself
-    args = (maps, friction, setup.external_wrench, tau_min, tau_max, setup.weights)
-    J = maps.J
-    used = method
     if method == 'tau-qp':
-        qp = build_tau_qp(*args)
-        stage = None
-        if setup.objective == 'min-max':
-            # The LP's t*, then the sum of squares within |tau + offset| <= t* limit / w.
-            t_lp = time.perf_counter()  # the LP first, with the QP's share of the time
-            stage = minmax_stage(qp, setup.hand.torque_limits, setup.weights,
-                                 setup.torque_offset, None if deadline is None else
-                                 t_lp + PRIMARY_SHARE * max(0.0, deadline - t_lp))
-            qp = stage.qp
-        t2 = time.perf_counter()
-        solver = solver or make_solver(backend)
-        used = getattr(solver, 'name', backend)
-        if stage is not None and stage.status not in ('optimal', 'infeasible'):
-            raw = RawResult('error', None, 0, 0.0, stage.message)  # no min-max optimum: none
-            fallback = None
-        else:
-            if stage is not None and fallback is None and used != 'daqp' and \
-                    available('daqp'):
-                # The tightened box leaves a thin feasible set: ProxSuite called 5 of 60
-                # such QPs on random Allegro grasps PRIMAL_INFEASIBLE, DAQP solved all.
-                fallback = make_solver('daqp')
-            first = None if deadline is None else \
-                t2 + PRIMARY_SHARE * max(0.0, deadline - t2)
-            try:
-                raw = _timed(solver, qp, first)
-            except SolverError as e:
-                if fallback is None:
-                    raise
-                raw = RawResult('error', None, 0, 0.0, str(e))
-            if stage is not None:
-                raw = dataclasses.replace(raw, message=f'{stage.message}; {raw.message}')
-        raw, tau, f = qp_answer(qp, raw)
+        answer, t2 = _tau_qp(grasp, solver, backend, fallback, deadline)
     else:
         t2 = time.perf_counter()
-        # The reference methods' solvers (Clarabel, SciPy's SLSQP) are imported where
-        # they are used: the node runs the tau-QP without them.
-        if method == 'force-qp':
-            from grasp_torque_opt.reference.force_qp import solve_force_qp
-            raw = solve_force_qp(*args, objective='force')
-        elif method == 'socp':
-            from grasp_torque_opt.reference.exact_socp import solve_exact_socp
-            raw = solve_exact_socp(*args)
-        else:
-            from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp
-            raw = solve_exact_nlp(*args)
-        f = None if raw.x is None else raw.x[:J.shape[0]]
-        tau = None if f is None else J.T @ f
+        answer = _reference(grasp, method)
     t3 = time.perf_counter()
     timings['build'] = t2 - t1
     timings['solve'] = t3 - t2
-
-    def certified(tau, f) -> Certificate | None:
-        return None if f is None else certify(maps.G, J, setup.external_wrench,
-                                              friction, tau_min, tau_max, tau, f,
-                                              tolerance)
-
-    cert = certified(tau, f)
-    if method == 'tau-qp' and getattr(solver, 'last_warm', False) and \
-            raw.status == 'solved' and cert is not None and not cert.ok:
-        # A warm start that lands off the certificate is redone cold in the same call.
-        raw, tau, f = qp_answer(qp, _timed(solver, qp, first, cold=True))
-        cert = certified(tau, f)
+    answer.cert = grasp.certify(answer.tau, answer.f)
+    if method == 'tau-qp':
+        _redo_cold(grasp, answer)
     timings['certify'] = time.perf_counter() - t3
-    if method == 'tau-qp' and fallback is not None and \
-            not (raw.status == 'solved' and cert is not None and cert.ok):
+    if method == 'tau-qp' and answer.fallback is not None and not answer.certified:
         t4 = time.perf_counter()
-        raw2, tau2, f2 = qp_answer(qp, _timed(fallback, qp, deadline))
-        if raw2.status == 'solved' and f2 is not None:
-            cert2 = certified(tau2, f2)
-            if cert2.ok:
-                used = getattr(fallback, 'name', 'fallback')
-                raw = dataclasses.replace(raw2, message=f'{raw2.message}; fallback after '
-                                          f'{raw.message}')
-                tau, f, cert = tau2, f2, cert2
+        _fallback(grasp, answer, deadline)
         timings['fallback'] = time.perf_counter() - t4
+    return _decide(grasp, method, answer, timings, deadline)
 
+
+def _check_method(setup: GraspSetup, method: str) -> None:
+    """
+    Refuse an unknown method, and min-max with a method other than tau-qp.
+
+    Raises:
+        ValueError: an unknown method, naming the known ones.
+        InputError: ``objective.type`` min-max with another method.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if setup.objective == 'min-max' and method != 'tau-qp':
+        raise InputError('objective.type', f'min-max is solved by the tau-qp method only, '
+                         f'not {method}')
+
+
+def _grasp(setup: GraspSetup, maps: GraspMaps | None, tolerance: float) -> _Grasp:
+    """Return the grasp's maps (computed unless given) and its planned data."""
+    if maps is None:
+        maps = setup.maps()
+    tau_min, tau_max = setup.tau_bounds
+    # The margin's reduced cone, or the friction itself.
+    return _Grasp(setup, maps, planned_friction(setup.friction), tau_min, tau_max, tolerance)
+
+
+def _tau_qp(grasp: _Grasp, solver: Backend | None, backend: str, fallback: Backend | None,
+            deadline: float | None) -> tuple[_Answer, float]:
+    """
+    Build the tau-QP (after the min-max LP for that objective) and ask the first backend.
+
+    The first backend gets :data:`PRIMARY_SHARE` of the time left. A first backend that
+    raises is an error answer when there is a fallback to ask.
+
+    Returns:
+        The answer, and the ``time.perf_counter()`` value when the build ended [s].
+
+    Raises:
+        SolverError: the first backend raised and there is no fallback.
+    """
+    setup = grasp.setup
+    qp = build_tau_qp(*grasp.args)
+    stage = None
+    if setup.objective == 'min-max':
+        # The LP's t*, then the sum of squares within |tau + offset| <= t* limit / w.
+        t_lp = time.perf_counter()  # the LP first, with the QP's share of the time
+        stage = minmax_stage(qp, setup.hand.torque_limits, setup.weights,
+                             setup.torque_offset, _share(t_lp, deadline))
+        qp = stage.qp
+    t2 = time.perf_counter()
+    solver = as_backend(solver if solver is not None else make_solver(backend), backend)
+    answer = _Answer(RawResult('error', None, 0, 0.0, ''), None, None, solver.name, qp, solver)
+    if stage is not None and stage.status not in ('optimal', 'infeasible'):
+        answer.raw = RawResult('error', None, 0, 0.0, stage.message)  # no min-max optimum
+        return answer, t2
+    if stage is not None and fallback is None and solver.name != 'daqp' and \
+            available('daqp'):
+        # The tightened box leaves a thin feasible set: ProxSuite called 5 of 60
+        # such QPs on random Allegro grasps PRIMAL_INFEASIBLE, DAQP solved all.
+        fallback = make_solver('daqp')
+    answer.fallback = None if fallback is None else as_backend(fallback, 'fallback')
+    answer.first = _share(t2, deadline)
+    try:
+        raw = _ask(solver, qp, answer.first)
+    except SolverError as e:
+        if fallback is None:
+            raise
+        raw = RawResult('error', None, 0, 0.0, str(e))
+    if stage is not None:
+        raw = dataclasses.replace(raw, message=f'{stage.message}; {raw.message}')
+    answer.raw, answer.tau, answer.f = qp_answer(qp, raw)
+    return answer, t2
+
+
+def _share(start: float, deadline: float | None) -> float | None:
+    """Return the first backend's deadline: :data:`PRIMARY_SHARE` of the time left [s]."""
+    return None if deadline is None else start + PRIMARY_SHARE * max(0.0, deadline - start)
+
+
+def _reference(grasp: _Grasp, method: str) -> _Answer:
+    """Solve with a reference method (f in its x)."""
+    # The reference methods' solvers (Clarabel, SciPy's SLSQP) are imported where
+    # they are used: the node runs the tau-QP without them.
+    if method == 'force-qp':
+        from grasp_torque_opt.reference.force_qp import solve_force_qp
+        raw = solve_force_qp(*grasp.args, objective='force')
+    elif method == 'socp':
+        from grasp_torque_opt.reference.exact_socp import solve_exact_socp
+        raw = solve_exact_socp(*grasp.args)
+    else:
+        from grasp_torque_opt.reference.exact_nlp import solve_exact_nlp
+        raw = solve_exact_nlp(*grasp.args)
+    J = grasp.maps.J
+    f = None if raw.x is None else raw.x[:J.shape[0]]
+    return _Answer(raw, None if f is None else J.T @ f, f, method)
+
+
+def _redo_cold(grasp: _Grasp, answer: _Answer) -> None:
+    """Redo cold, in the same call, a warm answer that lands off the certificate."""
+    if answer.solver.last_warm and answer.raw.status == 'solved' and \
+            answer.cert is not None and not answer.cert.ok:
+        answer.raw, answer.tau, answer.f = qp_answer(
+            answer.qp, _ask(answer.solver, answer.qp, answer.first, cold=True))
+        answer.cert = grasp.certify(answer.tau, answer.f)
+
+
+def _fallback(grasp: _Grasp, answer: _Answer, deadline: float | None) -> None:
+    """Ask the fallback backend, with the rest of the time; keep its answer if certified."""
+    raw, tau, f = qp_answer(answer.qp, _ask(answer.fallback, answer.qp, deadline))
+    if raw.status == 'solved' and f is not None:
+        cert = grasp.certify(tau, f)
+        if cert.ok:
+            answer.used = answer.fallback.name
+            answer.raw = dataclasses.replace(raw, message=f'{raw.message}; fallback after '
+                                             f'{answer.raw.message}')
+            answer.tau, answer.f, answer.cert = tau, f, cert
+
+
+def _decide(grasp: _Grasp, method: str, answer: _Answer, timings: dict,
+            deadline: float | None) -> Solution:
+    """
+    Decide the status: optimal if certified; infeasible only if confirmed; else failed.
+
+    A polygon method's infeasible verdict needs the independent LP to agree (skipped
+    once the deadline has passed); the SOCP's is its solver's.
+    """
+    setup, raw, cert = grasp.setup, answer.raw, answer.cert
     out = Solution(status=FAILED, method=method, joints=list(setup.hand.joints),
                    iterations=raw.iterations, solve_time_s=raw.solve_time_s,
-                   certificate=cert, timings=timings, backend=used,
+                   certificate=cert, timings=timings, backend=answer.used,
                    objective=setup.objective, friction_margin=setup.friction.margin)
-    if raw.status == 'solved' and cert is not None and cert.ok:
-        out.status, out.tau, out.wrenches = OPTIMAL, tau, f.reshape(-1, 4)
+    if answer.certified:
+        out.status, out.tau, out.wrenches = OPTIMAL, answer.tau, answer.f.reshape(-1, 4)
         out.message = f'certified (solver: {raw.message})'
         return planner_metrics(out, setup)
     why = (f'solver: {raw.message}' if cert is None or cert.ok or raw.status != 'solved'
@@ -256,8 +363,8 @@ def solve(setup: GraspSetup, method: str = 'tau-qp', *, maps: GraspMaps | None =
     if method in LINEARIZED and deadline is not None and time.perf_counter() >= deadline:
         out.message = f'not certified, LP skipped: time budget spent ({why})'
     elif method in LINEARIZED:
-        feasible = linearized_feasible(maps, friction, setup.external_wrench,
-                                       tau_min, tau_max)
+        feasible = linearized_feasible(grasp.maps, grasp.friction, setup.external_wrench,
+                                       grasp.tau_min, grasp.tau_max)
         if feasible is False:
             out.status, out.message = INFEASIBLE, f'infeasible, confirmed by LP ({why})'
         elif feasible:

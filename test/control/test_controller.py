@@ -8,6 +8,7 @@
 
 """The control cycle on plain arrays: inputs, gate, staleness, fault policy, gravity."""
 
+import copy
 import dataclasses
 from pathlib import Path
 import time
@@ -460,3 +461,13 @@ def test_a_failing_solver_never_passes_through(planar, mode, policy):
     ctrl.solver.healthy = True
     ctrl.update_joint_state(*js, 0.2)
     assert ctrl.cycle(0.2).kind == 'solution' and ctrl.counters.recoveries == 1
+
+
+def test_a_shallow_copy_keeps_the_setup_and_config_of_its_time(planar):
+    ctrl = fresh(planar)
+    then = copy.copy(ctrl)
+    ctrl.setup = dataclasses.replace(ctrl.setup, weights=2.0 * ctrl.setup.weights)
+    ctrl.config = dataclasses.replace(ctrl.config, hold_time=1.0)
+    assert then.setup is not ctrl.setup and then.config.hold_time != 1.0
+    assert ctrl.store.setup is ctrl.solving.setup is ctrl.policy.setup is ctrl.setup
+    assert then.counters is ctrl.counters  # shallow: the running totals are shared

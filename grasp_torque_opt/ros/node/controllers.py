@@ -21,6 +21,7 @@ import dataclasses
 from typing import Any
 
 from grasp_torque_opt.backends import available, make_solver
+from grasp_torque_opt.backends.registry import settings_for
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.controller import TorqueController
@@ -95,11 +96,13 @@ def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
             ctrl.solver = make_solver(backend, settings, False, slice_s)
         return ctrl
     ctrl.setup, ctrl.config = setup_of(ctrl.setup, p), config
-    if settings != ctrl.solver.settings or backend != getattr(ctrl.solver, 'name', None) or \
-            warm != getattr(ctrl.solver, 'warm_start', False):
+    # Each backend holds its own settings type: compare in it.
+    if settings_for(backend, settings) != ctrl.solver.settings or \
+            backend != ctrl.solver.name or warm != ctrl.solver.warm_start:
         ctrl.solver = make_solver(backend, settings, warm, slice_s)
     if fallback != getattr(ctrl.fallback, 'name', None) or \
-            (ctrl.fallback is not None and ctrl.fallback.settings != settings):
+            (ctrl.fallback is not None and
+             ctrl.fallback.settings != settings_for(fallback, settings)):
         ctrl.fallback = make_solver(fallback, settings) if fallback else None
     return ctrl
 

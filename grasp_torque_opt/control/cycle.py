@@ -1,0 +1,247 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The cycle's solve: the grasp of the inputs, the compiled or the Python path, the gate.
+
+A solve is certified (:func:`grasp_torque_opt.methods.dispatch.solve`, or the
+compiled cycle of :mod:`grasp_torque_opt.control.compiled` where it applies, which
+hands back what it cannot certify). The solvers are given a deadline that they keep
+themselves (:meth:`Cycle.budget`); :meth:`Cycle.attempt` never raises: every failure
+is a fault reason for the fault policy.
+"""
+
+from __future__ import annotations
+
+import time
+
+from grasp_torque_opt.backends.base import Backend
+from grasp_torque_opt.backends.daqp import DaqpSettings
+from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.backends.registry import is_backend, settings_for
+from grasp_torque_opt.control import compiled
+from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.fault_policy import CycleResult
+from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
+from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import ContactSpec
+from grasp_torque_opt.core.solution import Solution
+from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
+from grasp_torque_opt.methods.dispatch import solve
+import numpy as np
+import pinocchio as pin
+
+
+def round_settings(solver: Backend) -> DaqpSettings:
+    """
+    Return DAQP's settings for tau-qp-adaptive's rounds, from the cycle's backend.
+
+    The rounds solve with DAQP whatever the backend: ProxSuite's ``eps_abs`` and
+    ``max_iter`` map to DAQP's as :func:`~grasp_torque_opt.backends.registry.settings_for`
+    maps them, DAQP's are its own; quadprog and a solver of the caller's own have none
+    (DAQP's defaults).
+    """
+    settings = solver.settings if is_backend(solver) else None
+    if isinstance(settings, (ProxSuiteSettings, DaqpSettings)):
+        return settings_for('daqp', settings)
+    return DaqpSettings()
+
+
+class Cycle:
+    """
+    Solve the grasp of a snapshot of inputs, certified, and gate its command.
+
+    Args:
+        setup: the grasp of the scenario. Its hand's Pinocchio data is used here.
+        config: the method, tolerance, gravity and budget settings.
+        counters: where solver failures are counted (shared).
+        solver: the first backend.
+        fallback: a second backend, asked in the same cycle when the first gives
+            nothing certifiable; None for none.
+    """
+
+    def __init__(self, setup: GraspSetup, config: CycleConfig, counters: Counters,
+                 solver: Backend, fallback: Backend | None = None) -> None:
+        self.setup, self.config, self.counters = setup, config, counters
+        self.solver, self.fallback = solver, fallback
+        self.refiner: Refiner | None = None  # tau-qp-adaptive's, made when first used
+        #: The scenario's load for a gravity input [m/s^2] (the object's weight moves with
+        #: it), or None: the load does not depend on gravity.
+        self.load_of_gravity = None
+        #: The compiled cycle in use (None: the Python cycle), and why not when None.
+        self.compiled_cycle: compiled.CompiledCycle | None = None
+        self.compiled_reason = ''
+
+    def grasp_at(self, inputs: Inputs, jacobians: bool = False
+                 ) -> tuple[GraspSetup, np.ndarray | None]:
+        """
+        Return the grasp of a snapshot of inputs, and g(q) if compensated.
+
+        With ``jacobians``, the joint Jacobians are computed with the placements (the
+        compiled cycle reads both from the hand's Pinocchio data).
+
+        Raises:
+            InputError: a contact point beyond ``max_contact_distance``, or the
+                contacts cannot be placed on their links.
+        """
+        setup = self.setup
+        hand = setup.hand
+        q = inputs.q
+        model, data = hand.model, hand.data
+        if jacobians:
+            pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacements(model, data)
+        else:
+            pin.framesForwardKinematics(model, data, q)
+        contacts = setup.contacts
+        if inputs.contacts is not None:
+            cp = inputs.contacts
+            oMF = data.oMf[model.getFrameId(cp.frame)] if cp.frame else pin.SE3.Identity()
+            contacts = []
+            limit = self.config.max_contact_distance
+            for i, (spec, p, R) in enumerate(zip(setup.contacts, cp.positions, cp.rotations)):
+                distance = float(np.linalg.norm(oMF.act(p)))
+                if distance > limit:
+                    raise InputError(f'contacts.poses[{i}].position',
+                                     f'is {distance:.6g} m from the base origin, beyond '
+                                     f'max_contact_distance ({limit} m)')
+                R_base = oMF.rotation @ R
+                oMl = data.oMf[model.getFrameId(spec.link)]
+                contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(oMF.act(p)),
+                                            normal=R_base[:, 2], tangent=R_base[:, 0]))
+        wrench = setup.external_wrench
+        if inputs.wrench is not None:
+            frame, w = inputs.wrench
+            R = data.oMf[model.getFrameId(frame)].rotation if frame else np.eye(3)
+            wrench = np.concatenate((R @ w[:3], R @ w[3:]))
+        elif inputs.gravity is not None and self.load_of_gravity is not None:
+            wrench = self.load_of_gravity(inputs.gravity)
+        g = None
+        if self.config.gravity_compensation:
+            model.gravity.linear = np.asarray(
+                self.config.gravity if inputs.gravity is None else inputs.gravity, dtype=float)
+            g = pin.computeGeneralizedGravity(model, data, q)[hand.idx_v].copy()
+        return replaced(setup, q=q, contacts=contacts, external_wrench=wrench,
+                        torque_offset=g), g
+
+    def budget(self) -> float:
+        """
+        Return the time a cycle's solvers may take [s].
+
+        That is ``cycle_budget``, or ``joint_state_timeout`` if smaller (a command later
+        than that would answer a stale joint state).
+        """
+        return min(self.config.cycle_budget, self.config.joint_state_timeout)
+
+    def solve_inputs(self, inputs: Inputs, deadline: float | None = None
+                     ) -> tuple[Solution, GraspMaps, np.ndarray | None]:
+        """
+        Solve the grasp of a snapshot of inputs with the tau-QP (certified).
+
+        Args:
+            inputs: the snapshot.
+            deadline: ``time.perf_counter()`` value by which the solvers stop [s]
+                (None: only their iteration caps).
+
+        Raises:
+            InputError: the inputs do not make a grasp (e.g. a tangent parallel to
+                its normal).
+        """
+        fast = self._compiled(self.setup)
+        setup, g = self.grasp_at(inputs, jacobians=fast is not None)
+        solver, fallback, handed_back = self.solver, self.fallback, ''
+        if fast is not None:
+            sol, maps = fast.solve(setup, None if deadline is None else
+                                   deadline - time.perf_counter(), kinematics=False)
+            if sol is not None:
+                return sol, maps, g
+            handed_back = maps
+            if fast.last_code in compiled.SOLVER_CODES and fallback is not None:
+                # ProxSuite was tried, warm and cold: the fallback answers, with the rest of
+                # the time (the Python cycle would ask ProxSuite again first).
+                solver, fallback = fallback, None
+        maps = setup.maps()
+        sol = solve(setup, self.config.method, maps=maps, solver=solver,
+                    fallback=fallback, tolerance=self.config.certificate_tolerance,
+                    refiner=self._refiner(), deadline=deadline)
+        if handed_back:
+            sol.message = f'{sol.message}; after the {handed_back}'
+        return sol, maps, g
+
+    def _compiled(self, setup: GraspSetup) -> compiled.CompiledCycle | None:
+        """Return the compiled cycle for this grasp and solver, or None (the reason kept)."""
+        if not self.config.compiled:
+            # Dropped, not kept aside: turned on again, it starts anew (cold).
+            self.compiled_cycle, self.compiled_reason = None, 'off (compiled: false)'
+            return None
+        fast, tol = self.compiled_cycle, self.config.certificate_tolerance
+        if fast is not None and fast.fits(setup, self.solver, tol):
+            if fast.gave_up:
+                self.compiled_reason = fast.gave_up
+                return None
+            return fast
+        why = compiled.unsupported(setup, self.config.method, self.solver)
+        self.compiled_reason = why
+        self.compiled_cycle = None if why else compiled.CompiledCycle(setup, self.solver, tol)
+        return self.compiled_cycle
+
+    def _refiner(self) -> Refiner | None:
+        """tau-qp-adaptive's rounds (kept across cycles, warm as the solver is), else None."""
+        if self.config.method != 'tau-qp-adaptive':
+            return None
+        warm = self.solver.warm_start if is_backend(self.solver) else False
+        daqp = round_settings(self.solver)
+        wanted = AdaptiveSettings(warm_start=warm, eps_abs=daqp.primal_tol,
+                                  max_iter=daqp.iter_limit)
+        if self.refiner is None or self.refiner.settings != wanted:
+            self.refiner = Refiner(wanted)
+        return self.refiner
+
+    def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
+        """Check a command last before it leaves: certified, finite, sized, within limits."""
+        if not solution.optimal:
+            return None, f'no certified solution ({solution.status}: {solution.message})'
+        cmd = solution.tau + (0.0 if g is None else g)
+        lim = self.setup.hand.torque_limits
+        if cmd.shape != lim.shape:
+            return None, f'command has {cmd.size} values for {lim.size} joints'
+        if (np.abs(cmd) <= lim).all():  # False for NaN as well
+            return cmd, ''
+        if not np.all(np.isfinite(cmd)):
+            return None, 'command not finite'
+        if np.any(np.abs(cmd) > lim):
+            k = int(np.argmax(np.abs(cmd) - lim))
+            return None, f'command over the limit at {self.setup.hand.joints[k]}'
+        return cmd, ''
+
+    def attempt(self, inputs: Inputs, deadline: float) -> CycleResult:
+        """
+        Solve and gate; never raises.
+
+        Returns:
+            A certified command (kind ``solution``, not yet committed), or a result of
+            kind ``none`` whose ``fault`` says why there is none.
+        """
+        try:
+            sol, maps, g = self.solve_inputs(inputs, deadline)
+        except InputError as e:
+            return CycleResult(None, 'none', fault=f'inputs do not make a grasp: {e}')
+        except GraspTorqueError as e:
+            self.counters.solver_failures += 1
+            return CycleResult(None, 'none', fault=f'solver failed: {e}')
+        except Exception as e:  # noqa: BLE001 -- a control loop fails safe, it does not die
+            self.counters.solver_failures += 1
+            return CycleResult(None, 'none', fault=f'cycle failed: {type(e).__name__}: {e}')
+        if sol.status == 'failed':
+            self.counters.solver_failures += 1
+        cmd, why = self.gate(sol, g)
+        if cmd is None:
+            return CycleResult(None, 'none', sol, maps, g, why)
+        return CycleResult(cmd, 'solution', sol, maps, g)
