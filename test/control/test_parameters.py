@@ -21,8 +21,8 @@ from grasp_torque_opt.control.parameters import (
     cycle_config,
     CycleConfig,
     SCHEMA,
-    SCHEMA_FILE,
     Schema,
+    SCHEMA_FILE,
 )
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
 from grasp_torque_opt.core.exceptions import InputError

@@ -63,9 +63,8 @@ def _stops_on(module, args, name, sig):
 
 
 def test_sigterm_ends_the_plain_node_with_sim_time_and_no_clock():
-    _stops_on('grasp_torque_opt.ros.node', ['-p', f'scenario:={PLANAR}',
-                                           '-p', 'use_sim_time:=true'],
-              'sim_time_tester', signal.SIGTERM)
+    args = ['-p', f'scenario:={PLANAR}', '-p', 'use_sim_time:=true']
+    _stops_on('grasp_torque_opt.ros.node', args, 'sim_time_tester', signal.SIGTERM)
 
 
 def test_sigint_ends_the_unconfigured_managed_node():

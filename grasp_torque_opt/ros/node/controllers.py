@@ -21,8 +21,8 @@ import dataclasses
 from typing import Any
 
 from grasp_torque_opt.backends import available, make_solver
-from grasp_torque_opt.backends.registry import settings_for
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
+from grasp_torque_opt.backends.registry import is_backend, settings_for
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.parameters import cycle_config
@@ -96,9 +96,11 @@ def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
             ctrl.solver = make_solver(backend, settings, False, slice_s)
         return ctrl
     ctrl.setup, ctrl.config = setup_of(ctrl.setup, p), config
-    # Each backend holds its own settings type: compare in it.
-    if settings_for(backend, settings) != ctrl.solver.settings or \
-            backend != ctrl.solver.name or warm != ctrl.solver.warm_start:
+    # Each backend holds its own settings type: compare in it. (A solver of one's own,
+    # set on the controller, meets no backend's settings: it is replaced.)
+    solver = ctrl.solver
+    if not is_backend(solver) or settings_for(backend, settings) != solver.settings or \
+            backend != solver.name or warm != solver.warm_start:
         ctrl.solver = make_solver(backend, settings, warm, slice_s)
     if fallback != getattr(ctrl.fallback, 'name', None) or \
             (ctrl.fallback is not None and
