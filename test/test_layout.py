@@ -73,3 +73,22 @@ def test_the_parser_sees_imports_at_module_and_function_level():
     assert 'grasp_torque_opt.core.hand' in imports(code)
     sample = ROOT / 'test' / 'ros_harness.py'
     assert 'grasp_torque_opt.ros.node' in imports(sample)
+
+
+#: The size rule (docs/architecture.md): a module a newcomer reads in one sitting.
+MAX_MODULE_LINES = 500
+MAX_CLASS_LINES = 300
+
+
+def test_no_module_or_class_is_too_long_to_read():
+    long = []
+    for module, path in modules().items():
+        text = path.read_text()
+        if text.count('\n') > MAX_MODULE_LINES:
+            long.append(f'{module}: {text.count(chr(10))} lines (at most {MAX_MODULE_LINES})')
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ClassDef):
+                n = node.end_lineno - node.lineno + 1
+                if n > MAX_CLASS_LINES:
+                    long.append(f'{module}.{node.name}: {n} lines (at most {MAX_CLASS_LINES})')
+    assert not long, '\n'.join(long)

@@ -1,0 +1,204 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The checks of the node's parameters: small pure functions, named in the schema.
+
+Built-in validators are generate_parameter_library's (``bounds<>``, ``one_of<>``,
+``fixed_size<>``, ``element_bounds<>``); custom ones take (parameter, value,
+:class:`Context`) and give the problem in words ('' if none), or raise
+:class:`~grasp_torque_opt.core.exceptions.InputError` naming an entry. The ROS side
+adds its own (topic names) in :mod:`grasp_torque_opt.ros.node.parameters`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+import math
+from typing import Any
+
+from grasp_torque_opt.backends import available
+from grasp_torque_opt.core.exceptions import cut, InputError, quote
+from grasp_torque_opt.core.hand import Hand
+from grasp_torque_opt.core.scenario import MAX_NAME_MAP, parse_name_map
+import numpy as np
+
+#: Largest accepted norm of a gravity input [m/s^2] (about 10 g), parameter or message.
+MAX_GRAVITY = 100.0
+#: Each weight's range, and the largest ratio of two weights: W's condition number
+#: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
+WEIGHT_RANGE = (1e-6, 1e6)
+MAX_WEIGHT_RATIO = 1e6
+
+
+@dataclass(frozen=True)
+class Context:
+    """
+    What some checks need beyond the value: the hand, once loaded.
+
+    Attributes:
+        m: number of actuated joints (None: no hand yet, lengths are not checked).
+        joints: their names, for messages.
+        torque_bounds: the largest accepted torque limit per joint [N m] (None:
+            unchecked).
+    """
+
+    m: int | None = None
+    joints: tuple[str, ...] = ()
+    torque_bounds: np.ndarray | None = None
+
+
+#: A custom validator: (parameter, value, context) -> the problem, '' if none.
+Validator = Callable[[str, Any, Context], str]
+
+
+def _check_size(name: str, value: Any, n: int | None) -> str:
+    if n is not None and len(value) != n:
+        return f'must have {n} entries, got {len(value)}'
+    return ''
+
+
+def _bounds(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    low, high = args
+    return '' if low <= value <= high else f'must be in [{low}, {high}], got {value}'
+
+
+def _one_of(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    return '' if value in args[0] else f"must be one of {', '.join(args[0])}"
+
+
+def _fixed_size(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    return _check_size(name, value, int(args[0]))
+
+
+def _element_bounds(name: str, value: Any, args: tuple, ctx: Context) -> str:
+    low, high = args
+    return '' if all(low <= v <= high for v in value) else \
+        f'every entry must be in [{low:g}, {high:g}]'
+
+
+#: generate_parameter_library's validators that this schema uses.
+BUILT_IN: dict[str, Callable[[str, Any, tuple, Context], str]] = {
+    'bounds<>': _bounds, 'one_of<>': _one_of, 'fixed_size<>': _fixed_size,
+    'element_bounds<>': _element_bounds,
+}
+
+
+def name_map_of(entries: list[str] | None) -> dict[str, str]:
+    """
+    Parse the ``name_map`` parameter: entries ``SCENARIO_NAME=URDF_NAME``.
+
+    Args:
+        entries: the parameter's value (None or empty: no map).
+
+    Returns:
+        scenario name -> URDF name.
+
+    Raises:
+        InputError: an entry without one ``=`` between two names, a name mapped
+            twice, two names mapped to one, more than MAX_NAME_MAP entries.
+    """
+    if not entries:
+        return {}
+    if len(entries) > MAX_NAME_MAP:
+        raise InputError('name_map', f'{len(entries)} entries, more than {MAX_NAME_MAP}')
+    out: dict[str, str] = {}
+    for i, entry in enumerate(entries):
+        key, sep, target = (part.strip() for part in str(entry).partition('='))
+        if not sep or not key or not target or '=' in target:
+            raise InputError(f'name_map[{i}]', f'must be SCENARIO_NAME=URDF_NAME, got '
+                             f'{quote(entry)}')
+        if key in out:
+            raise InputError(f'name_map[{i}]', f"maps '{cut(key)}' a second time")
+        out[key] = target
+    return parse_name_map(out, 'name_map')
+
+
+# -- custom validators: small pure functions, named in the schema ---------------------------
+
+def validate_name_map(name: str, value: Any, ctx: Context) -> str:
+    """Each entry ``SCENARIO_NAME=URDF_NAME``, one to one."""
+    name_map_of(value)  # raises with its own field (name_map[i]) naming the entry
+    return ''
+
+
+def validate_size_of_joints(name: str, value: Any, ctx: Context) -> str:
+    """One entry per actuated joint (unchecked before the hand is loaded)."""
+    return _check_size(name, value, ctx.m)
+
+
+def validate_positive_entries(name: str, value: Any, ctx: Context) -> str:
+    """Every entry > 0."""
+    return '' if all(v > 0 for v in value) else 'every entry must be > 0'
+
+
+def validate_within_urdf_limits(name: str, value: Any, ctx: Context) -> str:
+    """Each torque limit at most its joint's bound (the URDF's effort limit)."""
+    if ctx.torque_bounds is None:
+        return ''
+    Hand.check_limits(np.array(value, dtype=float), list(ctx.joints), ctx.torque_bounds,
+                      name, 'torque_limits_above_urdf (read-only: at start)')
+    return ''
+
+
+def validate_weight_range(name: str, value: Any, ctx: Context) -> str:
+    """Refuse a weight outside WEIGHT_RANGE, or a ratio above MAX_WEIGHT_RATIO."""
+    if not value:
+        return ''
+    low, high = WEIGHT_RANGE
+    if not all(low <= v <= high for v in value):
+        return f'every entry must be in [{low:g}, {high:g}]'
+    if max(value) > MAX_WEIGHT_RATIO * min(value):
+        return (f'the largest entry may be at most {MAX_WEIGHT_RATIO:g} times the smallest, '
+                f'got {max(value) / min(value):.3g}')
+    return ''
+
+
+def validate_gravity_norm(name: str, value: Any, ctx: Context) -> str:
+    """Refuse a norm above MAX_GRAVITY, as on the gravity topic."""
+    if math.sqrt(sum(v * v for v in value)) > MAX_GRAVITY:
+        return f'norm must be at most {MAX_GRAVITY:g} m/s^2 (as on the topic)'
+    return ''
+
+
+def validate_backend_installed(name: str, value: Any, ctx: Context) -> str:
+    """Refuse a backend whose Python module cannot be imported here."""
+    return '' if available(value) else f'{value} is not installed (pip install {value})'
+
+
+def validate_method_available(name: str, value: Any, ctx: Context) -> str:
+    """tau-qp-adaptive needs DAQP."""
+    if value == 'tau-qp' or available('daqp'):
+        return ''
+    return f'{value} needs daqp, which is not installed (pip install daqp)'
+
+
+#: The custom validators that need no ROS, by the names the schema gives them.
+VALIDATORS: dict[str, Validator] = {
+    'name_map': validate_name_map,
+    'size_of_joints': validate_size_of_joints,
+    'positive_entries': validate_positive_entries,
+    'within_urdf_limits': validate_within_urdf_limits,
+    'weight_range': validate_weight_range,
+    'gravity_norm': validate_gravity_norm,
+    'backend_installed': validate_backend_installed,
+    'method_available': validate_method_available,
+}
+
+
+def check_pairs(values: Mapping[str, Any]) -> None:
+    """
+    Check the rules between parameters (after each one's own check).
+
+    Raises:
+        InputError: min-max with a method other than tau-qp (docs/planner.md).
+    """
+    if values.get('objective') == 'min-max' and values.get('solver.method') != 'tau-qp':
+        raise InputError('objective', 'min-max needs solver.method tau-qp, not '
+                         f"{values.get('solver.method')}")
