@@ -99,8 +99,9 @@ class Capacity:
     Attributes:
         status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds;
             confirmed by the independent feasibility LP, and ``binding`` and
-            ``relaxed`` from its infeasibility certificate, :mod:`.infeasibility`), ``unbounded`` (alpha reached :data:`ALPHA_MAX`
-            on the unit direction, or the load is zero) or ``failed``.
+            ``conflict`` from its infeasibility certificate, :mod:`.infeasibility`),
+            ``unbounded`` (alpha reached :data:`ALPHA_MAX` on the unit direction, or the
+            load is zero) or ``failed``.
         value: alpha: a factor on the load [-], or for an axis direction the largest
             load along it [N or N m]; None unless ``optimal``.
         unit: ``-``, ``N`` or ``N m``.

@@ -395,16 +395,30 @@ def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
             cluster.close()
 
 
+def rank_key(records: Sequence[dict[str, Any]], by: str = 'capacity') -> str:
+    """
+    Return the key :func:`rank` sorts by.
+
+    That is ``by``, or ``torque_norm`` for ``capacity`` when no record has one
+    (``metrics="basic"``).
+
+    Raises:
+        ValueError: ``by`` is not one of :data:`RANK_KEYS`.
+    """
+    if by not in RANK_KEYS:
+        raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
+    if by == 'capacity' and not any('capacity' in r for r in records):
+        return 'torque_norm'
+    return by
+
+
 def rank(records: Sequence[dict[str, Any]], by: str = 'capacity') -> list[dict[str, Any]]:
     """
     Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
 
     Without capacities (``metrics="basic"``) ``capacity`` falls back to ``torque_norm``.
     """
-    if by not in RANK_KEYS:
-        raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
-    if by == 'capacity' and not any('capacity' in r for r in records):
-        by = 'torque_norm'
+    by = rank_key(records, by)
     larger = RANK_KEYS[by]
 
     def key(r: dict) -> tuple:

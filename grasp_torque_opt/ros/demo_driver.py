@@ -29,12 +29,18 @@ from pathlib import Path
 import sys
 import time
 
+from grasp_torque_opt.core.command_line import add_version, HelpFormatter
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 import numpy as np
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog='grasp-torque-demo', description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog='grasp-torque-demo', formatter_class=HelpFormatter,
+                                description=__doc__.strip(), epilog=(
+                                    'exit codes: 0 certified commands flowed (--watch: the '
+                                    'watch ended), 1 none or malformed ones, 2 bad input. '
+                                    'docs/node.md'))
+    add_version(p)
     p.add_argument('--params', default='allegro_right_node.yaml',
                    help='node params file (bundled name or path); its scenario is played')
     p.add_argument('--duration', type=float, default=5.0, help='seconds to play [s]')

@@ -123,7 +123,7 @@ def test_score_json_and_bad_files(tmp_path, capsys):
                        capsys)
     assert code == 2 and err.count('\n') == 1 and 'candidates: cannot read' in err
     code, _, err = run(['score', str(batch), '--scenario', str(tmp_path / 'none.yaml')], capsys)
-    assert code == 2 and 'scenario: cannot read' in err
+    assert code == 2 and 'scenario: file not found' in err
 
 
 def test_the_progress_bar_is_drawn_on_a_terminal_only(tmp_path, capsys, monkeypatch):

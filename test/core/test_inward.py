@@ -30,7 +30,7 @@ def test_a_normal_away_from_the_object_origin_names_its_contact(planar_doc, i):
     doc = copy.deepcopy(planar_doc)
     doc['grasp']['contacts'][i]['normal'] = [-x for x in doc['grasp']['contacts'][i]['normal']]
     link = doc['grasp']['contacts'][i]['link']
-    with pytest.raises(InputError, match=rf"^grasp\.contacts\[{i}\]\.normal: the normal of the "
+    with pytest.raises(InputError, match=rf'^grasp\.contacts\[{i}\]\.normal: the normal of the '
                        rf"contact on '{link}' points away from grasp\.object_origin"):
         setup_from_doc(doc)
 
@@ -43,7 +43,7 @@ def test_a_normal_against_the_objects_surface_is_refused(tmp_path):
     doc['object']['position'] = [0.0, 0.0, 0.0]
     box_grasp.write(tmp_path, doc)
     doc['grasp']['contacts'][2]['normal'] = [1.0, 0.0, 0.0]
-    with pytest.raises(InputError, match=r"^grasp\.contacts\[2\]\.normal: the normal of the "
+    with pytest.raises(InputError, match=r'^grasp\.contacts\[2\]\.normal: the normal of the '
                        r"contact on 'thumb_tip' points out of the object's box surface"):
         GraspSetup.from_file(box_grasp.write(tmp_path, doc))
 
