@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import shutil
 import sys
 import time
 
@@ -307,26 +308,32 @@ def _score_parser(sub) -> None:
     p.add_argument('--objective', choices=OBJECTIVES, help='objective instead of the '
                    "scenario's")
     p.add_argument('--no-progress', action='store_true', help='no progress bar')
+    p.add_argument('--solutions', action='store_true', help="also record each candidate's "
+                   'torques (tau) and contact wrenches, so the winner need not be solved '
+                   'again (larger records)')
 
 
 class _Progress:
-    """A progress bar on stderr, drawn only on a terminal."""
+    """A progress bar on stderr (tqdm), drawn only on a terminal."""
 
     def __init__(self, enabled: bool) -> None:
         self.enabled = enabled and sys.stderr.isatty()
-        self.t0 = time.perf_counter()
+        self.bar = None
 
     def __call__(self, done: int, total: int) -> None:
         if not self.enabled:
             return
-        width = 30
-        filled = width * done // max(total, 1)
-        rate = done / max(time.perf_counter() - self.t0, 1e-9)
-        sys.stderr.write(f"\rscoring [{'#' * filled}{'.' * (width - filled)}] {done}/{total} "
-                         f'({rate:.0f}/s)')
+        if self.bar is None:
+            from tqdm import tqdm
+
+            # A terminal without a size (a pty's 0 x 0) would get no bar at all:
+            # shutil's size falls back to 80 x 24 there.
+            cols, rows = shutil.get_terminal_size()
+            self.bar = tqdm(total=total, desc='scoring', unit='candidate', file=sys.stderr,
+                            ncols=cols, nrows=rows)
+        self.bar.update(done - self.bar.n)
         if done >= total:
-            sys.stderr.write('\n')
-        sys.stderr.flush()
+            self.bar.close()
 
 
 def _score(args: argparse.Namespace) -> int:
@@ -344,7 +351,8 @@ def _score(args: argparse.Namespace) -> int:
     where = args.scenario
     try:
         job = ScoreJob.from_file(find_config(args.scenario), backend=args.backend,
-                                 metrics=args.metrics, objective=args.objective)
+                                 metrics=args.metrics, objective=args.objective,
+                                 solutions=args.solutions)
         where = args.candidates
         lines = read_candidates(args.candidates)
         where = args.scenario

@@ -394,7 +394,7 @@ def _mujoco_version() -> str:
 
 
 def _picture(hsim, path: str, predicted) -> str:
-    from grasp_torque_opt.sim.render import render_grasp, RenderUnavailable
+    from grasp_torque_opt.sim.render import CAPTION, render_grasp, RenderUnavailable
 
     try:
         written = render_grasp(hsim, path, predicted)
@@ -402,8 +402,7 @@ def _picture(hsim, path: str, predicted) -> str:
         return f'picture: not written, offscreen rendering is unavailable ({e})'
     except OSError as e:
         return f'picture: not written, cannot write {path}: {e.strerror}'
-    return (f"picture: {written.resolve()} (simulated contact forces orange, the node's "
-            'predicted green)')
+    return f'picture: {written.resolve()} ({CAPTION})'
 
 
 if __name__ == '__main__':

@@ -151,3 +151,43 @@ def test_score_takes_a_bundled_base_and_says_what_it_ranks_by(tmp_path):
                          '--engine', 'serial', cwd=tmp_path)
     assert code == 0, err
     assert '(ranked by capacity)' in out
+
+
+def test_score_draws_its_progress_bar_with_tqdm_on_a_terminal(tmp_path):
+    import os
+    import pty
+
+    candidates = tmp_path / 'c.jsonl'
+    candidates.write_text('{"id": "a"}\n{"id": "b"}\n')
+    main_fd, tty = pty.openpty()
+    try:
+        done = subprocess.run([sys.executable, '-m', 'grasp_torque_opt.cli', 'score',
+                               str(candidates), '--scenario', 'planar_two_finger.yaml',
+                               '--metrics', 'basic', '--engine', 'serial'],
+                              stdout=subprocess.PIPE, stderr=tty, text=True, timeout=120,
+                              cwd=tmp_path)
+        os.close(tty)
+        err = b''
+        while True:
+            try:
+                chunk = os.read(main_fd, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            err += chunk
+    finally:
+        os.close(main_fd)
+    assert done.returncode == 0
+    assert b'scoring: 100%' in err and b'2/2' in err
+
+
+def test_score_records_carry_the_solutions_on_request(tmp_path):
+    candidates = tmp_path / 'c.jsonl'
+    candidates.write_text('{"id": "a"}\n')
+    code, out, err = cli('score', candidates, '--scenario', 'planar_two_finger.yaml',
+                         '--metrics', 'basic', '--engine', 'serial', '--json', '--solutions',
+                         cwd=tmp_path)
+    assert code == 0, err
+    (record,) = [json.loads(line) for line in out.splitlines()]
+    assert len(record['tau']) == 4 and len(record['wrenches']) == 2

@@ -134,4 +134,4 @@ def test_the_progress_bar_is_drawn_on_a_terminal_only(tmp_path, capsys, monkeypa
     assert run(argv, capsys)[2] == ''  # captured stderr is no terminal
     monkeypatch.setattr(sys.stderr, 'isatty', lambda: True, raising=False)
     code, _, err = run(argv, capsys)
-    assert code == 0 and '\rscoring [' in err and '2/2' in err
+    assert code == 0 and '\rscoring: 100%' in err and '2/2' in err
