@@ -159,8 +159,8 @@ def test_a_local_dask_cluster_gives_the_serial_records(job, lines):
 
 def test_in_memory_candidates_score_as_their_lines(allegro):
     job = ScoreJob.from_file(ALLEGRO, metrics='basic', backend='daqp')
-    docs = [{'friction': {'mu_tangential': 0.6}}, {'id': 'b', 'load': {'external_wrench':
-                                                                         [0, 0, 1, 0, 0, 0]}}]
+    docs = [{'friction': {'mu_tangential': 0.6}},
+            {'id': 'b', 'load': {'external_wrench': [0, 0, 1, 0, 0, 0]}}]
     from_lines = score_batch(job, [(i, json.dumps(d)) for i, d in enumerate(docs, 1)],
                              engine='serial')
     from_dicts = score_batch(job, docs, engine='serial')
@@ -192,11 +192,11 @@ def test_single_threaded_math_is_exported():
     grasp_torque_opt.single_threaded_math()
 
 
-SCRIPT = '''
-from grasp_torque_opt import ScoreJob, score_batch
-job = ScoreJob.from_file({scenario!r}, metrics="basic")
-print(len(score_batch(job, [{{}}, {{}}, {{}}], workers=2, chunk=1)))
-'''
+SCRIPT = (
+    'from grasp_torque_opt import ScoreJob, score_batch\n'
+    'job = ScoreJob.from_file({scenario!r}, metrics="basic")\n'
+    'print(len(score_batch(job, [{{}}, {{}}, {{}}], workers=2, chunk=1)))\n'
+)
 
 
 def test_a_script_without_the_main_guard_raises_instead_of_hanging(tmp_path):
