@@ -125,6 +125,8 @@ setup(
         'quadprog',
         # One BLAS thread in the node and the CLI (grasp_torque_opt.backends).
         'threadpoolctl',
+        # The score command's progress bar.
+        'tqdm',
     ],
     extras_require={
         # ROS 2 Jazzy from the registry's ros-jazzy-* wheels; optional so that the
@@ -166,7 +168,8 @@ setup(
         # bench/: the other solvers compared, and process memory.
         'bench': ['osqp', 'psutil'],
         # grasp_torque_opt.sim and grasp-torque-sim: the hand in MuJoCo (docs/simulation.md).
-        'sim': ['mujoco>=3.2'],
+        # Pillow writes the picture's PNG.
+        'sim': ['mujoco>=3.2', 'pillow'],
         # grasp-torque-opt score --engine dask: candidate sets that outgrow one machine
         # (docs/planner.md).
         'distributed': ['dask', 'distributed'],

@@ -44,6 +44,7 @@ _EXPORTS = {
     'SolverError': 'grasp_torque_opt.core.exceptions',
     'BACKENDS': 'grasp_torque_opt.backends',
     'make_solver': 'grasp_torque_opt.backends',
+    'single_threaded_math': 'grasp_torque_opt.backends',
     'ProxSuiteSettings': 'grasp_torque_opt.backends.proxsuite',
     'METHODS': 'grasp_torque_opt.methods.dispatch',
     'Refiner': 'grasp_torque_opt.methods.adaptive',

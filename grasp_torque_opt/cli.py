@@ -18,13 +18,16 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+import shutil
 import sys
 import time
 
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
+from grasp_torque_opt.core.command_line import add_version, HelpFormatter
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.report import solution_dict, strict_json
+from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import OBJECTIVES
 from grasp_torque_opt.core.solution import INFEASIBLE, OPTIMAL
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
@@ -37,25 +40,43 @@ PROG = 'grasp-torque-opt'
 MAX_ERROR_LENGTH = 2000
 
 
+#: What a scenario argument is: a file, or a bundled one by name.
+SCENARIO_HELP = ('scenario YAML file, or the name of a bundled one (allegro_right.yaml, '
+                 'planar_two_finger.yaml)')
+#: The methods, in words (docs/method.md).
+METHOD_HELP = ("tau-qp: the paper's QP over joint torques, the N-gon cones; "
+               'tau-qp-adaptive: tau-qp refined towards the exact cone, with a certified '
+               'gap; force-qp: the QP over contact forces; socp: the exact cone (Clarabel); '
+               'nlp: the exact cone (SciPy)')
+#: Exit codes, for --help.
+EPILOG = ('exit codes: 0 optimal, 2 bad input (one line on stderr naming the field) or '
+          'usage, 3 infeasible (confirmed by an independent LP), 4 nothing certifiable. '
+          'Contracts: docs/design.md section 4.')
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog=PROG, description=(
+    fmt = HelpFormatter
+    parser = argparse.ArgumentParser(prog=PROG, formatter_class=fmt, epilog=EPILOG, description=(
         'Minimum-effort joint torques for a grasp (linearized soft-finger cones, '
-        'certified against the exact cone).'))
+        'certified against the exact cone): solve one scenario, compare every method, '
+        'or score many candidate grasps.'))
+    add_version(parser)
     sub = parser.add_subparsers(dest='command', required=True)
-    p_solve = sub.add_parser('solve', help='solve one scenario with one method')
-    p_solve.add_argument('scenario', help='scenario YAML file')
-    p_solve.add_argument('--method', choices=METHODS, default='tau-qp')
+    p_solve = sub.add_parser('solve', help='solve one scenario with one method',
+                             formatter_class=fmt, epilog=EPILOG, description=(
+                                 'Solve one scenario: the torques, their certificate, and '
+                                 'with --json one JSON object (docs/design.md section 4.2).'))
+    p_solve.add_argument('scenario', help=SCENARIO_HELP)
+    p_solve.add_argument('--method', choices=METHODS, default='tau-qp', help=METHOD_HELP)
     p_solve.add_argument('--backend', choices=BACKENDS, default='proxsuite',
-                         help='QP solver of the tau-qp method (default: proxsuite)')
+                         help='QP solver of the tau-qp method')
     p_solve.add_argument('--fallback', choices=(*BACKENDS, 'none'), default='daqp',
-                         help='backend asked when the first gives nothing certifiable '
-                              '(default: daqp)')
+                         help='backend asked when the first gives nothing certifiable')
     p_solve.add_argument('--gap', type=_gap, default=AdaptiveSettings.gap_tolerance,
                          help='tau-qp-adaptive: stop at this certified gap to the exact '
-                              f'optimum (default: {AdaptiveSettings.gap_tolerance})')
+                              'optimum')
     p_solve.add_argument('--max-rounds', type=_rounds, default=AdaptiveSettings.max_rounds,
-                         help='tau-qp-adaptive: refinement rounds at most, 0 to 100 '
-                              f'(default: {AdaptiveSettings.max_rounds})')
+                         help='tau-qp-adaptive: refinement rounds at most, 0 to 100')
     p_solve.add_argument('--json', action='store_true', help='print one JSON object')
     p_solve.add_argument('--objective', choices=OBJECTIVES,
                          help="objective instead of the scenario's objective.type")
@@ -64,8 +85,11 @@ def _parser() -> argparse.ArgumentParser:
                               'plan in the cone of mu/(1+k)')
     p_solve.add_argument('--capacity', action='store_true',
                          help='also the load capacity and the 12 axis capacities')
-    p_cmp = sub.add_parser('compare', help="every method side by side (the paper's Table 2)")
-    p_cmp.add_argument('scenario', help='scenario YAML file')
+    p_cmp = sub.add_parser('compare', help="every method side by side (the paper's Table 2)",
+                           formatter_class=fmt, epilog=EPILOG, description=(
+                               "Every method on one scenario, side by side (the paper's "
+                               "Table 2, extended); the exit code is the tau-qp's."))
+    p_cmp.add_argument('scenario', help=SCENARIO_HELP)
     p_cmp.add_argument('--json', action='store_true', help='print one JSON object')
     _score_parser(sub)
     return parser
@@ -207,7 +231,7 @@ def _main(argv: list[str] | None) -> int:
     if args.command == 'score':
         return _score(args)
     try:
-        setup = _overridden(GraspSetup.from_file(args.scenario), args)
+        setup = _overridden(GraspSetup.from_file(find_config(args.scenario)), args)
         if args.command == 'solve':
             fallback = None if args.fallback in ('none', args.backend) else \
                 make_solver(args.fallback)
@@ -252,60 +276,71 @@ def _score_parser(sub) -> None:
     from grasp_torque_opt.methods.score import ENGINES, METRICS, RANK_KEYS
 
     p = sub.add_parser('score', help='score candidate grasps of one hand (JSON Lines), in '
-                       'parallel, ranked', description=(
+                       'parallel, ranked', formatter_class=HelpFormatter,
+                       description=(
                            'Score candidate grasps: each line of CANDIDATES is a JSON object, '
-                           'a partial scenario merged into --scenario (docs/planner.md).'))
+                           'a partial scenario merged into --scenario (docs/planner.md).'),
+                       epilog='exit codes: 0 every line scored, 2 a bad line (each named on '
+                       'stderr, the others scored) or a bad base scenario or candidates file, '
+                       '4 any other error.')
     p.add_argument('candidates', help='JSON Lines file, one candidate per line')
-    p.add_argument('--scenario', required=True, help='base scenario YAML file (the hand and '
-                   'every default)')
+    p.add_argument('--scenario', required=True, help='base scenario YAML file, or the name '
+                   'of a bundled one (the hand and every default)')
     p.add_argument('--out', help='write one JSON record per candidate here (JSON Lines, '
                    'input order, with its rank)')
     p.add_argument('--json', action='store_true', help='print the records (JSON Lines, '
                    'ranked) instead of the table')
     p.add_argument('--top', type=_count(0, 10**9), default=10,
-                   help='rows of the ranked table (default 10)')
+                   help='rows of the ranked table')
     p.add_argument('--rank-by', choices=tuple(RANK_KEYS), default='capacity',
-                   help='capacity (largest first, the default) or torque_norm, '
-                        'max_torque_ratio, friction_usage_max (smallest first)')
+                   help='capacity (largest first; torque_norm with --metrics basic) or '
+                        'torque_norm, max_torque_ratio, friction_usage_max (smallest first)')
     p.add_argument('--metrics', choices=METRICS, default='full',
-                   help='full (with the capacities, the default) or basic (solve only)')
-    p.add_argument('--workers', type=_count(1, 256), help="processes (default: the machine's "
-                   'cores), 1 to 256')
+                   help='full (with the capacities) or basic (solve only)')
+    p.add_argument('--workers', type=_count(1, 256), help='processes, 1 to 256 (default: the '
+                   "machine's cores)")
     p.add_argument('--engine', choices=ENGINES, default='processes',
-                   help='processes (default), serial, or dask (Dask distributed)')
+                   help='processes, serial, or dask (Dask distributed)')
     p.add_argument('--scheduler', help='Dask scheduler address (engine dask; default: a '
                    'local cluster)')
     p.add_argument('--backend', choices=BACKENDS, default='daqp',
-                   help='QP backend (default: daqp, the fastest on these grasps)')
+                   help='QP backend (daqp: the fastest on these grasps)')
     p.add_argument('--objective', choices=OBJECTIVES, help='objective instead of the '
                    "scenario's")
     p.add_argument('--no-progress', action='store_true', help='no progress bar')
+    p.add_argument('--solutions', action='store_true', help="also record each candidate's "
+                   'torques (tau) and contact wrenches, so the winner need not be solved '
+                   'again (larger records)')
 
 
 class _Progress:
-    """A progress bar on stderr, drawn only on a terminal."""
+    """A progress bar on stderr (tqdm), drawn only on a terminal."""
 
     def __init__(self, enabled: bool) -> None:
         self.enabled = enabled and sys.stderr.isatty()
-        self.t0 = time.perf_counter()
+        self.bar = None
 
     def __call__(self, done: int, total: int) -> None:
         if not self.enabled:
             return
-        width = 30
-        filled = width * done // max(total, 1)
-        rate = done / max(time.perf_counter() - self.t0, 1e-9)
-        sys.stderr.write(f"\rscoring [{'#' * filled}{'.' * (width - filled)}] {done}/{total} "
-                         f'({rate:.0f}/s)')
+        if self.bar is None:
+            from tqdm import tqdm
+
+            # A terminal without a size (a pty's 0 x 0) would get no bar at all:
+            # shutil's size falls back to 80 x 24 there.
+            cols, rows = shutil.get_terminal_size()
+            self.bar = tqdm(total=total, desc='scoring', unit='candidate', file=sys.stderr,
+                            ncols=cols, nrows=rows)
+        self.bar.update(done - self.bar.n)
         if done >= total:
-            sys.stderr.write('\n')
-        sys.stderr.flush()
+            self.bar.close()
 
 
 def _score(args: argparse.Namespace) -> int:
     from grasp_torque_opt.methods.score import (
         format_table,
         rank,
+        rank_key,
         read_candidates,
         record_json,
         score_batch,
@@ -315,8 +350,9 @@ def _score(args: argparse.Namespace) -> int:
 
     where = args.scenario
     try:
-        job = ScoreJob.from_file(args.scenario, backend=args.backend, metrics=args.metrics,
-                                 objective=args.objective)
+        job = ScoreJob.from_file(find_config(args.scenario), backend=args.backend,
+                                 metrics=args.metrics, objective=args.objective,
+                                 solutions=args.solutions)
         where = args.candidates
         lines = read_candidates(args.candidates)
         where = args.scenario
@@ -331,7 +367,8 @@ def _score(args: argparse.Namespace) -> int:
     except (GraspTorqueError, OSError) as e:
         print(_one_line(f'{PROG}: error: {e}'), file=sys.stderr)
         return EXIT_FAILED
-    ranked = rank(records, args.rank_by)
+    by = rank_key(records, args.rank_by)
+    ranked = rank(records, by)
     for i, r in enumerate(ranked, 1):
         r['rank'] = i
     bad = [r for r in records if r['status'] == 'error']
@@ -350,7 +387,7 @@ def _score(args: argparse.Namespace) -> int:
             print(record_json(r))
     else:
         print(f'{args.candidates}: {len(records)} candidates on {args.scenario} '
-              f'(ranked by {args.rank_by})')
+              f'(ranked by {by})')
         print(format_table(ranked, args.top))
         print(summary(records, seconds))
     return EXIT_BAD_INPUT if bad else EXIT_OPTIMAL

@@ -9,6 +9,8 @@
 """Exceptions of grasp_torque_opt: one base class, subclasses that name the bad input."""
 
 from collections.abc import Iterable
+import difflib
+import os
 import reprlib
 
 #: Longest quotation of the user's input in an error message [characters].
@@ -63,21 +65,50 @@ class InputError(GraspTorqueError):
         super().__init__(f'{field}: {problem}')
 
 
-def _choices(available: Iterable[str], limit: int = 12) -> str:
-    names = sorted(available)
-    shown = ', '.join(cut(n) for n in names[:limit])
-    return shown + (f', ... ({len(names)} in all)' if len(names) > limit else '')
+#: Closest names suggested for an unknown one (difflib's ratio of at least 0.6).
+SUGGESTIONS = 3
+
+
+def _choices(available: list[str], limit: int = 12) -> str:
+    shown = ', '.join(cut(n) for n in available[:limit])
+    return shown + (f', ... ({len(available)} in all)' if len(available) > limit else '')
+
+
+def _ordered(available: Iterable[str]) -> list[str]:
+    """Keep a sequence's order (the relevant names first); sort a set."""
+    if isinstance(available, (set, frozenset)):
+        return sorted(available)
+    return list(dict.fromkeys(available))
+
+
+def _closest(name: str, available: list[str]) -> str:
+    """Suggest the closest names: difflib's ratio (>= 0.6), ties to the longest common prefix."""
+    scored = []
+    for n in available:
+        ratio = difflib.SequenceMatcher(None, name, n).ratio()
+        if ratio >= 0.6:
+            prefix = len(os.path.commonprefix([name, n]))
+            scored.append((-ratio, -prefix, n))
+    close = [n for _, _, n in sorted(scored)[:SUGGESTIONS]]
+    return f"did you mean {' or '.join(repr(cut(n)) for n in close)}? " if close else ''
 
 
 class FrameNotFound(InputError):
-    """A frame name is not in the model."""
+    """
+    A frame name is not in the model.
+
+    Attributes:
+        name: the unknown name.
+        available: the model's frames, the relevant first (the caller's order: links,
+            then joint and other frames).
+    """
 
     def __init__(self, field: str, name: str, available: Iterable[str]) -> None:
         self.name = name
-        self.available = sorted(available)
+        self.available = _ordered(available)
         super().__init__(field,
-                         f"unknown frame '{cut(name)}' (model frames: "
-                         f'{_choices(self.available)})')
+                         f"unknown frame '{cut(name)}' ({_closest(name, self.available)}"
+                         f'model frames: {_choices(self.available)})')
 
 
 class JointNotFound(InputError):
@@ -85,9 +116,10 @@ class JointNotFound(InputError):
 
     def __init__(self, field: str, name: str, available: Iterable[str]) -> None:
         self.name = name
-        self.available = sorted(available)
+        self.available = _ordered(available)
         super().__init__(
-            field, f"unknown joint '{cut(name)}' (1-DoF joints: {_choices(self.available)})"
+            field, f"unknown joint '{cut(name)}' ({_closest(name, self.available)}"
+                   f'1-DoF joints: {_choices(self.available)})'
         )
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps, GraspMaps
 from grasp_torque_opt.core.hand import Hand, resolve_urdf
+from grasp_torque_opt.core.inward import check_inward_normals
 from grasp_torque_opt.core.scenario import (
     ContactSpec,
     Friction,
@@ -73,7 +74,8 @@ class GraspSetup:
                 ``hand.urdf`` (e.g. the node's ``robot_description``).
 
         Raises:
-            InputError: naming the field (file, joint or frame not found, ...).
+            InputError: naming the field (file, joint or frame not found, a contact
+                normal pointing out of the object, ...).
         """
         above = scenario.torque_limits_above_urdf
         if urdf_xml:
@@ -90,7 +92,10 @@ class GraspSetup:
                     contacts=scenario.contacts, object_origin=scenario.object_origin,
                     friction=scenario.friction, external_wrench=scenario.external_wrench,
                     weights=weights, objective=scenario.objective)
-        setup.maps()  # names unknown frames and bad normals now, not at solve time
+        # Names unknown frames and bad normals now, not at solve time.
+        maps = setup.maps()
+        check_inward_normals(maps.positions, maps.rotations[:, :, 2], maps.links,
+                             scenario.object_origin, scenario.object)
         return setup
 
     @classmethod

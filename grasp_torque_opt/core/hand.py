@@ -118,6 +118,21 @@ def bounded_urdf(xml: str, field_name: str) -> str:
     return xml
 
 
+def frame_names(model: pin.Model) -> list[str]:
+    """
+    Return the model's frame names, the relevant first: links, then the other frames.
+
+    A contact sits on a link (a BODY frame); the joint frames (on the Allegro, as many
+    as its links) come after them, each group sorted by name.
+    """
+    def natural(name: str) -> list:
+        return [int(t) if t.isdigit() else t for t in re.split(r'(\d+)', name)]
+
+    bodies = sorted({f.name for f in model.frames if f.type == pin.FrameType.BODY}, key=natural)
+    others = sorted({f.name for f in model.frames} - set(bodies), key=natural)
+    return bodies + others
+
+
 @dataclass(frozen=True)
 class Hand:
     """
@@ -155,7 +170,7 @@ class Hand:
         fid = self._frame_ids.get(name)
         if fid is None:
             if not self.model.existFrame(name):
-                raise FrameNotFound(field_name, name, {f.name for f in self.model.frames})
+                raise FrameNotFound(field_name, name, frame_names(self.model))
             fid = self._frame_ids[name] = self.model.getFrameId(name)
         return fid
 

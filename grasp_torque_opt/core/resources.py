@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+import re
 import stat
 import sys
 
@@ -49,6 +50,28 @@ def find_config(name: str, field: str = 'scenario') -> Path:
                 return d / path
     raise InputError(field, f'file not found: {cut(name, PATH_LENGTH)} '
                      f"(nor in {', '.join(map(str, config_dirs()))})")
+
+
+def package_version() -> str:
+    """
+    Return the package's version: its installed metadata, else package.xml's ``<version>``.
+
+    Every console script's ``--version`` prints it.
+    """
+    from importlib import metadata
+
+    try:
+        return metadata.version(PACKAGE)
+    except metadata.PackageNotFoundError:  # a colcon build without pip metadata
+        pass
+    prefixes = [p for p in os.environ.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+    for xml in [Path(p) / 'share' / PACKAGE / 'package.xml' for p in prefixes + [sys.prefix]] \
+            + [Path(__file__).resolve().parents[2] / 'package.xml']:
+        if xml.is_file():
+            found = re.search(r'<version>\s*([^<\s]+)\s*</version>', xml.read_text())
+            if found:
+                return found.group(1)
+    return 'unknown'
 
 
 def read_bounded(path: Path, field_name: str, limit: int) -> bytes:

@@ -517,6 +517,25 @@ class _BoundedLoader(yaml.SafeLoader):
             self._depth -= 1
 
 
+def yaml_problem(error: Exception) -> str:
+    """
+    Say what PyYAML found wrong, and where: ``line L, column C: PROBLEM (CONTEXT at line L)``.
+
+    PyYAML's own message spans several lines (a snippet of the file with a caret);
+    this keeps its marks (1-based) and words on one line.
+    """
+    mark = getattr(error, 'problem_mark', None)
+    problem = getattr(error, 'problem', None)
+    if mark is None or not problem:
+        return cut((str(error).splitlines() or [''])[0])
+    text = f'line {mark.line + 1}, column {mark.column + 1}: {cut(problem)}'
+    context, where = getattr(error, 'context', None), getattr(error, 'context_mark', None)
+    if context:
+        at = '' if where is None else f' at line {where.line + 1}, column {where.column + 1}'
+        text += f' ({cut(context)}{at})'
+    return text
+
+
 def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> Scenario:
     """
     Read and validate a scenario file, within the bounds of the module's docstring.
@@ -533,7 +552,6 @@ def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> S
     try:
         data = yaml.load(text, Loader=_BoundedLoader)  # noqa: S506 -- a SafeLoader
     except (yaml.YAMLError, ValueError) as e:  # ValueError: an integer of 5000 digits
-        first = (str(e).splitlines() or [''])[0]
         raise InputError('scenario', f'{cut(path, PATH_LENGTH)} is not valid YAML: '
-                         f'{cut(first)}') from e
+                         f'{yaml_problem(e)}') from e
     return parse_scenario(data, path.resolve().parent, source=str(path), name_map=name_map)

@@ -42,6 +42,7 @@ from grasp_torque_opt.core.friction import friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import planned_friction
+from grasp_torque_opt.methods.infeasibility import Conflict, zero_load_conflict
 from grasp_torque_opt.methods.lp import DaqpForm, LPResult, solve_lp
 from grasp_torque_opt.reference.feasibility import linearized_feasible
 import numpy as np
@@ -96,19 +97,24 @@ class Capacity:
     One capacity.
 
     Attributes:
-        status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds: the
-            minimum normal force cannot be produced within the limits; confirmed by the
-            independent feasibility LP), ``unbounded`` (alpha reached :data:`ALPHA_MAX`
-            on the unit direction, or the load is zero) or ``failed``.
+        status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds;
+            confirmed by the independent feasibility LP, and ``binding`` and
+            ``conflict`` from its infeasibility certificate, :mod:`.infeasibility`),
+            ``unbounded`` (alpha reached :data:`ALPHA_MAX` on the unit direction, or the
+            load is zero) or ``failed``.
         value: alpha: a factor on the load [-], or for an axis direction the largest
             load along it [N or N m]; None unless ``optimal``.
         unit: ``-``, ``N`` or ``N m``.
         tau: joint torques holding value times the load [N m], or None.
         wrenches: the contact wrenches then, shape (p, 4) [N, N m], or None.
         certificate: of (tau, f) at the load value * w_ext, or None.
-        binding: what limits it, or None.
+        binding: what limits it (``infeasible``: the constraints of the certificate),
+            or None.
         solver: the LP solver that answered.
         message: what happened.
+        conflict: ``infeasible`` only: the infeasibility certificate (its
+            constraints, whether each constraint family's removal makes zero load
+            holdable, whether the certificate checked); else None.
     """
 
     status: str
@@ -120,11 +126,19 @@ class Capacity:
     binding: Binding | None = None
     solver: str = ''
     message: str = ''
+    conflict: Conflict | None = None
 
     def as_dict(self) -> dict:
-        """Plain data (JSON): ``status``, ``value``, ``unit``, ``binding``, ``certified``."""
+        """
+        Plain data (JSON): ``status``, ``value``, ``unit``, ``binding``, ``certified``.
+
+        ``certified``: the certificate of the answer passed (``infeasible``: the
+        infeasibility certificate checked).
+        """
+        certified = (self.certificate is not None and self.certificate.ok
+                     or self.conflict is not None and self.conflict.certified)
         return {'status': self.status, 'value': self.value, 'unit': self.unit,
-                'certified': self.certificate is not None and self.certificate.ok,
+                'certified': certified,
                 'binding': None if self.binding is None else self.binding.as_dict()}
 
 
@@ -197,9 +211,7 @@ class CapacityLP:
             # be held either (else the capacity LP's verdict is numerics, not the grasp).
             if linearized_feasible(self.maps, self.friction, np.zeros(6), self.tau_min,
                                    self.tau_max) is False:
-                return Capacity('infeasible', None, unit, solver=res.solver, message=(
-                    'not even zero load can be held: the minimum normal force cannot be '
-                    f'produced within the torque limits ({res.message})'))
+                return self._conflict(res, unit)
             return Capacity('failed', None, unit, solver=res.solver, message=(
                 f'{res.message}, but the feasibility LP does not confirm that zero load '
                 'cannot be held'))
@@ -222,6 +234,19 @@ class CapacityLP:
                         certificate=cert, binding=self._binding(res, f) if binding else None,
                         solver=res.solver,
                         message=f'certified ({res.message})')
+
+    def _conflict(self, res: LPResult, unit: str) -> Capacity:
+        """Zero load is not holdable: name the conflict from its certificate."""
+        conflict = zero_load_conflict(self.maps, self.friction, list(self.setup.hand.joints),
+                                      self.tau_min, self.tau_max)
+        if conflict is None:
+            return Capacity('infeasible', None, unit, solver=res.solver, message=(
+                'not even zero load can be held; no infeasibility certificate found '
+                f'({res.message})'))
+        return Capacity('infeasible', None, unit, solver=res.solver,
+                        binding=Binding(conflict.joints, conflict.contacts),
+                        conflict=conflict,
+                        message=conflict.text(self.friction.min_normal_force))
 
     def _binding(self, res: LPResult, f: np.ndarray) -> Binding:
         n = self.nf + 1

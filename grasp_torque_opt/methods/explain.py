@@ -16,7 +16,9 @@ multiplier at that optimum are what stops it (joints at a torque limit,
 contacts on their friction cone or at the minimum normal force, by name).
 Each of them is active at every optimal point, so relaxing one of them (a larger
 torque limit, more friction, a smaller minimum normal force) is where a larger
-fraction can come from.
+fraction can come from. When not even zero load is holdable there is no optimum:
+the constraints named are then those of an infeasibility certificate
+(:mod:`.infeasibility`), with the families whose removal would make it holdable.
 """
 
 from __future__ import annotations
@@ -63,12 +65,15 @@ class Explanation:
         """
         Return plain data (JSON).
 
-        The keys are ``holdable_fraction``, ``binding``, ``status``, ``certified`` and
-        ``text``.
+        The keys are ``holdable_fraction``, ``binding``, ``relaxed`` (when not even
+        zero load is holdable: constraint family -> holdable without it; else null),
+        ``status``, ``certified`` and ``text``.
         """
         d = self.capacity.as_dict()
         return {'holdable_fraction': d['value'], 'status': d['status'],
-                'certified': d['certified'], 'binding': d['binding'], 'text': self.text}
+                'certified': d['certified'], 'binding': d['binding'],
+                'relaxed': None if self.capacity.conflict is None
+                else dict(self.capacity.conflict.relaxed), 'text': self.text}
 
 
 def explain(setup: GraspSetup, maps: GraspMaps | None = None) -> Explanation:

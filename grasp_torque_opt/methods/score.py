@@ -30,18 +30,30 @@ line), ``error``, ``torque_norm`` [N m], ``max_torque_ratio`` [-],
 ``friction_usage_max`` [-], ``friction_usage`` (per contact), ``capacity``
 [-] and ``capacity_status``, ``capacities`` (direction -> N or N m, null where
 not certified), ``holdable_fraction`` (infeasible candidates: their capacity)
-and ``time_s`` (the candidate's scoring time [s]).
+and ``time_s`` (the candidate's scoring time [s]); with ``solutions=True``
+also ``tau`` (joint torques [N m], the base hand's joint order) and ``wrenches``
+(per contact [f_x, f_y, f_z, m_z] in its contact frame [N, N m]), null unless
+optimal, so the winner need not be solved again.
 
-Parallel over processes (``engine="processes"``, the default, multiprocessing
-with ``workers`` processes) or over a Dask distributed cluster
-(``engine="dask"``: a scheduler address, or a local cluster), with the same
-chunk function; each worker binds the base scenario once and reuses one solver.
+Candidates may also be given in memory (:func:`score_batch`): a mapping (the
+same partial scenario as a line's JSON object) or a :class:`GraspSetup` of the
+base hand (pickled to the workers: about 1 MB each for the Allegro), numbered
+1, 2, ... in the order given.
+
+Parallel over processes (``engine="processes"``, the default, a
+:class:`concurrent.futures.ProcessPoolExecutor` of ``workers`` spawned processes:
+a worker that dies raises :class:`BrokenProcessPool`, never a hang) or over a Dask
+distributed cluster (``engine="dask"``: a scheduler address, or a local cluster),
+with the same chunk function; each worker binds the base scenario once, reuses one
+solver and runs BLAS on one thread.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
+import copy
+import dataclasses
 from dataclasses import dataclass
 import hashlib
 import json
@@ -89,6 +101,8 @@ class ScoreJob:
         backend: the tau-QP backend (default DAQP, the fastest here).
         fallback: the backend asked when the first gives nothing certifiable, or None.
         objective: override of the scenario's ``objective.type``, or None.
+        solutions: also record ``tau`` and ``wrenches`` (off by default: records
+            stay small).
     """
 
     scenario_text: str
@@ -98,6 +112,7 @@ class ScoreJob:
     backend: str = 'daqp'
     fallback: str | None = 'proxsuite'
     objective: str | None = None
+    solutions: bool = False
 
     @classmethod
     def from_file(cls, path: str | Path, **options: Any) -> ScoreJob:
@@ -160,13 +175,31 @@ class Scorer:
         self.fallback = (make_solver(job.fallback) if job.fallback not in (None, job.backend)
                          else None)
 
-    def candidate(self, lineno: int, text: str) -> tuple[Any, GraspSetup]:
+    def candidate(self, lineno: int, text: str | dict | GraspSetup) -> tuple[Any, GraspSetup]:
         """
-        Return the candidate of one line, bound to the base hand.
+        Return the candidate of one line (or in-memory candidate), bound to the base hand.
+
+        Args:
+            lineno: its line number (in-memory: its position, from 1).
+            text: a JSON object's text, the same as a mapping, or a bound setup.
 
         Raises:
             InputError: naming the line and the field.
         """
+        if isinstance(text, GraspSetup):
+            if text.hand.joints != self.base.hand.joints:
+                raise InputError(f'line {lineno}', 'a GraspSetup of another hand (joints '
+                                 f'{text.hand.joints[:3]}..., the base has '
+                                 f'{self.base.hand.joints[:3]}...)')
+            setup = text
+            if self.job.objective:
+                setup = dataclasses.replace(setup, objective=self.job.objective)
+            return lineno, setup
+        if isinstance(text, dict):
+            return self._bind(lineno, copy.deepcopy(text))
+        if not isinstance(text, str):
+            raise InputError(f'line {lineno}', 'a candidate is a JSON text, a mapping or a '
+                             f'GraspSetup, got {type(text).__name__}')
         if len(text) > MAX_LINE:
             raise InputError(f'line {lineno}', f'longer than {MAX_LINE} characters')
         try:
@@ -178,6 +211,10 @@ class Scorer:
         if not isinstance(data, dict):
             raise InputError(f'line {lineno}', f'must be a JSON object, got '
                              f'{type(data).__name__}')
+        return self._bind(lineno, data)
+
+    def _bind(self, lineno: int, data: dict) -> tuple[Any, GraspSetup]:
+        """Merge a candidate's mapping into the base scenario and bind it to the hand."""
         for key in data:
             if key not in CANDIDATE_KEYS:
                 raise InputError(f'line {lineno}: {key}', 'unknown or fixed field (allowed: '
@@ -202,7 +239,7 @@ class Scorer:
             raise InputError(f'line {lineno}: {e.field}', e.problem) from e
         return ident, setup
 
-    def score_line(self, lineno: int, text: str) -> dict[str, Any]:
+    def score_line(self, lineno: int, text: str | dict | GraspSetup) -> dict[str, Any]:
         """Return the record of one line (a bad line gives status ``error``; never raises)."""
         t0 = time.perf_counter()
         record: dict[str, Any] = {'line': lineno, 'id': None}
@@ -238,6 +275,10 @@ class Scorer:
             'friction_usage': None if usage is None else [float(u) for u in usage],
             'backend': sol.backend, 'solve_time_s': sol.solve_time_s,
         }
+        if self.job.solutions:
+            out['tau'] = None if sol.tau is None else [float(t) for t in sol.tau]
+            out['wrenches'] = (None if sol.wrenches is None
+                               else [[float(v) for v in w] for w in sol.wrenches])
         if self.job.metrics == 'full':
             lp = CapacityLP(setup, maps)
             cap = lp.solve(setup.external_wrench, binding=False)
@@ -248,15 +289,15 @@ class Scorer:
                                  direction_capacities(setup, maps, lp, binding=False).items()}
         return out
 
-    def score_lines(self, lines: Iterable[tuple[int, str]]) -> list[dict[str, Any]]:
-        """Score (line number, text) pairs into records, in order."""
+    def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
+        """Score (line number, candidate) pairs into records, in order."""
         return [self.score_line(n, t) for n, t in lines]
 
 
 _SCORERS: dict[str, Scorer] = {}
 
 
-def score_chunk(job: ScoreJob, chunk: Sequence[tuple[int, str]]) -> list[dict[str, Any]]:
+def score_chunk(job: ScoreJob, chunk: Sequence[tuple[int, Any]]) -> list[dict[str, Any]]:
     """Score a chunk in this process, binding the job's hand on first use (any engine's task)."""
     scorer = _SCORERS.get(job.key)
     if scorer is None:
@@ -280,7 +321,23 @@ def read_candidates(path: str | Path) -> list[tuple[int, str]]:
         raise InputError('candidates', f'cannot read {path}: {e.strerror}') from e
 
 
-def chunks(lines: Sequence[tuple[int, str]], size: int = CHUNK) -> list[list[tuple[int, str]]]:
+def numbered(candidates: Iterable[Any]) -> list[tuple[int, Any]]:
+    """
+    Return (line number, candidate) pairs.
+
+    (line number, text) pairs are kept; a mapping or a :class:`GraspSetup` is
+    numbered by its position, from 1.
+    """
+    out = []
+    for i, c in enumerate(candidates, 1):
+        if isinstance(c, tuple) and len(c) == 2 and isinstance(c[0], int):
+            out.append(c)
+        else:
+            out.append((i, c))
+    return out
+
+
+def chunks(lines: Sequence[tuple[int, Any]], size: int = CHUNK) -> list[list[tuple[int, Any]]]:
     """Cut the lines into tasks of ``size``."""
     return [list(lines[i:i + size]) for i in range(0, len(lines), size)]
 
@@ -311,7 +368,7 @@ def thread_env(value: str | None) -> Iterator[None]:
                 os.environ[k] = v
 
 
-def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int | None = None,
+def score_batch(job: ScoreJob, lines: Iterable[Any], *, workers: int | None = None,
                 engine: str = 'processes', scheduler: str | None = None,
                 progress: Callable[[int, int], None] | None = None,
                 chunk: int = CHUNK) -> list[dict[str, Any]]:
@@ -320,7 +377,9 @@ def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int
 
     Args:
         job: the base scenario and options.
-        lines: (line number, text) pairs (:func:`read_candidates`).
+        lines: the candidates: (line number, text) pairs (:func:`read_candidates`),
+            or in memory mappings (partial scenarios, as a line's JSON object) or
+            :class:`GraspSetup` objects of the base hand, numbered from 1.
         workers: processes (``processes``; a local Dask cluster's workers); default
             the machine's cores.
         engine: one of :data:`ENGINES`.
@@ -332,11 +391,14 @@ def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int
     Raises:
         InputError: the base scenario is bad (the batch cannot start).
         ValueError: an unknown engine.
+        BrokenProcessPool: a worker process died (``processes``); the message says
+            why it may have (a script without ``if __name__ == "__main__":``).
     """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
     Scorer(job)  # a bad base scenario fails here, once, in this process
     workers = max(1, workers or os.cpu_count() or 1)
+    lines = numbered(lines)
     tasks = chunks(lines, chunk)
     total = len(lines)
     results: list[list[dict] | None] = [None] * len(tasks)
@@ -360,15 +422,27 @@ def score_batch(job: ScoreJob, lines: Sequence[tuple[int, str]], *, workers: int
 
 
 def _pool_map(job: ScoreJob, tasks: list, workers: int, finished) -> None:
+    from concurrent.futures import as_completed, ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
     import multiprocessing as mp
 
     ctx = mp.get_context('spawn')  # fork after Pinocchio and BLAS threads is not safe
-    with thread_env('1'):
-        pool = ctx.Pool(min(workers, len(tasks)))
-    with pool:
-        pending = [(i, pool.apply_async(score_chunk, (job, t))) for i, t in enumerate(tasks)]
-        for i, res in pending:
-            finished(i, res.get())
+    # The pool starts its processes as tasks arrive: the thread variables stay set
+    # until every task is submitted, and each worker limits BLAS itself as well.
+    with thread_env('1'), ProcessPoolExecutor(min(workers, len(tasks)), mp_context=ctx,
+                                              initializer=single_threaded_math) as pool:
+        futures = {pool.submit(score_chunk, job, t): i for i, t in enumerate(tasks)}
+        try:
+            for fut in as_completed(futures):
+                finished(futures[fut], fut.result())
+        except BrokenProcessPool as e:
+            for fut in futures:
+                fut.cancel()
+            raise BrokenProcessPool(
+                f'{e} A scoring worker died: its error is on stderr above. Run from a '
+                'script, score_batch must be called under `if __name__ == "__main__":` '
+                '(each spawned worker imports the script); else the worker ran out of '
+                'memory or was killed.') from e
 
 
 def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
@@ -395,16 +469,30 @@ def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
             cluster.close()
 
 
+def rank_key(records: Sequence[dict[str, Any]], by: str = 'capacity') -> str:
+    """
+    Return the key :func:`rank` sorts by.
+
+    That is ``by``, or ``torque_norm`` for ``capacity`` when no record has one
+    (``metrics="basic"``).
+
+    Raises:
+        ValueError: ``by`` is not one of :data:`RANK_KEYS`.
+    """
+    if by not in RANK_KEYS:
+        raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
+    if by == 'capacity' and not any('capacity' in r for r in records):
+        return 'torque_norm'
+    return by
+
+
 def rank(records: Sequence[dict[str, Any]], by: str = 'capacity') -> list[dict[str, Any]]:
     """
     Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
 
     Without capacities (``metrics="basic"``) ``capacity`` falls back to ``torque_norm``.
     """
-    if by not in RANK_KEYS:
-        raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
-    if by == 'capacity' and not any('capacity' in r for r in records):
-        by = 'torque_norm'
+    by = rank_key(records, by)
     larger = RANK_KEYS[by]
 
     def key(r: dict) -> tuple:

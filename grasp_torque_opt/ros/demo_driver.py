@@ -17,8 +17,12 @@ rate, solve time, torque norm, status), then a summary.
 
 ``--with-node`` starts ``grasp_torque_node`` in a child process first, on a
 private ROS domain with localhost-only discovery, and stops it at the end.
-``--watch`` publishes nothing and prints the live line of a node already
-running: a way to see what it does without RViz.
+``--watch`` creates no publisher and prints the live line of a node already
+running (on the current ROS_DOMAIN_ID) for ``--duration`` seconds: a way to see
+what it does without RViz. It follows a remapped node with the same remap
+(``--ros-args -r effort_commands:=/effort_controller/commands``) or by its name
+(``--node /right_hand/grasp_torque_node``: the topic that node publishes its
+commands on, found in the ROS graph). Ctrl-C ends it quietly.
 """
 
 from __future__ import annotations
@@ -29,12 +33,18 @@ from pathlib import Path
 import sys
 import time
 
+from grasp_torque_opt.core.command_line import add_version, HelpFormatter
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 import numpy as np
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog='grasp-torque-demo', description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog='grasp-torque-demo', formatter_class=HelpFormatter,
+                                description=__doc__.strip(), epilog=(
+                                    'exit codes: 0 certified commands flowed (--watch: the '
+                                    'watch ended), 1 none or malformed ones, 2 bad input. '
+                                    'docs/node.md'))
+    add_version(p)
     p.add_argument('--params', default='allegro_right_node.yaml',
                    help='node params file (bundled name or path); its scenario is played')
     p.add_argument('--duration', type=float, default=5.0, help='seconds to play [s]')
@@ -45,12 +55,27 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument('--watch', action='store_true',
                    help='publish nothing: only print what a running node does '
                         '(on the current ROS_DOMAIN_ID)')
+    p.add_argument('--node', metavar='NAME',
+                   help='--watch: follow this node (e.g. /right_hand/grasp_torque_node): '
+                        'its commands on whatever topic it publishes them, its diagnostics')
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the demo; exit code 0 when certified commands flowed and all were well-formed."""
-    args = _parser().parse_args(argv)
+    """
+    Run the demo; exit code 0 when certified commands flowed and all were well-formed.
+
+    ``argv`` is the whole command line with the program's name (None: ``sys.argv``);
+    what follows ``--ros-args`` goes to rclpy (remaps, a node name).
+    """
+    from rclpy.utilities import remove_ros_args
+
+    argv = sys.argv if argv is None else argv
+    args = _parser().parse_args(remove_ros_args(argv)[1:])
+    args.ros_argv = list(argv)
+    if args.node and not args.watch:
+        print('grasp-torque-demo: error: --node is for --watch', file=sys.stderr)
+        return 2
     if args.with_node and args.watch:
         print('grasp-torque-demo: error: --watch and --with-node exclude each other',
               file=sys.stderr)
@@ -66,15 +91,53 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as e:
         print(f'grasp-torque-demo: error: {e}', file=sys.stderr)
         return 2
-    with node_process(params, args.with_node):
-        return _play(args, scenario)
+    try:
+        with node_process(params, args.with_node):
+            return _play(args, scenario)
+    except KeyboardInterrupt:  # Ctrl-C: a watch, or a demo, stopped by hand
+        return 130
 
 
 def _play(args: argparse.Namespace, scenario: Path) -> int:
+    from grasp_torque_opt.core.grasp_setup import GraspSetup
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+
+    setup = GraspSetup.from_file(scenario)
+    rclpy.init(args=args.ros_argv)
+    node = rclpy.create_node('grasp_demo_driver')
+    try:
+        return _spin(args, scenario, node, setup)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        print('grasp-torque-demo: interrupted', file=sys.stderr)
+        return 130
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _commands_topic(node, name: str, until: float) -> str | None:
+    """Return the topic a node publishes its effort commands on, waited for until ``until``."""
+    import rclpy
+
+    ns, _, base = name.rstrip('/').rpartition('/')
+    ns = ns or '/'
+    while time.monotonic() < until:
+        try:
+            topics = node.get_publisher_names_and_types_by_node(base, ns)
+        except Exception:  # noqa: B902 -- rclpy raises NodeNameNonExistentError until it is up
+            topics = []
+        for topic, types in topics:
+            if 'std_msgs/msg/Float64MultiArray' in types:
+                return topic
+        rclpy.spin_once(node, timeout_sec=0.1)
+    return None
+
+
+def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
     from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
     from grasp_torque_opt.ros.node import COMMAND_QOS
     import pinocchio as pin
     import rclpy
@@ -82,19 +145,16 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    setup = GraspSetup.from_file(scenario)
     hand = setup.hand
     names = hand.one_dof_joints(hand.model)
     idx_q = [hand.model.joints[hand.model.getJointId(n)].idx_q for n in names]
     base = hand.base_frame
     limits = hand.torque_limits
-
-    rclpy.init()
-    node = rclpy.create_node('grasp_demo_driver')
-    js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
-    contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
-    wrench_pub = node.create_publisher(WrenchStamped, 'external_wrench',
-                                       qos_profile_sensor_data)
+    if not args.watch:  # a watch publishes nothing
+        js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+        contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+        wrench_pub = node.create_publisher(WrenchStamped, 'external_wrench',
+                                           qos_profile_sensor_data)
     received: list[tuple[float, np.ndarray]] = []
     diag: dict[str, str] = {}
     solve_times: list[float] = []
@@ -108,33 +168,42 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
             bad += 1
         received.append((time.monotonic(), cmd))
 
+    watched = (args.node or 'grasp_torque_node').rstrip('/').rpartition('/')[2]
+
     def on_diagnostics(msg: DiagnosticArray) -> None:
         for status in msg.status:
-            if status.name.startswith('grasp_torque_node'):
+            if status.name.startswith(f'{watched}: '):
                 diag.clear()
                 diag.update({kv.key: kv.value for kv in status.values})
                 diag['message'] = status.message
                 if 'solve_time_s' in diag:
                     solve_times.append(float(diag['solve_time_s']))
 
-    node.create_subscription(Float64MultiArray, 'effort_commands', on_command, COMMAND_QOS)
+    domain = os.environ.get('ROS_DOMAIN_ID', '0')
+    topic = 'effort_commands'
+    start = time.monotonic()
+    if args.node:
+        topic = _commands_topic(node, args.node, start + args.duration)
+        if topic is None:
+            print(f'grasp-torque-demo: no node {args.node} publishing effort commands on '
+                  f'ROS_DOMAIN_ID {domain} within {args.duration:g} s', file=sys.stderr)
+            return 1
+    sub = node.create_subscription(Float64MultiArray, topic, on_command, COMMAND_QOS)
     node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
 
-    domain = os.environ.get('ROS_DOMAIN_ID', '0')
     if args.watch:
-        print(f'grasp-torque-demo: watching effort_commands and /diagnostics for '
-              f'{args.duration:g} s (ROS_DOMAIN_ID {domain})')
+        print(f'grasp-torque-demo: watching {sub.topic_name} and /diagnostics for '
+              f'{args.duration:g} s (ROS_DOMAIN_ID {domain})', flush=True)
     else:
         print(f'grasp-torque-demo: {scenario.name}, {hand.m} joints, joint states at '
               f'{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID {domain})')
     deadline = time.monotonic() + 30.0
-    while node.count_subscribers('joint_states') == 0 and time.monotonic() < deadline:
+    while not args.watch and node.count_subscribers('joint_states') == 0 and \
+            time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.1)
-    if node.count_subscribers('joint_states') == 0 and not args.watch:
+    if not args.watch and node.count_subscribers('joint_states') == 0:
         print('grasp-torque-demo: no grasp_torque_node is listening on joint_states',
               file=sys.stderr)
-        node.destroy_node()
-        rclpy.try_shutdown()
         return 1
 
     if not args.watch:
@@ -148,7 +217,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
             rclpy.spin_once(node, timeout_sec=1.0 / args.rate)
         received.clear()
     period = 1.0 / args.rate
-    t0 = time.monotonic()
+    t0 = start if args.watch else time.monotonic()
     next_tick, next_print, next_slow = t0, t0 + 1.0, t0
     last_count = 0
     q = setup.q.copy()
@@ -192,7 +261,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
                 next_tick = next_print
             print(f't={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  '
                   f"|command| {norm:.4f} N m  status {diag.get('status', '-')}  "
-                  f"fault {diag.get('fault', '-')}")
+                  f"fault {diag.get('fault', '-')}", flush=True)
         rclpy.spin_once(node, timeout_sec=max(0.0, min(next_tick, next_print) - time.monotonic()))
     played = dict(diag)  # the node's state while joint states flowed
     end = time.monotonic() + 0.2  # the last commands in flight
@@ -209,8 +278,6 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
           + f"node cycles {played.get('cycles', '-')}, faults {played.get('faults', '-')}, "
           f"rejected joint states {played.get('rejected.joint_states', '-')}, "
           f"last status {played.get('status', '-')}")
-    node.destroy_node()
-    rclpy.try_shutdown()
     return 0 if (received or args.watch) and bad == 0 else 1
 
 

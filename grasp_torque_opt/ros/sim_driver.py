@@ -35,14 +35,24 @@ from pathlib import Path
 import sys
 import time
 
+from grasp_torque_opt.core.command_line import add_version, HelpFormatter
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 import numpy as np
 
 PROG = 'grasp-torque-sim'
 
 
+def _description() -> str:
+    """Return the module's docstring up to its exit codes: what the script does."""
+    return __doc__.split('Exit code:')[0].strip()
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog=PROG, description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog=PROG, formatter_class=HelpFormatter,
+                                description=_description(), epilog=(
+                                    'exit codes: 0 held, 1 not held (or no commands), 2 bad '
+                                    'input. docs/simulation.md'))
+    add_version(p)
     p.add_argument('--params', default='allegro_right_node.yaml',
                    help='node params file (bundled name or path); its scenario is simulated')
     p.add_argument('--duration', type=float, default=3.0,
@@ -62,7 +72,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument('--drift-limit', type=float, default=1.0,
                    help='the object counts as held while it moves less than this [mm]')
     p.add_argument('--picture', default='grasp_sim.png',
-                   help='PNG of the grasp written at the end (default: grasp_sim.png here)')
+                   help='PNG of the grasp written at the end, in the current folder unless a '
+                        'path')
     p.add_argument('--no-picture', action='store_true', help='write no picture')
     p.add_argument('--with-node', action='store_true',
                    help='start grasp_torque_node in a child process')
@@ -383,7 +394,7 @@ def _mujoco_version() -> str:
 
 
 def _picture(hsim, path: str, predicted) -> str:
-    from grasp_torque_opt.sim.render import render_grasp, RenderUnavailable
+    from grasp_torque_opt.sim.render import CAPTION, render_grasp, RenderUnavailable
 
     try:
         written = render_grasp(hsim, path, predicted)
@@ -391,8 +402,7 @@ def _picture(hsim, path: str, predicted) -> str:
         return f'picture: not written, offscreen rendering is unavailable ({e})'
     except OSError as e:
         return f'picture: not written, cannot write {path}: {e.strerror}'
-    return (f"picture: {written.resolve()} (simulated contact forces orange, the node's "
-            'predicted green)')
+    return f'picture: {written.resolve()} ({CAPTION})'
 
 
 if __name__ == '__main__':

@@ -45,6 +45,8 @@ import numpy as np
 #: Contact bits: hand geoms (type 1, affinity 2) touch the object (type 2, affinity 1) only.
 _HAND_BITS, _OBJECT_BITS = (1, 2), (2, 1)
 OBJECT_BODY = 'object'
+#: The object's colour: orange (the picture's arrows are blue and green against it).
+OBJECT_RGBA = [0.85, 0.45, 0.15, 1.0]
 
 
 @dataclass(frozen=True)
@@ -159,7 +161,7 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec, mass: float, friction: lis
     body.add_geom(name=f'{OBJECT_BODY}_geom', type=kind, size=size, mass=mass,
                   friction=friction, condim=4, solref=[timeconst, 1.0],
                   contype=_OBJECT_BITS[0], conaffinity=_OBJECT_BITS[1],
-                  rgba=[0.85, 0.45, 0.15, 1.0])
+                  rgba=OBJECT_RGBA)
 
 
 def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),

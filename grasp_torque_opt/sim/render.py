@@ -11,22 +11,27 @@ One offscreen picture of the simulated grasp, contact forces drawn as arrows.
 
 Rendering is offscreen through EGL (``MUJOCO_GL=egl``, set by
 :mod:`grasp_torque_opt.sim` unless already set): no display and no GPU needed,
-Mesa's software EGL does. The PNG is written with zlib, no imaging library.
+Mesa's software EGL does. The PNG is written with Pillow.
+
+The simulated forces are blue and the predicted ones a see-through green, both far
+in hue from the orange object (:data:`grasp_torque_opt.sim.model.OBJECT_RGBA`), so
+the arrows show against it; :data:`CAPTION` says so wherever the picture is named.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-import struct
-import zlib
 
 from grasp_torque_opt.sim.simulator import HandSim
 import mujoco
 import numpy as np
 
-#: Arrow colours: simulated force on the object, certified (predicted) force.
-SIMULATED_RGBA = np.array([1.0, 0.55, 0.0, 1.0], dtype=np.float32)
-PREDICTED_RGBA = np.array([0.1, 0.8, 0.2, 0.35], dtype=np.float32)
+#: Arrow colours: simulated force on the object (blue), certified (predicted) force
+#: (see-through green).
+SIMULATED_RGBA = np.array([0.15, 0.55, 1.0, 1.0], dtype=np.float32)
+PREDICTED_RGBA = np.array([0.1, 0.8, 0.2, 0.25], dtype=np.float32)
+#: The picture's caption: which arrow is which.
+CAPTION = "simulated contact forces blue, the node's predicted green"
 
 
 class RenderUnavailable(RuntimeError):
@@ -35,16 +40,9 @@ class RenderUnavailable(RuntimeError):
 
 def write_png(path: str | Path, rgb: np.ndarray) -> None:
     """Write an RGB image, shape (h, w, 3) uint8, as PNG."""
-    h, w, _ = rgb.shape
-    rows = b''.join(b'\x00' + np.ascontiguousarray(rgb[y]).tobytes() for y in range(h))
+    from PIL import Image
 
-    def chunk(kind: bytes, data: bytes) -> bytes:
-        return (struct.pack('>I', len(data)) + kind + data
-                + struct.pack('>I', zlib.crc32(kind + data) & 0xFFFFFFFF))
-
-    Path(path).write_bytes(b'\x89PNG\r\n\x1a\n'
-                           + chunk(b'IHDR', struct.pack('>IIBBBBB', w, h, 8, 2, 0, 0, 0))
-                           + chunk(b'IDAT', zlib.compress(rows, 6)) + chunk(b'IEND', b''))
+    Image.fromarray(np.ascontiguousarray(rgb, dtype=np.uint8), 'RGB').save(Path(path), 'PNG')
 
 
 def _arrow(scene: mujoco.MjvScene, start: np.ndarray, end: np.ndarray, rgba: np.ndarray,
@@ -92,7 +90,7 @@ def render_grasp(hsim: HandSim, path: str | Path, predicted: list[np.ndarray] | 
                                 if str(e).strip() else type(e).__name__) from e
     geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == hsim.sim.object_body]
     alpha = model.geom_rgba[geoms, 3].copy()
-    model.geom_rgba[geoms, 3] = 0.35  # see-through, so that the arrows inside show
+    model.geom_rgba[geoms, 3] = 0.2  # see-through, so that the arrows inside show
     try:
         camera = mujoco.MjvCamera()
         camera.lookat[:] = hsim.data.xpos[hsim.sim.object_body]
@@ -104,9 +102,9 @@ def render_grasp(hsim: HandSim, path: str | Path, predicted: list[np.ndarray] | 
                 # From the contact into the (see-through) object: the push it gets.
                 if predicted is not None:
                     _arrow(renderer.scene, r.position, r.position + scale * predicted[i],
-                           PREDICTED_RGBA, 0.004)
+                           PREDICTED_RGBA, 0.005)
                 _arrow(renderer.scene, r.position, r.position + scale * r.force,
-                       SIMULATED_RGBA, 0.002)
+                       SIMULATED_RGBA, 0.003)
         write_png(path, renderer.render())
     finally:
         model.geom_rgba[geoms, 3] = alpha

@@ -123,7 +123,7 @@ def test_score_json_and_bad_files(tmp_path, capsys):
                        capsys)
     assert code == 2 and err.count('\n') == 1 and 'candidates: cannot read' in err
     code, _, err = run(['score', str(batch), '--scenario', str(tmp_path / 'none.yaml')], capsys)
-    assert code == 2 and 'scenario: cannot read' in err
+    assert code == 2 and 'scenario: file not found' in err
 
 
 def test_the_progress_bar_is_drawn_on_a_terminal_only(tmp_path, capsys, monkeypatch):
@@ -134,4 +134,4 @@ def test_the_progress_bar_is_drawn_on_a_terminal_only(tmp_path, capsys, monkeypa
     assert run(argv, capsys)[2] == ''  # captured stderr is no terminal
     monkeypatch.setattr(sys.stderr, 'isatty', lambda: True, raising=False)
     code, _, err = run(argv, capsys)
-    assert code == 0 and '\rscoring [' in err and '2/2' in err
+    assert code == 0 and '\rscoring: 100%' in err and '2/2' in err

@@ -77,5 +77,6 @@ def test_default_normal_points_to_the_object_origin(planar):
 def test_unknown_frame_is_named(planar):
     spec = ContactSpec(link='finger3_tip', position=np.zeros(3))
     with pytest.raises(FrameNotFound, match=r'grasp\.contacts\[0\]\.link: unknown frame '
-                                            r"'finger3_tip' \(model frames: .*finger1_tip"):
+                                            r"'finger3_tip' \(did you mean 'finger1_tip' or "
+                                            r"'finger2_tip'.*model frames: finger1_distal"):
         compute_grasp_maps(planar.hand, planar.q, [spec], planar.object_origin)

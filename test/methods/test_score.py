@@ -15,12 +15,15 @@ serial answers.
 
 import copy
 import json
+import subprocess
+import sys
 
 from conftest import ALLEGRO
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.capacity import direction_capacities, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.methods.score import merge, rank, score_batch, ScoreJob
+from independent import assert_holds
 import numpy as np
 import pytest
 import yaml
@@ -152,3 +155,66 @@ def test_a_local_dask_cluster_gives_the_serial_records(job, lines):
     dask = score_batch(job, lines, engine='dask', workers=2, chunk=3)
     assert [(r['id'], r['status'], r['capacity'], r['torque_norm']) for r in dask] == \
         [(r['id'], r['status'], r['capacity'], r['torque_norm']) for r in serial]
+
+
+def test_in_memory_candidates_score_as_their_lines(allegro):
+    job = ScoreJob.from_file(ALLEGRO, metrics='basic', backend='daqp')
+    docs = [{'friction': {'mu_tangential': 0.6}},
+            {'id': 'b', 'load': {'external_wrench': [0, 0, 1, 0, 0, 0]}}]
+    from_lines = score_batch(job, [(i, json.dumps(d)) for i, d in enumerate(docs, 1)],
+                             engine='serial')
+    from_dicts = score_batch(job, docs, engine='serial')
+    for a, b in zip(from_lines, from_dicts):
+        assert a['line'] == b['line'] and a['id'] == b['id'] and a['status'] == b['status']
+        assert a['torque_norm'] == pytest.approx(b['torque_norm'], rel=1e-9)
+    assert docs[0] == {'friction': {'mu_tangential': 0.6}}  # not modified
+    (setup_record,) = score_batch(job, [allegro], engine='serial')
+    assert setup_record['line'] == 1 and setup_record['status'] == 'optimal'
+    assert setup_record['torque_norm'] == pytest.approx(solve(allegro).torque_norm, rel=1e-6)
+
+
+def test_records_carry_tau_and_wrenches_on_request(allegro):
+    plain = score_batch(ScoreJob.from_file(ALLEGRO, metrics='basic'), [{}], engine='serial')[0]
+    assert 'tau' not in plain and 'wrenches' not in plain
+    job = ScoreJob.from_file(ALLEGRO, metrics='basic', solutions=True)
+    (r,) = score_batch(job, [{}], engine='serial')
+    maps = allegro.maps()
+    tau, f = np.array(r['tau']), np.array(r['wrenches'])
+    assert tau.shape == (allegro.hand.m,) and f.shape == (len(allegro.contacts), 4)
+    assert_holds(allegro, maps, tau, f)
+    assert np.linalg.norm(tau) == pytest.approx(r['torque_norm'])
+
+
+def test_single_threaded_math_is_exported():
+    import grasp_torque_opt
+
+    assert 'single_threaded_math' in grasp_torque_opt.__all__
+    grasp_torque_opt.single_threaded_math()
+
+
+SCRIPT = (
+    'from grasp_torque_opt import ScoreJob, score_batch\n'
+    'job = ScoreJob.from_file({scenario!r}, metrics="basic")\n'
+    'print(len(score_batch(job, [{{}}, {{}}, {{}}], workers=2, chunk=1)))\n'
+)
+
+
+def test_a_script_without_the_main_guard_raises_instead_of_hanging(tmp_path):
+    path = tmp_path / 'no_guard.py'
+    path.write_text(SCRIPT.format(scenario=str(ALLEGRO)))
+    done = subprocess.run([sys.executable, str(path)], capture_output=True, text=True,
+                          timeout=240, cwd=tmp_path)
+    assert done.returncode != 0
+    assert 'BrokenProcessPool' in done.stderr
+    assert 'if __name__ == "__main__":' in done.stderr.splitlines()[-1]
+
+
+def test_the_same_script_with_the_guard_scores(tmp_path):
+    path = tmp_path / 'guarded.py'
+    body = SCRIPT.format(scenario=str(ALLEGRO)).strip().splitlines()
+    path.write_text('\n'.join(body[:1] + ['if __name__ == "__main__":']
+                              + ['    ' + line for line in body[1:]]) + '\n')
+    done = subprocess.run([sys.executable, str(path)], capture_output=True, text=True,
+                          timeout=240, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == '3'

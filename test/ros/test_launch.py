@@ -63,6 +63,25 @@ def test_the_executables_the_launch_file_starts_are_installed_by_setup_py():
         assert f"'{executable}'" in source, executable
 
 
+def test_package_xml_declares_what_the_launch_files_import():
+    """Each ROS package a launch file imports is an exec_depend (rosdep installs it)."""
+    import sys
+    import xml.etree.ElementTree as ET
+
+    declared = {e.text.strip() for e in ET.parse(ROOT / 'package.xml').getroot()
+                if e.tag in ('exec_depend', 'depend')}
+    for path in (ROOT / 'launch').glob('*.py'):
+        imported = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                imported.add(node.module.split('.')[0])
+            elif isinstance(node, ast.Import):
+                imported.update(a.name.split('.')[0] for a in node.names)
+        ros = imported - set(sys.stdlib_module_names) - {'grasp_torque_opt'}
+        assert ros, path
+        assert ros <= declared, f'{path.name} imports {sorted(ros - declared)} undeclared'
+
+
 @pytest.mark.skipif(importlib.util.find_spec('launch_ros') is None,
                     reason='launch_ros is absent (not on the package registry)')
 def test_the_launch_file_builds_its_description():

@@ -148,7 +148,8 @@ def test_the_scenarios_own_name_map_and_the_parameter_over_it(allegro, tmp_path)
 
 @pytest.mark.parametrize('name_map,error', [
     # Without the map, the scenario's names are not the URDF's: said, with the way out.
-    (None, r"^hand\.joints\[0\]: unknown joint 'joint_0\.0' \(1-DoF joints: ah_joint00, .*"
+    (None, r"^hand\.joints\[0\]: unknown joint 'joint_0\.0' \(did you mean .*\? "
+           r'1-DoF joints: ah_joint00, .*'
      r'map them to this URDF.s names with the name_map parameter \(SCENARIO_NAME=URDF_NAME\) '
      r'or the scenario.s hand\.name_map$'),
     (['joint_0.0'], r"^name_map\[0\]: must be SCENARIO_NAME=URDF_NAME, got 'joint_0\.0'$"),
