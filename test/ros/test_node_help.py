@@ -39,8 +39,6 @@ def test_the_parser_takes_what_remove_ros_args_leaves():
         parser.parse_args(['--version'])
 
 
-@pytest.mark.xfail(strict=True, reason='run() in ros/node.py must build its parser with '
-                   'ros.node_help.node_parser(prog) (issue 22; node.py is being rewritten)')
 @pytest.mark.parametrize('prog', NODES)
 def test_the_executables_show_it(prog):
     exe = str(Path(sys.executable).parent / prog)

@@ -62,6 +62,7 @@ class Inputs:
         self.root = root
         self.node = root.node
         self.joint_states_topic = ''  # remapped and resolved, once subscribed
+        self.sim_time: bool | None = None  # use_sim_time, read at the first message
 
     def start(self) -> list[Any]:
         """Make the four subscriptions; give them (to be destroyed at :meth:`stop`)."""
@@ -89,7 +90,17 @@ class Inputs:
         self.node.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
 
     def clock_now(self) -> float:
-        """Now on the node's clock (ROS time), the clock of header stamps [s]."""
+        """
+        Now on the node's clock (ROS time), the clock of header stamps [s].
+
+        Without sim time, ROS time is the system clock: read directly (rclpy's
+        ``Clock.now()`` cost 9 us of the joint state's path). ``use_sim_time`` is fixed
+        after start, so the choice holds.
+        """
+        if self.sim_time is None:
+            self.sim_time = bool(self.node.get_parameter('use_sim_time').value)
+        if not self.sim_time:
+            return time.time()
         return self.node.get_clock().now().nanoseconds * 1e-9
 
     def on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,

@@ -26,6 +26,7 @@ from grasp_torque_opt.core.exceptions import GraspTorqueError
 from grasp_torque_opt.ros import realtime
 from grasp_torque_opt.ros.node import signals
 from grasp_torque_opt.ros.node.qos import NODE_NAME
+from grasp_torque_opt.ros.node_help import node_parser
 import rclpy
 from rclpy.exceptions import NameValidationException, ParameterException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -43,9 +44,9 @@ EXECUTORS = {'single': SingleThreadedExecutor, 'events': EventsExecutor}
 
 def _init(prog: str, argv: list[str]) -> argparse.Namespace | None:
     """Parse the arguments and start rclpy; None (and one line on stderr) if refused."""
-    parser = argparse.ArgumentParser(prog=prog)
+    parser = node_parser(prog)  # what it does, the --ros-args it takes, --version
     parser.add_argument('--executor', choices=sorted(EXECUTORS), default='single',
-                        help='rclpy executor to spin (default: single)')
+                        help='rclpy executor to spin')
     try:
         opts = parser.parse_args(remove_ros_args(argv)[1:])
         single_threaded_math()
