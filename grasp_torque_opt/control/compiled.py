@@ -238,7 +238,7 @@ class CompiledCycle:
     def kinematics(self, setup: GraspSetup, compute: bool = True
                    ) -> tuple[np.ndarray, np.ndarray]:
         """
-        Return what the maps stage takes from Pinocchio: the contact links' placements and Jacobians.
+        Return what the maps stage takes from Pinocchio: the contact links' placements, Jacobians.
 
         Args:
             setup: the grasp at its configuration.
