@@ -126,25 +126,76 @@ struct Settings
   double inner_iteration_s, estimate_decay, primary_share;
 };
 
+using Wrench = Eigen::Matrix<double, 6, 1>;
+
+// The maps stage's inputs: one cycle's kinematics as Pinocchio gave them (borrowed).
+struct Kinematics
+{
+  int p = 0, nv = 0;
+  const double * oMf = nullptr;      // (p, 4, 4) link placements, row-major
+  const double * J6 = nullptr;       // (p, 6, nv) LOCAL_WORLD_ALIGNED link Jacobians
+  const double * points = nullptr;   // (p, 3) contact points in their link frames
+  const double * normals = nullptr;  // (p, 3) base axes, where has_normal
+  const bool * has_normal = nullptr;
+  const double * tangents = nullptr;  // (p, 3) base axes, where has_tangent
+  const bool * has_tangent = nullptr;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();  // object origin, base frame
+};
+
+// The maps stage's output (core/grasp_maps.GraspMaps).
+struct Maps
+{
+  RowMat G, J, positions, rotations;  // rotations: p rows of 9 (row-major R_i)
+};
+
+// The build stage's output (core/tau_qp.TauQP with k = 0: no N, x = tau), and the
+// certificate's torque bounds.
+struct QPData
+{
+  Mat H, A, C;
+  Vec g, b, l, u, l_box, u_box;
+  Mat pinv;  // [M1 M2] = pinv([G; J^T]), 4p x (6 + m)
+  Vec w, tau_min, tau_max;
+
+  int n_eq() const {return static_cast<int>(A.rows());}
+  auto M1() const {return pinv.leftCols(6);}
+  auto M2() const {return pinv.rightCols(pinv.cols() - 6);}
+};
+
+// The certify stage's output (core/certificate.Certificate without its tolerance).
+struct Certificate
+{
+  double r[5] = {0, 0, 0, 0, 0};  // equilibrium, torque, cone, normal_force, limit
+  bool finite = false;
+};
+
 // One cycle's answer, read by compiled.py.
 struct Answer
 {
   int code = NOT_HANDLED;
   std::string message;
   Vec tau, f;
-  RowMat G, J, positions, rotations;  // rotations: p rows of 9 (row-major R_i)
+  Maps maps;
   int iterations = 0;
   bool warm = false;        // the answer came from a warm start
   int warm_solves = 0;      // warm starts tried in this call (0 or 1)
   int redone_cold = 0;      // warm answers redone cold in this call
-  double cert[5] = {0, 0, 0, 0, 0};    // equilibrium, torque, cone, normal_force, limit
-  bool finite = false;
+  Certificate cert;
   Vec usage;
   double max_torque_ratio = 0.0;
   double solve_time_s = 0.0;
   double t_maps = 0.0, t_build = 0.0, t_solve = 0.0, t_certify = 0.0;
 };
 
+// The compiled cycle bound to one grasp's friction, weights, limits and settings.
+//
+// solve() runs one cycle: run() calls the four stages in order, each the twin of a
+// Python stage and exposed on its own for the parity tests
+// (test/control/test_compiled_stages.py):
+//   maps      core/grasp_maps.compute_grasp_maps  contact frames, G, J
+//   build     core/tau_qp.build_tau_qp            the tau-QP (the QR branch)
+//   solve_qp  backends/proxsuite.TauQPSolver      the warm ProxSuite solve, KKT-checked
+//   certify   core/certificate.certify            the certificate of (tau, f)
 class FastCycle
 {
 public:
@@ -186,230 +237,338 @@ public:
   {
     Answer a;
     const auto t0 = Clock::now();
-    const int p = static_cast<int>(oMf.shape(0));
-    if (oMf.ndim() != 3 || oMf.shape(1) != 4 || oMf.shape(2) != 4 || J6.ndim() != 3 ||
-      J6.shape(0) != p || J6.shape(1) != 6 || points.shape(0) != p ||
-      normals.shape(0) != p || tangents.shape(0) != p || has_normal.size() != p ||
-      has_tangent.size() != p || c.size() != 3 || w_ext.size() != 6 ||
-      (offset.size() != 0 && offset.size() != m_) || p == 0)
+    Kinematics k;
+    if (w_ext.size() != 6 || (offset.size() != 0 && offset.size() != m_) ||
+      !borrow(oMf, J6, points, normals, has_normal, tangents, has_tangent, c, k, a.message))
     {
-      a.message = "inputs of the wrong shape";
+      if (a.message.empty()) {
+        a.message = "inputs of the wrong shape";
+      }
       return a;
     }
-    const int nv = static_cast<int>(J6.shape(2));
-    for (int64_t j : idx_v_) {
-      if (j < 0 || j >= nv) {
-        a.message = "joint index out of range";
-        return a;
-      }
-    }
-    Eigen::Map<const Eigen::Vector3d> cc(c.data());
-    Eigen::Map<const Eigen::Matrix<double, 6, 1>> w_ext_v(w_ext.data());
+    Eigen::Map<const Wrench> w_ext_v(w_ext.data());
     Vec off = offset.size() ? Vec(Eigen::Map<const Vec>(offset.data(), m_)) :
       Vec::Zero(m_);
     {
       // The GIL is released from here on: nothing below touches a Python object.
       py::gil_scoped_release release;
-      run(a, p, nv, oMf.data(), J6.data(), points.data(), normals.data(),
-          has_normal.data(), tangents.data(), has_tangent.data(), cc, w_ext_v, off,
-          time_left, t0);
+      run(a, k, w_ext_v, off, time_left, t0);
     }
     return a;
   }
 
-  int dims_changes() const {return inits_;}
-
-private:
-  void run(
-    Answer & a, int p, int nv, const double * oMf, const double * J6,
-    const double * pts, const double * nrm, const bool * has_n, const double * tng,
-    const bool * has_t, const Eigen::Vector3d & c,
-    const Eigen::Matrix<double, 6, 1> & w_ext, const Vec & off, double time_left,
-    Clock::time_point t0)
+  // The arrays of one cycle's kinematics as the maps stage takes them; false and why
+  // where they do not fit.
+  bool borrow(
+    const Array & oMf, const Array & J6, const Array & points, const Array & normals,
+    const py::array_t<bool> & has_normal, const Array & tangents,
+    const py::array_t<bool> & has_tangent, const Array & c, Kinematics & k,
+    std::string & why) const
   {
-    const int m = m_, cols = 4 * p;
-    // -- maps (core/grasp_maps.compute_grasp_maps) -------------------------------------
-    a.G.setZero(6, cols);
-    a.J.resize(cols, m);
-    a.positions.resize(p, 3);
-    a.rotations.resize(p, 9);
+    const int p = static_cast<int>(oMf.shape(0));
+    if (oMf.ndim() != 3 || oMf.shape(1) != 4 || oMf.shape(2) != 4 || J6.ndim() != 3 ||
+      J6.shape(0) != p || J6.shape(1) != 6 || points.shape(0) != p ||
+      normals.shape(0) != p || tangents.shape(0) != p || has_normal.size() != p ||
+      has_tangent.size() != p || c.size() != 3 || p == 0)
+    {
+      why = "inputs of the wrong shape";
+      return false;
+    }
+    const int nv = static_cast<int>(J6.shape(2));
+    for (int64_t j : idx_v_) {
+      if (j < 0 || j >= nv) {
+        why = "joint index out of range";
+        return false;
+      }
+    }
+    k.p = p;
+    k.nv = nv;
+    k.oMf = oMf.data();
+    k.J6 = J6.data();
+    k.points = points.data();
+    k.normals = normals.data();
+    k.has_normal = has_normal.data();
+    k.tangents = tangents.data();
+    k.has_tangent = has_tangent.data();
+    k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
+    return true;
+  }
+
+  // -- maps (core/grasp_maps.compute_grasp_maps) ---------------------------------------
+  // Contact frames, G (6 x 4p) and J (4p x m); false and why where Python raises.
+  bool maps(const Kinematics & k, Maps & out, std::string & why) const
+  {
+    const int p = k.p, nv = k.nv, m = m_;
+    out.G.setZero(6, 4 * p);
+    out.J.resize(4 * p, m);
+    out.positions.resize(p, 3);
+    out.rotations.resize(p, 9);
     for (int i = 0; i < p; ++i) {
-      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf + 16 * i);
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(k.oMf + 16 * i);
       const Eigen::Matrix3d Rl = M.topLeftCorner<3, 3>();
       const Eigen::Vector3d o = M.topRightCorner<3, 1>();
-      const Eigen::Vector3d point = Rl * Eigen::Map<const Eigen::Vector3d>(pts + 3 * i) + o;
+      const Eigen::Vector3d point =
+        Rl * Eigen::Map<const Eigen::Vector3d>(k.points + 3 * i) + o;
       Eigen::Vector3d n;
-      if (has_n[i]) {
-        n = Eigen::Map<const Eigen::Vector3d>(nrm + 3 * i);
+      if (k.has_normal[i]) {
+        n = Eigen::Map<const Eigen::Vector3d>(k.normals + 3 * i);
       } else {
-        n = c - point;
+        n = k.c - point;
         if (n.dot(n) < 1e-18) {
-          a.message = "a normal cannot be defaulted";
-          return;
+          why = "a normal cannot be defaulted";
+          return false;
         }
       }
       Eigen::Matrix3d R;
-      if (!contact_rotation(n, has_t[i] ? tng + 3 * i : nullptr, R)) {
-        a.message = "a contact frame cannot be made";
-        return;
+      if (!contact_rotation(n, k.has_tangent[i] ? k.tangents + 3 * i : nullptr, R)) {
+        why = "a contact frame cannot be made";
+        return false;
       }
-      for (int k = 0; k < 3; ++k) {
-        a.positions(i, k) = point(k);
+      for (int j = 0; j < 3; ++j) {
+        out.positions(i, j) = point(j);
       }
-      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.rotations.row(i).data()) = R;
-      a.G.block<3, 3>(0, 4 * i) = R;
-      a.G.block<3, 3>(3, 4 * i) = skew(point - c) * R;
-      a.G.block<3, 1>(3, 4 * i + 3) = R.col(2);
-      Eigen::Map<const RowMat> Jl(J6 + 6 * nv * i, 6, nv);
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(out.rotations.row(i).data()) = R;
+      out.G.block<3, 3>(0, 4 * i) = R;
+      out.G.block<3, 3>(3, 4 * i) = skew(point - k.c) * R;
+      out.G.block<3, 1>(3, 4 * i + 3) = R.col(2);
+      Eigen::Map<const RowMat> Jl(k.J6 + 6 * nv * i, 6, nv);
       Eigen::Matrix<double, 6, Eigen::Dynamic> Ja(6, m);
       for (int j = 0; j < m; ++j) {
         Ja.col(j) = Jl.col(idx_v_[j]);
       }
       const auto Jv = Ja.topRows<3>();
       const auto Jw = Ja.bottomRows<3>();
-      a.J.block(4 * i, 0, 3, m) = R.transpose() * (Jv - skew(point - o) * Jw);
-      a.J.row(4 * i + 3) = R.col(2).transpose() * Jw;
+      out.J.block(4 * i, 0, 3, m) = R.transpose() * (Jv - skew(point - o) * Jw);
+      out.J.row(4 * i + 3) = R.col(2).transpose() * Jw;
     }
-    const auto t1 = Clock::now();
-    a.t_maps = std::chrono::duration<double>(t1 - t0).count();
+    return true;
+  }
 
-    // -- build (core/tau_qp.build_tau_qp, the QR branch of decompose) ----------------
+  // -- build (core/tau_qp.build_tau_qp, the QR branch of decompose) --------------------
+  // The tau-QP of G (6 x 4p) and J (4p x m) into qp; false and why where A = [G; J^T]
+  // needs the SVD branch (the Python cycle's) or is not finite.
+  bool build(
+    const RowMat & G, const RowMat & J, const Wrench & w_ext, const Vec & off,
+    QPData & qp, std::string & why) const
+  {
+    const int m = m_, cols = static_cast<int>(G.cols()), p = cols / 4;
     const int rows = 6 + m;
     if (rows < cols) {
-      a.message = "A = [G; J^T] has more columns than rows";
-      return;
+      why = "A = [G; J^T] has more columns than rows";
+      return false;
     }
     Mat A_full(rows, cols);
-    A_full.topRows(6) = a.G;
-    A_full.bottomRows(m) = a.J.transpose();
+    A_full.topRows(6) = G;
+    A_full.bottomRows(m) = J.transpose();
     if (!A_full.allFinite()) {
-      a.message = "maps not finite";
-      return;
+      why = "maps not finite";
+      return false;
     }
     Eigen::HouseholderQR<Mat> qr(A_full);
     const Mat & packed = qr.matrixQR();
     const Vec d = packed.diagonal().head(cols).cwiseAbs();
     if (!(d.minCoeff() > s_.qr_rtol * d.maxCoeff())) {
-      a.message = "A = [G; J^T] is not of full column rank";
-      return;
+      why = "A = [G; J^T] is not of full column rank";
+      return false;
     }
     const Mat Q = qr.householderQ();  // rows x rows
     const auto Rup = packed.topRows(cols).triangularView<Eigen::Upper>();
-    const Mat pinv = Rup.solve(Q.leftCols(cols).transpose());  // cols x rows
+    qp.pinv = Rup.solve(Q.leftCols(cols).transpose());  // cols x rows
     const auto U_perp = Q.rightCols(rows - cols);
-    const int n_eq = rows - cols;
-    const auto M1 = pinv.leftCols(6);
-    const auto M2 = pinv.rightCols(m);
-    const Vec w = -w_ext;
+    const auto M1 = qp.M1();
+    const auto M2 = qp.M2();
+    qp.w = -w_ext;
     const int block = static_cast<int>(S_i_.rows()), n_in = block * p;
-    Mat C(n_in, m);
-    Vec u(n_in);
-    const Vec f_w = M1 * w;  // M1 w
+    qp.C.resize(n_in, m);
+    qp.u.resize(n_in);
+    const Vec f_w = M1 * qp.w;  // M1 w
     for (int i = 0; i < p; ++i) {
-      C.middleRows(block * i, block) = S_i_ * M2.middleRows(4 * i, 4);
-      u.segment(block * i, block) = b_i_ - S_i_ * f_w.segment<4>(4 * i);
+      qp.C.middleRows(block * i, block) = S_i_ * M2.middleRows(4 * i, 4);
+      qp.u.segment(block * i, block) = b_i_ - S_i_ * f_w.segment<4>(4 * i);
     }
-    Mat H = Mat::Zero(m, m);
-    H.diagonal() = 2.0 * weights_;
-    const Vec g = Vec::Zero(m);
-    const Mat A = U_perp.bottomRows(m).transpose();
-    const Vec b = -U_perp.topRows(6).transpose() * w;
-    const Vec tau_min = -limits_ - off, tau_max = limits_ - off;
-    const Vec l_box = tau_min.array() + s_.box_margin;
-    const Vec u_box = tau_max.array() - s_.box_margin;
-    const Vec l = Vec::Constant(n_in, -std::numeric_limits<double>::infinity());
-    const auto t2 = Clock::now();
-    a.t_build = std::chrono::duration<double>(t2 - t1).count();
+    qp.H.setZero(m, m);
+    qp.H.diagonal() = 2.0 * weights_;
+    qp.g.setZero(m);
+    qp.A = U_perp.bottomRows(m).transpose();
+    qp.b.noalias() = -U_perp.topRows(6).transpose() * qp.w;
+    qp.tau_min = -limits_ - off;
+    qp.tau_max = limits_ - off;
+    qp.l_box = qp.tau_min.array() + s_.box_margin;
+    qp.u_box = qp.tau_max.array() - s_.box_margin;
+    qp.l.setConstant(n_in, -std::numeric_limits<double>::infinity());
+    return true;
+  }
 
-    // -- solve (backends/proxsuite.TauQPSolver.solve) ---------------------------------
+  // -- solve (backends/proxsuite.TauQPSolver.solve) -------------------------------------
+  // check_data, then ProxSuite on qp: cold on a new size or when cold, else warm if
+  // enabled, a warm answer that ProxSuite does not call solved or that fails the KKT
+  // check redone cold. True with a.tau and a.f (TauQP.wrenches) set when ProxSuite
+  // solved it; else false with a.code and a.message.
+  bool solve_qp(
+    const QPData & qp, bool cold, bool has_deadline, Clock::time_point deadline,
+    Answer & a)
+  {
+    if (cold && a.warm) {  // the caller's redo of a warm answer off the certificate
+      a.redone_cold += 1;
+    }
+    a.warm = false;
     // tau_qp.check_data: one sum per array, then the bounds.
-    const double total = H.sum() + g.sum() + A.sum() + b.sum() + C.sum() + u.sum();
+    const double total = qp.H.sum() + qp.g.sum() + qp.A.sum() + qp.b.sum() + qp.C.sum() +
+      qp.u.sum();
     if (!std::isfinite(total)) {
       a.code = BAD_DATA;
       a.message = "QP data not finite";
-      return;
+      return false;
     }
-    if (!(l_box.array() <= u_box.array()).all()) {
+    if (!(qp.l_box.array() <= qp.u_box.array()).all()) {
       a.code = BAD_DATA;
       a.message = "QP bounds NaN or inverted (lower > upper)";
-      return;
+      return false;
     }
-    Clock::time_point deadline = Clock::time_point::max();
-    if (time_left >= 0.0) {
-      // dispatch.PRIMARY_SHARE of the time left after the build, as the Python cycle.
-      const double left = time_left - std::chrono::duration<double>(t2 - t0).count();
-      deadline = t2 + std::chrono::duration_cast<Clock::duration>(
-                        std::chrono::duration<double>(s_.primary_share * std::max(0.0, left)));
-    }
-    const bool has_deadline = time_left >= 0.0;
-    bool stopped = false;
-    bool warm = false;
+    const int m = m_, n_eq = qp.n_eq(), n_in = static_cast<int>(qp.C.rows());
+    bool stopped = false, warm = false;
     try {
       const std::tuple<int, int, int> dims(m, n_eq, n_in);
       if (!qp_ || dims != dims_) {
         inner_s_ = s_.inner_iteration_s *
           std::max(1.0, static_cast<double>(m) * (m + n_eq + n_in) / (16.0 * 144.0));
-        init(m, n_eq, n_in, H, g, A, b, C, l, u, l_box, u_box);
+        init(qp);
         dims_ = dims;
       } else {
-        warm = warm_start_;
+        warm = warm_start_ && !cold;
         qp_->settings.initial_guess =
           warm ? proxsuite::proxqp::InitialGuessStatus::WARM_START_WITH_PREVIOUS_RESULT :
           proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
-        update(n_eq, H, g, A, b, C, l, u, l_box, u_box);
+        update(qp);
       }
-      a.iterations = solve_until(has_deadline, deadline, stopped);
+      a.iterations += solve_until(has_deadline, deadline, stopped);
       if (warm) {
-        a.warm_solves = 1;
+        a.warm_solves += 1;
         const auto & r = qp_->results;
-        bool ok = r.info.status == proxsuite::proxqp::QPSolverOutput::PROXQP_SOLVED &&
-          kkt_violation(H, g, A, b, C, u, l_box, u_box, r.x, r.y, r.z) <=
-          s_.kkt_tolerance;
-        if (!ok && !stopped) {  // the same data, cold
-          a.redone_cold = 1;
+        warm = r.info.status == proxsuite::proxqp::QPSolverOutput::PROXQP_SOLVED &&
+          kkt_violation(qp, r.x, r.y, r.z) <= s_.kkt_tolerance;
+        if (!warm && !stopped) {  // the same data, cold
+          a.redone_cold += 1;
           qp_->settings.initial_guess = proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
           a.iterations += solve_until(has_deadline, deadline, stopped);
-          warm = false;
         }
       }
-      const auto t3 = Clock::now();
-      a.solve_time_s = std::chrono::duration<double>(t3 - t2).count();
-      if (stopped) {
-        a.code = TIMED_OUT;
-        a.message = "time budget spent after " + std::to_string(a.iterations) + " iterations";
-        a.t_solve = a.solve_time_s;
-        return;
-      }
-      certify_answer(a, M1, M2, w, w_ext, tau_min, tau_max);
-      if (a.code == NOT_CERTIFIED && warm) {
-        // dispatch.solve: a warm start that lands off the certificate is redone cold.
-        a.redone_cold += 1;
-        qp_->settings.initial_guess = proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
-        update(n_eq, H, g, A, b, C, l, u, l_box, u_box);
-        a.iterations += solve_until(has_deadline, deadline, stopped);
-        warm = false;
-        if (stopped) {
-          a.code = TIMED_OUT;
-          a.message = "time budget spent after " + std::to_string(a.iterations) +
-            " iterations";
-          a.t_solve = seconds_since(t2);
-          return;
-        }
-        certify_answer(a, M1, M2, w, w_ext, tau_min, tau_max);
-      }
-      a.warm = warm;
-      a.t_solve = std::chrono::duration<double>(t3 - t2).count();
-      a.t_certify = seconds_since(t3);
     } catch (const std::exception & e) {
       qp_.reset();
       a.code = NOT_SOLVED;
       a.message = std::string("ProxSuite failed: ") + e.what();
+      return false;
+    }
+    if (stopped) {
+      a.code = TIMED_OUT;
+      a.message = "time budget spent after " + std::to_string(a.iterations) + " iterations";
+      return false;
+    }
+    const auto & r = qp_->results;
+    a.message = solver_status(r.info.status);
+    if (r.info.status != proxsuite::proxqp::QPSolverOutput::PROXQP_SOLVED) {
+      a.code = NOT_SOLVED;
+      return false;
+    }
+    a.warm = warm;
+    a.tau = r.x.head(m);
+    a.f = qp.M1() * qp.w + qp.M2() * a.tau;
+    return true;
+  }
+
+  // -- certify (core/certificate.certify) -----------------------------------------------
+  // The residuals of (tau, f) against the exact problem: G f + w_ext = 0, J^T f = tau,
+  // the exact cone, the minimum normal force and the torque bounds.
+  Certificate certify(
+    const RowMat & G, const RowMat & J, const Wrench & w_ext, const Vec & tau_min,
+    const Vec & tau_max, const Vec & tau, const Vec & f) const
+  {
+    Certificate c;
+    if (!std::isfinite(tau.sum() + f.sum())) {
+      std::fill(c.r, c.r + 5, std::numeric_limits<double>::infinity());
+      return c;
+    }
+    c.finite = true;
+    const int p = static_cast<int>(f.size() / 4);
+    double worst_margin = std::numeric_limits<double>::infinity();
+    double min_fz = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < p; ++i) {
+      const double fx = f(4 * i), fy = f(4 * i + 1), fz = f(4 * i + 2), mz = f(4 * i + 3);
+      worst_margin = std::min(worst_margin, fz - std::hypot(fx, fy) / mu1_ - std::abs(mz) / mu2_);
+      min_fz = std::min(min_fz, fz);
+    }
+    c.r[0] = max_abs(G * f + w_ext);
+    c.r[1] = max_abs(J.transpose() * f - tau);
+    c.r[2] = std::max(0.0, -worst_margin);
+    c.r[3] = std::max(0.0, fmin_ - min_fz);
+    c.r[4] = std::max(0.0, std::max((tau_min - tau).maxCoeff(), (tau - tau_max).maxCoeff()));
+    return c;
+  }
+
+  int dims_changes() const {return inits_;}
+  int m() const {return m_;}
+
+private:
+  // One cycle: maps, build, solve_qp, certify (a warm answer off the certificate solved
+  // again cold and certified again, as dispatch.solve does), then the planner's numbers.
+  void run(
+    Answer & a, const Kinematics & k, const Wrench & w_ext, const Vec & off,
+    double time_left, Clock::time_point t0)
+  {
+    if (!maps(k, a.maps, a.message)) {
       return;
     }
-    if (a.code != CERTIFIED) {
+    const auto t1 = Clock::now();
+    a.t_maps = std::chrono::duration<double>(t1 - t0).count();
+
+    QPData & qp = qp_data_;
+    if (!build(a.maps.G, a.maps.J, w_ext, off, qp, a.message)) {
       return;
     }
-    // dispatch.planner_metrics: usage on the unreduced cone, max |tau + offset| / limit.
+    const auto t2 = Clock::now();
+    a.t_build = std::chrono::duration<double>(t2 - t1).count();
+
+    Clock::time_point deadline = Clock::time_point::max();
+    const bool has_deadline = time_left >= 0.0;
+    if (has_deadline) {
+      // dispatch.PRIMARY_SHARE of the time left after the build, as the Python cycle.
+      const double left = time_left - std::chrono::duration<double>(t2 - t0).count();
+      deadline = t2 + std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(s_.primary_share * std::max(0.0, left)));
+    }
+    if (!solve_qp(qp, false, has_deadline, deadline, a)) {
+      a.solve_time_s = a.t_solve = seconds_since(t2);
+      return;
+    }
+    const auto t3 = Clock::now();
+    a.solve_time_s = a.t_solve = std::chrono::duration<double>(t3 - t2).count();
+
+    a.cert = certify(a.maps.G, a.maps.J, w_ext, qp.tau_min, qp.tau_max, a.tau, a.f);
+    a.code = passes(a.cert) ? CERTIFIED : NOT_CERTIFIED;
+    if (a.code == NOT_CERTIFIED && a.warm) {
+      // dispatch.solve: a warm start that lands off the certificate is redone cold.
+      if (!solve_qp(qp, true, has_deadline, deadline, a)) {
+        a.t_solve = seconds_since(t2);
+        return;
+      }
+      a.cert = certify(a.maps.G, a.maps.J, w_ext, qp.tau_min, qp.tau_max, a.tau, a.f);
+      a.code = passes(a.cert) ? CERTIFIED : NOT_CERTIFIED;
+    }
+    a.t_certify = seconds_since(t3);
+    if (a.code == CERTIFIED) {
+      planner_metrics(a, off);
+    }
+  }
+
+  bool passes(const Certificate & c) const
+  {
+    return c.finite && *std::max_element(c.r, c.r + 5) <= s_.certificate_tolerance;
+  }
+
+  // dispatch.planner_metrics: usage on the unreduced cone, max |tau + offset| / limit.
+  void planner_metrics(Answer & a, const Vec & off) const
+  {
+    const int p = static_cast<int>(a.f.size() / 4);
     a.usage.resize(p);
     for (int i = 0; i < p; ++i) {
       const double fx = a.f(4 * i), fy = a.f(4 * i + 1), fz = a.f(4 * i + 2),
@@ -418,47 +577,6 @@ private:
       a.usage(i) = fz > 0.0 ? demand / fz : std::numeric_limits<double>::infinity();
     }
     a.max_torque_ratio = ((a.tau + off).cwiseAbs().array() / limits_.array()).maxCoeff();
-  }
-
-  template<typename M1T, typename M2T>
-  void certify_answer(
-    Answer & a, const M1T & M1, const M2T & M2, const Vec & w,
-    const Eigen::Matrix<double, 6, 1> & w_ext, const Vec & tau_min,
-    const Vec & tau_max)
-  {
-    const auto & r = qp_->results;
-    const std::string status = solver_status(r.info.status);
-    a.message = status;
-    if (r.info.status != proxsuite::proxqp::QPSolverOutput::PROXQP_SOLVED) {
-      a.code = NOT_SOLVED;
-      return;
-    }
-    a.tau = r.x.head(m_);
-    a.f = M1 * w + M2 * a.tau;
-    // core/certificate.certify
-    const int p = static_cast<int>(a.f.size() / 4);
-    if (!std::isfinite(a.tau.sum() + a.f.sum())) {
-      a.finite = false;
-      std::fill(a.cert, a.cert + 5, std::numeric_limits<double>::infinity());
-      a.code = NOT_CERTIFIED;
-      return;
-    }
-    a.finite = true;
-    double worst_margin = std::numeric_limits<double>::infinity();
-    double min_fz = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < p; ++i) {
-      const double fx = a.f(4 * i), fy = a.f(4 * i + 1), fz = a.f(4 * i + 2),
-        mz = a.f(4 * i + 3);
-      worst_margin = std::min(worst_margin, fz - std::hypot(fx, fy) / mu1_ - std::abs(mz) / mu2_);
-      min_fz = std::min(min_fz, fz);
-    }
-    a.cert[0] = max_abs(a.G * a.f + w_ext);
-    a.cert[1] = max_abs(a.J.transpose() * a.f - a.tau);
-    a.cert[2] = std::max(0.0, -worst_margin);
-    a.cert[3] = std::max(0.0, fmin_ - min_fz);
-    a.cert[4] = std::max(0.0, std::max((tau_min - a.tau).maxCoeff(), (a.tau - tau_max).maxCoeff()));
-    const double worst = *std::max_element(a.cert, a.cert + 5);
-    a.code = worst <= s_.certificate_tolerance ? CERTIFIED : NOT_CERTIFIED;
   }
 
   static std::string solver_status(proxsuite::proxqp::QPSolverOutput s)
@@ -476,21 +594,18 @@ private:
   }
 
   // backends/proxsuite.kkt_violation
-  double kkt_violation(
-    const Mat & H, const Vec & g, const Mat & A, const Vec & b, const Mat & C,
-    const Vec & u, const Vec & l_box, const Vec & u_box, const Vec & x,
-    const Vec & y, const Vec & z) const
+  double kkt_violation(const QPData & qp, const Vec & x, const Vec & y, const Vec & z) const
   {
-    const int n_in = static_cast<int>(C.rows());
+    const int n_in = static_cast<int>(qp.C.rows());
     const auto z_C = z.head(n_in);
     const auto z_box = z.tail(x.size());
-    const Vec grad = H * x + g;
-    Vec residual = grad + C.transpose() * z_C + z_box;
-    if (A.rows()) {
-      residual += A.transpose() * y;
+    const Vec grad = qp.H * x + qp.g;
+    Vec residual = grad + qp.C.transpose() * z_C + z_box;
+    if (qp.A.rows()) {
+      residual += qp.A.transpose() * y;
     }
-    const Vec slack = u - C * x;
-    const Vec to_upper = u_box - x, to_lower = x - l_box;
+    const Vec slack = qp.u - qp.C * x;
+    const Vec to_upper = qp.u_box - x, to_lower = x - qp.l_box;
     const double scale = std::max(1.0, max_abs(z));
     double dual = std::max(0.0, z_C.size() ? -z_C.minCoeff() : 0.0);
     for (int i = 0; i < x.size(); ++i) {
@@ -506,18 +621,17 @@ private:
     }
     double primal = std::max({0.0, slack.size() ? -slack.minCoeff() : 0.0,
           -to_upper.minCoeff(), -to_lower.minCoeff()});
-    if (A.rows()) {
-      primal = std::max(primal, max_abs(A * x - b));
+    if (qp.A.rows()) {
+      primal = std::max(primal, max_abs(qp.A * x - qp.b));
     }
     return std::max({max_abs(residual) / std::max(1.0, max_abs(grad)), dual / scale, primal});
   }
 
-  void init(
-    int n, int n_eq, int n_in, const Mat & H, const Vec & g, const Mat & A, const Vec & b,
-    const Mat & C, const Vec & l, const Vec & u, const Vec & l_box, const Vec & u_box)
+  void init(const QPData & qp)
   {
     ++inits_;
-    qp_ = std::make_unique<dense::QP<double>>(n, n_eq, n_in, true,
+    const int n = static_cast<int>(qp.H.rows()), n_eq = qp.n_eq();
+    qp_ = std::make_unique<dense::QP<double>>(n, n_eq, static_cast<int>(qp.C.rows()), true,
                                                proxsuite::proxqp::HessianType::Diagonal,
                                                proxsuite::proxqp::DenseBackend::PrimalDualLDLT);
     auto & st = qp_->settings;
@@ -531,20 +645,20 @@ private:
     st.eps_duality_gap_rel = 0.0;
     st.initial_guess = proxsuite::proxqp::InitialGuessStatus::NO_INITIAL_GUESS;
     if (n_eq) {
-      qp_->init(H, g, A, b, C, l, u, l_box, u_box, true);
+      qp_->init(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, qp.l_box, qp.u_box, true);
     } else {
-      qp_->init(H, g, proxsuite::nullopt, proxsuite::nullopt, C, l, u, l_box, u_box, true);
+      qp_->init(qp.H, qp.g, proxsuite::nullopt, proxsuite::nullopt, qp.C, qp.l, qp.u,
+        qp.l_box, qp.u_box, true);
     }
   }
 
-  void update(
-    int n_eq, const Mat & H, const Vec & g, const Mat & A, const Vec & b, const Mat & C,
-    const Vec & l, const Vec & u, const Vec & l_box, const Vec & u_box)
+  void update(const QPData & qp)
   {
-    if (n_eq) {
-      qp_->update(H, g, A, b, C, l, u, l_box, u_box, false);
+    if (qp.n_eq()) {
+      qp_->update(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, qp.l_box, qp.u_box, false);
     } else {
-      qp_->update(H, g, proxsuite::nullopt, proxsuite::nullopt, C, l, u, l_box, u_box, false);
+      qp_->update(qp.H, qp.g, proxsuite::nullopt, proxsuite::nullopt, qp.C, qp.l, qp.u,
+        qp.l_box, qp.u_box, false);
     }
   }
 
@@ -603,6 +717,7 @@ private:
   bool warm_start_;
   Settings s_;
   std::unique_ptr<dense::QP<double>> qp_;
+  QPData qp_data_;  // the build stage's output, its storage kept from cycle to cycle
   std::tuple<int, int, int> dims_{-1, -1, -1};
   double inner_s_ = 0.0;
   int inits_ = 0;
@@ -622,6 +737,47 @@ py::array_t<double> to_array(const RowMat & m)
   return out;
 }
 
+py::array_t<double> to_array(const Mat & m)
+{
+  return to_array(RowMat(m));
+}
+
+// rotations: p rows of 9 as (p, 3, 3).
+py::array_t<double> to_rotations(const RowMat & r)
+{
+  py::array_t<double> out({r.rows(), py::ssize_t(3), py::ssize_t(3)});
+  std::copy(r.data(), r.data() + r.size(), out.mutable_data());
+  return out;
+}
+
+// The stages' Python entries copy their inputs in and their outputs out: they are for
+// the parity tests, not the hot path. A wrong shape is a ValueError, not Eigen's assert.
+void expect(bool ok, const std::string & what)
+{
+  if (!ok) {
+    throw std::invalid_argument(what);
+  }
+}
+
+RowMat as_matrix(const Array & a, py::ssize_t rows, py::ssize_t cols, const char * name)
+{
+  expect(
+    a.ndim() == 2 && (rows < 0 || a.shape(0) == rows) && (cols < 0 || a.shape(1) == cols),
+    std::string(name) + " of the wrong shape");
+  return Eigen::Map<const RowMat>(a.data(), a.shape(0), a.shape(1));
+}
+
+Vec as_vector(const Array & a, py::ssize_t size, const char * name)
+{
+  expect(a.ndim() == 1 && a.shape(0) == size, std::string(name) + " of the wrong shape");
+  return Eigen::Map<const Vec>(a.data(), size);
+}
+
+Wrench wrench(const Array & a)
+{
+  return as_vector(a, 6, "w_ext");
+}
+
 
 }  // namespace
 
@@ -632,7 +788,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 1;
+  mod.attr("API") = 2;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -661,22 +817,18 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
   .def_readonly("message", &Answer::message)
   .def_property_readonly("tau", [](const Answer & a) {return to_array(a.tau);})
   .def_property_readonly("f", [](const Answer & a) {return to_array(a.f);})
-  .def_property_readonly("G", [](const Answer & a) {return to_array(a.G);})
-  .def_property_readonly("J", [](const Answer & a) {return to_array(a.J);})
-  .def_property_readonly("positions", [](const Answer & a) {return to_array(a.positions);})
-  .def_property_readonly("rotations", [](const Answer & a) {
-      py::array_t<double> out({a.rotations.rows(), py::ssize_t(3), py::ssize_t(3)});
-      std::copy(a.rotations.data(), a.rotations.data() + a.rotations.size(),
-                out.mutable_data());
-      return out;
-    })
+  .def_property_readonly("G", [](const Answer & a) {return to_array(a.maps.G);})
+  .def_property_readonly("J", [](const Answer & a) {return to_array(a.maps.J);})
+  .def_property_readonly("positions", [](const Answer & a) {return to_array(a.maps.positions);})
+  .def_property_readonly("rotations", [](const Answer & a) {return to_rotations(a.maps.rotations);})
   .def_property_readonly("usage", [](const Answer & a) {return to_array(a.usage);})
   .def_readonly("iterations", &Answer::iterations)
   .def_readonly("warm", &Answer::warm)
   .def_readonly("warm_solves", &Answer::warm_solves)
   .def_readonly("redone_cold", &Answer::redone_cold)
   .def_property_readonly("certificate", [](const Answer & a) {
-      return py::make_tuple(a.cert[0], a.cert[1], a.cert[2], a.cert[3], a.cert[4], a.finite);
+      const Certificate & c = a.cert;
+      return py::make_tuple(c.r[0], c.r[1], c.r[2], c.r[3], c.r[4], c.finite);
     })
   .def_readonly("max_torque_ratio", &Answer::max_torque_ratio)
   .def_readonly("solve_time_s", &Answer::solve_time_s)
@@ -695,7 +847,100 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
          py::arg("normals"), py::arg("has_normal"), py::arg("tangents"),
          py::arg("has_tangent"), py::arg("c"), py::arg("w_ext"), py::arg("offset"),
          py::arg("time_left"))
-  .def_property_readonly("inits", &FastCycle::dims_changes);
+  .def_property_readonly("inits", &FastCycle::dims_changes)
+  // The four stages of solve() one by one, on given inputs (the parity tests).
+  .def("maps", [](const FastCycle & fc, Array oMf, Array J6, Array points, Array normals,
+    py::array_t<bool> has_normal, Array tangents, py::array_t<bool> has_tangent, Array c) {
+      Kinematics k;
+      Maps out;
+      std::string why;
+      expect(
+        fc.borrow(oMf, J6, points, normals, has_normal, tangents, has_tangent, c, k, why) &&
+        fc.maps(k, out, why), why);
+      py::dict d;
+      d["G"] = to_array(out.G);
+      d["J"] = to_array(out.J);
+      d["positions"] = to_array(out.positions);
+      d["rotations"] = to_rotations(out.rotations);
+      return d;
+    }, py::arg("oMf"), py::arg("J6"), py::arg("points"), py::arg("normals"),
+    py::arg("has_normal"), py::arg("tangents"), py::arg("has_tangent"), py::arg("c"),
+    "The maps stage: contact frames, G and J (ValueError where it hands back).")
+  .def("build", [](const FastCycle & fc, Array G, Array J, Array w_ext, Array offset) {
+      const RowMat Gm = as_matrix(G, 6, -1, "G");
+      const RowMat Jm = as_matrix(J, Gm.cols(), fc.m(), "J");
+      const Vec off = offset.size() ? as_vector(offset, fc.m(), "offset") : Vec(Vec::Zero(fc.m()));
+      QPData qp;
+      std::string why;
+      expect(fc.build(Gm, Jm, wrench(w_ext), off, qp, why), why);
+      py::dict d;
+      d["H"] = to_array(qp.H);
+      d["g"] = to_array(qp.g);
+      d["A"] = to_array(qp.A);
+      d["b"] = to_array(qp.b);
+      d["C"] = to_array(qp.C);
+      d["l"] = to_array(qp.l);
+      d["u"] = to_array(qp.u);
+      d["l_box"] = to_array(qp.l_box);
+      d["u_box"] = to_array(qp.u_box);
+      d["M1"] = to_array(RowMat(qp.M1()));
+      d["M2"] = to_array(RowMat(qp.M2()));
+      d["w"] = to_array(qp.w);
+      d["tau_min"] = to_array(qp.tau_min);
+      d["tau_max"] = to_array(qp.tau_max);
+      return d;
+    }, py::arg("G"), py::arg("J"), py::arg("w_ext"), py::arg("offset"),
+    "The build stage: the tau-QP of G and J (ValueError where it hands back).")
+  .def("solve_qp", [](FastCycle & fc, Array H, Array g, Array A, Array b, Array C, Array u,
+    Array l_box, Array u_box, Array M1, Array M2, Array w, bool cold, double time_left) {
+      const int m = fc.m();
+      QPData qp;
+      qp.H = as_matrix(H, m, m, "H");
+      qp.g = as_vector(g, m, "g");
+      qp.A = as_matrix(A, -1, m, "A");
+      qp.b = as_vector(b, qp.A.rows(), "b");
+      qp.C = as_matrix(C, -1, m, "C");
+      qp.u = as_vector(u, qp.C.rows(), "u");
+      qp.l.setConstant(qp.C.rows(), -std::numeric_limits<double>::infinity());
+      qp.l_box = as_vector(l_box, m, "l_box");
+      qp.u_box = as_vector(u_box, m, "u_box");
+      const RowMat M1m = as_matrix(M1, -1, 6, "M1");
+      qp.pinv.resize(M1m.rows(), 6 + m);
+      qp.pinv.leftCols(6) = M1m;
+      qp.pinv.rightCols(m) = as_matrix(M2, M1m.rows(), m, "M2");
+      qp.w = as_vector(w, 6, "w");
+      const bool has_deadline = time_left >= 0.0;
+      const auto deadline = has_deadline ? Clock::now() +
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(time_left)) :
+      Clock::time_point::max();
+      Answer a;
+      const bool solved = fc.solve_qp(qp, cold, has_deadline, deadline, a);
+      py::dict d;
+      d["solved"] = solved;
+      d["code"] = a.code;
+      d["message"] = a.message;
+      d["tau"] = to_array(a.tau);
+      d["f"] = to_array(a.f);
+      d["iterations"] = a.iterations;
+      d["warm"] = a.warm;
+      d["warm_solves"] = a.warm_solves;
+      d["redone_cold"] = a.redone_cold;
+      return d;
+    }, py::arg("H"), py::arg("g"), py::arg("A"), py::arg("b"), py::arg("C"), py::arg("u"),
+    py::arg("l_box"), py::arg("u_box"), py::arg("M1"), py::arg("M2"), py::arg("w"),
+    py::arg("cold") = false, py::arg("time_left") = -1.0,
+    "The solve stage on this cycle's ProxSuite QP (warm from its last solve).")
+  .def("certify", [](const FastCycle & fc, Array G, Array J, Array w_ext, Array tau_min,
+    Array tau_max, Array tau, Array f) {
+      const int m = fc.m();
+      const RowMat Gm = as_matrix(G, 6, -1, "G");
+      const Certificate c = fc.certify(
+        Gm, as_matrix(J, Gm.cols(), m, "J"), wrench(w_ext), as_vector(tau_min, m, "tau_min"),
+        as_vector(tau_max, m, "tau_max"), as_vector(tau, m, "tau"), as_vector(f, Gm.cols(), "f"));
+      return py::make_tuple(c.r[0], c.r[1], c.r[2], c.r[3], c.r[4], c.finite);
+    }, py::arg("G"), py::arg("J"), py::arg("w_ext"), py::arg("tau_min"), py::arg("tau_max"),
+    py::arg("tau"), py::arg("f"),
+    "The certify stage: (equilibrium, torque, cone, normal_force, limit, finite).");
 }
 
 #endif  // FAST_CYCLE_HPP_

@@ -52,7 +52,7 @@ import numpy as np
 import pinocchio as pin
 
 #: The interface of src/fast_cycle.hpp this module speaks (its ``API``).
-API = 1
+API = 2
 
 
 def cpu_has_avx2() -> bool:
@@ -235,6 +235,31 @@ class CompiledCycle:
             normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t)
         return c
 
+    def kinematics(self, setup: GraspSetup, compute: bool = True
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return what the maps stage takes from Pinocchio: the contact links' placements, Jacobians.
+
+        Args:
+            setup: the grasp at its configuration.
+            compute: compute the joint Jacobians and frame placements at ``setup.q``
+                here; False: the hand's data already holds them.
+
+        Returns:
+            (oMf, shape (p, 4, 4), base frame; J6, shape (p, 6, nv),
+            pinocchio.LOCAL_WORLD_ALIGNED at each link's origin).
+        """
+        c = self._arrays(setup)
+        model, data = setup.hand.model, setup.hand.data
+        if compute:
+            pin.computeJointJacobians(model, data, setup.q)
+            pin.updateFramePlacements(model, data)
+        placements = data.oMf
+        oMf = np.array([placements[fid].homogeneous for fid in c.frame_ids])
+        J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+                       for fid in c.frame_ids])
+        return oMf, J6
+
     def solve(self, setup: GraspSetup, time_left: float | None, kinematics: bool = True
               ) -> tuple[Solution, GraspMaps] | tuple[None, str]:
         """
@@ -251,15 +276,7 @@ class CompiledCycle:
             (certified solution, maps), or (None, why) when the Python cycle must answer.
         """
         c = self._arrays(setup)
-        hand = setup.hand
-        model, data = hand.model, hand.data
-        if kinematics:
-            pin.computeJointJacobians(model, data, setup.q)
-            pin.updateFramePlacements(model, data)
-        placements = data.oMf
-        oMf = np.array([placements[fid].homogeneous for fid in c.frame_ids])
-        J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-                       for fid in c.frame_ids])
+        oMf, J6 = self.kinematics(setup, kinematics)
         offset = self._no_offset if setup.torque_offset is None else setup.torque_offset
         a = self._cycle.solve(oMf, J6, c.points, c.normals, c.has_normal, c.tangents,
                               c.has_tangent, setup.object_origin, setup.external_wrench,
