@@ -30,23 +30,33 @@ them to the URDF's names before anything is checked against the model
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-import math
 from pathlib import Path
 from typing import Any
 
+from grasp_torque_opt.core.bounded_yaml import (  # noqa: F401 -- MAX_DEPTH: its bound
+    BoundedLoader,
+    MAX_DEPTH,
+    yaml_problem,
+)
 from grasp_torque_opt.core.exceptions import cut, InputError, PATH_LENGTH, quote
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
+from grasp_torque_opt.core.scenario_fields import (
+    mapping as _mapping,
+    margin as _margin,
+    MAX_JOINTS,
+    names as _names,
+    number as _number,
+    positive as _positive,
+    require as _require,
+    vector as _vector,
+)
 import numpy as np
 import yaml
 
 #: Largest scenario file read [bytes] (the bundled ones are about 2 KB).
 MAX_SCENARIO_BYTES = 256 * 1024
-#: Deepest nesting of a scenario document (the schema needs 5 levels).
-MAX_DEPTH = 16
 #: Most contacts of a scenario (1000 took over 4 GB in the QP's dense matrices).
 MAX_CONTACTS = 32
-#: Most actuated joints (``hand.joints``) and most entries of a per-joint list.
-MAX_JOINTS = 64
 #: Most sides of the friction polygon (the node's parameter has the same range; the QP
 #: grows with it: 2N rows per contact).
 MAX_POLYGON_SIDES = 64
@@ -218,73 +228,6 @@ def _object(value: Any, origin: np.ndarray) -> ObjectSpec:
     rpy = (_vector(section['rpy'], 'object.rpy', 3) if section.get('rpy') is not None
            else np.zeros(3))
     return ObjectSpec(shape=shape, size=size, mass=mass, position=position, rpy=rpy)
-
-
-def _mapping(value: Any, name: str, allowed: set[str]) -> dict:
-    if not isinstance(value, dict):
-        raise InputError(name, f'must be a mapping, got {type(value).__name__}')
-    for key in value:
-        if key not in allowed:
-            raise InputError(f'{name}.{cut(key)}' if name else cut(key),
-                             f"unknown field (allowed: {', '.join(sorted(allowed))})")
-    return value
-
-
-def _require(section: dict, key: str, name: str) -> Any:
-    if key not in section or section[key] is None:
-        raise InputError(f'{name}.{key}' if name else key, 'missing required field')
-    return section[key]
-
-
-def _number(value: Any, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(name, f'must be a number, got {quote(value)}')
-    try:
-        x = float(value)
-    except OverflowError:  # an integer of more than 308 digits
-        x = math.inf
-    if not math.isfinite(x):
-        raise InputError(name, f'must be finite, got {quote(value)}')
-    return x
-
-
-def _vector(value: Any, name: str, length: int | None = None) -> np.ndarray:
-    if not isinstance(value, (list, tuple)):
-        raise InputError(name, f'must be a list of numbers, got {quote(value)}')
-    if length is not None and len(value) != length:
-        raise InputError(name, f'must have {length} entries, got {len(value)}')
-    return np.array([_number(v, f'{name}[{i}]') for i, v in enumerate(value)], dtype=float)
-
-
-def _positive(value: Any, name: str) -> float:
-    x = _number(value, name)
-    if x <= 0.0:
-        raise InputError(name, f'must be > 0, got {quote(value)}')
-    return x
-
-
-def _margin(value: Any, name: str = 'friction.margin') -> float:
-    """Parse a friction margin k: finite and >= 0 [-]."""
-    k = _number(value, name)
-    if k < 0.0:
-        raise InputError(name, f'must be >= 0, got {value!r}')
-    return k
-
-
-def _names(value: Any, name: str) -> list[str]:
-    if not isinstance(value, list) or not value:
-        raise InputError(name, 'must be a non-empty list of names')
-    if len(value) > MAX_JOINTS:
-        raise InputError(name, f'{len(value)} names, more than {MAX_JOINTS}')
-    out, seen = [], set()
-    for i, v in enumerate(value):
-        if not isinstance(v, str) or not v:
-            raise InputError(f'{name}[{i}]', f'must be a name, got {quote(v)}')
-        if v in seen:
-            raise InputError(f'{name}[{i}]', f"duplicate name '{cut(v)}'")
-        out.append(v)
-        seen.add(v)
-    return out
 
 
 def parse_name_map(value: Any, name: str = 'hand.name_map') -> dict[str, str]:
@@ -491,51 +434,6 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
                     torque_limits_above_urdf=above_urdf, name_map=names)
 
 
-class _BoundedLoader(yaml.SafeLoader):
-    """
-    PyYAML's SafeLoader without aliases and with nesting bounded by :data:`MAX_DEPTH`.
-
-    An alias repeats a node by reference, so 2.8 KB of nested aliases expand to
-    billions of values (the "billion laughs"); a scenario never needs one. The
-    composer recurses once per level (5000 levels raised RecursionError).
-    """
-
-    _depth = 0
-
-    def compose_node(self, parent, index):
-        if self.check_event(yaml.AliasEvent):
-            mark = self.peek_event().start_mark
-            raise InputError('scenario', f'YAML aliases are not allowed (line {mark.line + 1})')
-        self._depth += 1
-        try:
-            if self._depth > MAX_DEPTH:
-                mark = self.peek_event().start_mark
-                raise InputError('scenario', f'nested more than {MAX_DEPTH} levels deep '
-                                 f'(line {mark.line + 1})')
-            return super().compose_node(parent, index)
-        finally:
-            self._depth -= 1
-
-
-def yaml_problem(error: Exception) -> str:
-    """
-    Say what PyYAML found wrong, and where: ``line L, column C: PROBLEM (CONTEXT at line L)``.
-
-    PyYAML's own message spans several lines (a snippet of the file with a caret);
-    this keeps its marks (1-based) and words on one line.
-    """
-    mark = getattr(error, 'problem_mark', None)
-    problem = getattr(error, 'problem', None)
-    if mark is None or not problem:
-        return cut((str(error).splitlines() or [''])[0])
-    text = f'line {mark.line + 1}, column {mark.column + 1}: {cut(problem)}'
-    context, where = getattr(error, 'context', None), getattr(error, 'context_mark', None)
-    if context:
-        at = '' if where is None else f' at line {where.line + 1}, column {where.column + 1}'
-        text += f' ({cut(context)}{at})'
-    return text
-
-
 def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> Scenario:
     """
     Read and validate a scenario file, within the bounds of the module's docstring.
@@ -550,7 +448,7 @@ def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> S
     path = Path(path)
     text = decode_utf8(read_bounded(path, 'scenario', MAX_SCENARIO_BYTES), path, 'scenario')
     try:
-        data = yaml.load(text, Loader=_BoundedLoader)  # noqa: S506 -- a SafeLoader
+        data = yaml.load(text, Loader=BoundedLoader)  # noqa: S506 -- a SafeLoader
     except (yaml.YAMLError, ValueError) as e:  # ValueError: an integer of 5000 digits
         raise InputError('scenario', f'{cut(path, PATH_LENGTH)} is not valid YAML: '
                          f'{yaml_problem(e)}') from e

@@ -57,7 +57,6 @@ import dataclasses
 from dataclasses import dataclass
 import hashlib
 import json
-import math
 import os
 from pathlib import Path
 import time
@@ -66,10 +65,17 @@ from typing import Any
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.report import strict_json
 from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
 from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.methods.ranking import (  # noqa: F401 -- re-exported, as before
+    format_table,
+    rank,
+    rank_key,
+    RANK_KEYS,
+    record_json,
+    summary,
+)
 import numpy as np
 import yaml
 
@@ -83,9 +89,6 @@ CANDIDATE_KEYS = ('id', 'grasp', 'friction', 'load', 'gravity', 'object', 'objec
 MAX_LINE = 1_000_000
 #: Candidates per task sent to a worker.
 CHUNK = 64
-#: What a rank key sorts by: True for "larger is better".
-RANK_KEYS = {'capacity': True, 'torque_norm': False, 'max_torque_ratio': False,
-             'friction_usage_max': False}
 
 
 @dataclass(frozen=True)
@@ -467,79 +470,3 @@ def _dask_map(job: ScoreJob, tasks: list, workers: int, scheduler: str | None,
     finally:
         if cluster is not None:
             cluster.close()
-
-
-def rank_key(records: Sequence[dict[str, Any]], by: str = 'capacity') -> str:
-    """
-    Return the key :func:`rank` sorts by.
-
-    That is ``by``, or ``torque_norm`` for ``capacity`` when no record has one
-    (``metrics="basic"``).
-
-    Raises:
-        ValueError: ``by`` is not one of :data:`RANK_KEYS`.
-    """
-    if by not in RANK_KEYS:
-        raise ValueError(f"rank key must be one of {', '.join(RANK_KEYS)}, got {by!r}")
-    if by == 'capacity' and not any('capacity' in r for r in records):
-        return 'torque_norm'
-    return by
-
-
-def rank(records: Sequence[dict[str, Any]], by: str = 'capacity') -> list[dict[str, Any]]:
-    """
-    Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
-
-    Without capacities (``metrics="basic"``) ``capacity`` falls back to ``torque_norm``.
-    """
-    by = rank_key(records, by)
-    larger = RANK_KEYS[by]
-
-    def key(r: dict) -> tuple:
-        v = r.get(by)
-        ok = r.get('status') == 'optimal' and v is not None and math.isfinite(v)
-        order = {'optimal': 0, 'infeasible': 1, 'failed': 2}.get(r.get('status'), 3)
-        return (not ok, order, (-v if larger else v) if ok else 0.0, r['line'])
-
-    return sorted(records, key=key)
-
-
-def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
-    """One line: how many of each status, and the rate."""
-    counts: dict[str, int] = {}
-    for r in records:
-        counts[r['status']] = counts.get(r['status'], 0) + 1
-    parts = ', '.join(f'{counts.get(s, 0)} {s}' for s in ('optimal', 'infeasible', 'failed',
-                                                          'error'))
-    rate = len(records) / seconds if seconds > 0 else float('inf')
-    return f'scored {len(records)} candidates in {seconds:.2f} s ({rate:.0f}/s): {parts}'
-
-
-def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
-    """Format the ranked table (text, not a contract)."""
-    def num(v, fmt):
-        return format(v, fmt) if v is not None else '-'.rjust(int(fmt.split('.')[0]))
-
-    full = any('capacity' in r for r in ranked)
-    head = f"{'rank':>4}  {'line':>6}  {'id':<12} {'status':<10} {'|tau| N m':>9} " \
-           f"{'max tau/lim':>11} {'friction':>8}"
-    if full:
-        head += f" {'capacity':>8} {'worst axis':>18}"
-    lines = [head]
-    for i, r in enumerate(ranked[:top], 1):
-        row = (f"{i:>4}  {r['line']:>6}  {str(r.get('id'))[:12]:<12} {r['status']:<10} "
-               f"{num(r.get('torque_norm'), '9.4f')} {num(r.get('max_torque_ratio'), '11.3f')} "
-               f"{num(r.get('friction_usage_max'), '8.3f')}")
-        if full:
-            caps = {k: v for k, v in (r.get('capacities') or {}).items() if v is not None}
-            worst = min(caps, key=caps.get) if caps else None
-            unit = 'N m' if worst and worst[1] == 'M' else 'N'
-            row += (f" {num(r.get('capacity'), '8.3f')} "
-                    f"{(f'{worst} {caps[worst]:.3g} {unit}' if worst else '-'):>18}")
-        lines.append(row)
-    return '\n'.join(lines)
-
-
-def record_json(record: dict[str, Any]) -> str:
-    """Return one record as strict JSON (a non-finite number becomes null)."""
-    return strict_json(record)
