@@ -24,12 +24,14 @@ command line at a time, each to exit 0; ``exit=N`` for the last one), within
 and stderr). ``stop_after=S`` stops a command that runs until stopped (a node) with
 SIGINT after S seconds, which it must end on with exit 0. ``background`` starts the
 block, waits ``wait`` seconds (default 5), keeps it running while the next ``run``
-block of the page runs, then stops it as ``stop_after`` does. A ``python`` block runs as a script with ``.venv/bin/python``.
+block of the page runs, then stops it as ``stop_after`` does. A ``python`` block runs
+as a script with ``.venv/bin/python``.
 ``skip`` needs a ``reason``. An unmarked command block fails.
 
 The commands run in a scratch folder that links every entry of the repository (so the
-files they write stay out of the checkout), on a ROS domain of this run with
-localhost-only discovery; a page's blocks share the folder and run in page order.
+files they write in the current folder stay out of the checkout), on a ROS domain of
+this run with localhost-only discovery; a page's blocks share the folder and run in
+page order.
 """
 
 from dataclasses import dataclass
@@ -73,7 +75,13 @@ class Block:
         """Return the block's command lines, continuation lines joined."""
         lines = self.text.splitlines()
         if any(line.lstrip().startswith('$ ') for line in lines):
-            lines = [line.lstrip()[2:] for line in lines if line.lstrip().startswith('$ ')]
+            # The `$ ` lines and their continuation lines; the rest is output.
+            prompted, continued = [], False
+            for line in lines:
+                if continued or line.lstrip().startswith('$ '):
+                    prompted.append(line if continued else line.lstrip()[2:])
+                    continued = line.rstrip().endswith('\\')
+            lines = prompted
         joined, current = [], ''
         for line in lines:
             if not current and (not line.strip() or line.lstrip().startswith('#')):
@@ -211,7 +219,7 @@ def stop(process: subprocess.Popen, grace: float = 20.0) -> int:
 
 def run_command(command: list[str], cwd: Path, log: Path, timeout: float,
                 stop_after: float | None) -> tuple[int, str]:
-    """Run one command (stopping it with SIGINT after ``stop_after``) and return its exit, output."""
+    """Run one command (SIGINT after ``stop_after``, if given); return its exit and output."""
     process = start(command, cwd, log)
     try:
         process.wait(stop_after if stop_after is not None else timeout)
