@@ -20,8 +20,9 @@ actuators' torques are u = C^T tau, and the hand Jacobian of the QP is J C
 A URDF's mimic tag may name a joint that is not in the model (the Alex file in
 example-robot-data names ``index_q1`` where the joint is ``Right_index_q1``). Such a
 target is resolved by the *prefix rule*: the one joint whose name is the target's with
-a prefix that the follower's name starts with; none or several is an error naming the
-follower and the target.
+a prefix that the follower's name starts with, the prefix ending in one of
+:data:`PREFIX_ENDS` (a namespace such as ``Right_``); none or several is an error naming
+the follower and the target.
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ import pinocchio as pin
 
 #: A position that differs from its coupling by more than this is a contradiction [rad, m].
 COUPLING_TOLERANCE = 1e-6
+#: Characters a namespace prefix of the prefix rule ends with.
+PREFIX_ENDS = '_/-.:'
 
 
 @dataclass(frozen=True)
@@ -95,7 +98,7 @@ def resolve_target(joint: str, target: str, names: list[str]) -> str | None:
     if target in names:
         return target
     found = [n for n in names if len(n) > len(target) and n.endswith(target)
-             and joint.startswith(n[:-len(target)])]
+             and n[-len(target) - 1] in PREFIX_ENDS and joint.startswith(n[:-len(target)])]
     return found[0] if len(found) == 1 else None
 
 

@@ -25,7 +25,7 @@ import os
 from pathlib import Path
 import re
 
-from grasp_torque_opt.core.coupling import COUPLING_TOLERANCE, Coupling, Mimic, urdf_mimics
+from grasp_torque_opt.core.coupling import Coupling, COUPLING_TOLERANCE, Mimic, urdf_mimics
 from grasp_torque_opt.core.exceptions import (
     cut,
     FrameNotFound,
