@@ -213,6 +213,21 @@ class Hand:
             return np.asarray(tau)[self.idx_v].copy()
         return self.velocity_map.T @ tau
 
+    def gravity_torques(self, q: np.ndarray, gravity: np.ndarray) -> np.ndarray:
+        """
+        Return the actuators' gravity torques C^T g(q) [N m], shape (m,).
+
+        Args:
+            q: full configuration.
+            gravity: gravity in the base frame (``base_link``'s axes if set) [m/s^2].
+        """
+        g = np.asarray(gravity, dtype=float)
+        if self.base_link is not None:
+            pin.framesForwardKinematics(self.model, self.data, q)
+            g = self.data.oMf[self.frame_index(self.base_link, 'hand.base_link')].rotation @ g
+        self.model.gravity.linear = g
+        return self.actuator_torques(pin.computeGeneralizedGravity(self.model, self.data, q))
+
     def complete(self, q: np.ndarray) -> np.ndarray:
         """Set the coupled joints' positions in ``q`` from their targets (in place)."""
         return self.coupling.apply(self.model, q)
