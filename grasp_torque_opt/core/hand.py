@@ -202,8 +202,11 @@ class Hand:
 
         Looked up once: the node stamps every command with it.
         """
-        if self.base_link is not None:
-            return self.base_link
+        return self.base_link if self.base_link is not None else self.root_frame
+
+    @cached_property
+    def root_frame(self) -> str:
+        """Return the name of the model's root link (Pinocchio's world, MuJoCo's)."""
         return next(f.name for f in self.model.frames
                     if f.type == pin.FrameType.BODY and f.parentJoint == 0)
 

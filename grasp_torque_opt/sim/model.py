@@ -212,13 +212,13 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     if urdf_xml is None:
         path = resolve_urdf(scenario.urdf, scenario.base_dir)
         urdf_xml, urdf_dir = path.read_text(), path.parent
-    if setup is None:
-        setup = GraspSetup.from_scenario(scenario, urdf_xml)
     try:
         spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml, urdf_dir))
     except (ValueError, RuntimeError) as e:
         raise InputError('hand.urdf', f'MuJoCo cannot load it: '
                          f'{str(e).strip().splitlines()[0]}') from e
+    if setup is None:
+        setup = GraspSetup.from_scenario(scenario, urdf_xml)
     coupled = weld_and_couple(spec, setup.hand, setup.q)
     base = base_placement(setup)
     mu1 = scenario.friction.mu1 if settings.mu_tangential is None else settings.mu_tangential
