@@ -25,7 +25,7 @@ ORIGIN = [0.0817507, 0.0345899, 0.0]
 
 
 def g1_doc(base_link=PALM, posture=None):
-    """A three-finger grasp of the G1's right Dex3-1 hand, written in ``base_link``."""
+    """Write a three-finger grasp of the G1's right Dex3-1 hand in ``base_link``'s frame."""
     hand = {'urdf': G1, 'joints': list(HAND_Q)}
     if base_link:
         hand['base_link'] = base_link

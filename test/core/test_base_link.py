@@ -11,14 +11,15 @@
 import copy
 
 from conftest import setup_from_doc
+from g1_grasp import ARM_Q, g1_doc, HAND_Q, ORIGIN, PALM
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import Hand, MAX_MODEL_DOF
 from grasp_torque_opt.methods.dispatch import solve
-from g1_grasp import ARM_Q, g1_doc, HAND_Q, ORIGIN, PALM
 from independent import assert_holds
 import numpy as np
 import pinocchio as pin
 import pytest
+
 
 def test_the_torques_do_not_depend_on_the_rest_of_the_robot():
     still = setup_from_doc(g1_doc())
@@ -67,8 +68,8 @@ def test_without_hand_joints_a_robot_is_refused_and_a_base_link_picks_its_hand()
 def test_a_joint_above_the_base_link_is_refused():
     doc = g1_doc()
     doc['hand']['joints'] = list(HAND_Q) + ['right_wrist_yaw_joint']
-    with pytest.raises(InputError, match="hand.joints\\[7\\]: joint 'right_wrist_yaw_joint' "
-                                         "does not move below hand.base_link"):
+    with pytest.raises(InputError, match='hand.joints\\[7\\]: joint .right_wrist_yaw_joint. '
+                                         'does not move below hand.base_link'):
         setup_from_doc(doc)
 
 
@@ -80,7 +81,7 @@ def test_an_unknown_base_link_names_close_frames():
 
 
 def chain_urdf(n):
-    """A chain of n revolute joints (a robot bigger than the old 64-DoF bound)."""
+    """Write a chain of n revolute joints (a robot bigger than the old 64-DoF bound)."""
     links = ''.join(f'<link name="l{i}"><inertial><mass value="0.1"/><inertia ixx="1e-4" '
                     'ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>'
                     for i in range(n + 1))

@@ -77,7 +77,7 @@ def test_a_hand_inside_a_robot_is_simulated_with_the_robot_welded():
 
 
 def coupled_allegro():
-    """The bundled Allegro grasp with PAIRS coupled at the grasp's ratios, and rigid."""
+    """Couple PAIRS of the bundled Allegro grasp at the grasp's ratios; also give it rigid."""
     doc = scenario_doc(ALLEGRO)
     q = doc['grasp']['joint_positions']
     actuators = [j for j in doc['hand']['joints'] if j not in dict(PAIRS)]
@@ -92,7 +92,7 @@ def coupled_allegro():
 
 def test_coupled_torques_hold_the_ball_and_the_rigid_share_drops_it():
     """
-    MuJoCo couples the joints (equalities); the coupled optimum holds, the other drops.
+    Hold with the coupled optimum and drop with the rigid share (MuJoCo equalities).
 
     The rigid share: the same actuators solved as if the followers were locked (a
     coupling ignored), the command the issue saw. Impedance 0.1 N m/rad, the least the
