@@ -140,6 +140,11 @@ def adapt_urdf(xml: str, urdf_dir: Path | None = None) -> str:
         for visual in link.findall('visual'):
             link.remove(visual)
     resolve_meshes(root, urdf_dir)
+    for joint in root.iter('joint'):
+        # The hand's coupling (mimic tags resolved, hand.coupling) becomes joint equalities
+        # (sim/robot.py); MuJoCo's own mimic import would add another, or warn and ignore.
+        for mimic in joint.findall('mimic'):
+            joint.remove(mimic)
     for dynamics in root.iter('dynamics'):
         dynamics.set('friction', '0')
         dynamics.set('damping', '0')

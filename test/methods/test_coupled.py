@@ -9,15 +9,19 @@
 """Every method on coupled hands, against joint torques with the coupling as constraints."""
 
 import copy
+import dataclasses
+import json
 
-from conftest import setup_from_doc
+from conftest import CONFIG, setup_from_doc
 from coupled_reference import coupled_lp, coupled_qp, mechanism
 from grasp_torque_opt.methods.capacity import load_capacity
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.methods.explain import explain
+from grasp_torque_opt.methods.score import score_batch, ScoreJob
 from independent import assert_holds
 import numpy as np
 import pytest
+import yaml
 
 #: Allegro fingers with the distal joint coupled to the middle one, as in many hands.
 ALLEGRO_COUPLED = [('joint_3.0', 'joint_2.0'), ('joint_7.0', 'joint_6.0'),
@@ -121,7 +125,6 @@ def test_capacity_and_min_max_equal_the_coupled_joint_torque_lps(hand):
     cap = load_capacity(setup)
     alpha = coupled_lp(uncoupled, uncoupled.maps(), S, A, lim, load=setup.external_wrench)
     assert cap.value == pytest.approx(alpha, rel=1e-6)
-    import dataclasses
     mm = solve(dataclasses.replace(setup, objective='min-max'))
     assert mm.optimal
     t = coupled_lp(uncoupled, uncoupled.maps(), S, A, lim)
@@ -130,7 +133,6 @@ def test_capacity_and_min_max_equal_the_coupled_joint_torque_lps(hand):
 
 def test_explain_names_actuators_on_an_infeasible_coupled_load(hand):
     setup, uncoupled, S, A = hand
-    import dataclasses
     heavy = dataclasses.replace(setup, external_wrench=setup.external_wrench * 200.0)
     sol = solve(heavy)
     assert sol.status == 'infeasible'
@@ -139,3 +141,25 @@ def test_explain_names_actuators_on_an_infeasible_coupled_load(hand):
                        load=heavy.external_wrench)
     assert why.holdable_fraction == pytest.approx(alpha, rel=1e-6)
     assert all(name in setup.hand.joints for name, _ in why.capacity.binding.joints)
+
+
+def test_score_ranks_coupled_candidates_as_single_solves(planar_doc, tmp_path):
+    setup, _, _, _ = coupled(planar_doc, PLANAR_COUPLED)
+    doc = copy.deepcopy(planar_doc)
+    q = doc['grasp']['joint_positions']
+    doc['hand'] = {'urdf': str((CONFIG / doc['hand']['urdf']).resolve()),
+                   'joints': ['joint1', 'joint3'], 'torque_limits': [10.0, 10.0],
+                   'coupling': {f: {'follows': t, 'multiplier': q[f] / q[t]}
+                                for f, t in PLANAR_COUPLED}}
+    for f, _ in PLANAR_COUPLED:
+        del q[f]
+    path = tmp_path / 'coupled.yaml'
+    path.write_text(yaml.safe_dump(doc))
+    loads = [[0.0, -1.0, 1.0, 0.5, 0.0, 0.0], [0.2, -0.5, 0.3, 0.1, 0.0, 0.0]]
+    lines = [(i + 1, json.dumps({'id': str(i), 'load': {'external_wrench': w}}))
+             for i, w in enumerate(loads)]
+    records = score_batch(ScoreJob.from_file(path), lines, engine='serial')
+    for rec, w in zip(records, loads):
+        sol = solve(dataclasses.replace(setup, external_wrench=np.array(w)))
+        assert rec['status'] == sol.status == 'optimal'
+        assert rec['torque_norm'] == pytest.approx(sol.torque_norm, rel=1e-6)
