@@ -41,6 +41,16 @@ def test_the_nodes_torques_hold_the_ball_over_ros(tmp_path):
     assert picture.read_bytes()[:4] == b'\x89PNG'
 
 
+def test_the_g1_hand_inside_its_robot_holds_the_ball_through_the_node():
+    """The bundled G1 grasp: the robot welded, the palm's frame, contacts fed back."""
+    done = run('--with-node', '--params', 'g1_right_node.yaml', '--duration', '1.5', '--kp',
+               '0.1', '--contacts', '--no-picture')
+    assert done.returncode == 0, done.stdout + done.stderr
+    summary = next(line for line in done.stdout.splitlines() if line.startswith('summary: '))
+    assert summary.startswith('summary: held: drift '), summary
+    assert float(re.search(r'drift ([0-9.]+) mm', summary).group(1)) < 1.0
+
+
 def test_bad_arguments_give_one_line_and_exit_2():
     done = run('--kp', '-1', timeout=60)
     assert done.returncode == 2 and done.stdout == ''
