@@ -85,6 +85,8 @@ def sweep_grasp(doc: dict[str, Any], base_dir: Path,
             idx, end = fingers[link]
             q[idx] = s * end
         data.qpos[sim.qpos_adr] = q
+        for follower, target, k, b in sim.followers:  # coupled joints follow their actuators
+            data.qpos[follower] = k * data.qpos[target] + b
         mujoco.mj_forward(sim.model, data)
         return _touching(sim, data)
 
@@ -122,7 +124,7 @@ def sweep_grasp(doc: dict[str, Any], base_dir: Path,
     model = setup.hand.model
     full = setup.q.copy()
     full[setup.hand.idx_q] = q
-    pin.framesForwardKinematics(model, setup.hand.data, full)
+    pin.framesForwardKinematics(model, setup.hand.data, setup.hand.complete(full))
     positions = {n: round(float(v), 4) for n, v in zip(joints, q)}
     doc['grasp']['joint_positions'] = {**doc['grasp'].get('joint_positions', {}), **positions}
     for contact in doc['grasp']['contacts']:

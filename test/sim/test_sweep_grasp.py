@@ -13,7 +13,7 @@ import copy
 from conftest import CONFIG, scenario_doc
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import load_scenario
+from grasp_torque_opt.core.scenario import load_scenario, parse_scenario
 from grasp_torque_opt.sim.hold import hold, HoldSettings
 from grasp_torque_opt.sim.sweep_grasp import sweep_grasp
 import numpy as np
@@ -75,3 +75,21 @@ def test_the_bundled_g1_grasp_holds_its_ball_with_its_torques_only():
     assert held.held, held.reason
     dropped = hold(scenario, HoldSettings(kp=0.1, duration=1.0, feedforward=0.0))
     assert not dropped.held, dropped.reason
+
+
+def test_the_sweep_moves_coupled_joints_with_their_actuators():
+    """On the Ability hand (URDF mimic tags), the contacts found lie on the ball."""
+    doc = {'hand': {'urdf': 'example-robot-data:alex_description/urdf/alex_psyonic_hands.urdf',
+                    'base_link': 'RightPsyonicAbilityBaseLink'},
+           'grasp': {'object_origin': [-0.025, 0.04, 0.1],
+                     'contacts': [{'link': 'Right_thumb_L2'}, {'link': 'Right_index_L2'}]},
+           'friction': {'mu_tangential': 1.0, 'mu_torsional': 0.005, 'polygon_sides': 8},
+           'object': {'shape': 'sphere', 'size': [0.025], 'mass': 0.1},
+           'gravity': [0.0, 0.0, -9.81]}
+    closed = {'Right_index_L2': {'Right_index_q1': 2.0},
+              'Right_thumb_L2': {'Right_thumb_q1': -1.3, 'Right_thumb_q2': 1.5}}
+    made = sweep_grasp(doc, CONFIG, closed)
+    assert 'Right_index_q2' not in made['grasp']['joint_positions']  # it follows
+    setup = GraspSetup.from_scenario(parse_scenario(made, CONFIG))
+    distances = np.linalg.norm(setup.maps().positions - [-0.025, 0.04, 0.1], axis=1)
+    np.testing.assert_allclose(distances, 0.025, atol=1e-4)
