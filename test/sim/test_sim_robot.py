@@ -9,13 +9,14 @@
 """Any URDF the solver accepts in MuJoCo: meshes, a welded robot, coupled joints."""
 
 import copy
+import re
 
 from conftest import ALLEGRO, CONFIG, scenario_doc
 from g1_grasp import ARM_Q, g1_doc, ORIGIN, PALM
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import example_robot_data_dir
-from grasp_torque_opt.core.scenario import parse_scenario
+from grasp_torque_opt.core.scenario import load_scenario, parse_scenario
 from grasp_torque_opt.sim.hold import certified_torques, hold, HoldSettings
 from grasp_torque_opt.sim.model import build_model
 from grasp_torque_opt.sim.robot import resolve_mesh
@@ -105,6 +106,32 @@ def test_coupled_torques_hold_the_ball_and_the_rigid_share_drops_it():
     settings = HoldSettings(kp=0.1, duration=1.0)
     sim = build_model(scenario, setup=setup)
     assert sim.model.neq == len(PAIRS)
+    held = hold(scenario, settings)
+    assert held.held, held.reason
+    dropped = hold(scenario, settings, tau=wrong.tau)
+    assert not dropped.held and dropped.max_drift > 0.01, dropped.reason
+
+
+def test_the_bundled_ability_grasp_holds_with_actuator_torques_and_drops_with_the_rigid_share():
+    """
+    The issue's case on the real coupled hand: u = C^T tau holds, the q1 share drops.
+
+    The rigid share: the URDF without its mimic tags, each q2 locked where the coupling
+    puts it, the same six actuators solved: the command that ignored the coupling.
+    """
+    scenario = load_scenario(CONFIG / 'ability_right.yaml')
+    setup, _, sol, _ = certified_torques(scenario)
+    rigid_doc = scenario_doc(CONFIG / 'ability_right.yaml')
+    model = setup.hand.model
+    for f in ('Right_index_q2', 'Right_middle_q2', 'Right_ring_q2', 'Right_pinky_q2'):
+        rigid_doc['grasp']['joint_positions'][f] = float(setup.q[model.joints[
+            model.getJointId(f)].idx_q])
+    xml = (example_robot_data_dir() / 'alex_description/urdf/alex_psyonic_hands.urdf')
+    rigid_xml = re.sub(r'<mimic[^>]*/>', '', xml.read_text())
+    _, _, wrong, _ = certified_torques(parse_scenario(rigid_doc, CONFIG), rigid_xml)
+    # The coupled fingers need more than their q1 share (index and middle here).
+    assert np.all(sol.tau[:2] > wrong.tau[:2] * 1.2)
+    settings = HoldSettings(kp=0.1, duration=1.0)
     held = hold(scenario, settings)
     assert held.held, held.reason
     dropped = hold(scenario, settings, tau=wrong.tau)

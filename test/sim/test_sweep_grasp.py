@@ -93,3 +93,15 @@ def test_the_sweep_moves_coupled_joints_with_their_actuators():
     setup = GraspSetup.from_scenario(parse_scenario(made, CONFIG))
     distances = np.linalg.norm(setup.maps().positions - [-0.025, 0.04, 0.1], axis=1)
     np.testing.assert_allclose(distances, 0.025, atol=1e-4)
+
+
+def test_the_sweep_makes_the_bundled_ability_grasp_again():
+    bundled = scenario_doc(CONFIG / 'ability_right.yaml')
+    closed = {'Right_index_L2': {'Right_index_q1': 2.0},
+              'Right_middle_L2': {'Right_middle_q1': 2.0},
+              'Right_thumb_L2': {'Right_thumb_q1': -1.3, 'Right_thumb_q2': 1.5}}
+    made = sweep_grasp(unswept(bundled), CONFIG, closed)
+    assert made['grasp']['joint_positions'] == pytest.approx(bundled['grasp']['joint_positions'],
+                                                             abs=1e-4)
+    for a, b in zip(made['grasp']['contacts'], bundled['grasp']['contacts']):
+        np.testing.assert_allclose(a['position'], b['position'], atol=2e-5)
