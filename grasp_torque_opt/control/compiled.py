@@ -115,6 +115,10 @@ def unsupported(setup: GraspSetup, method: str, solver) -> str:
     """
     if _fast_cycle is None:
         return IMPORT_ERROR
+    if setup.hand.velocity_map is not None:
+        return 'coupled joints (the compiled cycle takes a column selection of J)'
+    if setup.hand.base_link is not None:
+        return 'hand.base_link (the compiled cycle writes the grasp in the root frame)'
     if method != 'tau-qp':
         return f'method {method} (the compiled cycle solves tau-qp)'
     if setup.objective != 'sum-of-squares':

@@ -94,6 +94,9 @@ class Cycle:
         setup = self.setup
         hand = setup.hand
         q = inputs.q
+        if hand.coupling.mimics:
+            # Coupled joints follow their actuators, whatever a joint state says of them.
+            q = hand.complete(q.copy())
         model, data = hand.model, hand.data
         if jacobians:
             pin.computeJointJacobians(model, data, q)
@@ -103,7 +106,9 @@ class Cycle:
         contacts = setup.contacts
         if inputs.contacts is not None:
             cp = inputs.contacts
-            oMF = data.oMf[model.getFrameId(cp.frame)] if cp.frame else pin.SE3.Identity()
+            oMF = data.oMf[model.getFrameId(cp.frame or hand.base_frame)]
+            if hand.base_link is not None:  # the grasp is written in the base link's frame
+                oMF = data.oMf[model.getFrameId(hand.base_link)].actInv(oMF)
             contacts = []
             limit = self.config.max_contact_distance
             for i, (spec, p, R) in enumerate(zip(setup.contacts, cp.positions, cp.rotations)):
@@ -114,20 +119,27 @@ class Cycle:
                                      f'max_contact_distance ({limit} m)')
                 R_base = oMF.rotation @ R
                 oMl = data.oMf[model.getFrameId(spec.link)]
+                if hand.base_link is not None:
+                    oMl = data.oMf[model.getFrameId(hand.base_link)].actInv(oMl)
                 contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(oMF.act(p)),
                                             normal=R_base[:, 2], tangent=R_base[:, 0]))
         wrench = setup.external_wrench
         if inputs.wrench is not None:
             frame, w = inputs.wrench
-            R = data.oMf[model.getFrameId(frame)].rotation if frame else np.eye(3)
+            R = data.oMf[model.getFrameId(frame or hand.base_frame)].rotation
+            if hand.base_link is not None:
+                R = data.oMf[model.getFrameId(hand.base_link)].rotation.T @ R
             wrench = np.concatenate((R @ w[:3], R @ w[3:]))
         elif inputs.gravity is not None and self.load_of_gravity is not None:
             wrench = self.load_of_gravity(inputs.gravity)
         g = None
         if self.config.gravity_compensation:
-            model.gravity.linear = np.asarray(
+            gravity = np.asarray(
                 self.config.gravity if inputs.gravity is None else inputs.gravity, dtype=float)
-            g = pin.computeGeneralizedGravity(model, data, q)[hand.idx_v].copy()
+            if hand.base_link is not None:  # given in the base link's axes; Pinocchio's: root
+                gravity = data.oMf[model.getFrameId(hand.base_link)].rotation @ gravity
+            model.gravity.linear = gravity
+            g = hand.actuator_torques(pin.computeGeneralizedGravity(model, data, q))
         return replaced(setup, q=q, contacts=contacts, external_wrench=wrench,
                         torque_offset=g), g
 

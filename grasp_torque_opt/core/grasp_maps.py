@@ -16,7 +16,9 @@ functions here only stack them.
   base axes: G_i = [[R_i, 0], [skew(p_i - c) R_i, R_i e_z]] on [fx, fy, fz, mz].
 - J (4p x m): rows of the 6 x nv Jacobian (pinocchio.LOCAL_WORLD_ALIGNED) of
   the point of the finger link that coincides with p_i, projected on x_i, y_i,
-  z_i (linear part) and z_i (angular part), actuated columns only.
+  z_i (linear part) and z_i (angular part), actuated columns only (J C, C the
+  coupling's velocity map, with coupled joints: then J^T f is the actuators' u).
+  With ``hand.base_link`` every point and axis is in that frame, not the model's root.
   tau = J^T f.
 """
 
@@ -142,6 +144,13 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
         oMf = data.oMf[fid]
         po[i] = oMf.act(spec.position)
         po[p + i] = oMf.translation
+    Rb = None
+    if hand.base_link is not None:
+        # The grasp is written in hand.base_link: points, and below the Jacobians' rows, in
+        # its axes (the actuated joints move only links below it: Hand.from_model).
+        oMb = data.oMf[hand.frame_index(hand.base_link, 'hand.base_link')]
+        Rb = oMb.rotation
+        po = (po - oMb.translation) @ Rb
     points = po[:p]
     normals = [spec.normal for spec in contacts]
     for i, n in enumerate(normals):
@@ -166,7 +175,11 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
     Gb[3:, :, 3] = R[:, :, 2].T
 
     J6 = np.array([pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-                   for fid in fids])[:, :, hand.idx_v]
+                   for fid in fids])
+    # Actuated columns: J C with coupled joints (dq = C dtheta), else a column selection.
+    J6 = J6[:, :, hand.idx_v] if hand.velocity_map is None else J6 @ hand.velocity_map
+    if Rb is not None:
+        J6 = np.concatenate((Rb.T @ J6[:, :3], Rb.T @ J6[:, 3:]), axis=1)
     ang = J6[:, 3:]
     Jb = np.empty((p, 4, hand.m))
     # Velocity of the contact point: v_o + w x (p - o) = J_v - skew(p - o) J_w.

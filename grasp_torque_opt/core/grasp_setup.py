@@ -80,10 +80,11 @@ class GraspSetup:
         above = scenario.torque_limits_above_urdf
         if urdf_xml:
             hand = Hand.from_urdf_string(urdf_xml, scenario.joints, scenario.torque_limits,
-                                         above)
+                                         above, scenario.coupling, scenario.base_link)
         else:
             hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
-                                  scenario.joints, scenario.torque_limits, above)
+                                  scenario.joints, scenario.torque_limits, above,
+                                  scenario.coupling, scenario.base_link)
         weights = np.ones(hand.m) if scenario.weights is None else np.asarray(scenario.weights)
         if weights.shape != (hand.m,):
             raise InputError('objective.weights',

@@ -25,6 +25,7 @@ import os
 from pathlib import Path
 import re
 
+from grasp_torque_opt.core.coupling import Coupling, COUPLING_TOLERANCE, Mimic, urdf_mimics
 from grasp_torque_opt.core.exceptions import (
     cut,
     FrameNotFound,
@@ -45,8 +46,14 @@ MAX_URDF_BYTES = 2 * 1024 * 1024
 #: Most ``<joint`` and ``<link`` elements each (transmissions name joints too), counted
 #: before Pinocchio parses the document (a 256-joint chain took 0.8 s to build here).
 MAX_URDF_ELEMENTS = 512
-#: Most degrees of freedom (nv) of a model: its workspace is allocated next.
+#: Most actuated joints of a hand (its actuators: coupled joints count once).
 MAX_MODEL_DOF = 64
+#: Most degrees of freedom (nv) of the whole model (a hand inside a robot): its workspace
+#: is allocated next.
+MAX_ROBOT_DOF = 128
+#: Most one-DoF joints a model may have for ``hand.joints`` to be left out: a model with
+#: more is a robot around a hand, whose legs and arms must not become actuators.
+MAX_IMPLICIT_JOINTS = 30
 _ELEMENT = {tag: re.compile(rf'<{tag}[\s/>]') for tag in ('joint', 'link')}
 
 
@@ -139,12 +146,18 @@ class Hand:
     A hand model with its actuated joints in command order.
 
     Attributes:
-        model: Pinocchio model; its world frame is the base frame.
-        joints: actuated joint names in command order (m of them).
+        model: Pinocchio model; its world frame is the root frame.
+        joints: actuated joint names in command order (m of them): with coupled
+            joints, the actuators (docs/design.md section 1).
         data: Pinocchio workspace of ``model``.
         idx_q: index of each actuated joint in q, shape (m,).
         idx_v: index of each actuated joint in v (columns of the Jacobians), shape (m,).
         torque_limits: |tau_i| <= torque_limits[i] [N m], shape (m,).
+        coupling: the coupled joints (URDF mimic tags and ``hand.coupling``).
+        velocity_map: C, shape (nv, m), dq = C dtheta, or None when no coupled joint
+            follows an actuator (then C selects the columns ``idx_v``).
+        base_link: the frame the grasp is written in (``hand.base_link``), or None for
+            the model's root link.
     """
 
     model: pin.Model
@@ -152,6 +165,9 @@ class Hand:
     idx_q: np.ndarray
     idx_v: np.ndarray
     torque_limits: np.ndarray
+    coupling: Coupling = field(default_factory=Coupling)
+    velocity_map: np.ndarray | None = None
+    base_link: str | None = None
     data: pin.Data = field(init=False, repr=False, compare=False)
     _frame_ids: dict[str, int] = field(init=False, repr=False, compare=False)
 
@@ -182,12 +198,42 @@ class Hand:
     @cached_property
     def base_frame(self) -> str:
         """
-        Return the name of the root link: the base frame.
+        Return the name of the base frame: ``base_link``, else the root link.
 
         Looked up once: the node stamps every command with it.
         """
+        return self.base_link if self.base_link is not None else self.root_frame
+
+    @cached_property
+    def root_frame(self) -> str:
+        """Return the name of the model's root link (Pinocchio's world, MuJoCo's)."""
         return next(f.name for f in self.model.frames
                     if f.type == pin.FrameType.BODY and f.parentJoint == 0)
+
+    def actuator_torques(self, tau: np.ndarray) -> np.ndarray:
+        """Return u = C^T tau, shape (m,), from joint torques tau of shape (nv,) [N m]."""
+        if self.velocity_map is None:
+            return np.asarray(tau)[self.idx_v].copy()
+        return self.velocity_map.T @ tau
+
+    def gravity_torques(self, q: np.ndarray, gravity: np.ndarray) -> np.ndarray:
+        """
+        Return the actuators' gravity torques C^T g(q) [N m], shape (m,).
+
+        Args:
+            q: full configuration.
+            gravity: gravity in the base frame (``base_link``'s axes if set) [m/s^2].
+        """
+        g = np.asarray(gravity, dtype=float)
+        if self.base_link is not None:
+            pin.framesForwardKinematics(self.model, self.data, q)
+            g = self.data.oMf[self.frame_index(self.base_link, 'hand.base_link')].rotation @ g
+        self.model.gravity.linear = g
+        return self.actuator_torques(pin.computeGeneralizedGravity(self.model, self.data, q))
+
+    def complete(self, q: np.ndarray) -> np.ndarray:
+        """Set the coupled joints' positions in ``q`` from their targets (in place)."""
+        return self.coupling.apply(self.model, q)
 
     @staticmethod
     def one_dof_joints(model: pin.Model) -> list[str]:
@@ -226,32 +272,64 @@ class Hand:
     @classmethod
     def from_model(cls, model: pin.Model, joints: list[str] | None = None,
                    torque_limits: float | list[float] | np.ndarray | None = None,
-                   above_urdf: bool = False) -> Hand:
+                   above_urdf: bool = False, mimics: list[Mimic] | None = None,
+                   base_link: str | None = None) -> Hand:
         """
         Bind actuated joints and limits to a model.
 
         Args:
             model: the Pinocchio model.
-            joints: actuated joints in command order; None for every 1-DoF joint.
+            joints: actuated joints in command order; None for every 1-DoF joint that
+                follows no other (below ``base_link`` if given).
             torque_limits: scalar or per-joint bound [N m]; None for the URDF
                 effort limits.
             above_urdf: allow limits above the URDF's effort limits (up to
                 :data:`MAX_TORQUE_LIMIT`).
+            mimics: coupled joints (the URDF's, then the scenario's over them).
+            base_link: the frame of the grasp (``hand.base_link``), or None.
 
         Raises:
             JointNotFound: a joint is not a 1-DoF joint of the model (``hand.joints[i]``).
             InputError: a limit is missing, not positive, or above the joint's URDF
-                effort limit without ``above_urdf`` (``hand.torque_limits``).
+                effort limit without ``above_urdf`` (``hand.torque_limits``); a coupled
+                joint listed as actuated; an actuated joint not below ``base_link``; a
+                robot-sized model without ``hand.joints``.
         """
-        if model.nv > MAX_MODEL_DOF:
+        if model.nv > MAX_ROBOT_DOF:
             raise InputError('hand.urdf', f'the model has {model.nv} degrees of freedom, more '
-                             f'than {MAX_MODEL_DOF}')
+                             f'than {MAX_ROBOT_DOF}')
+        coupling = Coupling.resolve(model, mimics or [])
+        followers = coupling.followers
         available = cls.one_dof_joints(model)
+        base_joint = None
+        if base_link is not None:
+            if not model.existFrame(base_link):
+                raise FrameNotFound('hand.base_link', base_link, frame_names(model))
+            base_joint = model.frames[model.getFrameId(base_link)].parentJoint
         if joints is None:
-            joints = available
+            joints = [n for n in available if n not in followers and (
+                base_joint is None or cls._below(model, n, base_joint))]
+            if len(joints) > MAX_IMPLICIT_JOINTS:
+                raise InputError('hand.joints', f'required: the model has {len(joints)} '
+                                 f'one-DoF joints, more than a hand ({MAX_IMPLICIT_JOINTS}); '
+                                 "list the hand's joints (or set hand.base_link to the hand's "
+                                 'palm: then the joints below it are the default)')
+        if len(joints) > MAX_MODEL_DOF:
+            raise InputError('hand.joints', f'{len(joints)} actuated joints, more than '
+                             f'{MAX_MODEL_DOF}')
         for i, name in enumerate(joints):
             if name not in available:
                 raise JointNotFound(f'hand.joints[{i}]', name, available)
+            if name in followers:
+                m = followers[name]
+                raise InputError(f'hand.joints[{i}]', f"'{name}' follows '{m.target}' "
+                                 f'(coupled in {m.source}): list its actuator '
+                                 f"'{coupling.root(name)}' only")
+        if base_joint is not None:
+            for i, name in enumerate(joints):
+                if not cls._below(model, name, base_joint):
+                    raise InputError(f'hand.joints[{i}]', f"joint '{name}' does not move "
+                                     f"below hand.base_link '{base_link}'")
         ids = [model.getJointId(n) for n in joints]
         idx_q = np.array([model.joints[j].idx_q for j in ids], dtype=int)
         idx_v = np.array([model.joints[j].idx_v for j in ids], dtype=int)
@@ -276,17 +354,28 @@ class Hand:
                 bounds[known] = np.minimum(effort[known], MAX_TORQUE_LIMIT)
             cls.check_limits(limits, list(joints), bounds, 'hand.torque_limits',
                              'hand.torque_limits_above_urdf')
+        C = coupling.velocity_map(model, idx_v)
+        selection = np.count_nonzero(C) == len(joints)
         return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
-                   torque_limits=np.array(limits, dtype=float))
+                   torque_limits=np.array(limits, dtype=float), coupling=coupling,
+                   velocity_map=None if selection else C, base_link=base_link)
+
+    @staticmethod
+    def _below(model: pin.Model, name: str, base_joint: int) -> bool:
+        """Tell whether joint ``name`` moves its child links relative to ``base_joint``'s."""
+        j = model.getJointId(name)
+        return j != base_joint and base_joint in list(model.supports[j])
 
     @classmethod
     def from_urdf(cls, path: str | Path, joints: list[str] | None = None,
                   torque_limits: float | list[float] | np.ndarray | None = None,
-                  above_urdf: bool = False) -> Hand:
+                  above_urdf: bool = False, mimics: list[Mimic] | None = None,
+                  base_link: str | None = None) -> Hand:
         """
         Load a hand from a URDF file, within the module's bounds.
 
-        The base is fixed; meshes are not needed.
+        The base is fixed; meshes are not needed. The URDF's mimic tags couple joints,
+        ``mimics`` (the scenario's ``hand.coupling``) over them.
         """
         path = Path(path)
         xml = decode_utf8(read_bounded(path, 'hand.urdf', MAX_URDF_BYTES), path, 'hand.urdf')
@@ -295,12 +384,14 @@ class Hand:
         except (RuntimeError, ValueError) as e:
             raise InputError('hand.urdf',
                              f'cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}') from e
-        return cls.from_model(model, joints, torque_limits, above_urdf)
+        return cls.from_model(model, joints, torque_limits, above_urdf,
+                              urdf_mimics(xml) + list(mimics or []), base_link)
 
     @classmethod
     def from_urdf_string(cls, xml: str, joints: list[str] | None = None,
                          torque_limits: float | list[float] | np.ndarray | None = None,
-                         above_urdf: bool = False) -> Hand:
+                         above_urdf: bool = False, mimics: list[Mimic] | None = None,
+                         base_link: str | None = None) -> Hand:
         """
         Load a hand from a URDF document, within the module's bounds.
 
@@ -310,15 +401,20 @@ class Hand:
             model = pin.buildModelFromXML(bounded_urdf(xml, 'robot_description'))
         except (RuntimeError, ValueError) as e:
             raise InputError('robot_description', f'cannot parse the URDF: {cut(e, 400)}') from e
-        return cls.from_model(model, joints, torque_limits, above_urdf)
+        return cls.from_model(model, joints, torque_limits, above_urdf,
+                              urdf_mimics(xml) + list(mimics or []), base_link)
 
     def configuration(self, positions: dict[str, float],
                       field: str = 'grasp.joint_positions') -> np.ndarray:
         """
         Full configuration q from joint positions by name; others stay at 0.
 
+        Coupled joints take the positions their coupling gives; one given a position
+        that contradicts it is an error.
+
         Raises:
             JointNotFound: a name is not a 1-DoF joint of the model.
+            InputError: a coupled joint's position contradicts its coupling.
         """
         q = pin.neutral(self.model)
         available = self.one_dof_joints(self.model)
@@ -326,4 +422,12 @@ class Hand:
             if name not in available:
                 raise JointNotFound(f'{field}.{name}', name, available)
             q[self.model.joints[self.model.getJointId(name)].idx_q] = value
+        self.complete(q)
+        for m in self.coupling.mimics:
+            value = q[self.model.joints[self.model.getJointId(m.joint)].idx_q]
+            if m.joint not in positions or abs(positions[m.joint] - value) <= COUPLING_TOLERANCE:
+                continue
+            raise InputError(f'{field}.{m.joint}', f'is {positions[m.joint]:.6g}, but '
+                             f"'{m.joint}' = {m.multiplier:g} * '{m.target}' + {m.offset:g} "
+                             f'= {value:.6g} (coupled in {m.source}); leave it out')
         return q

@@ -38,6 +38,7 @@ from grasp_torque_opt.core.bounded_yaml import (  # noqa: F401 -- MAX_DEPTH: its
     MAX_DEPTH,
     yaml_problem,
 )
+from grasp_torque_opt.core.coupling import Mimic
 from grasp_torque_opt.core.exceptions import cut, InputError, PATH_LENGTH, quote
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
 from grasp_torque_opt.core.scenario_fields import (
@@ -46,6 +47,7 @@ from grasp_torque_opt.core.scenario_fields import (
     MAX_JOINTS,
     names as _names,
     number as _number,
+    parse_coupling,
     positive as _positive,
     require as _require,
     vector as _vector,
@@ -163,6 +165,9 @@ class Scenario:
             name -> URDF name; ``hand.name_map`` with the caller's entries over it):
             ``joints``, ``joint_positions`` and the contacts' links are already the
             URDF's names.
+        coupling: ``hand.coupling``: coupled joints besides the URDF's mimic tags.
+        base_link: ``hand.base_link``: the frame the grasp, gravity and load are
+            written in, or None for the model's root link.
     """
 
     urdf: str
@@ -182,6 +187,8 @@ class Scenario:
     objective: str = 'sum-of-squares'
     torque_limits_above_urdf: bool = False
     name_map: dict[str, str] = field(default_factory=dict)
+    coupling: list[Mimic] = field(default_factory=list)
+    base_link: str | None = None
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
@@ -198,7 +205,8 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 
 
 _SECTIONS = {
-    'hand': {'urdf', 'joints', 'torque_limits', 'torque_limits_above_urdf', 'name_map'},
+    'hand': {'urdf', 'joints', 'torque_limits', 'torque_limits_above_urdf', 'name_map',
+             'coupling', 'base_link'},
     'grasp': {'joint_positions', 'object_origin', 'contacts'},
     'friction': {'mu_tangential', 'mu_torsional', 'polygon_sides', 'min_normal_force',
                  'margin'},
@@ -332,6 +340,12 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
                                  f'got {len(limits)}')
         else:
             limits = _positive(limits, 'hand.torque_limits')
+    coupling = parse_coupling(hand.get('coupling'), names)
+    base_link = hand.get('base_link')
+    if base_link is not None:
+        if not isinstance(base_link, str) or not base_link:
+            raise InputError('hand.base_link', f'must be a frame name, got {quote(base_link)}')
+        base_link = names.get(base_link, base_link)
     above_urdf = hand.get('torque_limits_above_urdf', False)
     if not isinstance(above_urdf, bool):
         raise InputError('hand.torque_limits_above_urdf', 'must be true or false')
@@ -431,7 +445,8 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
                     joint_positions=positions, object_origin=origin, contacts=contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,
                     object=obj, gravity=gravity, extra_wrench=extra, objective=kind,
-                    torque_limits_above_urdf=above_urdf, name_map=names)
+                    torque_limits_above_urdf=above_urdf, name_map=names, coupling=coupling,
+                    base_link=base_link)
 
 
 def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> Scenario:

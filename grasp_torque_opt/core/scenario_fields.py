@@ -19,11 +19,13 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from grasp_torque_opt.core.coupling import Mimic
 from grasp_torque_opt.core.exceptions import cut, InputError, quote
 import numpy as np
 
 #: Most joints a scenario may list (the model's size is bounded where it is loaded).
 MAX_JOINTS = 64
+_COUPLING_KEYS = {'follows', 'multiplier', 'offset'}
 
 
 def mapping(value: Any, name: str, allowed: set[str]) -> dict:
@@ -90,4 +92,37 @@ def names(value: Any, name: str) -> list[str]:
             raise InputError(f'{name}[{i}]', f"duplicate name '{cut(v)}'")
         out.append(v)
         seen.add(v)
+    return out
+
+
+def parse_coupling(value: Any, names: dict[str, str]) -> list[Mimic]:
+    """
+    Validate ``hand.coupling``: joint -> {follows: joint, multiplier: k, offset: b}.
+
+    Args:
+        value: the section as parsed (None: no coupling).
+        names: the scenario's name map (scenario name -> URDF name).
+
+    Returns:
+        One :class:`Mimic` per entry, URDF names (the targets resolved by the hand).
+    """
+    if value is None:
+        return []
+    if not isinstance(value, dict):
+        raise InputError('hand.coupling', 'must be a mapping joint -> {follows, multiplier, '
+                         f'offset}}, got {quote(value)}')
+    if len(value) > MAX_JOINTS:
+        raise InputError('hand.coupling', f'{len(value)} entries, more than {MAX_JOINTS}')
+    out = []
+    for joint, entry in value.items():
+        if not isinstance(joint, str) or not joint:
+            raise InputError('hand.coupling', f'a key must be a joint name, got {quote(joint)}')
+        field = f'hand.coupling.{cut(joint)}'
+        entry = mapping(entry, field, _COUPLING_KEYS)
+        target = require(entry, 'follows', field)
+        if not isinstance(target, str) or not target:
+            raise InputError(f'{field}.follows', f'must be a joint name, got {quote(target)}')
+        k = number(entry.get('multiplier', 1.0), f'{field}.multiplier')
+        b = number(entry.get('offset', 0.0), f'{field}.offset')
+        out.append(Mimic(names.get(joint, joint), names.get(target, target), k, b, field))
     return out

@@ -217,7 +217,7 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
 
     dt = sim_model.model.opt.timestep
     period = 1.0 / args.rate
-    base = hand.base_frame
+    base = hand.root_frame  # MuJoCo's world: the simulated contacts are read in it
 
     def publish() -> None:
         stamp = node.get_clock().now().to_msg()
@@ -360,10 +360,11 @@ def _publish_contacts(hsim, setup, pub, base, stamp, compute_grasp_maps, Pose, P
         return
     q = setup.q.copy()
     q[setup.hand.idx_q] = hsim.q
-    maps = compute_grasp_maps(setup.hand, q, setup.contacts, setup.object_origin)
+    maps = compute_grasp_maps(setup.hand, setup.hand.complete(q), setup.contacts,
+                              setup.object_origin)
     msg = PoseArray()
     msg.header.frame_id, msg.header.stamp = base, stamp
-    for r, R_plan in zip(readings, maps.rotations):
+    for r, R_plan in zip(readings, hsim.sim.base_rotation @ maps.rotations):
         z = r.normal
         x = R_plan[:, 0] - (R_plan[:, 0] @ z) * z
         x /= np.linalg.norm(x)

@@ -28,7 +28,6 @@ from grasp_torque_opt.methods import solve
 from grasp_torque_opt.sim.model import build_model, SimSettings
 from grasp_torque_opt.sim.simulator import friction_usage, HandSim, wrench_in_frame
 import numpy as np
-import pinocchio as pin
 
 
 @dataclass(frozen=True)
@@ -138,17 +137,17 @@ def certified_torques(scenario: Scenario, urdf_xml: str | None = None
 
 def gravity_torque(setup: GraspSetup, q: np.ndarray, gravity: np.ndarray) -> np.ndarray:
     """g(q) of the actuated joints for a full configuration q [N m]."""
-    model = setup.hand.model
-    model.gravity.linear = np.asarray(gravity, dtype=float)
-    data = model.createData()
-    return pin.computeGeneralizedGravity(model, data, q)[setup.hand.idx_v].copy()
+    return setup.hand.gravity_torques(q, gravity)
 
 
 def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
-         sim_settings: SimSettings = SimSettings(), urdf_xml: str | None = None
-         ) -> HoldReport:
+         sim_settings: SimSettings = SimSettings(), urdf_xml: str | None = None,
+         tau: np.ndarray | None = None) -> HoldReport:
     """
     Run one hold episode of the scenario's certified torques.
+
+    ``tau`` (actuator torques [N m], shape (m,)) replaces them when given: e.g. another
+    method's, to see whether they hold too (the certified solution stays in the report).
 
     Raises:
         InputError: the scenario cannot be simulated (field named).
@@ -158,18 +157,15 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
     setup, maps, sol, _ = certified_torques(scenario, urdf_xml)
     if not sol.optimal:
         raise ValueError(f'no certified torques to simulate: {sol.status} ({sol.message})')
-    sim_model = build_model(scenario, sim_settings, urdf_xml)
+    sim_model = build_model(scenario, sim_settings, urdf_xml, setup)
     hand = setup.hand
     hsim = HandSim(sim_model, setup.q[hand.idx_q], settings.kp, settings.kd)
-    model = hand.model
-    model.gravity.linear = np.asarray(scenario.gravity, dtype=float)
-    data = model.createData()
     q_full = setup.q.copy()
-    feedforward = settings.feedforward * sol.tau
+    feedforward = settings.feedforward * (sol.tau if tau is None else np.asarray(tau))
 
     def command() -> np.ndarray:
         q_full[hand.idx_q] = hsim.q
-        return feedforward + pin.computeGeneralizedGravity(model, data, q_full)[hand.idx_v]
+        return feedforward + hand.gravity_torques(hand.complete(q_full), scenario.gravity)
 
     dt = sim_model.model.opt.timestep
     for _ in range(max(1, round(settings.settle / dt))):
@@ -206,7 +202,7 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
 
     contacts = []
     for i, (link, r) in enumerate(zip(maps.links, readings)):
-        w_sim = wrench_in_frame(r, maps.rotations[i])
+        w_sim = wrench_in_frame(r, sim_model.base_rotation @ maps.rotations[i])
         w_pred = sol.wrenches[i]
         mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
         contacts.append(ContactReport(link, w_pred, w_sim, friction_usage(w_pred, mu1, mu2),

@@ -33,14 +33,18 @@ the bundled grasp), ``impratio`` 10 and a few noslip iterations.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 import xml.etree.ElementTree as ET
 
 from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.scenario import ObjectSpec, Scenario
+from grasp_torque_opt.sim.robot import resolve_meshes, weld_and_couple
 import mujoco
 import numpy as np
+import pinocchio as pin
 
 #: Contact bits: hand geoms (type 1, affinity 2) touch the object (type 2, affinity 1) only.
 _HAND_BITS, _OBJECT_BITS = (1, 2), (2, 1)
@@ -94,6 +98,10 @@ class SimModel:
         gravity: gravity in the base frame [m/s^2], shape (3,).
         mu_tangential: simulated tangential friction [-].
         mu_torsional: simulated torsional friction [m].
+        base_rotation: the base frame's axes in MuJoCo's world (the URDF's root),
+            shape (3, 3): identity unless ``hand.base_link``.
+        followers: coupled joints that move, (qpos address, its target's, multiplier,
+            offset): a MuJoCo joint equality holds each; the simulator starts them on it.
     """
 
     model: mujoco.MjModel
@@ -107,14 +115,17 @@ class SimModel:
     gravity: np.ndarray
     mu_tangential: float
     mu_torsional: float
+    base_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    followers: tuple[tuple[int, int, float, float], ...] = ()
 
 
-def adapt_urdf(xml: str) -> str:
+def adapt_urdf(xml: str, urdf_dir: Path | None = None) -> str:
     """
     Rewrite the URDF as MuJoCo should load it.
 
-    No joint friction or damping, no visuals, and a ``<mujoco><compiler .../></mujoco>``
-    extension (see the module docstring).
+    No joint friction or damping, no visuals, collision meshes at absolute paths
+    (:func:`grasp_torque_opt.sim.robot.resolve_meshes`, relative ones in ``urdf_dir``),
+    and a ``<mujoco><compiler .../></mujoco>`` extension (see the module docstring).
 
     Raises:
         InputError: the document is not XML with a ``robot`` root (field ``hand.urdf``).
@@ -128,6 +139,12 @@ def adapt_urdf(xml: str) -> str:
     for link in root.iter('link'):
         for visual in link.findall('visual'):
             link.remove(visual)
+    resolve_meshes(root, urdf_dir)
+    for joint in root.iter('joint'):
+        # The hand's coupling (mimic tags resolved, hand.coupling) becomes joint equalities
+        # (sim/robot.py); MuJoCo's own mimic import would add another, or warn and ignore.
+        for mimic in joint.findall('mimic'):
+            joint.remove(mimic)
     for dynamics in root.iter('dynamics'):
         dynamics.set('friction', '0')
         dynamics.set('damping', '0')
@@ -135,7 +152,7 @@ def adapt_urdf(xml: str) -> str:
         root.remove(old)
     ext = ET.SubElement(root, 'mujoco')
     ET.SubElement(ext, 'compiler', balanceinertia='true', fusestatic='false',
-                  discardvisual='true', angle='radian')
+                  discardvisual='true', angle='radian', strippath='false')
     return ET.tostring(root, encoding='unicode')
 
 
@@ -147,9 +164,13 @@ def rpy_quaternion(rpy: np.ndarray) -> np.ndarray:
 
 
 def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec, mass: float, friction: list[float],
-                timeconst: float) -> None:
-    body = spec.worldbody.add_body(name=OBJECT_BODY, pos=list(obj.position),
-                                   quat=list(rpy_quaternion(obj.rpy)))
+                timeconst: float, base: tuple[np.ndarray, np.ndarray]) -> None:
+    R, t = base  # the base frame's rotation and origin in MuJoCo's world
+    quat, Rb = np.zeros(4), np.zeros(4)
+    mujoco.mju_mat2Quat(Rb, np.ascontiguousarray(R).ravel())
+    mujoco.mju_mulQuat(quat, Rb, rpy_quaternion(obj.rpy))
+    body = spec.worldbody.add_body(name=OBJECT_BODY, pos=list(R @ obj.position + t),
+                                   quat=list(quat))
     body.add_freejoint(name=f'{OBJECT_BODY}_free')
     if obj.shape == 'sphere':
         kind, size = mujoco.mjtGeom.mjGEOM_SPHERE, [obj.size[0], 0.0, 0.0]
@@ -165,7 +186,7 @@ def _add_object(spec: mujoco.MjSpec, obj: ObjectSpec, mass: float, friction: lis
 
 
 def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
-                urdf_xml: str | None = None) -> SimModel:
+                urdf_xml: str | None = None, setup: GraspSetup | None = None) -> SimModel:
     """
     Compile the scenario's hand and object into a MuJoCo model.
 
@@ -173,9 +194,14 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         scenario: a validated scenario with ``object`` and ``gravity``.
         settings: simulation settings (friction and mass overrides included).
         urdf_xml: a URDF document to use instead of the scenario's ``hand.urdf``.
+        setup: the scenario bound to its hand (made here if None): which joints move,
+            their coupling, and where ``hand.base_link`` is.
 
     Returns:
-        The model, with the object at its pose and every joint at 0.
+        The model, with the object at its pose, the actuators at 0, their followers at
+        their grasp positions and every other joint welded at its grasp position.
+        MuJoCo's world is the URDF's root; the object and gravity are placed there from
+        ``hand.base_link``'s frame.
 
     Raises:
         InputError: naming the field: no object or gravity in the scenario, a
@@ -187,19 +213,25 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
                          '(shape, size, mass)')
     if scenario.gravity is None:
         raise InputError('gravity', "the simulation needs the scenario's gravity")
+    urdf_dir = None
     if urdf_xml is None:
-        urdf_xml = resolve_urdf(scenario.urdf, scenario.base_dir).read_text()
+        path = resolve_urdf(scenario.urdf, scenario.base_dir)
+        urdf_xml, urdf_dir = path.read_text(), path.parent
     try:
-        spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml))
+        spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml, urdf_dir))
     except (ValueError, RuntimeError) as e:
         raise InputError('hand.urdf', f'MuJoCo cannot load it: '
                          f'{str(e).strip().splitlines()[0]}') from e
+    if setup is None:
+        setup = GraspSetup.from_scenario(scenario, urdf_xml)
+    coupled = weld_and_couple(spec, setup.hand, setup.q)
+    base = base_placement(setup)
     mu1 = scenario.friction.mu1 if settings.mu_tangential is None else settings.mu_tangential
     mu2 = scenario.friction.mu2 if settings.mu_torsional is None else settings.mu_torsional
     mass = scenario.object.mass if settings.mass is None else settings.mass
     friction = [mu1, mu2, 0.0]
     spec.option.timestep = settings.timestep
-    spec.option.gravity = [float(x) for x in scenario.gravity]
+    spec.option.gravity = [float(x) for x in base[0] @ scenario.gravity]
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = settings.impratio
     spec.option.noslip_iterations = settings.noslip_iterations
@@ -208,7 +240,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         geom.condim = 4
         geom.solref = [settings.contact_timeconst, 1.0]
         geom.contype, geom.conaffinity = _HAND_BITS
-    _add_object(spec, scenario.object, mass, friction, settings.contact_timeconst)
+    _add_object(spec, scenario.object, mass, friction, settings.contact_timeconst, base)
     try:
         model = spec.compile()
     except (ValueError, RuntimeError) as e:
@@ -218,7 +250,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     names = [model.joint(j).name for j in range(model.njnt)
              if int(model.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_HINGE),
                                            int(mujoco.mjtJoint.mjJNT_SLIDE))]
-    joints = scenario.joints if scenario.joints is not None else names
+    joints = setup.hand.joints
     for i, name in enumerate(joints):
         if name not in names:
             raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
@@ -243,4 +275,19 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         dof_adr=np.array([model.joint(n).dofadr[0] for n in joints]),
         object_body=model.body(OBJECT_BODY).id, object_qpos=int(free.qposadr[0]),
         object_dof=int(free.dofadr[0]), contact_bodies=tuple(bodies),
-        gravity=np.array(scenario.gravity, dtype=float), mu_tangential=mu1, mu_torsional=mu2)
+        gravity=np.array(scenario.gravity, dtype=float), mu_tangential=mu1, mu_torsional=mu2,
+        base_rotation=base[0],
+        followers=tuple((int(model.joint(m.joint).qposadr[0]),
+                         int(model.joint(m.target).qposadr[0]), m.multiplier, m.offset)
+                        for m in coupled))
+
+
+def base_placement(setup: GraspSetup) -> tuple[np.ndarray, np.ndarray]:
+    """Rotation and origin of the grasp's base frame in the URDF root's, at the grasp."""
+    hand = setup.hand
+    if hand.base_link is None:
+        return np.eye(3), np.zeros(3)
+    data = hand.model.createData()
+    pin.framesForwardKinematics(hand.model, data, setup.q)
+    oMb = data.oMf[hand.model.getFrameId(hand.base_link)]
+    return oMb.rotation.copy(), oMb.translation.copy()

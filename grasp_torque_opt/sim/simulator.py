@@ -72,6 +72,7 @@ class HandSim:
         self.kp, self.kd = kp, kd
         self.data = mujoco.MjData(self.model)
         self.data.qpos[sim.qpos_adr] = q0
+        self._follow()
         self.q_ref = np.array(q0, dtype=float)
         self.command = np.zeros(len(sim.joints))
         self._pose = self.data.qpos[sim.object_qpos:sim.object_qpos + 7].copy()
@@ -128,6 +129,12 @@ class HandSim:
         if self.hold_joints:
             d.qpos[s.qpos_adr] = self.q_ref
             d.qvel[s.dof_adr] = 0.0
+            self._follow()
+
+    def _follow(self) -> None:
+        """Put the coupled joints where their couplings say (their equalities hold them)."""
+        for follower, target, k, b in self.sim.followers:
+            self.data.qpos[follower] = k * self.data.qpos[target] + b
 
     def object_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Object position [m] and quaternion [w, x, y, z], base frame."""

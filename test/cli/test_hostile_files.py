@@ -107,7 +107,7 @@ def hostile_files(tmp_path, planar_doc) -> list[tuple[str, str, str]]:
     d['grasp']['joint_positions'] = {}
     d['grasp']['contacts'] = [{'link': 'l500'}, {'link': 'l250'}]
     write('500_joint_urdf', yaml.safe_dump(d), 'hand.urdf: the model has 500 degrees of '
-          'freedom, more than 64')
+          'freedom, more than 128')
     for label, urdf, expect in (('urdf_directory', str(tmp_path), 'hand.urdf: .* is a '
                                  'directory, not a file'),
                                 ('urdf_device', '/dev/zero', 'hand.urdf: /dev/zero is not a '

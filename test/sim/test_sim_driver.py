@@ -13,6 +13,7 @@ import re
 import subprocess
 import sys
 
+import pytest
 from ros_harness import DOMAIN
 
 
@@ -39,6 +40,17 @@ def test_the_nodes_torques_hold_the_ball_over_ros(tmp_path):
     commands = int(re.search(r'; (\d+) commands', summary).group(1))
     assert commands > 100  # 1.5 s at 250 joint states a second
     assert picture.read_bytes()[:4] == b'\x89PNG'
+
+
+@pytest.mark.parametrize('params', ['g1_right_node.yaml', 'ability_right_node.yaml'])
+def test_a_hand_inside_its_robot_holds_the_ball_through_the_node(params):
+    """The bundled G1 and Ability grasps: robot welded, base link's frame, contacts fed back."""
+    done = run('--with-node', '--params', params, '--duration', '1.5', '--kp', '0.1',
+               '--contacts', '--no-picture')
+    assert done.returncode == 0, done.stdout + done.stderr
+    summary = next(line for line in done.stdout.splitlines() if line.startswith('summary: '))
+    assert summary.startswith('summary: held: drift '), summary
+    assert float(re.search(r'drift ([0-9.]+) mm', summary).group(1)) < 1.0
 
 
 def test_bad_arguments_give_one_line_and_exit_2():
