@@ -104,16 +104,15 @@ def test_the_preset_runs_the_imu_reads_the_base_and_efforts_are_published():
     """
     The driver's own preset, the base accelerating 5 m/s^2 along +x from release on.
 
-    The settling is long enough for this listener to be matched before the release. The
-    driver waits for no listener with a baseline: on this shared machine discovery now and
-    then fails to match in time (nothing heard at all); the run is then tried again, at
-    most three times.
+    The driver waits for no listener with a baseline: on this shared machine discovery
+    now and then matches late (the settling's readings missed) or not at all within
+    the run (a topic not heard); the run is then tried again, at most three times.
     """
     args = ['--controller', 'preset', '--preset-level', '1.0', '--duration', '0.5',
-            '--settle', '1.5', '--base-accel', '5,0,0', '--no-picture']
+            '--settle', '2', '--base-accel', '5,0,0', '--no-picture']
     for attempt in range(3):
         imus, states, out, err, code = listen(args, 101 + (DOMAIN + attempt) % 100)
-        if imus or states:
+        if imus and states:
             break
     assert code in (0, 1), out + err
     assert 'controller preset; base acceleration [5, 0, 0] m/s^2' in out
@@ -121,10 +120,12 @@ def test_the_preset_runs_the_imu_reads_the_base_and_efforts_are_published():
     assert imus and states, out + err
     forces = np.array([[m.linear_acceleration.x, m.linear_acceleration.y,
                         m.linear_acceleration.z] for m in imus])
-    # Specific force a - g: palm down (g = 9.81 along +x) at rest, then 5 m/s^2 along +x.
+    # Specific force a - g: palm down (g = 9.81 along +x) at rest, then 5 m/s^2 along +x
+    # (the readings at rest are heard when discovery is quick; test_sim_base_motion.py
+    # checks them without ROS).
     at_rest = np.all(np.isclose(forces, [-9.81, 0, 0], atol=1e-6), axis=1)
     moving = np.all(np.isclose(forces, [5 - 9.81, 0, 0], atol=1e-6), axis=1)
-    assert at_rest.any() and moving.any() and np.all(at_rest | moving), forces
+    assert moving.any() and np.all(at_rest | moving), forces
     assert all(m.header.frame_id == 'palm_link' for m in imus)
     assert all(m.orientation_covariance[0] == -1.0 for m in imus)
     assert all(m.angular_velocity.x == m.angular_velocity.y == m.angular_velocity.z == 0.0
