@@ -8,12 +8,12 @@
 """
 Robustness benchmark (issue 24, item 6): the node and two baselines on a disturbed hand.
 
-Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1]
+Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--rate 250]
        [--out bench/results/robustness.json] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
 Allegro grasp, in simulated time (the rig of grasp-torque-sim, without ROS): the
-controller is asked at 250 Hz with the encoder's reading, the fingers press on the
+controller is asked at --rate (250 Hz) with the encoder's reading, the fingers press on the
 pinned ball for 0.3 s, the ball is released and watched for --duration seconds. The
 controllers:
 
@@ -86,10 +86,17 @@ def grid(smoke: bool) -> list[tuple[str, str, dict]]:
     return cases
 
 
-def node_controller(setup):
-    """Return the node's cycle as a controller: a joint state in, its command out."""
-    ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True, cycle_budget=1.0),
-                            fallback='daqp')
+def node_controller(setup, gravity):
+    """
+    Return the node's cycle as a controller: a joint state in, its command out.
+
+    Configured as config/allegro_right_node.yaml configures the node: gravity
+    compensation with the scenario's gravity (the parameter's default from the
+    scenario), DAQP as the fallback; the budget generous, as the node's tests set it.
+    """
+    config = CycleConfig(gravity_compensation=True, gravity=tuple(float(x) for x in gravity),
+                         cycle_budget=1.0)
+    ctrl = TorqueController(setup, config, fallback='daqp')
     names = list(setup.hand.joints)
     clock = {'t': 0.0}
 
@@ -106,7 +113,7 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
     setup, rig = simulated(scenario, settings)
     reference = None
     if controller == 'node':
-        command = node_controller(setup)
+        command = node_controller(setup, scenario.gravity)
     elif controller == 'preset':
         command = Preset(setup, scenario.gravity, preset_level)
     else:
@@ -120,14 +127,15 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
             'effort_Nm': r.mean_effort}
 
 
-def run(duration: float, gains: tuple[float, ...], smoke: bool) -> dict:
+def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0) -> dict:
     scenario = load_scenario(find_config('allegro_right.yaml'))
-    out = {'duration_s': duration, 'gains': list(gains), 'rows': [], 'presets': {}}
+    out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
+           'presets': {}}
     for kp in gains:
-        tuned = tune_preset(scenario, kp, 0.01)
+        tuned = tune_preset(scenario, kp, 0.01, rate=rate)
         out['presets'][str(kp)] = {'level_N': tuned.level, 'drift_mm': 1e3 * tuned.drift}
         for family, label, fields in grid(smoke):
-            settings = EpisodeSettings(kp=kp, duration=duration, **fields)
+            settings = EpisodeSettings(kp=kp, duration=duration, rate=rate, **fields)
             out['rows'].append({'kp': kp, 'family': family, 'case': label, **{
                 c: episode(scenario, c, settings, tuned.level) for c in CONTROLLERS}})
     return out
@@ -135,7 +143,8 @@ def run(duration: float, gains: tuple[float, ...], smoke: bool) -> dict:
 
 def tables(r: dict) -> str:
     lines = ['Held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
-             f"joint torque after release) over {r['duration_s']:g} s; preset levels: "
+             f"joint torque after release) over {r['duration_s']:g} s, controllers asked at "
+             f"{r['rate_hz']:g} Hz; preset levels: "
              + ', '.join(f"Kp {k}: {p['level_N']:.2f} N" for k, p in r['presets'].items()),
              '', '| Kp | family | cases | ' + ' | '.join(
                  f'{c} held | {c} effort [N m]' for c in CONTROLLERS) + ' |',
@@ -162,13 +171,16 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument('--duration', type=float, default=3.0, help='simulated hold [s]')
     p.add_argument('--gains', default='0.3,1', help='driver Kp values [N m/rad]')
+    p.add_argument('--rate', type=float, default=250.0,
+                   help="how often the controllers are asked [Hz] (grasp-torque-sim's joint "
+                        'state rate)')
     p.add_argument('--out', type=Path, default=Path('bench/results/robustness.json'))
     p.add_argument('--smoke', action='store_true',
                    help='one case per family, Kp 1, 0.5 s: that it runs')
     a = p.parse_args()
     gains = (1.0,) if a.smoke else tuple(float(k) for k in a.gains.split(','))
     duration = 0.5 if a.smoke else a.duration
-    r = run(duration, gains, a.smoke)
+    r = run(duration, gains, a.smoke, a.rate)
     r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
     report(r, tables(r), None if a.smoke else a.out,
            f"commit {r['commit']}, {len(r['rows']) * len(CONTROLLERS)} episodes"
