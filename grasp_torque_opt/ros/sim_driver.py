@@ -35,11 +35,9 @@ from pathlib import Path
 import sys
 import time
 
-from grasp_torque_opt.core.command_line import add_version, HelpFormatter
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
+from grasp_torque_opt.ros.sim_options import check, describe, parser, PROG, rig_settings
 import numpy as np
-
-PROG = 'grasp-torque-sim'
 
 
 def _description() -> str:
@@ -47,59 +45,10 @@ def _description() -> str:
     return __doc__.split('Exit code:')[0].strip()
 
 
-def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog=PROG, formatter_class=HelpFormatter,
-                                description=_description(), epilog=(
-                                    'exit codes: 0 held, 1 not held (or no commands), 2 bad '
-                                    'input. docs/simulation.md'))
-    add_version(p)
-    p.add_argument('--params', default='allegro_right_node.yaml',
-                   help='node params file (bundled name or path); its scenario is simulated')
-    p.add_argument('--duration', type=float, default=3.0,
-                   help='seconds to hold after release [s]')
-    p.add_argument('--settle', type=float, default=0.3,
-                   help='seconds the commands press on the pinned object before release [s]')
-    p.add_argument('--kp', type=float, default=1.0, help='joint impedance stiffness [N m/rad]')
-    p.add_argument('--kd', type=float, default=0.01,
-                   help='joint impedance damping [N m s/rad]')
-    p.add_argument('--rate', type=float, default=250.0, help='joint state rate [Hz]')
-    p.add_argument('--contacts', action='store_true',
-                   help="publish the contact frames measured in the simulation on 'contacts'")
-    p.add_argument('--mu-tangential', type=float, default=None,
-                   help="simulated tangential friction [-] (default: the scenario's)")
-    p.add_argument('--mu-torsional', type=float, default=None,
-                   help="simulated torsional friction [m] (default: the scenario's)")
-    p.add_argument('--drift-limit', type=float, default=1.0,
-                   help='the object counts as held while it moves less than this [mm]')
-    p.add_argument('--picture', default='grasp_sim.png',
-                   help='PNG of the grasp written at the end, in the current folder unless a '
-                        'path')
-    p.add_argument('--no-picture', action='store_true', help='write no picture')
-    p.add_argument('--with-node', action='store_true',
-                   help='start grasp_torque_node in a child process')
-    p.add_argument('--wait', type=float, default=30.0,
-                   help='how long to wait for the node and its first command [s]')
-    return p
-
-
-def _check(args: argparse.Namespace) -> str:
-    for name in ('duration', 'rate', 'wait', 'drift_limit'):
-        if not getattr(args, name) > 0:
-            return f"--{name.replace('_', '-')}: must be > 0"
-    for name in ('settle', 'kp', 'kd'):
-        if not getattr(args, name) >= 0:
-            return f'--{name}: must be >= 0'
-    for name in ('mu_tangential', 'mu_torsional'):
-        value = getattr(args, name)
-        if value is not None and not value > 0:
-            return f"--{name.replace('_', '-')}: must be > 0"
-    return ''
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the simulated hand; exit code 0 when the object stayed held."""
-    args = _parser().parse_args(argv)
-    reason = _check(args)
+    args = parser(_description()).parse_args(argv)
+    reason = check(args)
     if reason:
         print(f'{PROG}: error: {reason}', file=sys.stderr)
         return 2
@@ -114,24 +63,44 @@ def main(argv: list[str] | None = None) -> int:
     from grasp_torque_opt.core.exceptions import InputError
     from grasp_torque_opt.core.resources import find_config
     from grasp_torque_opt.core.scenario import load_scenario
-    from grasp_torque_opt.sim.model import build_model, SimSettings
+    from grasp_torque_opt.sim.episode import simulated
+    from grasp_torque_opt.sim.model import SimSettings
 
     if args.with_node:
         isolate()
     try:
         params = find_config(args.params, '--params')
         scenario = load_scenario(find_config(scenario_of(params)))
-        sim_model = build_model(scenario, SimSettings(mu_tangential=args.mu_tangential,
-                                                      mu_torsional=args.mu_torsional))
-    except InputError as e:
+        setup, rig = simulated(scenario, rig_settings(args), sim=SimSettings(
+            mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional))
+        baseline = _baseline(args, scenario, setup)
+    except (InputError, ValueError) as e:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
         with node_process(params, args.with_node):
-            return _run(args, scenario, sim_model)
+            return _run(args, scenario, setup, rig, baseline)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
         return 130
+
+
+def _baseline(args: argparse.Namespace, scenario, setup):
+    """Return the baseline controller asked for (None: the node), and say how it is set."""
+    from grasp_torque_opt.sim.baselines import Preset, Squeeze, tune_preset
+
+    if args.controller == 'preset':
+        level = args.preset_level
+        if level is None:
+            tuned = tune_preset(scenario, args.kp, args.kd, rate=args.rate)
+            level = tuned.level
+            print(f'{PROG}: preset level {level:.3f} N, tuned on the nominal load at Kp '
+                  f'{args.kp:g} N m/rad (the level of least drift, '
+                  f'{tuned.drift * 1e3:.2f} mm in 1 s)', flush=True)
+        return Preset(setup, scenario.gravity, level)
+    if args.controller == 'impedance':
+        return Squeeze(setup, scenario.gravity, args.squeeze_depth * 1e-3)
+    return None
 
 
 def _predicted(message: str) -> list[np.ndarray] | None:
@@ -150,22 +119,20 @@ def _predicted(message: str) -> list[np.ndarray] | None:
         return None
 
 
-def _run(args: argparse.Namespace, scenario, sim_model) -> int:
+def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
     from geometry_msgs.msg import Pose, PoseArray
     from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
     from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME, SERVICE_QOS
-    from grasp_torque_opt.sim.simulator import friction_usage, HandSim
+    from grasp_torque_opt.ros.sim_topics import imu_message, publish_contacts
+    from grasp_torque_opt.sim.simulator import friction_usage
     import rclpy
     from rclpy.qos import qos_profile_sensor_data
-    from sensor_msgs.msg import JointState
+    from sensor_msgs.msg import Imu, JointState
     from std_msgs.msg import Float64MultiArray
     from std_srvs.srv import Trigger
 
-    setup = GraspSetup.from_scenario(scenario)
     hand = setup.hand
-    hsim = HandSim(sim_model, setup.q[hand.idx_q], args.kp, args.kd)
-    names = list(sim_model.joints)
+    names = list(hsim.sim.joints)
     m = len(names)
     mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
 
@@ -173,6 +140,7 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     node = rclpy.create_node('grasp_sim_driver')
     js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
     contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+    imu_pub = node.create_publisher(Imu, 'imu', qos_profile_sensor_data)
     solve = node.create_client(Trigger, f'{NODE_NAME}/solve', qos_profile=SERVICE_QOS)
     state = {'command': None, 'commands': 0, 'malformed': 0, 'predicted': None,
              'pending': None}
@@ -204,31 +172,38 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
             if result is not None and result.success:
                 state['predicted'] = _predicted(result.message) or state['predicted']
 
+    disturbed = describe(args)
     print(f'{PROG}: {Path(scenario.source).name} in MuJoCo {_mujoco_version()}, {m} joints, '
           f'1 kHz physics, joint states at {args.rate:g} Hz, impedance Kp {args.kp:g} N m/rad '
-          f'Kd {args.kd:g} N m s/rad')
+          f'Kd {args.kd:g} N m s/rad, controller {args.controller}'
+          + (f'; {disturbed}' if disturbed else ''), flush=True)
     deadline = time.monotonic() + args.wait
-    while js_pub.get_subscription_count() == 0 and time.monotonic() < deadline:
+    while baseline is None and js_pub.get_subscription_count() == 0 and \
+            time.monotonic() < deadline:
         rclpy.spin_once(node, timeout_sec=0.1)
-    if js_pub.get_subscription_count() == 0:
+    if baseline is None and js_pub.get_subscription_count() == 0:
         print(f'{PROG}: no {NODE_NAME} is listening on joint_states (start one, or '
               'use --with-node)', file=sys.stderr)
         return close(1)
 
-    dt = sim_model.model.opt.timestep
+    dt = hsim.model.opt.timestep
     period = 1.0 / args.rate
-    base = hand.root_frame  # MuJoCo's world: the simulated contacts are read in it
+    base = hand.base_frame
 
     def publish() -> None:
         stamp = node.get_clock().now().to_msg()
-        js = JointState(name=names, position=[float(x) for x in hsim.q],
+        js = JointState(name=names, position=[float(x) for x in hsim.reading],
                         velocity=[float(x) for x in hsim.qdot],
                         effort=[float(x) for x in hsim.effort()])
         js.header.stamp = stamp
         js_pub.publish(js)
+        imu_pub.publish(imu_message(Imu, *hsim.imu(), base, stamp))
+        if baseline is not None:  # the driver's own controller, on what it publishes
+            on_command(Float64MultiArray(data=[float(x) for x in baseline(hsim.reading)]))
         if args.contacts:
-            _publish_contacts(hsim, setup, contacts_pub, base, stamp, compute_grasp_maps,
-                              Pose, PoseArray)
+            # In the root frame (MuJoCo's world), where the simulated contacts are read.
+            publish_contacts(hsim, setup, contacts_pub, hand.root_frame, stamp,
+                             compute_grasp_maps, Pose, PoseArray)
 
     def run_for(seconds: float, until=None, each_second=None) -> bool:
         """Step in real time; publish joint states, apply commands; stop early on until()."""
@@ -256,7 +231,10 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
 
     # 1. Fingers held at the grasp configuration (as a driver's position mode would),
     #    object pinned, until the node commands.
-    hsim.hold_joints = True
+    hsim.hold_joints = baseline is None
+    reference = getattr(baseline, 'reference', None)
+    if reference is not None:  # position control: the driver's reference is the target
+        hsim.q_ref = reference(hsim.q_ref)
     if not run_for(args.wait, until=lambda: state['commands'] > 0):
         print(f'{PROG}: no effort command from {NODE_NAME} within {args.wait:g} s',
               file=sys.stderr)
@@ -265,6 +243,8 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     ask_prediction()
     run_for(args.settle)
     hsim.release()
+    if reference is not None:
+        hsim.q_ref = reference(hsim.q_ref)
     t_release_wall, sim_release = time.monotonic(), hsim.time
     counted_at_release = state['commands']
     limit = args.drift_limit * 1e-3
@@ -340,52 +320,11 @@ def _run(args: argparse.Namespace, scenario, sim_model) -> int:
     extra.append(f'{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed '
                  f"{state['malformed']})")
     extra.append(f'real-time factor {simulated / max(wall, 1e-9):.2f}')
+    why += f'; mean effort {hsim.mean_effort():.4f} N m (RMS joint torque)'
     print('summary: ' + why + '; ' + '; '.join(extra))
     if not args.no_picture:
         print(_picture(hsim, args.picture, state['predicted']))
     return close(0 if held and commands > 0 else 1)
-
-
-def _publish_contacts(hsim, setup, pub, base, stamp, compute_grasp_maps, Pose, PoseArray
-                      ) -> None:
-    """
-    Publish the contact frames measured in the simulation.
-
-    Each has the measured point and normal, and the x axis from the planned frame at the
-    current configuration. Nothing is published while a planned contact does not touch
-    (the node's contacts_timeout then applies).
-    """
-    readings, _ = hsim.readings()
-    if not all(r.touching for r in readings):
-        return
-    q = setup.q.copy()
-    q[setup.hand.idx_q] = hsim.q
-    maps = compute_grasp_maps(setup.hand, setup.hand.complete(q), setup.contacts,
-                              setup.object_origin)
-    msg = PoseArray()
-    msg.header.frame_id, msg.header.stamp = base, stamp
-    for r, R_plan in zip(readings, hsim.sim.base_rotation @ maps.rotations):
-        z = r.normal
-        x = R_plan[:, 0] - (R_plan[:, 0] @ z) * z
-        x /= np.linalg.norm(x)
-        R = np.column_stack((x, np.cross(z, x), z))
-        qx, qy, qz, qw = _quaternion(R)
-        pose = Pose()
-        pose.position.x, pose.position.y, pose.position.z = (float(v) for v in r.position)
-        pose.orientation.x, pose.orientation.y = qx, qy
-        pose.orientation.z, pose.orientation.w = qz, qw
-        msg.poses.append(pose)
-    pub.publish(msg)
-
-
-def _quaternion(R: np.ndarray) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation matrix."""
-    import mujoco
-
-    quat = np.zeros(4)
-    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(R).ravel())
-    w, x, y, z = quat
-    return float(x), float(y), float(z), float(w)
 
 
 def _mujoco_version() -> str:

@@ -18,7 +18,14 @@ Optional: needs the ``sim`` extra (``pip install -e '.[sim]'``, which
 - :mod:`~grasp_torque_opt.sim.simulator`: stepping with a joint impedance, pinning
   the object while the fingers settle, contact and object measurements;
 - :mod:`~grasp_torque_opt.sim.hold`: a hold episode of the certified torques and its report;
-- :mod:`~grasp_torque_opt.sim.render`: one offscreen picture with contact force arrows.
+- :mod:`~grasp_torque_opt.sim.render`: one offscreen picture with contact force arrows;
+- :mod:`~grasp_torque_opt.sim.base_motion`: the base's acceleration as apparent gravity,
+  the palm IMU;
+- :mod:`~grasp_torque_opt.sim.rig`: the hand on a moving base with a noisy encoder,
+  reporting the torques it applies;
+- :mod:`~grasp_torque_opt.sim.episode`: one episode on the rig for any controller;
+- :mod:`~grasp_torque_opt.sim.baselines`: a grasp preset and a position-controlled
+  squeeze, the controllers hands ship with.
 """
 
 import os

@@ -1,0 +1,184 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+``grasp-torque-sim``'s options: the arguments, their checks, and the rig they ask for.
+
+A test harness drives the simulated hand through these (docs/simulation.md,
+"Disturbances"): the base's acceleration and shake, the object's true mass and
+centre, encoder noise, the driver's gains, and which controller commands.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from grasp_torque_opt.core.command_line import add_version, HelpFormatter
+import numpy as np
+
+PROG = 'grasp-torque-sim'
+CONTROLLERS = ('node', 'preset', 'impedance')
+AXES = {'x': (1, 0, 0), 'y': (0, 1, 0), 'z': (0, 0, 1)}
+
+
+def parser(description: str) -> argparse.ArgumentParser:
+    """Return the argument parser."""
+    p = argparse.ArgumentParser(prog=PROG, formatter_class=HelpFormatter,
+                                description=description, epilog=(
+                                    'exit codes: 0 held, 1 not held (or no commands), 2 bad '
+                                    'input. docs/simulation.md'))
+    add_version(p)
+    p.add_argument('--params', default='allegro_right_node.yaml',
+                   help='node params file (bundled name or path); its scenario is simulated')
+    p.add_argument('--duration', type=float, default=3.0,
+                   help='seconds to hold after release [s]')
+    p.add_argument('--settle', type=float, default=0.3,
+                   help='seconds the commands press on the pinned object before release [s]')
+    p.add_argument('--kp', type=float, default=1.0, help='joint impedance stiffness [N m/rad]')
+    p.add_argument('--kd', type=float, default=0.01,
+                   help='joint impedance damping [N m s/rad]')
+    p.add_argument('--rate', type=float, default=250.0,
+                   help='joint state (and IMU) rate [Hz]')
+    p.add_argument('--contacts', action='store_true',
+                   help="publish the contact frames measured in the simulation on 'contacts'")
+    p.add_argument('--mu-tangential', type=float, default=None,
+                   help="simulated tangential friction [-] (default: the scenario's)")
+    p.add_argument('--mu-torsional', type=float, default=None,
+                   help="simulated torsional friction [m] (default: the scenario's)")
+    p.add_argument('--drift-limit', type=float, default=1.0,
+                   help='the object counts as held while it moves less than this [mm]')
+    g = p.add_argument_group('disturbances the controller is not told')
+    g.add_argument('--base-accel', metavar='AX,AY,AZ', default=None,
+                   help="the hand base's extra static acceleration from release on, base "
+                        'axes [m/s^2] (simulated as apparent gravity)')
+    g.add_argument('--base-shake', metavar='AMPLITUDE_G,FREQUENCY_HZ,AXIS', default=None,
+                   help='sinusoidal base acceleration from release on: peak [g], frequency '
+                        '[Hz], base axis x, y or z (e.g. 1,1,z)')
+    g.add_argument('--mass-scale', type=float, default=1.0,
+                   help="the simulated object's mass over the scenario's [-]")
+    g.add_argument('--object-offset', metavar='DX,DY,DZ', default=None,
+                   help="the simulated object's centre minus the scenario's, base axes [mm]")
+    g.add_argument('--joint-noise', type=float, default=0.0,
+                   help='encoder noise, standard deviation per 1 ms reading [mrad]: on the '
+                        'published joint states and in the impedance')
+    g.add_argument('--seed', type=int, default=0, help='seed of the encoder noise')
+    c = p.add_argument_group('controller')
+    c.add_argument('--controller', choices=CONTROLLERS, default='node',
+                   help='node: grasp_torque_node over ROS; preset: fixed closing torques of '
+                        'one level, tuned on the nominal load; impedance: the grasp pose '
+                        'commanded inside the object (position control)')
+    c.add_argument('--preset-level', type=float, default=None,
+                   help='preset: the normal force level [N] (default: tuned at start)')
+    c.add_argument('--squeeze-depth', type=float, default=5.0,
+                   help='impedance: how far inside the object the contacts are commanded '
+                        '[mm]')
+    p.add_argument('--picture', default='grasp_sim.png',
+                   help='PNG of the grasp written at the end, in the current folder unless a '
+                        'path')
+    p.add_argument('--no-picture', action='store_true', help='write no picture')
+    p.add_argument('--with-node', action='store_true',
+                   help='start grasp_torque_node in a child process')
+    p.add_argument('--wait', type=float, default=30.0,
+                   help='how long to wait for the node and its first command [s]')
+    return p
+
+
+def _triple(text: str) -> np.ndarray | None:
+    try:
+        values = np.array([float(v) for v in text.split(',')])
+    except ValueError:
+        return None
+    return values if values.shape == (3,) and np.all(np.isfinite(values)) else None
+
+
+def _shake(text: str) -> tuple[float, float, np.ndarray] | None:
+    parts = text.split(',')
+    if len(parts) != 3 or parts[2].strip().lower() not in AXES:
+        return None
+    try:
+        amplitude, frequency = float(parts[0]), float(parts[1])
+    except ValueError:
+        return None
+    if not (np.isfinite(amplitude) and np.isfinite(frequency) and amplitude >= 0
+            and frequency > 0):
+        return None
+    return amplitude, frequency, np.array(AXES[parts[2].strip().lower()], dtype=float)
+
+
+def check(args: argparse.Namespace) -> str:
+    """
+    Check the arguments and parse the compound ones in place; return the error ('' if none).
+
+    Sets ``args.base_accel`` (m/s^2, shape (3,)), ``args.base_shake`` (amplitude [g],
+    frequency [Hz], unit axis, or None) and ``args.object_offset`` (m, shape (3,)).
+    """
+    for name in ('duration', 'rate', 'wait', 'drift_limit', 'mass_scale'):
+        if not getattr(args, name) > 0:
+            return f"--{name.replace('_', '-')}: must be > 0"
+    for name in ('settle', 'kp', 'kd', 'joint_noise', 'squeeze_depth'):
+        if not getattr(args, name) >= 0:
+            return f"--{name.replace('_', '-')}: must be >= 0"
+    for name in ('mu_tangential', 'mu_torsional', 'preset_level'):
+        value = getattr(args, name)
+        if value is not None and not value > 0:
+            return f"--{name.replace('_', '-')}: must be > 0"
+    for name in ('base_accel', 'object_offset'):
+        text = getattr(args, name)
+        value = np.zeros(3) if text is None else _triple(text)
+        if value is None:
+            return f"--{name.replace('_', '-')}: three numbers separated by commas, got {text!r}"
+        setattr(args, name, value)
+    args.object_offset = args.object_offset * 1e-3
+    if args.base_shake is not None:
+        shake = _shake(args.base_shake)
+        if shake is None:
+            return ('--base-shake: AMPLITUDE_G,FREQUENCY_HZ,AXIS with amplitude >= 0, '
+                    f'frequency > 0 and axis x, y or z, got {args.base_shake!r}')
+        args.base_shake = shake
+    if args.with_node and args.controller != 'node':
+        return f'--with-node: only with --controller node (got {args.controller})'
+    return ''
+
+
+def rig_settings(args: argparse.Namespace):
+    """Return the episode settings (disturbances, mass, offset, gains) the checked args ask."""
+    from grasp_torque_opt.sim.base_motion import BaseMotion, STANDARD_GRAVITY
+    from grasp_torque_opt.sim.episode import EpisodeSettings
+    from grasp_torque_opt.sim.rig import Disturbances
+
+    motion = BaseMotion(accel=args.base_accel)
+    if args.base_shake is not None:
+        amplitude, frequency, axis = args.base_shake
+        motion = BaseMotion(accel=args.base_accel, shake_amplitude=amplitude * STANDARD_GRAVITY,
+                            shake_frequency=frequency, shake_axis=axis)
+    return EpisodeSettings(
+        kp=args.kp, kd=args.kd, duration=args.duration, settle=args.settle, rate=args.rate,
+        drift_limit=args.drift_limit * 1e-3,
+        disturbances=Disturbances(motion=motion, joint_noise=args.joint_noise * 1e-3,
+                                  seed=args.seed),
+        mass_scale=args.mass_scale, object_offset=tuple(args.object_offset))
+
+
+def describe(args: argparse.Namespace) -> str:
+    """Return the disturbances asked for, in words ('' for none)."""
+    parts = []
+    if np.any(args.base_accel):
+        parts.append('base acceleration [' + ', '.join(f'{v:g}' for v in args.base_accel)
+                     + '] m/s^2')
+    if args.base_shake is not None:
+        amplitude, frequency, axis = args.base_shake
+        name = next(k for k, v in AXES.items() if np.allclose(v, axis))
+        parts.append(f'base shake {amplitude:g} g at {frequency:g} Hz along {name}')
+    if args.mass_scale != 1.0:
+        parts.append(f'mass x{args.mass_scale:g}')
+    if np.any(args.object_offset):
+        parts.append('object offset [' + ', '.join(f'{1e3 * v:g}' for v in args.object_offset)
+                     + '] mm')
+    if args.joint_noise > 0:
+        parts.append(f'joint noise {args.joint_noise:g} mrad')
+    return ', '.join(parts)
