@@ -177,7 +177,8 @@ def checked_wrench(model: pin.Model, frame: str, force: np.ndarray, torque: np.n
 
 
 def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndarray | None,
-                    unresolved: str) -> np.ndarray:
+                    unresolved: str, bounds: tuple[float, float] = (0.0, MAX_GRAVITY)
+                    ) -> np.ndarray:
     """
     Check gravity and return it in base axes [m/s^2].
 
@@ -187,10 +188,11 @@ def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndar
         vector: gravity in ``frame`` [m/s^2], shape (3,).
         rotation: base-from-frame rotation, shape (3, 3), or None.
         unresolved: why ``frame`` could not be looked up (for the message).
+        bounds: ``gravity_norm_bounds``, [low, high] [m/s^2].
 
     Raises:
         InputError: another frame without ``rotation``, not finite, a norm above
-            :data:`MAX_GRAVITY`.
+            :data:`MAX_GRAVITY` or outside ``bounds``.
     """
     if frame not in ('', base) and rotation is None:
         raise InputError('gravity.header.frame_id', f"'{show(frame)}' is not the "
@@ -206,4 +208,7 @@ def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndar
     if norm > MAX_GRAVITY:
         raise InputError('gravity.vector', f'norm {norm:.6g} m/s^2 exceeds '
                          f'{MAX_GRAVITY:g} m/s^2')
+    if not bounds[0] <= norm <= bounds[1]:
+        raise InputError('gravity.vector', f'norm {norm:.6g} m/s^2 is outside '
+                         f'gravity_norm_bounds [{bounds[0]:g}, {bounds[1]:g}]')
     return g

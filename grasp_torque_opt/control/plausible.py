@@ -1,0 +1,131 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+Whether estimated contacts can be the grasp's: on their own links, pushing into the object.
+
+A well-formed lie on ``contacts`` was certified before: four flipped normals (a
+perception sign bug) gave commands that pull, and swapped fingertips put contacts 71 to
+95 mm from their own links (docs/node.md, "Input checks"). The rules, in the base frame
+at the configuration of the moment:
+
+- a contact point at most ``max_contact_link_distance`` from its own link's frame;
+- its normal points into the object (:func:`grasp_torque_opt.core.inward.check_inward_normals`:
+  towards the object origin, and into the scenario object's surface where it has one);
+- a contact's link is not the root, a frame fixed to the root, nor a joint frame
+  (:func:`check_contact_links`, when the scenario is bound).
+"""
+
+from __future__ import annotations
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.inward import check_inward_normals
+from grasp_torque_opt.core.scenario import ObjectSpec
+import numpy as np
+import pinocchio as pin
+
+
+def check_contact_links(model: pin.Model, links: list[str], field: str = 'grasp.contacts'
+                        ) -> None:
+    """
+    Refuse a contact link that cannot carry a fingertip's contact.
+
+    A contact on the root (or a frame welded to it) gives the fingers nothing to push
+    with; a joint frame is no body. Either way the grasp map would be certified for a
+    contact no finger makes.
+
+    Args:
+        model: the hand's model.
+        links: the contacts' links (the URDF's names, after the name map).
+        field: the field named in the message.
+
+    Raises:
+        InputError: ``<field>[i].link``, naming the link and why.
+    """
+    root = model.frames[1].name if len(model.frames) > 1 else ''
+    for i, link in enumerate(links):
+        if not model.existFrame(link):
+            continue  # the binding names unknown frames itself
+        frame = model.frames[model.getFrameId(link)]
+        if frame.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT):
+            why = 'is a joint frame, not a link'
+        elif frame.parentJoint == 0:
+            why = f"is the root '{root}'" if link == root else \
+                f"is fixed to the root '{root}'"
+        else:
+            continue
+        raise InputError(f'{field}[{i}].link', f"'{link}' {why}: a contact must be on a "
+                         'link that a joint moves (check the name map)')
+
+
+def placed(model: pin.Model, data: pin.Data, frame: str, positions: np.ndarray,
+           rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return contact points and normals in the base frame, at ``data``'s placements.
+
+    Args:
+        frame: model frame of the poses ('' = the base frame).
+        positions: contact points, shape (p, 3) [m].
+        rotations: contact frame axes, shape (p, 3, 3).
+
+    Returns:
+        Points [m] and unit normals, each shape (p, 3), base frame.
+    """
+    if not frame:
+        return positions, rotations[:, :, 2]
+    oMF = data.oMf[model.getFrameId(frame)]
+    R = oMF.rotation
+    return positions @ R.T + oMF.translation, rotations[:, :, 2] @ R.T
+
+
+def check_on_links(points: np.ndarray, link_origins: np.ndarray, links: tuple[str, ...],
+                   limit: float) -> None:
+    """
+    Refuse a contact point farther than ``limit`` from its own link's frame.
+
+    Args:
+        points: contact points, base frame, shape (p, 3) [m].
+        link_origins: their links' frame origins, base frame, shape (p, 3) [m].
+        links: the links' names, for the message.
+        limit: ``max_contact_link_distance`` [m].
+
+    Raises:
+        InputError: ``contacts.poses[i].position``.
+    """
+    d = np.linalg.norm(points - link_origins, axis=1)
+    if (d <= limit).all():  # False for NaN as well
+        return
+    i = int(np.argmax(np.where(np.isnan(d), np.inf, d)))
+    raise InputError(f'contacts.poses[{i}].position', f'is {d[i]:.4g} m from its link '
+                     f"'{links[i]}', beyond max_contact_link_distance ({limit} m): a "
+                     'contact of another finger, or a wrong frame')
+
+
+def check_inward(points: np.ndarray, normals: np.ndarray, links: tuple[str, ...],
+                 origin: np.ndarray, obj: ObjectSpec | None) -> None:
+    """
+    Refuse a contact whose normal points out of the object (the scenario's rule).
+
+    Raises:
+        InputError: ``contacts.poses[i].orientation``, with the scenario check's words.
+    """
+    try:
+        check_inward_normals(points, normals, links, origin, obj)
+    except InputError as e:
+        i = e.field[len('grasp.contacts['):].split(']')[0]
+        raise InputError(f'contacts.poses[{i}].orientation', e.problem) from e
+
+
+def points_inward(points: np.ndarray, normals: np.ndarray, origin: np.ndarray) -> int:
+    """
+    Return the first contact whose normal points away from the object origin, or -1.
+
+    The cheap half of :func:`check_inward`, for every cycle (vectorized).
+    """
+    bad = np.einsum('ij,ij->i', normals, origin - points) < 0.0
+    return int(np.argmax(bad)) if bad.any() else -1
