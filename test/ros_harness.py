@@ -8,6 +8,7 @@
 
 """The node under test beside a tester node, on a ROS domain of this test run's own."""
 
+import math
 import os
 from pathlib import Path
 import subprocess
@@ -46,6 +47,9 @@ class Harness:
         # The most generous cycle budget unless a test is about it: other processes may
         # load this machine, and an overrun drops the command by design.
         params.setdefault('cycle_budget', 1.0)
+        # The rate rule off unless a test is about it: tests compare each command with the
+        # certified solution of its state.
+        params.setdefault('max_torque_rate', math.inf)
         # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
         params.setdefault('diagnostics_period', 0.1)
         overrides = [] if scenario is None else [Parameter('scenario', value=str(scenario))]

@@ -163,7 +163,7 @@ class Cycle:
         check_on_links(points, origins, links, self.config.max_contact_link_distance)
         i = points_inward(points, normals, self.setup.object_origin)
         if i >= 0:
-            raise InputError(f'contacts.poses[{i}].orientation', f"the normal of the contact "
+            raise InputError(f'contacts.poses[{i}].orientation', 'the normal of the contact '
                              f"on '{links[i]}' points away from the object origin at this "
                              'configuration: the torques would pull')
 

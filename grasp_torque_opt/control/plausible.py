@@ -18,7 +18,8 @@ at the configuration of the moment:
 - its normal points into the object (:func:`grasp_torque_opt.core.inward.check_inward_normals`:
   towards the object origin, and into the scenario object's surface where it has one);
 - a contact's link is not the root, a frame fixed to the root, nor a joint frame
-  (:func:`check_contact_links`, when the scenario is bound).
+  (:func:`grasp_torque_opt.core.contact_links.check_contact_links`, when the scenario
+  is bound).
 """
 
 from __future__ import annotations
@@ -28,39 +29,6 @@ from grasp_torque_opt.core.inward import check_inward_normals
 from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
 import pinocchio as pin
-
-
-def check_contact_links(model: pin.Model, links: list[str], field: str = 'grasp.contacts'
-                        ) -> None:
-    """
-    Refuse a contact link that cannot carry a fingertip's contact.
-
-    A contact on the root (or a frame welded to it) gives the fingers nothing to push
-    with; a joint frame is no body. Either way the grasp map would be certified for a
-    contact no finger makes.
-
-    Args:
-        model: the hand's model.
-        links: the contacts' links (the URDF's names, after the name map).
-        field: the field named in the message.
-
-    Raises:
-        InputError: ``<field>[i].link``, naming the link and why.
-    """
-    root = model.frames[1].name if len(model.frames) > 1 else ''
-    for i, link in enumerate(links):
-        if not model.existFrame(link):
-            continue  # the binding names unknown frames itself
-        frame = model.frames[model.getFrameId(link)]
-        if frame.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT):
-            why = 'is a joint frame, not a link'
-        elif frame.parentJoint == 0:
-            why = f"is the root '{root}'" if link == root else \
-                f"is fixed to the root '{root}'"
-        else:
-            continue
-        raise InputError(f'{field}[{i}].link', f"'{link}' {why}: a contact must be on a "
-                         'link that a joint moves (check the name map)')
 
 
 def placed(model: pin.Model, data: pin.Data, frame: str, positions: np.ndarray,

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import time
 
 from grasp_torque_opt.control.parameters import name_map_of
-from grasp_torque_opt.control.plausible import check_contact_links
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import MAX_URDF_BYTES
@@ -183,7 +182,7 @@ def bind(scenario_name: str | None, name_map: list[str] | None, urdf: str,
         a, b = swapped[0]
         raise InputError('joints', f"must be given: the name map sends the scenario's joint "
                          f"'{a}' to '{b}', the name of another of its joints, which would "
-                         "reorder the command silently; set joints to the effort "
+                         'reorder the command silently; set joints to the effort '
                          "controller's joint order")
     bound = scenario if joints is None else dataclasses.replace(scenario, joints=list(joints))
     try:
@@ -195,7 +194,6 @@ def bind(scenario_name: str | None, name_map: list[str] | None, urdf: str,
                          "URDF of this hand does, map them to this URDF's names with the "
                          'name_map parameter (SCENARIO_NAME=URDF_NAME) or the '
                          "scenario's hand.name_map") from e
-    check_contact_links(setup.hand.model, [c.link for c in setup.contacts])
     return Grasp(scenario, setup)
 
 

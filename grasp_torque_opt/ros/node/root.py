@@ -143,8 +143,10 @@ class GraspTorque:
         one in force is now over the limits) at the next callback of the executor, not at
         the next cycle: rclpy calls this once for each parameter of a set_parameters
         request (unless atomic), and no cycle runs between them, so the rule's cycle
-        waits until the whole request is applied (:meth:`on_changed`). Not while the
-        node does not command (the managed node's activation runs the same rule).
+        waits until the whole request is applied (:meth:`on_changed`). Except when the
+        command in force exceeds the new torque limits: then the rule runs at once too.
+        Not while the node does not command (the managed node's activation runs the same
+        rule).
         """
         if self.controller is None:
             return  # nothing loaded yet: configure takes the values
@@ -155,7 +157,16 @@ class GraspTorque:
             controllers.configure(self.service.controller, self.grasp.setup, p, service=True)
             if any(x.name == 'solver.fallback' for x in params):
                 self._warn_missing_fallback(p)
-            if self.commanding and self._changed is not None:
+            if not self.commanding:
+                return
+            in_force, lim = self.controller.in_force, self.controller.setup.hand.torque_limits
+            if in_force is not None and not (np.abs(in_force) <= lim).all():
+                # A torque the user has just forbidden is not held until the request ends.
+                self._change_due = False
+                result = self.controller.reconfigured(time.monotonic())
+                if result is not None:
+                    self.outputs.publish(result, self.last_stamp)
+            if self._changed is not None:
                 self._change_due = True
                 self._changed.trigger()
 
