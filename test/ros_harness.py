@@ -8,7 +8,6 @@
 
 """The node under test beside a tester node, on a ROS domain of this test run's own."""
 
-import math
 import os
 from pathlib import Path
 import subprocess
@@ -49,7 +48,7 @@ class Harness:
         params.setdefault('cycle_budget', 1.0)
         # The rate rule off unless a test is about it: tests compare each command with the
         # certified solution of its state.
-        params.setdefault('max_torque_rate', math.inf)
+        params.setdefault('max_torque_rate', 1e6)  # N m/s: 1 kN m a millisecond
         # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
         params.setdefault('diagnostics_period', 0.1)
         overrides = [] if scenario is None else [Parameter('scenario', value=str(scenario))]
@@ -91,7 +90,7 @@ class Harness:
 
     def _on_diag(self, msg):
         for s in msg.status:
-            if s.name.startswith('grasp_torque_node'):
+            if s.name.startswith('/grasp_torque_node: '):
                 self.diagnostics.append({**{kv.key: kv.value for kv in s.values},
                                          '_level': s.level[0], '_message': s.message,
                                          '_hardware_id': s.hardware_id})

@@ -44,7 +44,6 @@ this module has always exported are exported from here still.
 from __future__ import annotations
 
 import copy
-import math
 from operator import attrgetter
 import time
 
@@ -282,7 +281,7 @@ class TorqueController:
         times the time since the command in force towards the certified command.
         """
         policy, rate = self.policy, self.config.max_torque_rate
-        if policy.in_force is None or policy.in_force_time is None or rate == math.inf:
+        if policy.in_force is None or policy.in_force_time is None:
             return
         cmd = slewed(policy.in_force, result.command, rate * max(now - policy.in_force_time,
                                                                  0.0),

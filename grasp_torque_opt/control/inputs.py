@@ -30,7 +30,7 @@ from grasp_torque_opt.control.checks import (
 )
 from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.plausible import check_inward, check_on_links, placed
-from grasp_torque_opt.control.rates import towards
+from grasp_torque_opt.control.rates import turned_towards
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import ObjectSpec
@@ -383,7 +383,7 @@ class InputStore:
         old = self.inputs.gravity
         if old is not None and not self._expired(now):
             step = self.config.max_gravity_rate * (now - self.inputs.gravity_time)
-            g = towards(old, g, step)
+            g = turned_towards(old, g, step)
         self.inputs = dataclasses.replace(self.inputs, gravity=g, gravity_time=now)
 
     def reject(self, source: str, error: InputError) -> None:

@@ -15,23 +15,10 @@ between two values made every command a full step.
 """
 
 from conftest import PLANAR
-from cycle_inputs import base_poses, fresh, joint_state
+from cycle_inputs import base_poses, flipped, fresh, joint_state, tilted
 import numpy as np
-import pinocchio as pin
 from rclpy.parameter import Parameter
 from ros_harness import Harness
-
-
-def flipped(quat: np.ndarray) -> np.ndarray:
-    """Turn each contact frame half a turn about its x axis: its normal z points outward."""
-    half = pin.Quaternion(pin.exp3(np.array([np.pi, 0.0, 0.0])))
-    return np.array([(pin.Quaternion(q[3], *q[:3]) * half).coeffs() for q in quat])
-
-
-def tilted(quat: np.ndarray, angle: float) -> np.ndarray:
-    """Turn each contact frame about its x axis by ``angle``: its normal still points inward."""
-    turn = pin.Quaternion(pin.exp3(np.array([angle, 0.0, 0.0])))
-    return np.array([(pin.Quaternion(q[3], *q[:3]) * turn).coeffs() for q in quat])
 
 
 def test_flipped_normals_are_rejected_and_never_commanded(planar):

@@ -18,13 +18,14 @@ beyond the URDF's limits were commanded; get_parameters of every parameter gave 
 from conftest import PLANAR
 from cycle_inputs import joint_state
 from grasp_torque_opt.core.exceptions import InputError
-from grasp_torque_opt.ros.node import GraspTorqueNode
+from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
 import numpy as np
 import pytest
 import rclpy
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.parameter import Parameter
 from ros_harness import DOMAIN, Harness
+from std_msgs.msg import Float64MultiArray
 
 SWAP = ['joint1=joint3', 'joint3=joint1']  # two joints of the same torque limit
 
@@ -125,5 +126,22 @@ def test_get_parameters_answers_for_every_parameter(planar):
         values = h.call(client, GetParameters.Request(names=list(names))).values
         assert len(values) == len(names)
         assert list(h.node.get_parameter('name_map').value) == []
+    finally:
+        h.close()
+
+
+def test_another_publisher_on_the_command_topic_is_an_error(planar):
+    h = Harness(PLANAR)
+    try:
+        h.send_joint_state(*joint_state(planar))
+        assert h.next_command() is not None
+        assert h.spin_until(lambda: h.diagnostics, 2.0)
+        assert h.diagnostics[-1]['command_topic.other_publishers'] == 'none'
+        h.tester.create_publisher(Float64MultiArray, 'effort_commands', COMMAND_QOS)
+        assert h.spin_until(lambda: h.diagnostics[-1]['_level'] == 2, 5.0)
+        last = h.diagnostics[-1]  # its status named /grasp_torque_node (the harness's filter)
+        assert last['command_topic.other_publishers'] == '/tester'
+        assert last['_message'].startswith('another publisher on /effort_commands (/tester); ')
+        assert h.node.controller is not None  # the node goes on (docs/node.md, Faults)
     finally:
         h.close()

@@ -76,8 +76,9 @@ class GraspTorque:
         self.service = SolveService(self)
         self.tf = TfGravity()
         self._made: list[tuple[str, Any]] = []
-        #: Triggered by a parameter change: the rule's cycle runs once the request is
-        #: applied whole (None while the interfaces are not made).
+        #: Started by a parameter change (a timer, cancelled until then: rclpy's
+        #: EventsExecutor takes no guard conditions): the rule's cycle runs once the
+        #: request is applied whole (None while the interfaces are not made).
         self._changed = None
         self._change_due = False
 
@@ -168,10 +169,11 @@ class GraspTorque:
                     self.outputs.publish(result, self.last_stamp)
             if self._changed is not None:
                 self._change_due = True
-                self._changed.trigger()
+                self._changed.reset()
 
     def on_changed(self) -> None:
-        """Run the parameter-change rule once a request is applied whole (a guard condition)."""
+        """Run the parameter-change rule once a request is applied whole (a one-shot timer)."""
+        self._changed.cancel()
         with self.lock:
             if not (self._change_due and self.commanding):
                 return
@@ -218,8 +220,9 @@ class GraspTorque:
                                  (p.diagnostics_period, self.status.on_diagnostics),
                                  (p.marker_period, self.outputs.on_markers)):
             made.append(('timer', self.node.create_timer(period, callback, clock=steady)))
-        self._changed = self.node.create_guard_condition(self.on_changed)
-        made.append(('guard', self._changed))
+        self._changed = self.node.create_timer(1e-6, self.on_changed, clock=steady)
+        self._changed.cancel()
+        made.append(('timer', self._changed))
         self.tf.start(self.node)
 
     def stop_interfaces(self) -> None:
@@ -231,12 +234,10 @@ class GraspTorque:
                 node.destroy_subscription(entity)
             elif kind == 'timer':
                 node.destroy_timer(entity)
-            elif kind == 'guard':
-                node.destroy_guard_condition(entity)
-                self._changed, self._change_due = None, False
             else:
                 self.outputs.destroy(kind, entity)
         self._made.clear()
+        self._changed, self._change_due = None, False
         self.peers.clear()
         self.outputs.stop()
         self.status.stop()
