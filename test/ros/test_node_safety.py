@@ -18,6 +18,7 @@ beyond the URDF's limits were commanded; get_parameters of every parameter gave 
 from conftest import PLANAR
 from cycle_inputs import joint_state
 from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
 import numpy as np
 import pytest
@@ -72,23 +73,26 @@ def test_the_command_order_is_in_diagnostics(planar):
 
 
 def test_a_request_is_applied_whole_before_a_command_uses_it(planar):
-    h = Harness(PLANAR)
+    h = Harness(PLANAR, joint_state_timeout=5.0)  # fresh inputs: the rule's cycle commands
     try:
         names, pos = joint_state(planar)
         h.send_joint_state(names, pos)
         assert h.next_command() is not None
+        fmin = 1.5 * float(np.max(solve(planar).wrenches[:, 2]))
         client = h.tester.create_client(SetParameters, 'grasp_torque_node/set_parameters')
-        # Not atomic: rclpy sets (and calls back) one parameter after the other.
+        # Not atomic: rclpy sets (and calls back) one parameter after the other; each
+        # changes the command.
         request = SetParameters.Request(parameters=[
-            Parameter('weights', value=[1.0, 4.0, 1.0, 4.0]).to_parameter_msg(),
-            Parameter('min_normal_force', value=2.0).to_parameter_msg()])
-        n = len(h.commands)
+            Parameter('min_normal_force', value=fmin).to_parameter_msg(),
+            Parameter('mu_tangential', value=0.8).to_parameter_msg()])
+        counters = h.node.controller.counters
+        before = counters.commands
         assert all(r.successful for r in h.call(client, request).results)
         h.spin_for(0.3)
-        assert len(h.commands) == n + 1, 'one command per request, with all of it applied'
+        assert counters.commands == before + 1, 'one command per request, all of it applied'
+        sent = h.commands[-1][1]
         h.send_joint_state(names, pos)
-        both = h.next_command()
-        np.testing.assert_allclose(h.commands[n][1], both, atol=1e-9)
+        np.testing.assert_allclose(h.next_command(), sent, atol=1e-9)
     finally:
         h.close()
 
