@@ -116,6 +116,32 @@ def check_joint_names(names: list[str], positions: list[float], q: np.ndarray,
     return (list(names), np.array(used, dtype=np.intp), np.array(to, dtype=np.intp), joints)
 
 
+def check_joint_limits(q: np.ndarray, used: np.ndarray, lower: np.ndarray,
+                       upper: np.ndarray, names: dict[int, str], tolerance: float) -> None:
+    """
+    Refuse a used position beyond its joint's URDF limits plus ``joint_limit_tolerance``.
+
+    Args:
+        q: the configuration, shape (nq,).
+        used: the indices in q the joint state gave.
+        lower: the lower limits minus the tolerance, shape (nq,).
+        upper: the upper limits plus the tolerance, shape (nq,).
+        names: index in q -> joint name, for the message.
+        tolerance: ``joint_limit_tolerance`` [rad or m].
+
+    Raises:
+        InputError: naming the joint, its position and its limits.
+    """
+    values = q[used]
+    ok = (values >= lower[used]) & (values <= upper[used])
+    if ok.all():
+        return
+    k = int(used[int(np.argmin(ok))])
+    raise InputError('joint_states', f"position of '{names.get(k, k)}' is {q[k]:.6g}, beyond "
+                     f'its URDF limits [{lower[k] + tolerance:.6g}, {upper[k] - tolerance:.6g}] '
+                     f'by more than joint_limit_tolerance ({tolerance:g})')
+
+
 def contact_rotations(model: pin.Model, p: int, frame: str, positions: np.ndarray,
                       quaternions: np.ndarray) -> np.ndarray:
     """

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import math
 
 from grasp_torque_opt.control.checks import (
+    check_joint_limits,
     check_joint_names,
     checked_gravity,
     checked_wrench,
@@ -29,13 +30,12 @@ from grasp_torque_opt.control.checks import (
     MAX_ABS_JOINT_POSITION,
 )
 from grasp_torque_opt.control.config import CycleConfig
-from grasp_torque_opt.control.plausible import check_inward, check_on_links, placed
+from grasp_torque_opt.control.plausible import check_contacts
 from grasp_torque_opt.control.rates import turned_towards
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
-import pinocchio as pin
 
 #: The input topics, as named in counters, stamps and messages (and ``gravity``, counted
 #: from its first rejection: it is optional).
@@ -143,11 +143,9 @@ class InputStore:
         self._model_joints = {model.names[j]: model.joints[j].idx_q
                               for j in range(1, model.njoints) if model.joints[j].nq == 1}
         self._q_names = {i: n for n, i in self._model_joints.items()}
-        #: The joints' URDF limits widened by ``joint_limit_tolerance``, and the config
-        #: they were made for (remade when the config changes).
+        #: (config, URDF lower and upper limits widened by joint_limit_tolerance).
         self._limits: tuple[CycleConfig, np.ndarray, np.ndarray] | None = None
-        #: The scenario's object, for the inward rule (None: only its origin is known).
-        self.object: ObjectSpec | None = None
+        self.object: ObjectSpec | None = None  #: the scenario's object (the inward rule)
         #: The last accepted joint state's names, which of its entries are model joints,
         #: their indices in q, and the commanded joints it was checked against (a state
         #: with the same names skips the name checks).
@@ -244,27 +242,14 @@ class InputStore:
         self.inputs = replaced(self.inputs, q=q, q_time=now)
 
     def _check_limits(self, q: np.ndarray, used: np.ndarray) -> None:
-        """
-        Refuse a used position beyond its joint's URDF limits plus ``joint_limit_tolerance``.
-
-        Raises:
-            InputError: naming the joint, its position and its limits.
-        """
+        """Refuse a used position beyond its URDF limits (:func:`.checks.check_joint_limits`)."""
         limits = self._limits
         if limits is None or limits[0] is not self.config:
             model, tol = self.setup.hand.model, self.config.joint_limit_tolerance
             limits = self._limits = (self.config, model.lowerPositionLimit - tol,
                                      model.upperPositionLimit + tol)
-        values = q[used]
-        ok = (values >= limits[1][used]) & (values <= limits[2][used])
-        if ok.all():
-            return
-        k = int(used[int(np.argmin(ok))])
-        tol = self.config.joint_limit_tolerance
-        raise InputError('joint_states', f"position of '{self._q_names.get(k, k)}' is "
-                         f'{q[k]:.6g}, beyond its URDF limits [{limits[1][k] + tol:.6g}, '
-                         f'{limits[2][k] - tol:.6g}] by more than joint_limit_tolerance '
-                         f'({tol:g})')
+        check_joint_limits(q, used, limits[1], limits[2], self._q_names,
+                           self.config.joint_limit_tolerance)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
                         now: float, stamp: float = 0.0, clock: float | None = None) -> None:
@@ -281,10 +266,9 @@ class InputStore:
 
         Raises:
             InputError: wrong count or shape, unknown frame, non-finite values, a
-                non-unit quaternion, a point farther than ``max_contact_link_distance``
-                from its link or a normal out of the object (at the latest joint state),
-                a bad stamp. The contacts are not kept. (The distance from the base is
-                checked in the cycle, where the frame is placed.)
+                non-unit quaternion, an implausible contact at the latest joint state
+                (:func:`.plausible.check_contacts`), a bad stamp. The contacts are not
+                kept. (The cycle checks them again, where the frame is placed.)
         """
         positions = np.asarray(positions, dtype=float)
         quaternions = np.asarray(quaternions, dtype=float)
@@ -304,20 +288,9 @@ class InputStore:
     def _check_plausible(self, frame: str, positions: np.ndarray,
                          rotations: np.ndarray) -> None:
         """Check contacts on their links and pushing inward, at the latest joint state."""
-        setup = self.setup
-        model, data = setup.hand.model, setup.hand.data
-        q = setup.q if self.inputs.q is None else self.inputs.q
-        pin.framesForwardKinematics(model, data, q)
-        points, normals = placed(model, data, frame, positions, rotations)
-        links = tuple(c.link for c in setup.contacts)
-        origins = np.array([data.oMf[model.getFrameId(link)].translation for link in links])
-        check_on_links(points, origins, links, self.config.max_contact_link_distance)
-        check_inward(points, normals, links, setup.object_origin, self.object)
-
-    def _expired(self, now: float) -> bool:
-        """Whether the gravity in use is stale (then a message is taken whole)."""
-        timeout = self.config.gravity_timeout
-        return timeout > 0 and now - self.inputs.gravity_time > timeout
+        q = self.setup.q if self.inputs.q is None else self.inputs.q
+        check_contacts(self.setup, self.object, q, frame, positions, rotations,
+                       self.config.max_contact_link_distance)
 
     def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
                       now: float, stamp: float = 0.0, clock: float | None = None) -> None:
@@ -367,10 +340,8 @@ class InputStore:
         Raises:
             InputError: another frame without ``rotation``, not finite, a norm above
                 :data:`~grasp_torque_opt.control.checks.MAX_GRAVITY` or outside
-                ``gravity_norm_bounds``, a bad stamp. The vector is not kept.
-
-        The gravity in use then moves towards it at most ``max_gravity_rate``
-        (:mod:`.rates`).
+                ``gravity_norm_bounds``, a bad stamp. The vector is not kept. Else the
+                gravity in use turns towards it at ``max_gravity_rate`` (:mod:`.rates`).
         """
         try:
             g = checked_gravity(self.setup.hand.base_frame, frame, vector, rotation,
@@ -380,8 +351,8 @@ class InputStore:
             self.reject('gravity', e)
             raise
         self._keep_stamp('gravity', stamp, now, clock)
-        old = self.inputs.gravity
-        if old is not None and not self._expired(now):
+        old, timeout = self.inputs.gravity, self.config.gravity_timeout
+        if old is not None and not (timeout > 0 and now - self.inputs.gravity_time > timeout):
             step = self.config.max_gravity_rate * (now - self.inputs.gravity_time)
             g = turned_towards(old, g, step)
         self.inputs = dataclasses.replace(self.inputs, gravity=g, gravity_time=now)

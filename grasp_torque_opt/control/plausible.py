@@ -25,10 +25,37 @@ at the configuration of the moment:
 from __future__ import annotations
 
 from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.inward import check_inward_normals
 from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
 import pinocchio as pin
+
+
+def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, frame: str,
+                   positions: np.ndarray, rotations: np.ndarray, limit: float) -> None:
+    """
+    Check contact poses at configuration ``q``: on their own links, pushing into the object.
+
+    Args:
+        setup: the grasp (its hand's model and data, its contacts' links, object origin).
+        obj: the scenario's object, or None.
+        q: the configuration the links are placed at.
+        frame: model frame of the poses ('' = the base frame).
+        positions: contact points, shape (p, 3) [m].
+        rotations: contact frame axes, shape (p, 3, 3).
+        limit: ``max_contact_link_distance`` [m].
+
+    Raises:
+        InputError: naming the contact (:func:`check_on_links`, :func:`check_inward`).
+    """
+    model, data = setup.hand.model, setup.hand.data
+    pin.framesForwardKinematics(model, data, q)
+    points, normals = placed(model, data, frame, positions, rotations)
+    links = tuple(c.link for c in setup.contacts)
+    origins = np.array([data.oMf[model.getFrameId(link)].translation for link in links])
+    check_on_links(points, origins, links, limit)
+    check_inward(points, normals, links, setup.object_origin, obj)
 
 
 def placed(model: pin.Model, data: pin.Data, frame: str, positions: np.ndarray,

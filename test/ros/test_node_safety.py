@@ -16,14 +16,14 @@ beyond the URDF's limits were commanded; get_parameters of every parameter gave 
 """
 
 from conftest import PLANAR
-from cycle_inputs import joint_state
+from cycle_inputs import joint_state, Slow
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
 import numpy as np
 import pytest
-import rclpy
 from rcl_interfaces.srv import GetParameters, SetParameters
+import rclpy
 from rclpy.parameter import Parameter
 from ros_harness import DOMAIN, Harness
 from std_msgs.msg import Float64MultiArray
@@ -44,7 +44,7 @@ def start(**params):
 
 
 def test_a_name_map_that_permutes_joints_needs_joints_given():
-    with pytest.raises(InputError, match=r"^joints: must be given: the name map sends the "
+    with pytest.raises(InputError, match=r'^joints: must be given: the name map sends the '
                        r"scenario's joint 'joint1' to 'joint3'"):
         start(name_map=SWAP)
     # Given, the order is the user's: what stops this map now is the swapped fingers'
@@ -147,5 +147,36 @@ def test_another_publisher_on_the_command_topic_is_an_error(planar):
         assert last['command_topic.other_publishers'] == '/tester'
         assert last['_message'].startswith('another publisher on /effort_commands (/tester); ')
         assert h.node.controller is not None  # the node goes on (docs/node.md, Faults)
+    finally:
+        h.close()
+
+
+def test_the_solve_worker_keeps_to_its_share_and_sheds_load_early(planar):
+    from grasp_torque_opt.ros.node import service
+    from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+    from std_srvs.srv import Trigger
+
+    h = Harness(PLANAR, joint_state_timeout=10.0)
+    try:
+        client = h.tester.create_client(Trigger, 'grasp_torque_node/solve', qos_profile=QoSProfile(
+            history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
+        assert h.spin_until(client.service_is_ready, 5.0)
+        names, pos = joint_state(planar)
+        h.send_joint_state(names, pos)
+        assert h.next_command() is not None
+        h.node.root.service.controller.solver = Slow(0.01)
+        futures = [client.call_async(Trigger.Request()) for _ in range(40)]
+        n = len(h.commands)
+        for _ in range(20):  # the loop answers joint states while the worker solves
+            h.send_joint_state(names, pos)
+            h.spin_for(0.01)
+        assert h.spin_until(lambda: all(f.done() for f in futures), 30.0)
+        busy = [f for f in futures if f.result().message.startswith('busy: ')]
+        # At most 10 queued (a few more solved meanwhile); 100 before: none was busy.
+        assert service.MAX_PENDING_SOLVES == 10 and len(busy) >= 25
+        assert len(h.commands) - n >= 10
+        worker = h.node.root.service
+        share = worker.solving_time / (worker.solving_time + worker.resting_time)
+        assert share <= service.WORKER_SHARE + 1e-9
     finally:
         h.close()
