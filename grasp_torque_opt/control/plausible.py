@@ -49,33 +49,23 @@ def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, fra
     Raises:
         InputError: naming the contact (:func:`check_on_links`, :func:`check_inward`).
     """
-    model, data = setup.hand.model, setup.hand.data
+    hand = setup.hand
+    model, data = hand.model, hand.data
+    if hand.coupling.mimics:  # coupled joints follow their actuators, as in the cycle
+        q = hand.complete(q.copy())
     pin.framesForwardKinematics(model, data, q)
-    points, normals = placed(model, data, frame, positions, rotations)
+    # In the grasp's base frame (the base link's, in a robot), as the cycle places them.
+    base = data.oMf[model.getFrameId(hand.base_link)] if hand.base_link is not None else None
+    oMF = data.oMf[model.getFrameId(frame or hand.base_frame)]
+    oMF = base.actInv(oMF) if base is not None else oMF
+    R = oMF.rotation
+    points, normals = positions @ R.T + oMF.translation, rotations[:, :, 2] @ R.T
     links = tuple(c.link for c in setup.contacts)
-    origins = np.array([data.oMf[model.getFrameId(link)].translation for link in links])
+    placements = [data.oMf[model.getFrameId(link)] for link in links]
+    origins = np.array([(base.actInv(m) if base is not None else m).translation
+                        for m in placements])
     check_on_links(points, origins, links, limit)
     check_inward(points, normals, links, setup.object_origin, obj)
-
-
-def placed(model: pin.Model, data: pin.Data, frame: str, positions: np.ndarray,
-           rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """
-    Return contact points and normals in the base frame, at ``data``'s placements.
-
-    Args:
-        frame: model frame of the poses ('' = the base frame).
-        positions: contact points, shape (p, 3) [m].
-        rotations: contact frame axes, shape (p, 3, 3).
-
-    Returns:
-        Points [m] and unit normals, each shape (p, 3), base frame.
-    """
-    if not frame:
-        return positions, rotations[:, :, 2]
-    oMF = data.oMf[model.getFrameId(frame)]
-    R = oMF.rotation
-    return positions @ R.T + oMF.translation, rotations[:, :, 2] @ R.T
 
 
 def check_on_links(points: np.ndarray, link_origins: np.ndarray, links: tuple[str, ...],

@@ -19,8 +19,8 @@ from grasp_torque_opt.core.exceptions import InputError
 import pinocchio as pin
 
 
-def check_contact_links(model: pin.Model, links: list[str], field: str = 'grasp.contacts'
-                        ) -> None:
+def check_contact_links(model: pin.Model, links: list[str], field: str = 'grasp.contacts',
+                        base: str | None = None) -> None:
     """
     Refuse a contact link that cannot carry a fingertip's contact.
 
@@ -32,20 +32,25 @@ def check_contact_links(model: pin.Model, links: list[str], field: str = 'grasp.
         model: the hand's model.
         links: the contacts' links (the URDF's names, after the name map).
         field: the field named in the message.
+        base: the hand's base frame (``hand.base_link`` in a robot: a link fixed to it
+            is the palm, not a finger), or None for the root.
 
     Raises:
         InputError: ``<field>[i].link``, naming the link and why.
     """
-    root = model.frames[1].name if len(model.frames) > 1 else ''
+    root, word = (model.frames[1].name if len(model.frames) > 1 else ''), 'root'
+    if base is not None and model.existFrame(base):
+        root, word = base, 'base link'
+    fixed = model.frames[model.getFrameId(root)].parentJoint if root else 0
     for i, link in enumerate(links):
         if not model.existFrame(link):
             continue  # the binding names unknown frames itself
         frame = model.frames[model.getFrameId(link)]
         if frame.type in (pin.FrameType.JOINT, pin.FrameType.FIXED_JOINT):
             why = 'is a joint frame, not a link'
-        elif frame.parentJoint == 0:
-            why = f"is the root '{root}'" if link == root else \
-                f"is fixed to the root '{root}'"
+        elif frame.parentJoint == fixed:
+            why = f"is the {word} '{root}'" if link == root else \
+                f"is fixed to the {word} '{root}'"
         else:
             continue
         raise InputError(f'{field}[{i}].link', f"'{link}' {why}: a contact must be on a "

@@ -96,7 +96,8 @@ class GraspSetup:
                     weights=weights, objective=scenario.objective)
         # Names unknown frames, links that no joint moves and bad normals now, not at
         # solve time.
-        check_contact_links(hand.model, [c.link for c in scenario.contacts])
+        check_contact_links(hand.model, [c.link for c in scenario.contacts],
+                            base=hand.base_link)
         maps = setup.maps()
         check_inward_normals(maps.positions, maps.rotations[:, :, 2], maps.links,
                              scenario.object_origin, scenario.object)
