@@ -319,7 +319,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
 
     def on_diag(msg: DiagnosticArray) -> None:
         for status in msg.status:
-            if status.name.startswith('grasp_torque_node'):
+            if status.name.startswith('/grasp_torque_node: '):
                 diag.clear()
                 diag.update({kv.key: kv.value for kv in status.values})
                 diag['_level'] = str(status.level[0] if isinstance(status.level, bytes)

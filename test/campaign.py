@@ -29,7 +29,7 @@ from hypothesis import strategies as st
 import numpy as np
 
 #: Counts of the whole run, printed by conftest's terminal summary.
-COUNTS = {'inputs': 0, 'commands': 0, 'broken': 0}
+COUNTS = {'inputs': 0, 'commands': 0, 'broken': 0, 'pulling': 0, 'chattering': 0, 'late': 0}
 
 #: Reproducible and bounded: CI sees the same examples every run.
 CAMPAIGN = settings(deadline=None, derandomize=True, database=None,

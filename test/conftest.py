@@ -82,4 +82,5 @@ def pytest_terminal_summary(terminalreporter):
     if COUNTS['inputs']:
         terminalreporter.write_line(
             f"campaign: {COUNTS['inputs']} inputs tried, {COUNTS['commands']} commands "
-            f"published, {COUNTS['broken']} invariants broken")
+            f"published, {COUNTS['broken']} invariants broken; {COUNTS['pulling']} pulling, "
+            f"{COUNTS['chattering']} chattering, {COUNTS['late']} late commands")

@@ -51,6 +51,18 @@ def base_poses(setup, q=None):
     return pos, quat
 
 
+def flipped(quat: np.ndarray) -> np.ndarray:
+    """Turn each contact frame half a turn about its x axis: its normal z points outward."""
+    half = pin.Quaternion(pin.exp3(np.array([np.pi, 0.0, 0.0])))
+    return np.array([(pin.Quaternion(q[3], *q[:3]) * half).coeffs() for q in quat])
+
+
+def tilted(quat: np.ndarray, angle: float) -> np.ndarray:
+    """Turn each contact frame about its x axis by ``angle``: its normal still points inward."""
+    turn = pin.Quaternion(pin.exp3(np.array([angle, 0.0, 0.0])))
+    return np.array([(pin.Quaternion(q[3], *q[:3]) * turn).coeffs() for q in quat])
+
+
 class Injected:
     """
     A tau-QP solver (``solve(qp) -> RawResult``, ``settings``) that fails on purpose.

@@ -46,6 +46,9 @@ class Harness:
         # The most generous cycle budget unless a test is about it: other processes may
         # load this machine, and an overrun drops the command by design.
         params.setdefault('cycle_budget', 1.0)
+        # The rate rule off unless a test is about it: tests compare each command with the
+        # certified solution of its state.
+        params.setdefault('max_torque_rate', 1e6)  # N m/s: 1 kN m a millisecond
         # Diagnostics at 10 Hz (the node's default is 1 Hz), so tests need not wait seconds.
         params.setdefault('diagnostics_period', 0.1)
         overrides = [] if scenario is None else [Parameter('scenario', value=str(scenario))]
@@ -87,7 +90,7 @@ class Harness:
 
     def _on_diag(self, msg):
         for s in msg.status:
-            if s.name.startswith('grasp_torque_node'):
+            if s.name.startswith('/grasp_torque_node: '):
                 self.diagnostics.append({**{kv.key: kv.value for kv in s.values},
                                          '_level': s.level[0], '_message': s.message,
                                          '_hardware_id': s.hardware_id})

@@ -116,6 +116,32 @@ def check_joint_names(names: list[str], positions: list[float], q: np.ndarray,
     return (list(names), np.array(used, dtype=np.intp), np.array(to, dtype=np.intp), joints)
 
 
+def check_joint_limits(q: np.ndarray, used: np.ndarray, lower: np.ndarray,
+                       upper: np.ndarray, names: dict[int, str], tolerance: float) -> None:
+    """
+    Refuse a used position beyond its joint's URDF limits plus ``joint_limit_tolerance``.
+
+    Args:
+        q: the configuration, shape (nq,).
+        used: the indices in q the joint state gave.
+        lower: the lower limits minus the tolerance, shape (nq,).
+        upper: the upper limits plus the tolerance, shape (nq,).
+        names: index in q -> joint name, for the message.
+        tolerance: ``joint_limit_tolerance`` [rad or m].
+
+    Raises:
+        InputError: naming the joint, its position and its limits.
+    """
+    values = q[used]
+    ok = (values >= lower[used]) & (values <= upper[used])
+    if ok.all():
+        return
+    k = int(used[int(np.argmin(ok))])
+    raise InputError('joint_states', f"position of '{names.get(k, k)}' is {q[k]:.6g}, beyond "
+                     f'its URDF limits [{lower[k] + tolerance:.6g}, {upper[k] - tolerance:.6g}] '
+                     f'by more than joint_limit_tolerance ({tolerance:g})')
+
+
 def contact_rotations(model: pin.Model, p: int, frame: str, positions: np.ndarray,
                       quaternions: np.ndarray) -> np.ndarray:
     """
@@ -177,7 +203,8 @@ def checked_wrench(model: pin.Model, frame: str, force: np.ndarray, torque: np.n
 
 
 def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndarray | None,
-                    unresolved: str) -> np.ndarray:
+                    unresolved: str, bounds: tuple[float, float] = (0.0, MAX_GRAVITY)
+                    ) -> np.ndarray:
     """
     Check gravity and return it in base axes [m/s^2].
 
@@ -187,10 +214,11 @@ def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndar
         vector: gravity in ``frame`` [m/s^2], shape (3,).
         rotation: base-from-frame rotation, shape (3, 3), or None.
         unresolved: why ``frame`` could not be looked up (for the message).
+        bounds: ``gravity_norm_bounds``, [low, high] [m/s^2].
 
     Raises:
         InputError: another frame without ``rotation``, not finite, a norm above
-            :data:`MAX_GRAVITY`.
+            :data:`MAX_GRAVITY` or outside ``bounds``.
     """
     if frame not in ('', base) and rotation is None:
         raise InputError('gravity.header.frame_id', f"'{show(frame)}' is not the "
@@ -206,4 +234,7 @@ def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndar
     if norm > MAX_GRAVITY:
         raise InputError('gravity.vector', f'norm {norm:.6g} m/s^2 exceeds '
                          f'{MAX_GRAVITY:g} m/s^2')
+    if not bounds[0] <= norm <= bounds[1]:
+        raise InputError('gravity.vector', f'norm {norm:.6g} m/s^2 is outside '
+                         f'gravity_norm_bounds [{bounds[0]:g}, {bounds[1]:g}]')
     return g

@@ -68,6 +68,7 @@ from grasp_torque_opt.control.inputs import (
     SOURCES,
     stamp_seconds,
 )
+from grasp_torque_opt.control.rates import slewed
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.solution import Solution
@@ -265,11 +266,29 @@ class TorqueController:
             result = policy.faulted(now + elapsed, f'inputs went stale during the cycle: {late}',
                                     result.solution, result.maps, result.gravity_torque)
         if result.kind == 'solution':
+            self._slew(result, now)
             fallback = self.fallback
             policy.committed(result, now, fallback is not None
                              and result.solution.backend == fallback.name)
         result.cycle_time = elapsed
         return result
+
+    def _slew(self, result: CycleResult, now: float) -> None:
+        """
+        Cut a certified command's step from the command in force to ``max_torque_rate``.
+
+        The rate rule (docs/node.md): each joint's torque moves at most ``max_torque_rate``
+        times the time since the command in force towards the certified command.
+        """
+        policy, rate = self.policy, self.config.max_torque_rate
+        if policy.in_force is None or policy.in_force_time is None:
+            return
+        cmd = slewed(policy.in_force, result.command, rate * max(now - policy.in_force_time,
+                                                                 0.0),
+                     self.setup.hand.torque_limits)
+        if cmd is not None:
+            result.command = cmd
+            self.counters.slew_limited += 1
 
     def _attempt(self, now: float, deadline: float) -> CycleResult:
         """Solve and gate; a certified command is returned, not yet committed."""

@@ -28,6 +28,7 @@ from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
+from grasp_torque_opt.control.plausible import check_on_links, points_inward
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -88,8 +89,10 @@ class Cycle:
         compiled cycle reads both from the hand's Pinocchio data).
 
         Raises:
-            InputError: a contact point beyond ``max_contact_distance``, or the
-                contacts cannot be placed on their links.
+            InputError: a contact point beyond ``max_contact_distance`` or farther than
+                ``max_contact_link_distance`` from its link, a normal pointing away from
+                the object origin (at this configuration), or the contacts cannot be
+                placed on their links.
         """
         setup = self.setup
         hand = setup.hand
@@ -109,10 +112,11 @@ class Cycle:
             oMF = data.oMf[model.getFrameId(cp.frame or hand.base_frame)]
             if hand.base_link is not None:  # the grasp is written in the base link's frame
                 oMF = data.oMf[model.getFrameId(hand.base_link)].actInv(oMF)
-            contacts = []
+            contacts, points, normals, origins = [], [], [], []
             limit = self.config.max_contact_distance
             for i, (spec, p, R) in enumerate(zip(setup.contacts, cp.positions, cp.rotations)):
-                distance = float(np.linalg.norm(oMF.act(p)))
+                p_base = oMF.act(p)
+                distance = float(np.linalg.norm(p_base))
                 if distance > limit:
                     raise InputError(f'contacts.poses[{i}].position',
                                      f'is {distance:.6g} m from the base origin, beyond '
@@ -121,8 +125,12 @@ class Cycle:
                 oMl = data.oMf[model.getFrameId(spec.link)]
                 if hand.base_link is not None:
                     oMl = data.oMf[model.getFrameId(hand.base_link)].actInv(oMl)
-                contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(oMF.act(p)),
+                contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(p_base),
                                             normal=R_base[:, 2], tangent=R_base[:, 0]))
+                points.append(p_base)
+                normals.append(R_base[:, 2])
+                origins.append(oMl.translation)
+            self._check_plausible(np.array(points), np.array(normals), np.array(origins))
         wrench = setup.external_wrench
         if inputs.wrench is not None:
             frame, w = inputs.wrench
@@ -142,6 +150,22 @@ class Cycle:
             g = hand.actuator_torques(pin.computeGeneralizedGravity(model, data, q))
         return replaced(setup, q=q, contacts=contacts, external_wrench=wrench,
                         torque_offset=g), g
+
+    def _check_plausible(self, points: np.ndarray, normals: np.ndarray,
+                         origins: np.ndarray) -> None:
+        """
+        Check the contacts in use at this configuration: on their links, pushing inward.
+
+        The message was checked whole on receipt (at the joint state of then); here the
+        cheap, vectorized part runs again, since the links have moved since.
+        """
+        links = tuple(c.link for c in self.setup.contacts)
+        check_on_links(points, origins, links, self.config.max_contact_link_distance)
+        i = points_inward(points, normals, self.setup.object_origin)
+        if i >= 0:
+            raise InputError(f'contacts.poses[{i}].orientation', 'the normal of the contact '
+                             f"on '{links[i]}' points away from the object origin at this "
+                             'configuration: the torques would pull')
 
     def budget(self) -> float:
         """

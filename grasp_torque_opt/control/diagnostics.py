@@ -59,6 +59,8 @@ def report(controller: TorqueController, now: float) -> Report:
         else:
             level, message = ERROR, f'hold policy, last certified command kept: {c.fault}'
     values.append(('fault', c.fault or 'none'))
+    # The order of the command's values: a controller with a fixed joint list must match it.
+    values.append(('command_joints', ','.join(c.setup.hand.joints)))
     values.append(('fault_policy', cfg.fault_policy))
     if sol is not None:
         values += [('status', sol.status), ('solver_message', sol.message),
@@ -91,7 +93,8 @@ def report(controller: TorqueController, now: float) -> Report:
     values += [('cycles', str(n.cycles)), ('commands', str(n.commands)),
                ('zero_commands', str(n.zero_commands)), ('faults', str(n.faults)),
                ('recoveries', str(n.recoveries)), ('solver_failures', str(n.solver_failures)),
-               ('overruns', str(n.overruns)), ('max_cycle_time_s', f'{n.max_cycle_time:.6f}'),
+               ('overruns', str(n.overruns)), ('slew_limited', str(n.slew_limited)),
+               ('max_cycle_time_s', f'{n.max_cycle_time:.6f}'),
                ('cycle_budget_s', f'{cfg.cycle_budget:.6f}')]
     solver = c.solver
     values += [('solver.backend', getattr(solver, 'name', type(solver).__name__)),

@@ -73,6 +73,8 @@ class FaultPolicy:
         #: The last command returned for publishing, certified or the zero policy's: what
         #: the effort controller holds (it has no timeout) [N m].
         self.in_force: np.ndarray | None = None
+        #: When the command in force was returned for publishing [s] (None: unknown).
+        self.in_force_time: float | None = None
         #: The last result, certified or not.
         self.last: CycleResult | None = None
 
@@ -82,7 +84,7 @@ class FaultPolicy:
             self.counters.recoveries += 1
         self.fault = ''
         self.last_command, self.last_command_time = result.command, now
-        self.in_force = result.command
+        self.in_force, self.in_force_time = result.command, now
         self.counters.commands += 1
         if from_fallback:
             self.counters.fallback_solves += 1
@@ -103,6 +105,7 @@ class FaultPolicy:
                 and now - self.last_command_time <= self.config.hold_time)
         if not held and self.config.fault_policy == 'zero':
             result = self._zero(reason, sol, maps, g)
+            self.in_force_time = now
         else:
             result = CycleResult(None, 'none', sol, maps, g, reason)
         self.last = result

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import math
 
 from grasp_torque_opt.control.checks import (
+    check_joint_limits,
     check_joint_names,
     checked_gravity,
     checked_wrench,
@@ -29,8 +30,11 @@ from grasp_torque_opt.control.checks import (
     MAX_ABS_JOINT_POSITION,
 )
 from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.plausible import check_contacts
+from grasp_torque_opt.control.rates import turned_towards
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
 
 #: The input topics, as named in counters, stamps and messages (and ``gravity``, counted
@@ -84,7 +88,8 @@ class Counters:
     (not the confirmed infeasible ones); ``fallback_solves`` certified
     solutions that came from the fallback backend after the first one failed;
     ``overruns`` cycles over ``cycle_budget``; ``max_cycle_time`` is the longest
-    cycle [s]; ``rejected`` the rejected messages by source.
+    cycle [s]; ``slew_limited`` commands cut to ``max_torque_rate``; ``rejected`` the
+    rejected messages by source.
     """
 
     cycles: int = 0
@@ -96,6 +101,7 @@ class Counters:
     solver_failures: int = 0
     fallback_solves: int = 0
     max_cycle_time: float = 0.0
+    slew_limited: int = 0
     rejected: dict[str, int] = field(default_factory=lambda: dict.fromkeys(SOURCES, 0))
 
 
@@ -136,6 +142,10 @@ class InputStore:
         model = setup.hand.model
         self._model_joints = {model.names[j]: model.joints[j].idx_q
                               for j in range(1, model.njoints) if model.joints[j].nq == 1}
+        self._q_names = {i: n for n, i in self._model_joints.items()}
+        #: (config, URDF lower and upper limits widened by joint_limit_tolerance).
+        self._limits: tuple[CycleConfig, np.ndarray, np.ndarray] | None = None
+        self.object: ObjectSpec | None = None  #: the scenario's object (the inward rule)
         #: The last accepted joint state's names, which of its entries are model joints,
         #: their indices in q, and the commanded joints it was checked against (a state
         #: with the same names skips the name checks).
@@ -221,6 +231,7 @@ class InputStore:
             else:
                 checked = check_joint_names(names, positions, q, self._model_joints,
                                             self.setup.hand.joints)
+            self._check_limits(q, (checked or known)[2])
             self._check_stamp('joint_states', stamp, clock, now)
         except InputError as e:
             self.reject('joint_states', e)
@@ -229,6 +240,16 @@ class InputStore:
             self._names = checked
         self._keep_stamp('joint_states', stamp, now, clock)
         self.inputs = replaced(self.inputs, q=q, q_time=now)
+
+    def _check_limits(self, q: np.ndarray, used: np.ndarray) -> None:
+        """Refuse a used position beyond its URDF limits (:func:`.checks.check_joint_limits`)."""
+        limits = self._limits
+        if limits is None or limits[0] is not self.config:
+            model, tol = self.setup.hand.model, self.config.joint_limit_tolerance
+            limits = self._limits = (self.config, model.lowerPositionLimit - tol,
+                                     model.upperPositionLimit + tol)
+        check_joint_limits(q, used, limits[1], limits[2], self._q_names,
+                           self.config.joint_limit_tolerance)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
                         now: float, stamp: float = 0.0, clock: float | None = None) -> None:
@@ -245,9 +266,9 @@ class InputStore:
 
         Raises:
             InputError: wrong count or shape, unknown frame, non-finite values, a
-                non-unit quaternion, a bad stamp. The contacts are not kept. (The
-                distance from the base is checked in the cycle, where the frame
-                is placed.)
+                non-unit quaternion, an implausible contact at the latest joint state
+                (:func:`.plausible.check_contacts`), a bad stamp. The contacts are not
+                kept. (The cycle checks them again, where the frame is placed.)
         """
         positions = np.asarray(positions, dtype=float)
         quaternions = np.asarray(quaternions, dtype=float)
@@ -255,6 +276,7 @@ class InputStore:
         try:
             rotations = contact_rotations(self.setup.hand.model, len(self.setup.contacts),
                                           frame, positions, quaternions)
+            self._check_plausible(frame, positions, rotations)
             self._check_stamp('contacts', stamp, clock, now)
         except InputError as e:
             self.reject('contacts', e)
@@ -262,6 +284,13 @@ class InputStore:
         self._keep_stamp('contacts', stamp, now, clock)
         self.inputs = dataclasses.replace(
             self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
+
+    def _check_plausible(self, frame: str, positions: np.ndarray,
+                         rotations: np.ndarray) -> None:
+        """Check contacts on their links and pushing inward, at the latest joint state."""
+        q = self.setup.q if self.inputs.q is None else self.inputs.q
+        check_contacts(self.setup, self.object, q, frame, positions, rotations,
+                       self.config.max_contact_link_distance)
 
     def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
                       now: float, stamp: float = 0.0, clock: float | None = None) -> None:
@@ -310,17 +339,22 @@ class InputStore:
 
         Raises:
             InputError: another frame without ``rotation``, not finite, a norm above
-                :data:`~grasp_torque_opt.control.checks.MAX_GRAVITY`, a bad stamp. The
-                vector is not kept.
+                :data:`~grasp_torque_opt.control.checks.MAX_GRAVITY` or outside
+                ``gravity_norm_bounds``, a bad stamp. The vector is not kept. Else the
+                gravity in use turns towards it at ``max_gravity_rate`` (:mod:`.rates`).
         """
         try:
             g = checked_gravity(self.setup.hand.base_frame, frame, vector, rotation,
-                                unresolved)
+                                unresolved, self.config.gravity_norm_bounds)
             self._check_stamp('gravity', stamp, clock, now)
         except InputError as e:
             self.reject('gravity', e)
             raise
         self._keep_stamp('gravity', stamp, now, clock)
+        old, timeout = self.inputs.gravity, self.config.gravity_timeout
+        if old is not None and not (timeout > 0 and now - self.inputs.gravity_time > timeout):
+            step = self.config.max_gravity_rate * (now - self.inputs.gravity_time)
+            g = turned_towards(old, g, step)
         self.inputs = dataclasses.replace(self.inputs, gravity=g, gravity_time=now)
 
     def reject(self, source: str, error: InputError) -> None:

@@ -167,6 +167,11 @@ def validate_gravity_norm(name: str, value: Any, ctx: Context) -> str:
     return ''
 
 
+def validate_ordered_pair(name: str, value: Any, ctx: Context) -> str:
+    """Refuse [low, high] with low above high."""
+    return '' if value[0] <= value[1] else f'low {value[0]:g} is above high {value[1]:g}'
+
+
 def validate_backend_installed(name: str, value: Any, ctx: Context) -> str:
     """Refuse a backend whose Python module cannot be imported here."""
     return '' if available(value) else f'{value} is not installed (pip install {value})'
@@ -187,6 +192,7 @@ VALIDATORS: dict[str, Validator] = {
     'within_urdf_limits': validate_within_urdf_limits,
     'weight_range': validate_weight_range,
     'gravity_norm': validate_gravity_norm,
+    'ordered_pair': validate_ordered_pair,
     'backend_installed': validate_backend_installed,
     'method_available': validate_method_available,
 }
@@ -197,8 +203,16 @@ def check_pairs(values: Mapping[str, Any]) -> None:
     Check the rules between parameters (after each one's own check).
 
     Raises:
-        InputError: min-max with a method other than tau-qp (docs/planner.md).
+        InputError: gravity's norm outside gravity_norm_bounds; min-max with a method
+            other than tau-qp (docs/planner.md).
     """
+    gravity, bounds = values.get('gravity'), values.get('gravity_norm_bounds')
+    if gravity is not None and bounds is not None:
+        norm = math.sqrt(sum(v * v for v in gravity))
+        if not bounds[0] <= norm <= bounds[1]:
+            raise InputError('gravity', f'norm {norm:.6g} m/s^2 is outside gravity_norm_bounds '
+                             f'[{bounds[0]:g}, {bounds[1]:g}] (set those to allow it, e.g. '
+                             '[0.0, 15.0] for zero gravity)')
     if values.get('objective') == 'min-max' and values.get('solver.method') != 'tau-qp':
         raise InputError('objective', 'min-max needs solver.method tau-qp, not '
                          f"{values.get('solver.method')}")

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from grasp_torque_opt.core.contact_links import check_contact_links
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps, GraspMaps
 from grasp_torque_opt.core.hand import Hand, resolve_urdf
@@ -93,7 +94,10 @@ class GraspSetup:
                     contacts=scenario.contacts, object_origin=scenario.object_origin,
                     friction=scenario.friction, external_wrench=scenario.external_wrench,
                     weights=weights, objective=scenario.objective)
-        # Names unknown frames and bad normals now, not at solve time.
+        # Names unknown frames, links that no joint moves and bad normals now, not at
+        # solve time.
+        check_contact_links(hand.model, [c.link for c in scenario.contacts],
+                            base=hand.base_link)
         maps = setup.maps()
         check_inward_normals(maps.positions, maps.rotations[:, :, 2], maps.links,
                              scenario.object_origin, scenario.object)

@@ -24,6 +24,7 @@ from importlib import metadata
 import os
 from pathlib import Path
 import re
+from xml.etree import ElementTree
 
 from grasp_torque_opt.core.coupling import Coupling, COUPLING_TOLERANCE, Mimic, urdf_mimics
 from grasp_torque_opt.core.exceptions import (
@@ -123,6 +124,48 @@ def bounded_urdf(xml: str, field_name: str) -> str:
             raise InputError(field_name, f'the URDF has {n} <{tag}> elements, more than '
                              f'{MAX_URDF_ELEMENTS}')
     return xml
+
+
+def check_inertials(xml: str, field_name: str) -> None:
+    """
+    Refuse a URDF whose links' masses or inertias the model cannot use, naming the link.
+
+    Read before Pinocchio parses the document: urdfdom dropped a NaN inertia with a line
+    on the terminal for each (69 for one URDF), so g(q) was certified with a wrong model;
+    a negative mass started a node that never commanded; a malformed document gave
+    urdfdom's three lines. Each value must be a number, finite; a mass and the inertia's
+    diagonal not negative (0: a massless link).
+
+    Args:
+        xml: the URDF document (within :func:`bounded_urdf`'s bounds).
+        field_name: the field named in the message (``hand.urdf``, ``robot_description``).
+
+    Raises:
+        InputError: one line: the document does not parse as XML, or the link and value.
+    """
+    try:
+        root = ElementTree.fromstring(xml)
+    except ElementTree.ParseError as e:
+        raise InputError(field_name, f'cannot parse the URDF: {e}') from e
+    for link in root.iter('link'):
+        inertial = link.find('inertial')
+        if inertial is None:
+            continue
+        name = cut(link.get('name', '?'))
+        values = [('mass', (inertial.find('mass'), ('value',)), True),
+                  ('inertia', (inertial.find('inertia'), ('ixx', 'iyy', 'izz')), True),
+                  ('inertia', (inertial.find('inertia'), ('ixy', 'ixz', 'iyz')), False)]
+        for tag, (element, keys), signed in values:
+            for key in keys if element is not None else ():
+                text = element.get(key, '0')
+                try:
+                    value = float(text)
+                except ValueError:
+                    value = float('nan')
+                if not np.isfinite(value) or (signed and value < 0.0):
+                    raise InputError(field_name, f"link '{name}': {tag} {key}="
+                                     f"'{cut(text, 40)}' must be a finite number"
+                                     + (' >= 0' if signed else ''))
 
 
 def frame_names(model: pin.Model) -> list[str]:
@@ -379,8 +422,9 @@ class Hand:
         """
         path = Path(path)
         xml = decode_utf8(read_bounded(path, 'hand.urdf', MAX_URDF_BYTES), path, 'hand.urdf')
+        check_inertials(bounded_urdf(xml, 'hand.urdf'), 'hand.urdf')
         try:
-            model = pin.buildModelFromXML(bounded_urdf(xml, 'hand.urdf'))
+            model = pin.buildModelFromXML(xml)
         except (RuntimeError, ValueError) as e:
             raise InputError('hand.urdf',
                              f'cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}') from e
@@ -397,8 +441,9 @@ class Hand:
 
         The document may be, e.g., the ``robot_description`` parameter.
         """
+        check_inertials(bounded_urdf(xml, 'robot_description'), 'robot_description')
         try:
-            model = pin.buildModelFromXML(bounded_urdf(xml, 'robot_description'))
+            model = pin.buildModelFromXML(xml)
         except (RuntimeError, ValueError) as e:
             raise InputError('robot_description', f'cannot parse the URDF: {cut(e, 400)}') from e
         return cls.from_model(model, joints, torque_limits, above_urdf,

@@ -172,7 +172,8 @@ def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
 
     def on_diagnostics(msg: DiagnosticArray) -> None:
         for status in msg.status:
-            if status.name.startswith(f'{watched}: '):
+            # The node's fully qualified name, then ': grasp torques'.
+            if status.name.partition(': ')[0].rpartition('/')[2] == watched:
                 diag.clear()
                 diag.update({kv.key: kv.value for kv in status.values})
                 diag['message'] = status.message

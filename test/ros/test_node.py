@@ -24,7 +24,7 @@ from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.methods.dispatch import solve
-from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode
+from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode, MAX_PENDING_SOLVES
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -93,7 +93,9 @@ def test_service_returns_the_cli_json(planar_node, planar):
     assert d['status'] == 'optimal' and d['joints'] == planar.hand.joints
     np.testing.assert_allclose(d['command'], cmd, atol=1e-12)
     # Many calls while the loop runs: each answered, the loop keeps publishing.
-    futures = [planar_node.solve_client.call_async(Trigger.Request()) for _ in range(20)]
+    # (As many as the worker queues: beyond, the answer is "busy".)
+    futures = [planar_node.solve_client.call_async(Trigger.Request())
+               for _ in range(MAX_PENDING_SOLVES)]
     n = len(planar_node.commands)
     for _ in range(20):
         planar_node.send_joint_state(*joint_state(planar))

@@ -50,7 +50,7 @@ def test_gravity_defaults_to_the_scenarios_and_drives_g_of_q(allegro):
 
 
 def test_a_gravity_parameter_above_the_topics_bound_is_refused():
-    h = Harness(ALLEGRO, gravity_compensation=True)
+    h = Harness(ALLEGRO, gravity_compensation=True, gravity_norm_bounds=[0.0, 100.0])
     try:
         (result,) = h.node.set_parameters([Parameter('gravity', value=[0.0, 0.0, -101.0])])
         assert not result.successful and 'gravity: norm must be at most 100' in result.reason

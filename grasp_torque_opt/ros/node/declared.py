@@ -83,8 +83,10 @@ class DeclaredParameters:
         Returns:
             Its value.
         """
+        if value is None and name in UNSET_PARAMETERS:
+            return self._declare_empty(name)
         if value is None:
-            value = {**SCENARIO_PARAMETERS, **UNSET_PARAMETERS}[name]
+            value = SCENARIO_PARAMETERS[name]
         d = descriptor(name, self.managed)
         if not self.managed:
             return self.node.declare_parameter(name, value, d).value
@@ -96,6 +98,21 @@ class DeclaredParameters:
                 why = why[:-len(name) - 2]
             self.refused[name] = f'the value given at start was refused ({why})'
             self.node.declare_parameter(name, value, d, ignore_override=True)
+        return self.value(name)
+
+    def _declare_empty(self, name: str) -> Any:
+        """
+        Declare a parameter that may stay unset (``name_map``) with an empty list.
+
+        rclpy types an empty list as a byte array, so it is declared by type, then set
+        to an empty list of its own type: declared without a value, a get_parameters
+        request that named it answered nothing at all. Its descriptor is not read-only
+        (which would refuse that set); the on-set check keeps it fixed once configured.
+        """
+        kind = UNSET_PARAMETERS[name]
+        self.node.declare_parameter(name, kind, descriptor(name, managed=True))
+        if self.value(name) is None:
+            self.node.set_parameters([Parameter(name, kind, [])])
         return self.value(name)
 
     def declare_all_managed(self) -> None:

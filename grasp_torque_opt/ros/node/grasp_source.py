@@ -139,8 +139,24 @@ def urdf_document(node: Node, value: Callable[[str], object],
     return ''
 
 
+def permuted(scenario: Scenario) -> list[tuple[str, str]]:
+    """
+    Give the scenario's joints that its name map sends to another of its joints' names.
+
+    Such a map (a swap, a cycle) reorders the command without any name going missing.
+
+    Returns:
+        (scenario name, the name it is mapped to), in the scenario's order.
+    """
+    names = scenario.name_map
+    inverse = {v: k for k, v in names.items()}
+    before = [inverse.get(j, j) for j in scenario.joints]
+    known = set(before)
+    return [(k, names[k]) for k in before if names.get(k, k) != k and names[k] in known]
+
+
 def bind(scenario_name: str | None, name_map: list[str] | None, urdf: str,
-         joints: list[str] | None = None) -> Grasp:
+         joints: list[str] | None = None, joints_given: bool = False) -> Grasp:
     """
     Load the scenario, map its names (``name_map``) and bind it to the hand.
 
@@ -150,17 +166,27 @@ def bind(scenario_name: str | None, name_map: list[str] | None, urdf: str,
         urdf: the URDF document ('' for the scenario's ``hand.urdf``).
         joints: actuated joints in command order instead of the scenario's (URDF
             names), or None.
+        joints_given: the ``joints`` parameter was given (the caller binds again with
+            it): a name map that permutes the scenario's joints is then allowed.
 
     Raises:
-        InputError: naming the parameter or the scenario's field.
+        InputError: naming the parameter or the scenario's field; ``joints`` when the
+            name map permutes the scenario's joints and ``joints`` is not given.
     """
     if not scenario_name:
         raise InputError('scenario', 'parameter not set (a scenario file gives the '
                          'default contacts and load)')
     scenario = load_scenario(find_config(scenario_name), name_map_of(name_map))
+    swapped = permuted(scenario) if joints is None and not joints_given else []
+    if swapped:
+        a, b = swapped[0]
+        raise InputError('joints', f"must be given: the name map sends the scenario's joint "
+                         f"'{a}' to '{b}', the name of another of its joints, which would "
+                         'reorder the command silently; set joints to the effort '
+                         "controller's joint order")
     bound = scenario if joints is None else dataclasses.replace(scenario, joints=list(joints))
     try:
-        return Grasp(scenario, GraspSetup.from_scenario(bound, urdf or None))
+        setup = GraspSetup.from_scenario(bound, urdf or None)
     except (JointNotFound, FrameNotFound) as e:
         if not urdf:
             raise
@@ -168,6 +194,7 @@ def bind(scenario_name: str | None, name_map: list[str] | None, urdf: str,
                          "URDF of this hand does, map them to this URDF's names with the "
                          'name_map parameter (SCENARIO_NAME=URDF_NAME) or the '
                          "scenario's hand.name_map") from e
+    return Grasp(scenario, setup)
 
 
 def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | None:

@@ -50,7 +50,8 @@ class GraspTorqueNode(Node):
                      'robot_description_timeout', 'name_map'):
             declared.declare(name, defaults.get(name))
         PARAMETERS.check('name_map', declared.value('name_map'))
-        grasp = root.load(stop_requested)
+        # rclpy has no public way to ask whether a value was given at start.
+        grasp = root.load(stop_requested, joints_given='joints' in self._parameter_overrides)
         scenario = root.defaults(grasp)
         joints = declared.declare('joints', scenario.pop('joints'))
         if list(joints) != list(grasp.setup.hand.joints):

@@ -25,6 +25,7 @@ import time
 from typing import Any
 
 from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.parameters import check_pairs
 from grasp_torque_opt.ros.node import controllers
 from grasp_torque_opt.ros.node.declared import DeclaredParameters
 from grasp_torque_opt.ros.node.grasp_source import bind, Grasp, load_of_gravity, urdf_document
@@ -75,6 +76,11 @@ class GraspTorque:
         self.service = SolveService(self)
         self.tf = TfGravity()
         self._made: list[tuple[str, Any]] = []
+        #: Started by a parameter change (a timer, cancelled until then: rclpy's
+        #: EventsExecutor takes no guard conditions): the rule's cycle runs once the
+        #: request is applied whole (None while the interfaces are not made).
+        self._changed = None
+        self._change_due = False
 
     @property
     def commanding(self) -> bool:
@@ -83,9 +89,12 @@ class GraspTorque:
 
     # -- the grasp and the controllers --------------------------------------------------
 
-    def load(self, stop: Callable[[], bool], joints: list[str] | None = None) -> Grasp:
+    def load(self, stop: Callable[[], bool], joints: list[str] | None = None,
+             joints_given: bool = False) -> Grasp:
         """
         Load the URDF, the scenario and its name map.
+
+        ``joints_given``: the ``joints`` parameter was given, to be bound again with it.
 
         Raises:
             InputError: naming the parameter or the scenario's field.
@@ -93,7 +102,7 @@ class GraspTorque:
         value = self.parameters.value
         urdf = urdf_document(self.node, value, stop)
         self._urdf = urdf
-        return bind(value('scenario'), value('name_map'), urdf, joints)
+        return bind(value('scenario'), value('name_map'), urdf, joints, joints_given)
 
     def rebind(self, joints: list[str]) -> Grasp:
         """Bind the scenario again, with other actuated joints (the same URDF)."""
@@ -115,12 +124,14 @@ class GraspTorque:
         values = self.parameters.values()
         ctx = hand_context(setup.hand, bool(values['torque_limits_above_urdf']))
         check_all(values, ctx)
+        check_pairs(values)
         self.parameters.context = ctx
         self.params = p = self.parameters.snapshot()
         self._warn_missing_fallback(p)
         ctrl = controllers.configure(None, setup, p)
         service = controllers.configure(None, setup, p, service=True)
         ctrl.load_of_gravity = service.load_of_gravity = load_of_gravity(grasp.scenario)
+        ctrl.store.object = service.store.object = grasp.scenario.object
         self.grasp = grasp
         self.controller, self.service.controller = ctrl, service
         self.parameters.configured = True
@@ -129,9 +140,13 @@ class GraspTorque:
         """
         Bring both controllers to the parameters after a change (post-set callback).
 
-        The change acts on the command in force at once (a new certified command, or
-        zeros if the one in force is now over the limits), not at the next cycle; not
-        while the node does not command (the managed node's activation runs the same
+        The change acts on the command in force (a new certified command, or zeros if the
+        one in force is now over the limits) at the next callback of the executor, not at
+        the next cycle: rclpy calls this once for each parameter of a set_parameters
+        request (unless atomic), and no cycle runs between them, so the rule's cycle
+        waits until the whole request is applied (:meth:`on_changed`). Except when the
+        command in force exceeds the new torque limits: then the rule runs at once too.
+        Not while the node does not command (the managed node's activation runs the same
         rule).
         """
         if self.controller is None:
@@ -143,10 +158,29 @@ class GraspTorque:
             controllers.configure(self.service.controller, self.grasp.setup, p, service=True)
             if any(x.name == 'solver.fallback' for x in params):
                 self._warn_missing_fallback(p)
-            if self.commanding:
+            if not self.commanding:
+                return
+            in_force, lim = self.controller.in_force, self.controller.setup.hand.torque_limits
+            if in_force is not None and not (np.abs(in_force) <= lim).all():
+                # A torque the user has just forbidden is not held until the request ends.
+                self._change_due = False
                 result = self.controller.reconfigured(time.monotonic())
                 if result is not None:
                     self.outputs.publish(result, self.last_stamp)
+            if self._changed is not None:
+                self._change_due = True
+                self._changed.reset()
+
+    def on_changed(self) -> None:
+        """Run the parameter-change rule once a request is applied whole (a one-shot timer)."""
+        self._changed.cancel()
+        with self.lock:
+            if not (self._change_due and self.commanding):
+                return
+            self._change_due = False
+            result = self.controller.reconfigured(time.monotonic())
+            if result is not None:
+                self.outputs.publish(result, self.last_stamp)
 
     def _warn_missing_fallback(self, p: Any) -> None:
         name = p.solver.fallback
@@ -186,6 +220,9 @@ class GraspTorque:
                                  (p.diagnostics_period, self.status.on_diagnostics),
                                  (p.marker_period, self.outputs.on_markers)):
             made.append(('timer', self.node.create_timer(period, callback, clock=steady)))
+        self._changed = self.node.create_timer(1e-6, self.on_changed, clock=steady)
+        self._changed.cancel()
+        made.append(('timer', self._changed))
         self.tf.start(self.node)
 
     def stop_interfaces(self) -> None:
@@ -200,6 +237,7 @@ class GraspTorque:
             else:
                 self.outputs.destroy(kind, entity)
         self._made.clear()
+        self._changed, self._change_due = None, False
         self.peers.clear()
         self.outputs.stop()
         self.status.stop()

@@ -19,6 +19,7 @@ bounded memory. The answer is the CLI's JSON with the command and g(q).
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
+import threading
 import time
 from typing import Any, TYPE_CHECKING
 
@@ -34,8 +35,12 @@ if TYPE_CHECKING:
     from grasp_torque_opt.ros.node.root import GraspTorque
 
 #: Solves the service queues for its worker (each a snapshot of the inputs); a request
-#: beyond them is answered "busy" at once.
-MAX_PENDING_SOLVES = 100
+#: beyond them is answered "busy" at once. (100 before: three bursts of 1,000 calls kept
+#: the worker solving for seconds and took the command rate from 900 to 69-190 Hz.)
+MAX_PENDING_SOLVES = 10
+#: The worker's share of the time: after a solve of t seconds it rests t * (1 / share - 1),
+#: so that the control loop, which shares the interpreter lock with it, keeps the rest.
+WORKER_SHARE = 0.25
 
 
 class SolveService:
@@ -48,6 +53,9 @@ class SolveService:
         self.controller: TorqueController | None = None  # made by the root
         self.pending = 0
         self.busy_answers = 0
+        #: The worker's time solving and resting [s], for its share (tests, diagnostics).
+        self.solving_time = self.resting_time = 0.0
+        self._stopping = threading.Event()  # ends a rest at shutdown
 
     def start(self) -> None:
         """
@@ -62,6 +70,7 @@ class SolveService:
         self.worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix='solve_service',
                                          initializer=realtime.normal_scheduling)
         self.pending = 0
+        self._stopping.clear()
         # A group of its own: in the node's default (mutually exclusive) group, each call
         # held every callback of the node, the control loop's included, until its solve
         # was done; reentrant, so that requests are taken (and answered "busy") meanwhile.
@@ -72,6 +81,7 @@ class SolveService:
     def shutdown(self) -> None:
         """Stop the worker, dropping the requests still queued."""
         if self.worker is not None:
+            self._stopping.set()
             self.worker.shutdown(wait=True, cancel_futures=True)
 
     async def on_solve(self, request: Trigger.Request, response: Trigger.Response
@@ -115,6 +125,18 @@ class SolveService:
         ``done`` gets (success, the CLI's JSON or the reason).
         """
         ctrl = self.controller if ctrl is None else ctrl
+        start = time.perf_counter()
+        try:
+            self._solve(inputs, now, done, ctrl)
+        finally:
+            took = time.perf_counter() - start
+            rest = took * (1.0 / WORKER_SHARE - 1.0)
+            self.solving_time += took
+            self.resting_time += rest
+            self._stopping.wait(rest)  # the next queued solve waits: the loop keeps its share
+
+    def _solve(self, inputs: Any, now: float, done: Future, ctrl: TorqueController) -> None:
+        """Solve once and set ``done`` (:meth:`solve`)."""
         try:
             stale = ctrl.stale(now, inputs)
             if stale:

@@ -73,6 +73,20 @@ class Status:
                 return n
             time.sleep(0.05)
 
+    def command_rivals(self) -> list[str]:
+        """
+        Name the other nodes that publish on this node's command topic (from the graph).
+
+        Two nodes remapped to one controller's topic interleave their commands (one's
+        zeros with the other's torques); a foreign publisher may do the same.
+        """
+        node = self.node
+        me = (node.get_namespace(), node.get_name())
+        topic = self.root.outputs.command_pub.topic_name
+        return [f"{i.node_namespace.rstrip('/')}/{i.node_name}"
+                for i in node.get_publishers_info_by_topic(topic)
+                if (i.node_namespace, i.node_name) != me]
+
     def on_diagnostics(self) -> None:
         """Publish one diagnostic status (the diagnostics timer)."""
         root, node = self.root, self.node
@@ -106,6 +120,14 @@ class Status:
             level = diagnostics.ERROR
             message = f'another node named {name} is on this domain; {message}'
         values.append(('duplicate_nodes', str(self.duplicates)))
+        others = self.command_rivals()
+        values.append(('command_topic.other_publishers', ', '.join(others) or 'none'))
+        if others:
+            topic = root.outputs.command_pub.topic_name
+            log.error(f'another publisher on {topic}: {", ".join(others)}; the effort '
+                      'controller takes commands from both', throttle_duration_sec=10.0)
+            level = diagnostics.ERROR
+            message = f'another publisher on {topic} ({", ".join(others)}); {message}'
         values.append(('executor_thread', realtime.describe()))  # this callback's thread
         # What rclpy's default QoS event handlers would have logged, found from the graph.
         peers, new = root.peers.check(node)
@@ -115,8 +137,9 @@ class Status:
         if peers:
             level = max(level, diagnostics.WARN)  # at least WARN (STALE and ERROR stay)
             message = f'{len(peers)} incompatible peer(s) on its topics; {message}'
-        status = DiagnosticStatus(level=bytes([level]), name=f'{node.get_name()}: grasp '
-                                  'torques', message=message, hardware_id=hand,
+        # The fully qualified name: two nodes in two namespaces are told apart.
+        status = DiagnosticStatus(level=bytes([level]), name=f'{node.get_fully_qualified_name()}'
+                                  ': grasp torques', message=message, hardware_id=hand,
                                   values=[KeyValue(key=k, value=v) for k, v in values])
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = node.get_clock().now().to_msg()
