@@ -106,6 +106,9 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     setup = GraspSetup.from_file(scenario)
     rclpy.init(args=args.ros_argv)
     node = rclpy.create_node('grasp_demo_driver')
+    # The executor rclpy.spin_once uses, made now: a Ctrl-C inside its construction (at
+    # the first spin) left a half-made executor whose __del__ printed a traceback.
+    rclpy.get_global_executor()
     try:
         return _spin(args, scenario, node, setup)
     except (KeyboardInterrupt, ExternalShutdownException):
