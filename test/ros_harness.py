@@ -237,7 +237,11 @@ class NodeProcess:
     def first_command(self, names: list[str], positions: list[float],
                       timeout: float = 10.0) -> bool:
         """Publish a joint state until the child's first command arrives."""
-        assert self.spin_until(lambda: self.pub.get_subscription_count() > 0, 20.0)
+        subscribed = self.spin_until(lambda: self.pub.get_subscription_count() > 0, 20.0)
+        if not subscribed and self.child.poll() is not None:  # it ended: say why
+            raise AssertionError(f'the node exited ({self.child.returncode}) before '
+                                 f'subscribing: {self.child.communicate()[1]}')
+        assert subscribed, 'the node did not subscribe to joint_states within 20 s'
         end = time.monotonic() + timeout
         while not self.commands and time.monotonic() < end:
             self.pub.publish(JointState(name=names, position=positions))
