@@ -15,6 +15,8 @@ set_parameters request published commands computed with half of it; joint positi
 beyond the URDF's limits were commanded; get_parameters of every parameter gave nothing.
 """
 
+import time
+
 from conftest import PLANAR
 from cycle_inputs import joint_state, Slow
 from grasp_torque_opt.core.exceptions import InputError
@@ -166,18 +168,21 @@ def test_the_solve_worker_keeps_to_its_share_and_sheds_load_early(planar):
         h.send_joint_state(names, pos)
         assert h.next_command() is not None
         h.node.root.service.controller.solver = Slow(0.01)
+        t0 = time.monotonic()
         futures = [client.call_async(Trigger.Request()) for _ in range(40)]
         n = len(h.commands)
         for _ in range(20):  # the loop answers joint states while the worker solves
             h.send_joint_state(names, pos)
             h.spin_for(0.01)
         assert h.spin_until(lambda: all(f.done() for f in futures), 30.0)
+        elapsed = time.monotonic() - t0
         busy = [f for f in futures if f.result().message.startswith('busy: ')]
         # At most 10 queued (a few more solved meanwhile); 100 before: none was busy.
-        assert service.MAX_PENDING_SOLVES == 10 and len(busy) >= 25
+        assert len(busy) >= 25
         assert len(h.commands) - n >= 10
-        worker = h.node.root.service
-        share = worker.solving_time / (worker.solving_time + worker.resting_time)
-        assert share <= service.WORKER_SHARE + 1e-9
+        # Each 10 ms solve is followed by a rest, so that the worker takes at most its
+        # share of the time: the solved ones cannot have been answered sooner than this.
+        solved = len(futures) - len(busy)
+        assert elapsed >= 0.9 * (solved - 1) * 0.01 / service.WORKER_SHARE
     finally:
         h.close()

@@ -53,8 +53,6 @@ class SolveService:
         self.controller: TorqueController | None = None  # made by the root
         self.pending = 0
         self.busy_answers = 0
-        #: The worker's time solving and resting [s], for its share (tests, diagnostics).
-        self.solving_time = self.resting_time = 0.0
         self._stopping = threading.Event()  # ends a rest at shutdown
 
     def start(self) -> None:
@@ -130,10 +128,8 @@ class SolveService:
             self._solve(inputs, now, done, ctrl)
         finally:
             took = time.perf_counter() - start
-            rest = took * (1.0 / WORKER_SHARE - 1.0)
-            self.solving_time += took
-            self.resting_time += rest
-            self._stopping.wait(rest)  # the next queued solve waits: the loop keeps its share
+            # The next queued solve waits: the loop keeps its share of the time.
+            self._stopping.wait(took * (1.0 / WORKER_SHARE - 1.0))
 
     def _solve(self, inputs: Any, now: float, done: Future, ctrl: TorqueController) -> None:
         """Solve once and set ``done`` (:meth:`solve`)."""
