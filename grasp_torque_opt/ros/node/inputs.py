@@ -62,7 +62,8 @@ class Inputs:
         self.root = root
         self.node = root.node
         self.joint_states_topic = ''  # remapped and resolved, once subscribed
-        self.sim_time: bool | None = None  # use_sim_time, read at the first message
+        # use_sim_time is fixed after start (DeclaredParameters): read once.
+        self.sim_time = bool(root.node.get_parameter('use_sim_time').value)
 
     def start(self) -> list[Any]:
         """Make the four subscriptions; give them (to be destroyed at :meth:`stop`)."""
@@ -97,8 +98,6 @@ class Inputs:
         ``Clock.now()`` cost 9 us of the joint state's path). ``use_sim_time`` is fixed
         after start, so the choice holds.
         """
-        if self.sim_time is None:
-            self.sim_time = bool(self.node.get_parameter('use_sim_time').value)
         if not self.sim_time:
             return time.time()
         return self.node.get_clock().now().nanoseconds * 1e-9

@@ -68,6 +68,7 @@ class GraspTorque:
         self.grasp: Grasp | None = None
         self.params: Any = None  # the frozen snapshot the parts run with
         self.last_stamp = None  # header stamp of the last accepted joint state
+        self._urdf = ''  # the URDF document loaded ('' for the scenario's hand.urdf)
         self.parameters = DeclaredParameters(node, managed)
         self.peers = PeerWatch()  # what the parts made, checked against the graph
         self.inputs = Inputs(self)
