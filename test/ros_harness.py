@@ -35,6 +35,10 @@ from visualization_msgs.msg import MarkerArray
 # Each run on its own domain, heard only on this machine.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 DOMAIN = 1 + os.getpid() % 100
+#: The domain of the node processes this run starts (NodeProcess, the simulated hand):
+#: not this process's own, where its in-process nodes named grasp_torque_node live, so
+#: that a child's start-up check never takes one of those for a namesake.
+PROCESS_DOMAIN = 1 + (DOMAIN + 49) % 100
 
 
 class Harness:
@@ -204,12 +208,12 @@ class NodeProcess:
     """
 
     def __init__(self, module: str, args: list[str], tester_name: str) -> None:
-        env = dict(os.environ, ROS_DOMAIN_ID=str(DOMAIN),
+        env = dict(os.environ, ROS_DOMAIN_ID=str(PROCESS_DOMAIN),
                    ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
         self.child = subprocess.Popen([sys.executable, '-m', module, *args], env=env,
                                       stderr=subprocess.PIPE, text=True)
         self.context = rclpy.Context()
-        rclpy.init(context=self.context, domain_id=DOMAIN)
+        rclpy.init(context=self.context, domain_id=PROCESS_DOMAIN)
         self.tester = rclpy.create_node(tester_name, context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.tester)

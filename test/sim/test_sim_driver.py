@@ -18,11 +18,11 @@ import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
-from ros_harness import DOMAIN
+from ros_harness import DOMAIN, PROCESS_DOMAIN
 from sensor_msgs.msg import Imu, JointState
 
 
-def _command(args, domain=DOMAIN):
+def _command(args, domain=PROCESS_DOMAIN):
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     # As a user starts it: MuJoCo's GL backend not chosen beforehand (this process may have
     # set it by importing grasp_torque_opt.sim).
