@@ -68,11 +68,16 @@ from grasp_torque_opt.control.inputs import (
     SOURCES,
     stamp_seconds,
 )
-from grasp_torque_opt.control.rates import slewed
+from grasp_torque_opt.control.rates import slewed, step_wrenches
+from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.solution import Solution
 import numpy as np
+
+#: How far a rate-rule step's contact wrenches may lie outside the exact cone [N]: the
+#: certificate's tolerance (a convex combination of two certified wrenches is inside).
+STEP_CONE_TOLERANCE = 1e-6
 
 __all__ = ['ContactPoses', 'Counters', 'CycleConfig', 'CycleResult', 'Inputs',
            'MAX_ABS_JOINT_POSITION', 'MAX_GRAVITY', 'POLICIES', 'QUATERNION_TOLERANCE',
@@ -277,18 +282,33 @@ class TorqueController:
         """
         Cut a certified command's step from the command in force to ``max_torque_rate``.
 
-        The rate rule (docs/node.md): each joint's torque moves at most ``max_torque_rate``
-        times the time since the command in force towards the certified command.
+        The rate rule (docs/node.md): the command moves along the straight line from the
+        command in force towards the certified command, no joint faster than
+        ``max_torque_rate`` times the time since the command in force. The step's
+        contact wrenches (the same combination of both ends') must lie in the exact
+        cone, finite, with the step within the torque limits: else, or when they are
+        not known, the certified command is published whole (``slew_refused``).
         """
         policy, rate = self.policy, self.config.max_torque_rate
         if policy.in_force is None or policy.in_force_time is None:
             return
-        cmd = slewed(policy.in_force, result.command, rate * max(now - policy.in_force_time,
-                                                                 0.0),
-                     self.setup.hand.torque_limits)
-        if cmd is not None:
-            result.command = cmd
-            self.counters.slew_limited += 1
+        step = slewed(policy.in_force, result.command,
+                      rate * max(now - policy.in_force_time, 0.0),
+                      self.setup.hand.torque_limits)
+        if step is None:
+            return
+        cmd, s = step
+        wrenches = step_wrenches(policy.in_force_wrenches,
+                                 getattr(result.solution, 'wrenches', None), s)
+        friction = self.setup.friction
+        if (wrenches is None or not np.all(np.isfinite(cmd))
+                or not np.all(np.abs(cmd) <= self.setup.hand.torque_limits)
+                or float(cone_margin(wrenches, friction.mu1, friction.mu2).min())
+                < -STEP_CONE_TOLERANCE):
+            self.counters.slew_refused += 1
+            return
+        result.command, result.wrenches = cmd, wrenches
+        self.counters.slew_limited += 1
 
     def _attempt(self, now: float, deadline: float) -> CycleResult:
         """Solve and gate; a certified command is returned, not yet committed."""

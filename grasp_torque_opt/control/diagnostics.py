@@ -94,6 +94,7 @@ def report(controller: TorqueController, now: float) -> Report:
                ('zero_commands', str(n.zero_commands)), ('faults', str(n.faults)),
                ('recoveries', str(n.recoveries)), ('solver_failures', str(n.solver_failures)),
                ('overruns', str(n.overruns)), ('slew_limited', str(n.slew_limited)),
+               ('slew_refused', str(n.slew_refused)),
                ('max_cycle_time_s', f'{n.max_cycle_time:.6f}'),
                ('cycle_budget_s', f'{cfg.cycle_budget:.6f}')]
     solver = c.solver

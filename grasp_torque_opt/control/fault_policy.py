@@ -28,6 +28,10 @@ from grasp_torque_opt.core.solution import Solution
 import numpy as np
 
 
+#: The contact wrenches of zero torques: none, whatever the contacts (rates.step_wrenches).
+NO_WRENCH = np.zeros((0, 4))
+
+
 @dataclass
 class CycleResult:
     """
@@ -42,6 +46,8 @@ class CycleResult:
         gravity_torque: g(q) added to the solution, or None.
         fault: why no certified command was published ('' when healthy).
         cycle_time: wall time of the cycle [s] (0 for the watchdog's results).
+        wrenches: the contact wrenches of ``command`` when it is a step of the rate rule
+            (the same combination of its ends' wrenches), else None (the solution's).
     """
 
     command: np.ndarray | None
@@ -51,6 +57,7 @@ class CycleResult:
     gravity_torque: np.ndarray | None = None
     fault: str = ''
     cycle_time: float = 0.0
+    wrenches: np.ndarray | None = None
 
 
 class FaultPolicy:
@@ -75,6 +82,9 @@ class FaultPolicy:
         self.in_force: np.ndarray | None = None
         #: When the command in force was returned for publishing [s] (None: unknown).
         self.in_force_time: float | None = None
+        #: The contact wrenches of the command in force, shape (p, 4) (``NO_WRENCH`` for
+        #: zero torques; None: not known).
+        self.in_force_wrenches: np.ndarray | None = None
         #: The last result, certified or not.
         self.last: CycleResult | None = None
 
@@ -85,6 +95,8 @@ class FaultPolicy:
         self.fault = ''
         self.last_command, self.last_command_time = result.command, now
         self.in_force, self.in_force_time = result.command, now
+        self.in_force_wrenches = (result.wrenches if result.wrenches is not None
+                                  else getattr(result.solution, 'wrenches', None))
         self.counters.commands += 1
         if from_fallback:
             self.counters.fallback_solves += 1
@@ -144,4 +156,5 @@ class FaultPolicy:
         cmd = np.zeros(self.setup.hand.m)
         self.counters.zero_commands += 1
         self.in_force = cmd
+        self.in_force_wrenches = NO_WRENCH
         return CycleResult(cmd, 'zero', sol, maps, g, reason)

@@ -88,8 +88,9 @@ class Counters:
     (not the confirmed infeasible ones); ``fallback_solves`` certified
     solutions that came from the fallback backend after the first one failed;
     ``overruns`` cycles over ``cycle_budget``; ``max_cycle_time`` is the longest
-    cycle [s]; ``slew_limited`` commands cut to ``max_torque_rate``; ``rejected`` the
-    rejected messages by source.
+    cycle [s]; ``slew_limited`` commands cut to ``max_torque_rate``; ``slew_refused``
+    certified commands published whole because a step's contact wrenches were not known
+    or not in the exact cone; ``rejected`` the rejected messages by source.
     """
 
     cycles: int = 0
@@ -102,6 +103,7 @@ class Counters:
     fallback_solves: int = 0
     max_cycle_time: float = 0.0
     slew_limited: int = 0
+    slew_refused: int = 0
     rejected: dict[str, int] = field(default_factory=lambda: dict.fromkeys(SOURCES, 0))
 
 

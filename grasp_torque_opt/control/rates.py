@@ -17,7 +17,11 @@ N m) made every command a step. Two bounds:
   ``max_torque_rate`` allows since that command is published as a step of at most that
   rate towards it (:func:`slewed`); each joint's torque changes at most that fast,
   whatever the inputs do (the planar hand's torque moved 0.09 N m for a 0.05 rad turn of
-  its contact normals: no input bound gives a torque bound);
+  its contact normals: no input bound gives a torque bound). The step is taken along
+  the straight line, the same fraction of every joint's change, so that it is the
+  convex combination of two commands whose contact wrenches are known: the same
+  combination of those wrenches is the step's, inside the exact cone when both ends
+  are (:func:`step_wrenches`);
 - gravity: the gravity in use moves towards each accepted message at most
   ``max_gravity_rate`` times the time since the one in use was taken, turning
   (:func:`turned_towards`: its norm stays within the bounds both ends meet);
@@ -62,9 +66,14 @@ def turned_towards(old: np.ndarray, new: np.ndarray, step: float) -> np.ndarray:
 
 
 def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
-           limits: np.ndarray) -> np.ndarray | None:
+           limits: np.ndarray) -> tuple[np.ndarray, float] | None:
     """
     Return the command that moves from ``in_force`` towards ``target`` by at most ``step``.
+
+    The step is the same fraction ``s`` of every joint's change (a point of the segment
+    from ``in_force`` to ``target``), the largest with no joint moving more than
+    ``step``: a convex combination of the two commands, so within ``limits`` when both
+    are, and its contact wrenches are the same combination of theirs.
 
     Args:
         in_force: the command the effort controller holds [N m], shape (m,).
@@ -73,13 +82,40 @@ def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
         limits: the torque limits [N m], shape (m,).
 
     Returns:
-        The step, within ``limits`` (both ends are), or None when ``target`` is within
-        ``step`` already or ``in_force`` is not within ``limits`` (lowered since): then the
-        certified command is published whole.
+        The step and its fraction ``s`` in [0, 1), or None when ``target`` is within
+        ``step`` already or ``in_force`` is not within ``limits`` (lowered since): then
+        the certified command is published whole.
     """
     if in_force.shape != target.shape or not (np.abs(in_force) <= limits).all():
         return None
     delta = target - in_force
-    if (np.abs(delta) <= step).all():
+    largest = float(np.abs(delta).max()) if delta.size else 0.0
+    if largest <= step:
         return None
-    return in_force + np.clip(delta, -step, step)
+    s = max(step, 0.0) / largest
+    return in_force + s * delta, s
+
+
+def step_wrenches(in_force: np.ndarray | None, target: np.ndarray | None,
+                  s: float) -> np.ndarray | None:
+    """
+    Give the contact wrenches of a step: ``(1 - s) in_force + s target``.
+
+    Args:
+        in_force: the contact wrenches of the command in force, shape (p, 4) [N, N m],
+            shape (0, 4) for zero torques (a step from them is ``s`` times the
+            certified command's wrenches), or None (not known).
+        target: the certified command's, shape (p, 4).
+        s: the step's fraction.
+
+    Returns:
+        The step's wrenches, or None when they are not known or the contacts differ in
+        number (the certified command is then published whole).
+    """
+    if in_force is None or target is None:
+        return None
+    if in_force.size == 0:
+        return s * target
+    if in_force.shape != target.shape:
+        return None
+    return (1.0 - s) * in_force + s * target
