@@ -199,13 +199,7 @@ class Cycle:
 
     def _correction(self, at: GraspSetup, g: np.ndarray | None, inputs: Inputs,
                     model: np.ndarray, estimating: bool) -> np.ndarray:
-        """
-        Return the effort estimation's correction to the load (:mod:`.effort_load`).
-
-        The loop's cycle updates it from the joint state's efforts; the service's reads
-        the loop's. Without the scenario's weight, or without efforts: zero, and why is
-        kept (``effort_load.off``), to be said once.
-        """
+        """Return the effort estimation's correction (:mod:`.effort_load`; loop's updates)."""
         est = self.effort_load
         if not estimating:
             return est.correction

@@ -120,7 +120,7 @@ def report(controller: TorqueController, now: float) -> Report:
 
 
 def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
-    """The IMU's and the effort estimation's values: in use or why not, the load."""
+    """Give the IMU's and the effort estimation's values: in use or why not, the load."""
     solving, inputs = c.solving, c.inputs
     values = [('imu', 'none received' if inputs.motion is None else
                solving.imu_state or 'in use'),

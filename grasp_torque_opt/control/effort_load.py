@@ -70,8 +70,9 @@ class EffortLoad:
         over them turns small torque errors into large moments.
 
         Args:
-            G: grasp matrix (6, 4p); J: hand Jacobian (4p, m) (per contact: force x, y,
-                z, then the torsional moment).
+            G: grasp matrix (6, 4p).
+            J: hand Jacobian (4p, m) (per contact: force x, y, z, then the torsional
+                moment).
             effort: measured actuator torques [N m], shape (m,).
             gravity_torque: g(q) on the actuators [N m], or None (none).
         """

@@ -47,13 +47,13 @@ class Context:
         joints: their names, for messages.
         torque_bounds: the largest accepted torque limit per joint [N m] (None:
             unchecked).
-        object: the scenario's object (uncertainty.pose needs its radius; None: none).
+        scenario_object: the scenario's object (uncertainty.pose needs its radius; None: none).
     """
 
     m: int | None = None
     joints: tuple[str, ...] = ()
     torque_bounds: np.ndarray | None = None
-    object: Any = None
+    scenario_object: Any = None
 
 
 #: A custom validator: (parameter, value, context) -> the problem, '' if none.
@@ -210,7 +210,7 @@ def check_pairs(values: Mapping[str, Any], ctx: Context | None = None) -> None:
             friction, or a pose uncertainty without the scenario's object (with ``ctx``).
     """
     if ctx is not None and ctx.m is not None:
-        stated_margin(values, ctx.object)
+        stated_margin(values, ctx.scenario_object)
     gravity, bounds = values.get('gravity'), values.get('gravity_norm_bounds')
     if gravity is not None and bounds is not None:
         norm = math.sqrt(sum(v * v for v in gravity))

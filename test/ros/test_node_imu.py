@@ -35,7 +35,7 @@ MASS = load_scenario(find_config('allegro_right.yaml')).object.mass
 
 
 def reference(apparent, q):
-    """The command for the ball's weight under ``apparent`` gravity, solved here."""
+    """Give the command for the ball's weight under ``apparent`` gravity, solved here."""
     model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path('.'))))
     model.gravity.linear = np.asarray(apparent, dtype=float)
     setup = GraspSetup.from_file(ALLEGRO)
@@ -47,6 +47,7 @@ def reference(apparent, q):
 
 
 class ImuHarness(Harness):
+
     def __init__(self, **params):
         super().__init__(ALLEGRO, gravity_compensation=True, imu__enabled=True, **params)
         self.imu_pub = self.tester.create_publisher(Imu, 'imu', qos_profile_sensor_data)

@@ -5,7 +5,6 @@
 # https://developers.google.com/open-source/licenses/bsd
 #
 # SPDX-License-Identifier: BSD-3-Clause
-"""The rig's disturbances move the physics the right way; its efforts are what it applies."""
 
 """
 The node's cycle with its IMU and effort inputs on a disturbed simulated hand (MuJoCo).

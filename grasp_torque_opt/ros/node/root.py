@@ -130,8 +130,8 @@ class GraspTorque:
         """
         setup = grasp.setup
         values = self.parameters.values()
-        ctx = dataclasses.replace(hand_context(setup.hand, bool(values['torque_limits_above_urdf'])),
-                                  object=grasp.scenario.object)
+        ctx = hand_context(setup.hand, bool(values['torque_limits_above_urdf']))
+        ctx = dataclasses.replace(ctx, scenario_object=grasp.scenario.object)
         check_all(values, ctx)
         check_pairs(values, ctx)
         self.parameters.context = ctx
