@@ -142,8 +142,9 @@ class GraspTorque:
         ctrl.load_of_gravity = service.load_of_gravity = load_of_gravity(grasp.scenario)
         ctrl.store.object = service.store.object = grasp.scenario.object
         ctrl.solving.weight = service.solving.weight = weight_of(grasp.scenario)
-        # The service plans with the loop's correction of the load; it does not update it.
-        service.solving.effort_load, service.solving.estimating = ctrl.solving.effort_load, False
+        # The service plans for the model's load (the scenario's, the IMU's): it does not
+        # estimate, and a transient correction of the loop's is not its prediction.
+        service.solving.estimating = False
         self.grasp = grasp
         self.controller, self.service.controller = ctrl, service
         self.parameters.configured = True
