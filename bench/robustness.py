@@ -9,7 +9,7 @@
 Robustness benchmark (issue 24, item 6): the node and two baselines on a disturbed hand.
 
 Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--rate 250]
-       [--out bench/results/robustness.json] [--smoke]
+       [--out bench/results/robustness.json] [--node-inputs on|off] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
 Allegro grasp, in simulated time (the rig of grasp-torque-sim, without ROS): the
@@ -18,8 +18,9 @@ pinned ball for 0.3 s, the ball is released and watched for --duration seconds. 
 controllers:
 
 - node: the node's own cycle (TorqueController, gravity compensation, ProxSuite with
-  DAQP behind it), told only the scenario: the nominal mass, gravity and ball pose
-  (none of issue 24's new inputs);
+  DAQP behind it), told only the scenario: the nominal mass, gravity and ball pose;
+  with --node-inputs on, also the rig's palm IMU and measured efforts at each joint
+  state (imu and effort_estimation on, as config/allegro_right_node.yaml turns them on);
 - preset: fixed closing torques along the normals, one level tuned once per Kp on the
   nominal load (grasp_torque_opt.sim.baselines.tune_preset);
 - impedance: the grasp pose commanded 5 mm inside the ball, position control at the
@@ -86,34 +87,54 @@ def grid(smoke: bool) -> list[tuple[str, str, dict]]:
     return cases
 
 
-def node_controller(setup, gravity):
+def node_controller(setup, scenario, rig=None, inputs: bool = False, margin: float = 0.0):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
     Configured as config/allegro_right_node.yaml configures the node: gravity
     compensation with the scenario's gravity (the parameter's default from the
     scenario), DAQP as the fallback; the budget generous, as the node's tests set it.
+    With ``inputs`` (issue 24's inputs on, as the bundled params turn them on): the rig's
+    palm IMU and its measured efforts (effort_estimation) are given to the cycle at each
+    joint state. ``margin``: the friction margin k.
     """
-    config = CycleConfig(gravity_compensation=True, gravity=tuple(float(x) for x in gravity),
-                         cycle_budget=1.0)
+    import dataclasses
+
+    from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
+
+    setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
+                                                                    margin=margin))
+    config = CycleConfig(gravity_compensation=True,
+                         gravity=tuple(float(x) for x in scenario.gravity),
+                         cycle_budget=1.0, effort_estimation=inputs)
     ctrl = TorqueController(setup, config, fallback='daqp')
+    ctrl.load_of_gravity = load_of_gravity(scenario)
+    ctrl.solving.weight = weight_of(scenario)
     names = list(setup.hand.joints)
     clock = {'t': 0.0}
 
     def command(reading):
-        clock['t'] += 1e-3  # any increasing time: the inputs are always fresh here
-        ctrl.update_joint_state(names, reading.tolist(), clock['t'])
+        # The simulated time (the estimate's filters run on it); without a rig, any
+        # increasing time: the inputs are always fresh here.
+        clock['t'] = 1.0 + rig.time if rig is not None else clock['t'] + 1e-3
+        efforts = None
+        if inputs:
+            force, omega = rig.imu()
+            ctrl.update_imu('', force, omega, clock['t'])
+            efforts = rig.effort().tolist()
+        ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, efforts)
         return ctrl.cycle(clock['t']).command
+    command.controller = ctrl
     return command
 
 
 def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
-            preset_level: float) -> dict:
-    """Run one episode; return its record."""
+            preset_level: float, inputs: bool = False) -> dict:
+    """Run one episode; return its record (``inputs``: the node's IMU and efforts on)."""
     setup, rig = simulated(scenario, settings)
     reference = None
     if controller == 'node':
-        command = node_controller(setup, scenario.gravity)
+        command = node_controller(setup, scenario, rig, inputs)
     elif controller == 'preset':
         command = Preset(setup, scenario.gravity, preset_level)
     else:
@@ -127,24 +148,26 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
             'effort_Nm': r.mean_effort}
 
 
-def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0) -> dict:
+def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0,
+        inputs: bool = False) -> dict:
     scenario = load_scenario(find_config('allegro_right.yaml'))
     out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
-           'presets': {}}
+           'presets': {}, 'node_inputs': inputs}
     for kp in gains:
         tuned = tune_preset(scenario, kp, 0.01, rate=rate)
         out['presets'][str(kp)] = {'level_N': tuned.level, 'drift_mm': 1e3 * tuned.drift}
         for family, label, fields in grid(smoke):
             settings = EpisodeSettings(kp=kp, duration=duration, rate=rate, **fields)
             out['rows'].append({'kp': kp, 'family': family, 'case': label, **{
-                c: episode(scenario, c, settings, tuned.level) for c in CONTROLLERS}})
+                c: episode(scenario, c, settings, tuned.level, inputs) for c in CONTROLLERS}})
     return out
 
 
 def tables(r: dict) -> str:
     lines = ['Held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
              f"joint torque after release) over {r['duration_s']:g} s, controllers asked at "
-             f"{r['rate_hz']:g} Hz; preset levels: "
+             f"{r['rate_hz']:g} Hz; node inputs (IMU, efforts) "
+             f"{'on' if r.get('node_inputs') else 'off'}; preset levels: "
              + ', '.join(f"Kp {k}: {p['level_N']:.2f} N" for k, p in r['presets'].items()),
              '', '| Kp | family | cases | ' + ' | '.join(
                  f'{c} held | {c} effort [N m]' for c in CONTROLLERS) + ' |',
@@ -175,12 +198,15 @@ def main() -> int:
                    help="how often the controllers are asked [Hz] (grasp-torque-sim's joint "
                         'state rate)')
     p.add_argument('--out', type=Path, default=Path('bench/results/robustness.json'))
+    p.add_argument('--node-inputs', choices=('on', 'off'), default='off',
+                   help="the node's IMU and effort estimation (issue 24): on, as the "
+                        'bundled params, or off (the scenario only)')
     p.add_argument('--smoke', action='store_true',
                    help='one case per family, Kp 1, 0.5 s: that it runs')
     a = p.parse_args()
     gains = (1.0,) if a.smoke else tuple(float(k) for k in a.gains.split(','))
     duration = 0.5 if a.smoke else a.duration
-    r = run(duration, gains, a.smoke, a.rate)
+    r = run(duration, gains, a.smoke, a.rate, a.node_inputs == 'on')
     r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
     report(r, tables(r), None if a.smoke else a.out,
            f"commit {r['commit']}, {len(r['rows']) * len(CONTROLLERS)} episodes"

@@ -197,9 +197,18 @@ class TorqueController:
         self.store.check_size(source, n)
 
     def update_joint_state(self, names: list[str], positions: list[float], now: float,
-                           stamp: float = 0.0, clock: float | None = None) -> None:
+                           stamp: float = 0.0, clock: float | None = None,
+                           efforts: list[float] | None = None) -> None:
         """Take a joint state (:meth:`InputStore.update_joint_state`)."""
-        self.store.update_joint_state(names, positions, now, stamp, clock)
+        self.store.update_joint_state(names, positions, now, stamp, clock, efforts)
+
+    def update_imu(self, frame: str, specific_force: np.ndarray, omega: np.ndarray,
+                   now: float, stamp: float = 0.0, clock: float | None = None,
+                   transform: tuple[np.ndarray, np.ndarray] | None = None,
+                   unresolved: str = 'tf2_ros is not installed') -> None:
+        """Take the base's IMU (:meth:`InputStore.update_imu`)."""
+        self.store.update_imu(frame, specific_force, omega, now, stamp, clock, transform,
+                              unresolved)
 
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
                         now: float, stamp: float = 0.0, clock: float | None = None) -> None:

@@ -26,8 +26,10 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.backends.registry import is_backend, settings_for
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.effort_load import EffortLoad
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
+from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.plausible import check_on_links, points_inward
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -76,6 +78,18 @@ class Cycle:
         #: The scenario's load for a gravity input [m/s^2] (the object's weight moves with
         #: it), or None: the load does not depend on gravity.
         self.load_of_gravity = None
+        #: The scenario's weight [N] (None: no object or no gravity): the effort
+        #: estimation's bound, and whether it can run.
+        self.weight: float | None = None
+        #: The load estimated from efforts and its correction (:mod:`.effort_load`);
+        #: ``estimating``: this cycle updates it (the loop's; the service's reads it).
+        self.effort_load = EffortLoad()
+        self.estimating = True
+        self._gravity_in_use = np.zeros(3)  # base axes, of the last grasp_at
+        #: Why the IMU is not used, at the last cycle ('' while it is, or none came).
+        self.imu_state = ''
+        #: The load planned at the last cycle, about the origin, base axes (None: none yet).
+        self.load: np.ndarray | None = None
         #: The compiled cycle in use (None: the Python cycle), and why not when None.
         self.compiled_cycle: compiled.CompiledCycle | None = None
         self.compiled_reason = ''
@@ -131,6 +145,7 @@ class Cycle:
                 normals.append(R_base[:, 2])
                 origins.append(oMl.translation)
             self._check_plausible(np.array(points), np.array(normals), np.array(origins))
+        motion = self.motion_in_use(inputs)
         wrench = setup.external_wrench
         if inputs.wrench is not None:
             frame, w = inputs.wrench
@@ -138,18 +153,76 @@ class Cycle:
             if hand.base_link is not None:
                 R = data.oMf[model.getFrameId(hand.base_link)].rotation.T @ R
             wrench = np.concatenate((R @ w[:3], R @ w[3:]))
+        elif motion is not None and self.load_of_gravity is not None:
+            wrench = self.load_of_gravity(motion.gravity, motion)
         elif inputs.gravity is not None and self.load_of_gravity is not None:
             wrench = self.load_of_gravity(inputs.gravity)
+        estimating = self.config.effort_estimation and self.estimating
         g = None
-        if self.config.gravity_compensation:
-            gravity = np.asarray(
-                self.config.gravity if inputs.gravity is None else inputs.gravity, dtype=float)
+        gravity = self._gravity_in_use = np.asarray(
+            motion.gravity if motion is not None else self.config.gravity
+            if inputs.gravity is None else inputs.gravity, dtype=float)
+        if self.config.gravity_compensation or estimating:
             if hand.base_link is not None:  # given in the base link's axes; Pinocchio's: root
                 gravity = data.oMf[model.getFrameId(hand.base_link)].rotation @ gravity
             model.gravity.linear = gravity
             g = hand.actuator_torques(pin.computeGeneralizedGravity(model, data, q))
+        if self.config.effort_estimation:
+            wrench = wrench + self._correction(
+                replaced(setup, q=q, contacts=contacts), g, inputs, wrench, estimating)
+        elif self.estimating and self.effort_load.estimate is not None:
+            self.effort_load.reset()  # turned off: turned on again, it starts anew
+        if not self.config.gravity_compensation:
+            g = None
+        self.load = wrench
         return replaced(setup, q=q, contacts=contacts, external_wrench=wrench,
                         torque_offset=g), g
+
+    def motion_in_use(self, inputs: Inputs) -> Motion | None:
+        """
+        Return the IMU's motion if it is fresh at the joint state's receipt, else None.
+
+        Fresh: received no more than its timeout (a few of its periods, ``imu.*``) before
+        the joint state. Else the scenario's (or the gravity topic's) gravity is used, and
+        :attr:`imu_state` says why.
+        """
+        motion = inputs.motion
+        if motion is None:
+            return None
+        age = inputs.q_time - inputs.motion_time
+        if age > motion.timeout:
+            self.imu_state = (f'imu stale ({age:.4f} s > {motion.timeout:.4f} s): the '
+                              "scenario's gravity is used")
+            return None
+        self.imu_state = ''
+        return motion
+
+    def _correction(self, at: GraspSetup, g: np.ndarray | None, inputs: Inputs,
+                    model: np.ndarray, estimating: bool) -> np.ndarray:
+        """Return the effort estimation's correction (:mod:`.effort_load`; loop's updates)."""
+        est = self.effort_load
+        if not estimating:
+            return est.correction
+        if self.weight is None:
+            est.turn_off("effort_estimation needs the scenario's object and gravity (its "
+                         'weight bounds the correction)')
+            return est.correction
+        if inputs.effort is None:
+            est.turn_off('effort_estimation off: ' + (inputs.effort_why or 'no effort'))
+            return est.correction
+        est.off = ''
+        maps = at.maps()
+        c = self.config
+        bounds = est.bound(self.weight, c.effort_max_load_ratio, maps.positions,
+                           at.object_origin)
+        along = None
+        if c.effort_mass_only:
+            gravity = self._gravity_in_use
+            norm = float(np.linalg.norm(gravity))
+            along = gravity / norm if norm > 1e-6 else np.zeros(3)
+        return est.update(est.measured(maps.G, maps.J, inputs.effort, g), model,
+                          inputs.q_time, c.effort_filter, c.effort_time_constant, bounds,
+                          gap=c.joint_state_timeout, along=along)
 
     def _check_plausible(self, points: np.ndarray, normals: np.ndarray,
                          origins: np.ndarray) -> None:

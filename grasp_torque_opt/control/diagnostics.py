@@ -109,9 +109,38 @@ def report(controller: TorqueController, now: float) -> Report:
                 if fast is not None else 'none'),
                ('solver.compiled_solves', str(fast.solves if fast is not None else 0)),
                ('solver.compiled_handed_back', str(fast.handed_back if fast is not None else 0))]
+    values += motion_values(c, now)
+    if level == OK and c.solving.imu_state:
+        level, message = WARN, f'certified torques published; {c.solving.imu_state}'
     values += [(f'rejected.{k}', str(v)) for k, v in n.rejected.items()]
     values.append(('last_rejection', c.last_rejection or 'none'))
     values += [('age.joint_states_s', _ago(now, c.inputs.q_time)),
                ('age.contacts_s', _ago(now, c.inputs.contacts_time)),
                ('age.external_wrench_s', _ago(now, c.inputs.wrench_time))]
     return Report(level, message, values)
+
+
+def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
+    """Give the IMU's and the effort estimation's values: in use or why not, the load."""
+    solving, inputs = c.solving, c.inputs
+    values = [('imu', 'none received' if inputs.motion is None else
+               solving.imu_state or 'in use'),
+              ('age.imu_s', _ago(now, inputs.motion_time))]
+    if inputs.motion is not None:
+        values += [('imu.apparent_gravity', _vector(inputs.motion.gravity)),
+                   ('imu.timeout_s', f'{inputs.motion.timeout:.4f}')]
+    est = solving.effort_load
+    if not c.config.effort_estimation:
+        values.append(('effort_estimation', 'off (effort_estimation.enabled false)'))
+    else:
+        values.append(('effort_estimation', est.off or 'on'))
+        if est.estimate is not None:
+            values += [('load.estimated', _vector(est.estimate)),
+                       ('load.correction', _vector(est.correction))]
+    if solving.load is not None:
+        values.append(('load.planned', _vector(solving.load)))
+    return values
+
+
+def _vector(v) -> str:
+    return ','.join(f'{float(x):.5g}' for x in v)

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-import math
 
 from grasp_torque_opt.control.checks import (
     check_joint_limits,
@@ -30,8 +29,10 @@ from grasp_torque_opt.control.checks import (
     MAX_ABS_JOINT_POSITION,
 )
 from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.motion import checked_imu, efforts_of, ImuTracker, Motion
 from grasp_torque_opt.control.plausible import check_contacts
 from grasp_torque_opt.control.rates import turned_towards
+from grasp_torque_opt.control.stamps import StampRule
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import ObjectSpec
@@ -67,6 +68,9 @@ class Inputs:
     defaults are used); ``q`` is None until the first joint state. ``wrench`` is
     (frame, [F, M]) in that frame's axes. ``gravity`` is in base axes [m/s^2], None
     until one arrives (then ``CycleConfig.gravity`` and the scenario's load are used).
+    ``motion`` is the IMU's (:class:`~grasp_torque_opt.control.motion.Motion`, used while
+    fresh), ``effort`` the actuators' measured torques of the joint state (only with
+    ``effort_estimation``; None when the driver reports none).
     """
 
     q: np.ndarray | None = None
@@ -77,6 +81,10 @@ class Inputs:
     wrench_time: float | None = None
     gravity: np.ndarray | None = None
     gravity_time: float | None = None
+    motion: Motion | None = None
+    motion_time: float | None = None
+    effort: np.ndarray | None = None
+    effort_why: str = ''
 
 
 @dataclass
@@ -125,7 +133,7 @@ def stamp_seconds(sec: int, nanosec: int) -> float:
     return sec + 1e-9 * nanosec
 
 
-class InputStore:
+class InputStore(StampRule):
     """
     The latest valid inputs of the cycle, each checked whole before it is kept.
 
@@ -152,6 +160,10 @@ class InputStore:
         #: their indices in q, and the commanded joints it was checked against (a state
         #: with the same names skips the name checks).
         self._names: tuple | None = None
+        self.imu = ImuTracker()
+        #: Why the last joint state's efforts were not used ('' when they were).
+        self.effort_missing = ''
+        self._effort_index: tuple | None = None  # (names, indices of the actuators)
 
     def check_bytes(self, source: str, n: int) -> None:
         """
@@ -193,7 +205,8 @@ class InputStore:
             raise
 
     def update_joint_state(self, names: list[str], positions: list[float], now: float,
-                           stamp: float = 0.0, clock: float | None = None) -> None:
+                           stamp: float = 0.0, clock: float | None = None,
+                           efforts: list[float] | None = None) -> None:
         """
         Take a joint state: names and positions, any order, extra joints ignored.
 
@@ -207,6 +220,9 @@ class InputStore:
             now: monotonic receipt time [s].
             stamp: header stamp [s] (0: unstamped).
             clock: the clock the stamps are on, now [s] (None: not checked ahead).
+            efforts: their measured efforts [N m], read only with ``effort_estimation``
+                (empty or not finite: none, :attr:`effort_missing` says why; never a
+                rejection).
 
         Raises:
             InputError: more than ``max_joint_state_entries`` entries, length
@@ -241,7 +257,12 @@ class InputStore:
         if checked is not None:
             self._names = checked
         self._keep_stamp('joint_states', stamp, now, clock)
-        self.inputs = replaced(self.inputs, q=q, q_time=now)
+        effort = None
+        if self.config.effort_estimation:
+            effort, self.effort_missing, self._effort_index = efforts_of(
+                names, efforts, self.setup.hand.joints, self._effort_index)
+        self.inputs = replaced(self.inputs, q=q, q_time=now, effort=effort,
+                               effort_why=self.effort_missing)
 
     def _check_limits(self, q: np.ndarray, used: np.ndarray) -> None:
         """Refuse a used position beyond its URDF limits (:func:`.checks.check_joint_limits`)."""
@@ -359,6 +380,33 @@ class InputStore:
             g = turned_towards(old, g, step)
         self.inputs = dataclasses.replace(self.inputs, gravity=g, gravity_time=now)
 
+    def update_imu(self, frame: str, specific_force: np.ndarray, omega: np.ndarray,
+                   now: float, stamp: float = 0.0, clock: float | None = None,
+                   transform: tuple[np.ndarray, np.ndarray] | None = None,
+                   unresolved: str = 'tf2_ros is not installed') -> None:
+        """
+        Take an IMU reading of the base (frame '' or the base, else ``transform``'s).
+
+        ``specific_force`` [m/s^2] reads -g at rest; ``omega`` [rad/s]; ``transform``: the
+        IMU frame's rotation and origin in the base frame; the rest as
+        :meth:`update_gravity`'s. A reading :func:`.motion.checked_imu` refuses, or with a
+        bad stamp, raises InputError and is not kept (the last one ages out; then the
+        scenario's gravity is used again).
+        """
+        try:
+            g, w, point = checked_imu(self.setup.hand.base_frame, frame, specific_force,
+                                      omega, transform, unresolved, self.config)
+            self._check_stamp('imu', stamp, clock, now)
+        except InputError as e:
+            self.reject('imu', e)
+            raise
+        self._keep_stamp('imu', stamp, now, clock)
+        c = self.config
+        alpha = self.imu.update(now, w, c.imu_angular_filter, c.imu_timeout_bounds[1])
+        motion = Motion(g, w, alpha, point, self.imu.timeout(c.imu_timeout_periods,
+                                                             c.imu_timeout_bounds))
+        self.inputs = dataclasses.replace(self.inputs, motion=motion, motion_time=now)
+
     def reject(self, source: str, error: InputError) -> None:
         """Count a rejected message of ``source`` and keep its reason."""
         self.counters.rejected[source] = self.counters.rejected.get(source, 0) + 1
@@ -382,43 +430,3 @@ class InputStore:
                 now - i.gravity_time > c.gravity_timeout:
             return f'gravity stale ({now - i.gravity_time:.3f} s > {c.gravity_timeout} s)'
         return ''
-
-    def _check_stamp(self, source: str, stamp: float, clock: float | None, now: float) -> None:
-        """
-        Apply the header stamp rule (docs/node.md, "Input checks").
-
-        0 is an unstamped message: accepted, not compared. A stamp more than
-        ``stamp_future_tolerance`` ahead of ``clock`` (when the clock runs, > 0)
-        is rejected. A stamp before the topic's mark is rejected (out of order),
-        unless the mark is itself stale by receipt time: a restarted publisher
-        or a rewound clock recovers after the topic's timeout. The mark is the
-        last accepted stamp, but never later than the clock when that message
-        was accepted (:meth:`_keep_stamp`): a source stamping ahead of the clock,
-        by a fast clock or a lie, cannot push it into the future and lock out a
-        source whose stamps agree with the clock.
-        """
-        if stamp == 0.0:
-            return
-        if not math.isfinite(stamp) or stamp < 0.0:
-            raise InputError(f'{source}.header.stamp', f'is negative ({stamp:.9g} s)')
-        tol = self.config.stamp_future_tolerance
-        if clock is not None and clock > 0.0 and stamp > clock + tol:
-            raise InputError(f'{source}.header.stamp', f'is {stamp - clock:.3f} s ahead of the '
-                             f'clock (stamp_future_tolerance {tol} s)')
-        last = self._stamps.get(source)
-        if last is not None and stamp < last[0] and now - last[1] <= self._timeout(source):
-            raise InputError(f'{source}.header.stamp', f'goes backwards by '
-                             f'{last[0] - stamp:.6f} s (out of order)')
-
-    def _timeout(self, source: str) -> float:
-        """Return how long a source's stamp mark holds [s] (no timeout: joint_state_timeout)."""
-        c = self.config
-        t = {'joint_states': c.joint_state_timeout, 'contacts': c.contacts_timeout,
-             'external_wrench': c.wrench_timeout, 'gravity': c.gravity_timeout}[source]
-        return t if t > 0 else c.joint_state_timeout
-
-    def _keep_stamp(self, source: str, stamp: float, now: float, clock: float | None) -> None:
-        """Mark an accepted stamp, never later than the clock (:meth:`_check_stamp`)."""
-        if stamp != 0.0:
-            mark = min(stamp, clock) if clock is not None and clock > 0.0 else stamp
-            self._stamps[source] = (mark, now)

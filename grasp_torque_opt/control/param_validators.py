@@ -47,11 +47,13 @@ class Context:
         joints: their names, for messages.
         torque_bounds: the largest accepted torque limit per joint [N m] (None:
             unchecked).
+        scenario_object: the scenario's object (uncertainty.pose needs its radius; None: none).
     """
 
     m: int | None = None
     joints: tuple[str, ...] = ()
     torque_bounds: np.ndarray | None = None
+    scenario_object: Any = None
 
 
 #: A custom validator: (parameter, value, context) -> the problem, '' if none.
@@ -198,14 +200,17 @@ VALIDATORS: dict[str, Validator] = {
 }
 
 
-def check_pairs(values: Mapping[str, Any]) -> None:
+def check_pairs(values: Mapping[str, Any], ctx: Context | None = None) -> None:
     """
     Check the rules between parameters (after each one's own check).
 
     Raises:
         InputError: gravity's norm outside gravity_norm_bounds; min-max with a method
-            other than tau-qp (docs/planner.md).
+            other than tau-qp (docs/planner.md); a stated uncertainty that leaves no
+            friction, or a pose uncertainty without the scenario's object (with ``ctx``).
     """
+    if ctx is not None and ctx.m is not None:
+        stated_margin(values, ctx.scenario_object)
     gravity, bounds = values.get('gravity'), values.get('gravity_norm_bounds')
     if gravity is not None and bounds is not None:
         norm = math.sqrt(sum(v * v for v in gravity))
@@ -216,3 +221,23 @@ def check_pairs(values: Mapping[str, Any]) -> None:
     if values.get('objective') == 'min-max' and values.get('solver.method') != 'tau-qp':
         raise InputError('objective', 'min-max needs solver.method tau-qp, not '
                          f"{values.get('solver.method')}")
+
+
+def stated_margin(values: Mapping[str, Any], obj: Any) -> float | None:
+    """
+    Return the friction margin the stated uncertainty asks (None: none stated).
+
+    Raises:
+        InputError: the uncertainty leaves no friction, or uncertainty.pose without the
+            scenario's object.
+    """
+    # Here, not at the top: motion imports checks, which imports this module's family.
+    from grasp_torque_opt.control.motion import tilt_radius, uncertainty_margin
+
+    friction = values.get('uncertainty.friction') or 0.0
+    pose = values.get('uncertainty.pose') or 0.0
+    if friction <= 0.0 and pose <= 0.0:
+        return None
+    radius = tilt_radius(obj, values.get('uncertainty.tip_radius') or 0.0) if pose > 0.0 \
+        else math.inf
+    return uncertainty_margin(float(values.get('mu_tangential')), friction, pose, radius)

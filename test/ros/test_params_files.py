@@ -20,6 +20,14 @@ import yaml
 FILES = sorted(CONFIG.glob('*_node.yaml'))
 
 
+def flat(params, prefix=''):
+    """Give a params file's nested maps (imu: {enabled: ...}) as dotted names."""
+    out = {}
+    for k, v in params.items():
+        out.update(flat(v, f'{prefix}{k}.') if isinstance(v, dict) else {f'{prefix}{k}': v})
+    return out
+
+
 @pytest.mark.parametrize('path', FILES, ids=[p.name for p in FILES])
 @pytest.mark.parametrize('remap', [[], ['-r', '__node:=right_hand_torques'],
                                    ['-r', '__ns:=/right_hand']])
@@ -35,7 +43,7 @@ def test_every_parameter_of_the_file_applies_whatever_the_name(path, remap, kind
         try:
             if kind is GraspTorqueLifecycleNode:  # it loads the file's scenario at configure
                 assert node.trigger_configure() == TransitionCallbackReturn.SUCCESS
-            for name, value in params.items():
+            for name, value in flat(params).items():
                 got = node.get_parameter(name).value
                 assert (list(got) if isinstance(value, list) else got) == value, name
             if remap:

@@ -25,6 +25,7 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.backends.registry import is_backend, settings_for
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.param_validators import stated_margin
 from grasp_torque_opt.control.parameters import cycle_config
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 import numpy as np
@@ -44,8 +45,21 @@ def fallback_backend(backend: str, fallback: str) -> str | None:
     return None if fallback in ('none', backend) or not available(fallback) else fallback
 
 
-def setup_of(setup: GraspSetup, p: Any) -> GraspSetup:
-    """Give the grasp with the parameters' friction, weights, limits, objective, origin."""
+def setup_of(setup: GraspSetup, p: Any, obj: Any = None) -> GraspSetup:
+    """
+    Give the grasp with the parameters' friction, weights, limits, objective, origin.
+
+    The friction margin is the larger of ``friction_margin`` and the one the stated
+    uncertainty asks (:func:`~grasp_torque_opt.control.param_validators.stated_margin`;
+    ``obj``: the scenario's object, whose radius the pose uncertainty needs).
+    """
+    margin = p.friction_margin
+    stated = stated_margin({'uncertainty.friction': p.uncertainty.friction,
+                            'uncertainty.pose': p.uncertainty.pose,
+                            'uncertainty.tip_radius': p.uncertainty.tip_radius,
+                            'mu_tangential': p.mu_tangential}, obj)
+    if stated is not None:
+        margin = max(margin, stated)
     hand = setup.hand
     if not np.array_equal(hand.torque_limits, p.torque_limits):
         hand = dataclasses.replace(hand, torque_limits=np.array(p.torque_limits))
@@ -55,7 +69,7 @@ def setup_of(setup: GraspSetup, p: Any) -> GraspSetup:
         friction=dataclasses.replace(setup.friction, mu1=p.mu_tangential,
                                      mu2=p.mu_torsional, sides=p.polygon_sides,
                                      min_normal_force=p.min_normal_force,
-                                     margin=p.friction_margin))
+                                     margin=margin))
 
 
 def solver_settings(p: Any) -> ProxSuiteSettings:
@@ -65,7 +79,7 @@ def solver_settings(p: Any) -> ProxSuiteSettings:
 
 
 def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
-              service: bool = False) -> TorqueController:
+              service: bool = False, obj: Any = None) -> TorqueController:
     """
     Make a controller from the parameters, or bring one to them in place.
 
@@ -78,6 +92,7 @@ def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
         setup: the grasp as loaded (the parameters' values go over it).
         p: the parameters (a frozen snapshot, :meth:`Schema.params`).
         service: the service's controller (cold, in slices) instead of the loop's.
+        obj: the scenario's object (the stated pose uncertainty's radius).
 
     Returns:
         The controller.
@@ -91,11 +106,11 @@ def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
     if ctrl is None:
         if service:  # its own Pinocchio data
             setup = dataclasses.replace(setup, hand=dataclasses.replace(setup.hand))
-        ctrl = TorqueController(setup_of(setup, p), config, settings, backend, warm, fallback)
+        ctrl = TorqueController(setup_of(setup, p, obj), config, settings, backend, warm, fallback)
         if service:
             ctrl.solver = make_solver(backend, settings, False, slice_s)
         return ctrl
-    ctrl.setup, ctrl.config = setup_of(ctrl.setup, p), config
+    ctrl.setup, ctrl.config = setup_of(ctrl.setup, p, obj), config
     # Each backend holds its own settings type: compare in it. (A solver of one's own,
     # set on the controller, meets no backend's settings: it is replaced.)
     solver = ctrl.solver

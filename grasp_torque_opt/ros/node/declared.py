@@ -144,7 +144,7 @@ class DeclaredParameters:
             if reason:
                 return SetParametersResult(successful=False, reason=reason)
         try:
-            check_pairs({**self.values(), **{p.name: p.value for p in params}})
+            check_pairs({**self.values(), **{p.name: p.value for p in params}}, self.context)
         except InputError as e:
             return SetParametersResult(successful=False, reason=str(e))
         return SetParametersResult(successful=True)

@@ -23,6 +23,7 @@ import dataclasses
 from dataclasses import dataclass
 import time
 
+from grasp_torque_opt.control.motion import Motion, motion_wrench
 from grasp_torque_opt.control.parameters import name_map_of
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -201,6 +202,9 @@ def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | 
     """
     Give the scenario's load as a function of gravity [m/s^2], or None.
 
+    With a :class:`~grasp_torque_opt.control.motion.Motion` (the IMU's), the load is
+    the object's on the moving base (:func:`~grasp_torque_opt.control.motion.motion_wrench`).
+
     Only when the scenario's load is its object's weight (``object`` and ``gravity``
     both given): then it is ``load.external_wrench`` plus the weight under the gravity
     given, about the scenario's object origin, base axes. Otherwise the load does not
@@ -210,4 +214,16 @@ def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | 
         return None
     obj, origin = scenario.object, scenario.object_origin.copy()
     extra = scenario.extra_wrench.copy()
-    return lambda g: extra + weight_wrench(obj, np.asarray(g, dtype=float), origin)
+
+    def load(g: np.ndarray, motion: Motion | None = None) -> np.ndarray:
+        if motion is not None:  # the apparent gravity g and the base's rotation
+            return extra + motion_wrench(obj, origin, motion)
+        return extra + weight_wrench(obj, np.asarray(g, dtype=float), origin)
+    return load
+
+
+def weight_of(scenario: Scenario) -> float | None:
+    """Return the scenario's object's weight [N], or None (no object or no gravity)."""
+    if scenario.object is None or scenario.gravity is None:
+        return None
+    return float(scenario.object.mass * np.linalg.norm(scenario.gravity))

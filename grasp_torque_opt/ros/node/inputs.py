@@ -31,7 +31,7 @@ from grasp_torque_opt.ros.peers import quiet_subscription
 import numpy as np
 from rclpy.qos import qos_profile_sensor_data
 from rclpy.serialization import deserialize_message
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState
 
 if TYPE_CHECKING:
     from grasp_torque_opt.ros.node.root import GraspTorque
@@ -66,12 +66,15 @@ class Inputs:
         self.sim_time = bool(root.node.get_parameter('use_sim_time').value)
 
     def start(self) -> list[Any]:
-        """Make the four subscriptions; give them (to be destroyed at :meth:`stop`)."""
+        """Make the subscriptions (imu with imu.enabled); give them (destroyed at stop)."""
         made = []
-        for msg_type, topic, take in ((JointState, 'joint_states', self.on_joint_state),
-                                      (PoseArray, 'contacts', self.on_contacts),
-                                      (WrenchStamped, 'external_wrench', self.on_wrench),
-                                      (Vector3Stamped, 'gravity', self.on_gravity)):
+        topics = [(JointState, 'joint_states', self.on_joint_state),
+                  (PoseArray, 'contacts', self.on_contacts),
+                  (WrenchStamped, 'external_wrench', self.on_wrench),
+                  (Vector3Stamped, 'gravity', self.on_gravity)]
+        if self.root.params.imu.enabled:
+            topics.append((Imu, 'imu', self.on_imu))
+        for msg_type, topic, take in topics:
             callback = self._callback(topic, msg_type, take)
             qos = JOINT_STATE_QOS if topic == 'joint_states' else qos_profile_sensor_data
             sub = self.node.create_subscription(msg_type, topic, callback, qos, raw=True,
@@ -141,13 +144,17 @@ class Inputs:
             try:
                 # The controller checks the sizes first (the bytes are bounded already).
                 ctrl.update_joint_state(msg.name, msg.position, receipt, stamp,
-                                        self.clock_now())
+                                        self.clock_now(), msg.effort)
             except InputError as e:
                 self._rejected(e)
                 return
             root.last_stamp = header
             if root.commanding:
                 root.outputs.publish(ctrl.cycle(now), header)
+                load = ctrl.solving.effort_load
+                if load.off and not load.said:
+                    load.said = True
+                    self.node.get_logger().warn(load.off)
 
     def on_contacts(self, msg: PoseArray, receipt: float | None = None) -> None:
         """Take contact frames in a model frame: one pose per scenario contact."""
@@ -198,5 +205,30 @@ class Inputs:
             try:
                 self.root.controller.update_gravity(frame, [v.x, v.y, v.z], now, stamp,
                                                     self.clock_now(), rotation, why)
+            except InputError as e:
+                self._rejected(e)
+
+    def on_imu(self, msg: Imu, receipt: float | None = None) -> None:
+        """
+        Take the base's IMU: specific force and angular velocity (imu.enabled).
+
+        In the hand's base frame, or another frame through tf2 (its rotation and origin);
+        its orientation is not used. Rejected (counted, logged, not kept): the cycle
+        uses the last accepted reading while it is fresh, then the scenario's gravity.
+        """
+        now = time.monotonic() if receipt is None else receipt
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        frame, a, w = msg.header.frame_id, msg.linear_acceleration, msg.angular_velocity
+        with self.root.lock:
+            base = self.root.controller.setup.hand.base_frame
+        tf = self.root.tf
+        transform, why = None, 'tf2_ros is not installed'
+        if frame not in ('', base) and tf.running:
+            transform, why = tf.transform(base, frame)
+        with self.root.lock:
+            try:
+                self.root.controller.store.update_imu(frame, [a.x, a.y, a.z], [w.x, w.y, w.z],
+                                                      now, stamp, self.clock_now(), transform,
+                                                      why)
             except InputError as e:
                 self._rejected(e)

@@ -20,6 +20,7 @@ configured, and whether it commands as soon as it is built or only once activate
 from __future__ import annotations
 
 from collections.abc import Callable
+import dataclasses
 import threading
 import time
 from typing import Any
@@ -28,7 +29,13 @@ from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.parameters import check_pairs
 from grasp_torque_opt.ros.node import controllers
 from grasp_torque_opt.ros.node.declared import DeclaredParameters
-from grasp_torque_opt.ros.node.grasp_source import bind, Grasp, load_of_gravity, urdf_document
+from grasp_torque_opt.ros.node.grasp_source import (
+    bind,
+    Grasp,
+    load_of_gravity,
+    urdf_document,
+    weight_of,
+)
 from grasp_torque_opt.ros.node.inputs import Inputs
 from grasp_torque_opt.ros.node.outputs import Outputs
 from grasp_torque_opt.ros.node.parameters import check_all, hand_context, scenario_defaults
@@ -124,15 +131,20 @@ class GraspTorque:
         setup = grasp.setup
         values = self.parameters.values()
         ctx = hand_context(setup.hand, bool(values['torque_limits_above_urdf']))
+        ctx = dataclasses.replace(ctx, scenario_object=grasp.scenario.object)
         check_all(values, ctx)
-        check_pairs(values)
+        check_pairs(values, ctx)
         self.parameters.context = ctx
         self.params = p = self.parameters.snapshot()
         self._warn_missing_fallback(p)
-        ctrl = controllers.configure(None, setup, p)
-        service = controllers.configure(None, setup, p, service=True)
+        ctrl = controllers.configure(None, setup, p, obj=grasp.scenario.object)
+        service = controllers.configure(None, setup, p, service=True, obj=grasp.scenario.object)
         ctrl.load_of_gravity = service.load_of_gravity = load_of_gravity(grasp.scenario)
         ctrl.store.object = service.store.object = grasp.scenario.object
+        ctrl.solving.weight = service.solving.weight = weight_of(grasp.scenario)
+        # The service plans for the model's load (the scenario's, the IMU's): it does not
+        # estimate, and a transient correction of the loop's is not its prediction.
+        service.solving.estimating = False
         self.grasp = grasp
         self.controller, self.service.controller = ctrl, service
         self.parameters.configured = True
@@ -155,8 +167,10 @@ class GraspTorque:
         p = self.parameters.snapshot()
         with self.lock:
             self.params = p
-            controllers.configure(self.controller, self.grasp.setup, p)
-            controllers.configure(self.service.controller, self.grasp.setup, p, service=True)
+            obj = self.grasp.scenario.object
+            controllers.configure(self.controller, self.grasp.setup, p, obj=obj)
+            controllers.configure(self.service.controller, self.grasp.setup, p, service=True,
+                                  obj=obj)
             if any(x.name == 'solver.fallback' for x in params):
                 self._warn_missing_fallback(p)
             if not self.commanding:

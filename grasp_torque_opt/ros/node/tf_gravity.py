@@ -8,7 +8,7 @@
 
 
 """
-tf2 for the gravity input: the rotation from a message's frame to the hand's base.
+tf2 for the gravity and imu inputs: a message's frame in the hand's base frame.
 
 Its listener has a node and an executor thread of its own, in the node's context, so
 that /tf traffic never waits behind the control loop (nor holds it). Only when
@@ -72,8 +72,9 @@ class TfGravity:
         listener.unregister()
         tf_node.destroy_node()
 
-    def rotation(self, base: str, frame: str) -> tuple[np.ndarray | None, str]:
-        """Give the rotation from ``frame`` to ``base`` (latest), or None and why not."""
+    def transform(self, base: str, frame: str
+                  ) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
+        """Give the rotation and origin of ``frame`` in ``base`` (latest), or None and why."""
         if self._tf is None:
             return None, 'tf2_ros is not installed'
         import tf2_ros
@@ -82,12 +83,17 @@ class TfGravity:
             t = self._tf[0].lookup_transform(base, frame, Time())
         except tf2_ros.TransformException as e:
             return None, f'tf2: {cut(str(e))}'
-        r = t.transform.rotation
+        r, p = t.transform.rotation, t.transform.translation
         try:
-            return quaternion_matrix(np.array([r.x, r.y, r.z, r.w]),
-                                     'gravity.header.frame_id transform'), ''
+            return (quaternion_matrix(np.array([r.x, r.y, r.z, r.w]),
+                                      f'{frame} transform'), np.array([p.x, p.y, p.z])), ''
         except InputError as e:
             return None, f'tf2: {e}'
+
+    def rotation(self, base: str, frame: str) -> tuple[np.ndarray | None, str]:
+        """Give the rotation from ``frame`` to ``base`` (latest), or None and why not."""
+        transform, why = self.transform(base, frame)
+        return (None, why) if transform is None else (transform[0], '')
 
 
 def _spin(executor: SingleThreadedExecutor) -> None:

@@ -1,0 +1,134 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The load estimated from measured efforts, and the bounded integral action that follows it.
+
+The grasp's statics backwards: the joints' measured torques tau_m (joint_states'
+effort, what the driver applies: the node's command plus its impedance) less the
+fingers' own gravity g(q) are J^T f; the least-squares contact wrenches f give the
+wrench the hand applies, G f, and the load it holds is w_est = -G f (the tau-QP's
+G f = -w_ext). w_est is low-passed (``effort_estimation.filter``), and the load the
+cycle plans for is the model's load plus a correction b, moved by the integral action
+
+    db/dt = (w_est - (w_model + b)) / T,     T = ``effort_estimation.time_constant``,
+
+so that b tends to w_est - w_model: the feedforward takes over what the driver's
+impedance held. b is bounded: its force by ``effort_estimation.max_load_ratio`` times the
+scenario's weight, its moment by that force times the farthest contact's distance from
+the object origin (:meth:`EffortLoad.bound`). The sum is planned and certified as every
+load is: the estimate moves what is planned, never what is checked.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class EffortLoad:
+    """
+    The estimate and the correction, kept across cycles.
+
+    Attributes:
+        estimate: the filtered load estimate w_est, base axes about the origin, or None.
+        correction: b, added to the model's load [N, N m], shape (6,).
+        off: why the feature is off ('' while on or not asked).
+        said: whether ``off`` was said (the node logs it once).
+    """
+
+    def __init__(self) -> None:
+        """Start with no estimate and no correction."""
+        self.estimate: np.ndarray | None = None
+        self.correction = np.zeros(6)
+        self.off = ''
+        self.said = False
+        self._last: float | None = None
+
+    def reset(self) -> None:
+        """Drop the estimate and the correction (inputs lost, the feature turned off)."""
+        self.estimate, self.correction, self._last = None, np.zeros(6), None
+
+    def turn_off(self, why: str) -> None:
+        """Stop estimating, for a reason said once."""
+        if not self.off:
+            self.off, self.said = why, False
+        self.reset()
+
+    @staticmethod
+    def measured(G: np.ndarray, J: np.ndarray, effort: np.ndarray,
+                 gravity_torque: np.ndarray | None) -> np.ndarray:
+        """
+        Return the load the measured efforts hold: -G f, J^T f = tau_m - g(q) (least squares).
+
+        Only the contact forces are estimated, not the soft-finger torsional moments: a
+        fingertip's twist about its normal moves the joints little, and least squares
+        over them turns small torque errors into large moments.
+
+        Args:
+            G: grasp matrix (6, 4p).
+            J: hand Jacobian (4p, m) (per contact: force x, y, z, then the torsional
+                moment).
+            effort: measured actuator torques [N m], shape (m,).
+            gravity_torque: g(q) on the actuators [N m], or None (none).
+        """
+        forces = np.arange(G.shape[1]) % 4 != 3
+        tau = effort if gravity_torque is None else effort - gravity_torque
+        f = np.linalg.lstsq(J[forces].T, tau, rcond=1e-6)[0]
+        return -(G[:, forces] @ f)
+
+    @staticmethod
+    def bound(weight: float, ratio: float, positions: np.ndarray, origin: np.ndarray
+              ) -> tuple[float, float]:
+        """Return the correction's force and moment bounds [N, N m]."""
+        force = ratio * weight
+        lever = float(np.max(np.linalg.norm(positions - origin, axis=1))) if len(positions) \
+            else 0.0
+        return force, force * lever
+
+    def update(self, measured: np.ndarray, model: np.ndarray, now: float, filter_s: float,
+               time_constant: float, bounds: tuple[float, float], gap: float,
+               along: np.ndarray | None = None) -> np.ndarray:
+        """
+        Take one measurement; return the correction b to add to the model's load.
+
+        Args:
+            measured: :meth:`measured` at this cycle.
+            model: the load the cycle would plan without the correction.
+            now: the cycle's time [s].
+            filter_s: the estimate's low-pass time constant [s].
+            time_constant: T of the integral action [s].
+            bounds: the force and moment bounds (:meth:`bound`).
+            gap: a longer time between cycles starts the filter again [s].
+            along: a unit vector: only the force error along it is integrated (the
+                mass-only estimate, along the apparent gravity); None: the whole wrench.
+        """
+        if not np.all(np.isfinite(measured)):
+            return self.correction
+        last = self._last
+        self._last = now
+        if last is None or not 0.0 < now - last <= gap or self.estimate is None:
+            self.estimate = measured.copy()
+            return self.correction
+        dt = now - last
+        self.estimate = self.estimate + dt / (filter_s + dt) * (measured - self.estimate)
+        error = self.estimate - model - self.correction
+        if along is not None:  # a mass error: the force along the apparent gravity only
+            error = np.concatenate((along * float(error[:3] @ along), np.zeros(3)))
+        b = self.correction + dt / (time_constant + dt) * error
+        self.correction = clipped(b, bounds)
+        return self.correction
+
+
+def clipped(b: np.ndarray, bounds: tuple[float, float]) -> np.ndarray:
+    """Scale b's force and moment parts down to their bounds' norms."""
+    out = b.copy()
+    for part, limit in ((slice(0, 3), bounds[0]), (slice(3, 6), bounds[1])):
+        norm = float(np.linalg.norm(out[part]))
+        if norm > limit:
+            out[part] *= limit / norm if norm > 0 else 0.0
+    return out
