@@ -168,8 +168,8 @@ setup(
         # bench/: the other solvers compared, and process memory.
         'bench': ['osqp', 'psutil'],
         # grasp_torque_opt.sim and grasp-torque-sim: the hand in MuJoCo (docs/simulation.md).
-        # Pillow writes the picture's PNG.
-        'sim': ['mujoco>=3.2', 'pillow'],
+        # Pillow writes the picture's PNG, matplotlib the plot of drift and effort.
+        'sim': ['mujoco>=3.2', 'pillow', 'matplotlib'],
         # grasp-torque-opt score --engine dask: candidate sets that outgrow one machine
         # (docs/planner.md).
         'distributed': ['dask', 'distributed'],

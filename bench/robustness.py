@@ -45,9 +45,9 @@ import numpy as np
 # bench/ on sys.path for its sibling modules (E402, I100 as in bench/physics.py).
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, report  # noqa: E402, I100
-from grasp_torque_opt.control.controller import CycleConfig, TorqueController  # noqa: E402
 from grasp_torque_opt.core.resources import find_config  # noqa: E402
 from grasp_torque_opt.core.scenario import load_scenario, Scenario  # noqa: E402
+from grasp_torque_opt.ros.sim_compare import node_controller  # noqa: E402
 from grasp_torque_opt.sim.base_motion import BaseMotion, STANDARD_GRAVITY  # noqa: E402
 from grasp_torque_opt.sim.baselines import Preset, Squeeze, tune_preset  # noqa: E402
 from grasp_torque_opt.sim.episode import (  # noqa: E402
@@ -85,47 +85,6 @@ def grid(smoke: bool) -> list[tuple[str, str, dict]]:
         cases.append(('noise', f'{n:g} mrad', {'disturbances': Disturbances(
             joint_noise=1e-3 * n, seed=1)}))
     return cases
-
-
-def node_controller(setup, scenario, rig=None, inputs: bool = False, margin: float = 0.0):
-    """
-    Return the node's cycle as a controller: a joint state in, its command out.
-
-    Configured as config/allegro_right_node.yaml configures the node: gravity
-    compensation with the scenario's gravity (the parameter's default from the
-    scenario), DAQP as the fallback; the budget generous, as the node's tests set it.
-    With ``inputs`` (issue 24's inputs on, as the bundled params turn them on): the rig's
-    palm IMU and its measured efforts (effort_estimation) are given to the cycle at each
-    joint state. ``margin``: the friction margin k.
-    """
-    import dataclasses
-
-    from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
-
-    setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
-                                                                    margin=margin))
-    config = CycleConfig(gravity_compensation=True,
-                         gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=inputs)
-    ctrl = TorqueController(setup, config, fallback='daqp')
-    ctrl.load_of_gravity = load_of_gravity(scenario)
-    ctrl.solving.weight = weight_of(scenario)
-    names = list(setup.hand.joints)
-    clock = {'t': 0.0}
-
-    def command(reading):
-        # The simulated time (the estimate's filters run on it); without a rig, any
-        # increasing time: the inputs are always fresh here.
-        clock['t'] = 1.0 + rig.time if rig is not None else clock['t'] + 1e-3
-        efforts = None
-        if inputs:
-            force, omega = rig.imu()
-            ctrl.update_imu('', force, omega, clock['t'])
-            efforts = rig.effort().tolist()
-        ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, efforts)
-        return ctrl.cycle(clock['t']).command
-    command.controller = ctrl
-    return command
 
 
 def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,

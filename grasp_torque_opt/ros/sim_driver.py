@@ -248,7 +248,8 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
     t_release_wall, sim_release = time.monotonic(), hsim.time
     counted_at_release = state['commands']
     limit = args.drift_limit * 1e-3
-    track = {'passed': None, 'max_drift': 0.0, 'lost': {}, 'errors': [], 'usage': []}
+    track = {'passed': None, 'max_drift': 0.0, 'lost': {}, 'errors': [], 'usage': [],
+             'trace': []}
 
     def every_second() -> None:
         t = hsim.time - sim_release
@@ -288,6 +289,10 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
     def watch() -> bool:
         drift, _ = hsim.motion()
         track['max_drift'] = max(track['max_drift'], drift)
+        t = hsim.time - sim_release
+        if not track['trace'] or t - track['trace'][-1][0] >= 1.0 / args.rate:
+            applied = hsim.effort()
+            track['trace'].append((t, drift, float(np.sqrt(np.mean(applied ** 2)))))
         if drift > limit and track['passed'] is None:
             track['passed'] = hsim.time - sim_release
         return drift > max(20e-3, 10 * limit)  # fallen: no point in going on
@@ -324,6 +329,7 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
     print('summary: ' + why + '; ' + '; '.join(extra))
     if not args.no_picture:
         print(_picture(hsim, args.picture, state['predicted']))
+        print(_plot(args, scenario, track['trace'], baseline is None))
     return close(0 if held and commands > 0 else 1)
 
 
@@ -331,6 +337,29 @@ def _mujoco_version() -> str:
     import mujoco
 
     return mujoco.__version__
+
+
+def _plot(args: argparse.Namespace, scenario, trace: list, node: bool) -> str:
+    """Run the baseline on the same disturbances, plot both runs; return the line to print."""
+    from grasp_torque_opt.ros.sim_compare import baseline_trace
+    from grasp_torque_opt.sim.model import SimSettings
+    from grasp_torque_opt.sim.plot import PLOT_CAPTION, plot_runs
+
+    sim = SimSettings(mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional)
+    base = baseline_trace(scenario, rig_settings(args), sim)
+    label = 'this run (node over ROS, its bundled inputs)' if node else \
+        f'this run ({args.controller})'
+    drift = 1e3 * base[-1][1] if base else float('nan')
+    title = f"{describe(args) or 'no disturbance'}, Kp {args.kp:g} N m/rad"
+    try:
+        written = plot_runs(args.plot, {
+            label: trace,
+            'baseline: the node told only the scenario (no IMU, no efforts)': base},
+            title, args.drift_limit)
+    except OSError as e:
+        return f'plot: not written, cannot write {args.plot}: {e.strerror}'
+    return (f'plot: {written.resolve()} ({PLOT_CAPTION}; the baseline drifted '
+            f'{drift:.3f} mm)')
 
 
 def _picture(hsim, path: str, predicted) -> str:

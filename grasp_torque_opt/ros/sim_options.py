@@ -80,7 +80,11 @@ def parser(description: str) -> argparse.ArgumentParser:
     p.add_argument('--picture', default='grasp_sim.png',
                    help='PNG of the grasp written at the end, in the current folder unless a '
                         'path')
-    p.add_argument('--no-picture', action='store_true', help='write no picture')
+    p.add_argument('--plot', default='grasp_sim_plot.png',
+                   help="PNG of the object's drift and the hand's effort over time, this "
+                        'run beside the node told only the scenario (no IMU, no efforts) '
+                        'on the same disturbances; in the current folder unless a path')
+    p.add_argument('--no-picture', action='store_true', help='write no picture and no plot')
     p.add_argument('--with-node', action='store_true',
                    help='start grasp_torque_node in a child process')
     p.add_argument('--wait', type=float, default=30.0,

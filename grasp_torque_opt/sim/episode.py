@@ -111,7 +111,8 @@ def simulated(scenario: Scenario, settings: EpisodeSettings, setup: GraspSetup |
 
 
 def run_episode(rig: RigSim, controller: Controller, settings: EpisodeSettings,
-                reference: Callable[[np.ndarray], np.ndarray] | None = None) -> EpisodeReport:
+                reference: Callable[[np.ndarray], np.ndarray] | None = None,
+                trace: list | None = None) -> EpisodeReport:
     """
     Drive the rig with a controller for one episode (settle, release, hold).
 
@@ -122,6 +123,9 @@ def run_episode(rig: RigSim, controller: Controller, settings: EpisodeSettings,
         reference: the driver's impedance reference, from the one it has (the grasp
             configuration before the settling, the settled one after release); None:
             those (a driver in effort mode).
+        trace: if given, a row (time since release [s], drift [m], RMS of the applied
+            joint torques [N m]) is appended each time the controller is asked after
+            release.
     """
     dt = rig.model.opt.timestep
     every = max(1, round(1.0 / (settings.rate * dt)))
@@ -137,6 +141,10 @@ def run_episode(rig: RigSim, controller: Controller, settings: EpisodeSettings,
             rig.step()
             if watch:
                 drift, _ = rig.motion()
+                if trace is not None and k % every == 0:
+                    applied = rig.effort()
+                    trace.append((rig.time - rig.release_time, drift,
+                                  float(np.sqrt(np.mean(applied ** 2)))))
                 most = max(most, drift)
                 if drift > settings.drift_limit and passed is None:
                     passed = rig.time - rig.release_time

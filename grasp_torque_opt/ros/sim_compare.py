@@ -1,0 +1,78 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The node's cycle on the rig without ROS: the baseline beside a run, and the benchmark's node.
+
+``grasp-torque-sim`` runs the node over ROS in real time; beside it, for the plot, the
+same disturbances on a fresh rig in simulated time with the node's own cycle told only
+the scenario (no IMU, no efforts): what the node was before issue 24.
+bench/robustness.py drives every episode of its grid through :func:`node_controller`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.core.scenario import Scenario
+from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
+from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
+
+
+def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
+                    margin: float = 0.0):
+    """
+    Return the node's cycle as a controller: a joint state in, its command out.
+
+    Configured as config/allegro_right_node.yaml configures the node: gravity
+    compensation with the scenario's gravity (the parameter's default from the
+    scenario), DAQP as the fallback; the budget generous, as the node's tests set it.
+    With ``inputs`` (issue 24's inputs on, as the bundled params turn them on): the rig's
+    palm IMU and its measured efforts (effort_estimation) are given to the cycle at each
+    joint state. ``margin``: the friction margin k.
+    """
+    setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
+                                                                    margin=margin))
+    config = CycleConfig(gravity_compensation=True,
+                         gravity=tuple(float(x) for x in scenario.gravity),
+                         cycle_budget=1.0, effort_estimation=inputs)
+    ctrl = TorqueController(setup, config, fallback='daqp')
+    ctrl.load_of_gravity = load_of_gravity(scenario)
+    ctrl.solving.weight = weight_of(scenario)
+    names = list(setup.hand.joints)
+    clock = {'t': 0.0}
+
+    def command(reading):
+        # The simulated time (the estimate's filters run on it); without a rig, any
+        # increasing time: the inputs are always fresh here.
+        clock['t'] = 1.0 + rig.time if rig is not None else clock['t'] + 1e-3
+        efforts = None
+        if inputs:
+            force, omega = rig.imu()
+            ctrl.update_imu('', force, omega, clock['t'])
+            efforts = rig.effort().tolist()
+        ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, efforts)
+        return ctrl.cycle(clock['t']).command
+    command.controller = ctrl
+    return command
+
+
+def baseline_trace(scenario: Scenario, settings: EpisodeSettings, sim=None) -> list:
+    """
+    Run the node told only the scenario on a fresh rig; return its trace.
+
+    Rows of (time since release [s], drift [m], RMS applied joint torque [N m]), as
+    :func:`~grasp_torque_opt.sim.episode.run_episode` records them.
+    """
+    kw = {} if sim is None else {'sim': sim}
+    setup, rig = simulated(scenario, settings, **kw)
+    trace: list = []
+    run_episode(rig, node_controller(setup, scenario, rig, inputs=False), settings,
+                trace=trace)
+    return trace
