@@ -160,9 +160,9 @@ def parse_contacts(value: Any, names: dict[str, str], has_object: bool, most: in
     """
     Validate ``grasp.contacts``: a list of contacts, or ``auto`` (with an object).
 
-    A contact without ``position`` is found from geometry when the scenario has an
-    ``object`` (its ``normal`` then too: giving one alone is an error); without an
-    object its position is the link's origin, as always.
+    A contact given by its link only (no ``position``, no ``normal``; a ``tangent``
+    may be given) is found from geometry when the scenario has an ``object``; else, as
+    always, a missing position is the link's origin.
 
     Args:
         value: the field as parsed.
@@ -189,15 +189,11 @@ def parse_contacts(value: Any, names: dict[str, str], has_object: bool, most: in
         link = require(c, 'link', name)
         if not isinstance(link, str) or not link:
             raise InputError(f'{name}.link', f'must be a frame name, got {quote(link)}')
-        given = c.get('position') is not None
-        position = (vector(c['position'], f'{name}.position', 3) if given
-                    else None if has_object else np.zeros(3))
+        found = has_object and c.get('position') is None and c.get('normal') is None
+        position = (None if found else vector(c['position'], f'{name}.position', 3)
+                    if c.get('position') is not None else np.zeros(3))
         normal = None
         if c.get('normal') is not None:
-            if position is None:
-                raise InputError(f'{name}.normal', 'given without a position: with an object, '
-                                 'a contact given by its link has both found from geometry; '
-                                 'give both, or neither')
             normal = vector(c['normal'], f'{name}.normal', 3)
             norm = np.linalg.norm(normal)
             if norm < 1e-9:

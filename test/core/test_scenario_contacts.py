@@ -85,12 +85,14 @@ def test_auto_without_touch_or_object_is_an_error():
         setup_from_doc(doc)
 
 
-def test_a_normal_without_a_position_is_refused_with_an_object():
+def test_a_normal_without_a_position_keeps_the_links_origin():
+    """As before: only a contact given by its link alone is found from geometry."""
     doc = links_only(scenario_doc(ALLEGRO))
     doc['grasp']['contacts'][1]['normal'] = [0.0, 0.0, -1.0]
-    with pytest.raises(InputError, match=r'grasp\.contacts\[1\]\.normal: given without a '
-                       'position'):
-        setup_from_doc(doc)
+    with pytest.warns(GeometryWarning, match=r'grasp\.contacts\[1\]\.position: '):
+        setup = setup_from_doc(doc)
+    np.testing.assert_array_equal(setup.contacts[1].position, np.zeros(3))
+    assert setup.contacts[0].position is not None and setup.contacts[0].position.any()
 
 
 def test_a_written_point_off_the_object_is_warned_about():
