@@ -111,7 +111,7 @@ def coal_shape(shape: ObjectShape) -> coal.CollisionGeometry:
     except (ValueError, RuntimeError) as e:
         first = str(e).split('message:')[-1].strip().splitlines()
         raise GeometryError(shape.field, f'cannot read the mesh {shown}: '
-                         f"{cut(' '.join(first[:2]), 200)}") from e
+                            f"{cut(' '.join(first[:2]), 200)}") from e
     check_mesh(mesh, shape.field, shown)
     return mesh
 
@@ -127,7 +127,7 @@ def check_mesh(mesh: coal.BVHModelBase, field: str, shown: str) -> None:
         raise GeometryError(field, f'the mesh {shown} has no triangles')
     if mesh.num_tris > MAX_MESH_TRIANGLES:
         raise GeometryError(field, f'the mesh {shown} has {mesh.num_tris} triangles, more than '
-                         f'{MAX_MESH_TRIANGLES}')
+                            f'{MAX_MESH_TRIANGLES}')
     vertices = np.asarray(mesh.vertices(), dtype=float)
     if not np.all(np.isfinite(vertices)):
         raise GeometryError(field, f'the mesh {shown} has non-finite vertices')
@@ -135,8 +135,8 @@ def check_mesh(mesh: coal.BVHModelBase, field: str, shown: str) -> None:
     volume = abs(float(mesh.computeVolume()))
     if float(extent.min()) < 1e-6 or volume < 1e-6 * float(np.prod(extent)):
         raise GeometryError(field, f'the mesh {shown} is degenerate: extent '
-                         f'{np.round(extent, 6).tolist()} m, volume {volume:.3g} m^3 (a '
-                         'grasped object needs a solid: an inside and an outside)')
+                            f'{np.round(extent, 6).tolist()} m, volume {volume:.3g} m^3 (a '
+                            'grasped object needs a solid: an inside and an outside)')
 
 
 def nearest(kind: str, size: tuple[float, ...], x: float, y: float, z: float
@@ -161,7 +161,7 @@ def nearest(kind: str, size: tuple[float, ...], x: float, y: float, z: float
         rho = math.sqrt(x * x + y * y + z * z)
         if rho < 1e-12:
             raise GeometryError('object', "a link's centre is at the sphere's centre: no "
-                             'nearest surface point')
+                                'nearest surface point')
         r = size[0]
         n = (x / rho, y / rho, z / rho)
         return rho - r, n, (r * n[0], r * n[1], r * n[2])
@@ -195,7 +195,7 @@ def nearest(kind: str, size: tuple[float, ...], x: float, y: float, z: float
     if side <= cap:
         if rho <= 1e-12:
             raise GeometryError('object', "a link's centre is on the cylinder's axis: no "
-                             'nearest surface point')
+                                'nearest surface point')
         return -side, (ux, uy, 0.0), (a * ux, a * uy, z)
     sign = 1.0 if z >= 0.0 else -1.0
     return -cap, (0.0, 0.0, sign), (x, y, sign * h)

@@ -176,7 +176,7 @@ def parse_contacts(value: Any, names: dict[str, str], has_object: bool, most: in
     if value == AUTO:
         if not has_object:
             raise InputError('grasp.contacts', "'auto' needs the object section (the contacts "
-                             'are found from the hand\'s collision shapes and the object)')
+                             "are found from the hand's collision shapes and the object)")
         return AUTO
     if not isinstance(value, list) or not value:
         raise InputError('grasp.contacts', "must be a non-empty list of contacts or 'auto'")

@@ -6,7 +6,7 @@
 #
 # SPDX-License-Identifier: BSD-3-Clause
 
-"""Contacts from geometry on the real Allegro URDF: the hand-made grasp, rolling, lift-off, bad input."""
+"""Contacts from geometry on the real Allegro URDF: the grasp, rolling, lift-off, bad input."""
 
 from conftest import ALLEGRO
 from grasp_torque_opt.core.exceptions import FrameNotFound, GeometryError
