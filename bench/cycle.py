@@ -32,6 +32,10 @@ The paths:
   "compiled answered" counts its certified cycles) and with ``compiled=False``
   (the Python cycle everywhere).
 
+With ``--geometry`` it also times the contacts from geometry per call
+(``bench/geometry.py``: the Allegro's tips against the ball by the closed form and by
+coal, ``contacts: auto``, a mesh object), what the node would add to each cycle.
+
 Speed is measured here, never asserted in a test.
 """
 
@@ -253,11 +257,19 @@ def main() -> None:
     parser.add_argument('--backends', default=','.join(VARIANTS))
     parser.add_argument('--motions', default=','.join(MOTIONS))
     parser.add_argument('--out', type=Path, help='also write the results here (JSON)')
+    parser.add_argument('--geometry', action='store_true',
+                        help='also time the contacts from geometry (bench/geometry.py)')
     args = parser.parse_args()
     single_threaded_math()
     results = run(args.repeats, tuple(args.backends.split(',')),
                   tuple(args.motions.split(',')))
-    report(results, table(results), args.out)
+    text = table(results)
+    if args.geometry:
+        import geometry  # bench/geometry.py, beside this file
+
+        results['geometry'] = geometry.run(args.repeats)
+        text += '\n\ncontacts from geometry, per call:\n' + geometry.table(results['geometry'])
+    report(results, text, args.out)
 
 
 if __name__ == '__main__':

@@ -32,7 +32,8 @@ def g1_doc(base_link=PALM, posture=None):
     return {'hand': hand,
             'grasp': {'joint_positions': {**HAND_Q, **(posture or {})},
                       'object_origin': list(ORIGIN),
-                      'contacts': [{'link': link} for link in LINKS]},
+                      'contacts': [{'link': link, 'position': [0.0, 0.0, 0.0]}
+                                   for link in LINKS]},
             'friction': {'mu_tangential': 0.8, 'mu_torsional': 0.005, 'polygon_sides': 8,
                          'min_normal_force': 0.1},
             'load': {'external_wrench': [0.0, 0.3, -0.5, 0.01, 0.0, 0.0]}}

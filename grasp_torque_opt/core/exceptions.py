@@ -125,3 +125,17 @@ class JointNotFound(InputError):
 
 class SolverError(GraspTorqueError):
     """A solver raised or could not be set up; the original error is chained."""
+
+
+class GeometryError(InputError):
+    """
+    The contact geometry cannot give contacts: no collision shape, a bad mesh, overlap.
+
+    Raised by :mod:`grasp_torque_opt.core.geometry_contacts`: a contact link without
+    collision geometry, a degenerate object mesh, an object inside a link (or a link
+    inside it, or deeper in it than the bound). ``field`` names the input.
+    """
+
+
+class GeometryWarning(UserWarning):
+    """A contact written by hand is farther from the object's surface than the tolerance."""

@@ -142,6 +142,10 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
     po = np.empty((2 * p, 3))  # contact points p_i, then link origins o_i
     for i, (spec, fid) in enumerate(zip(contacts, fids)):
         oMf = data.oMf[fid]
+        if spec.position is None:
+            raise InputError(f'grasp.contacts[{i}].position', 'not found yet: a contact given '
+                             'by its link only is found from geometry when the scenario is '
+                             'bound (GraspSetup.from_scenario)')
         po[i] = oMf.act(spec.position)
         po[p + i] = oMf.translation
     Rb = None

@@ -24,6 +24,7 @@ from grasp_torque_opt.core.scenario import (
     load_scenario,
     Scenario,
 )
+from grasp_torque_opt.core.scenario_contacts import check_contact_points, resolve_contacts
 import numpy as np
 
 
@@ -76,31 +77,39 @@ class GraspSetup:
 
         Raises:
             InputError: naming the field (file, joint or frame not found, a contact
-                normal pointing out of the object, ...).
+                normal pointing out of the object, ...); GeometryError: a contact given
+                by link only (or ``auto``) not found from geometry.
+
+        A contact point written by hand farther from the object's surface than
+        ``grasp.contact_tolerance`` is a :class:`GeometryWarning`.
         """
         above = scenario.torque_limits_above_urdf
         if urdf_xml:
+            urdf = urdf_xml
             hand = Hand.from_urdf_string(urdf_xml, scenario.joints, scenario.torque_limits,
                                          above, scenario.coupling, scenario.base_link)
         else:
-            hand = Hand.from_urdf(resolve_urdf(scenario.urdf, scenario.base_dir),
-                                  scenario.joints, scenario.torque_limits, above,
+            urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
+            hand = Hand.from_urdf(urdf, scenario.joints, scenario.torque_limits, above,
                                   scenario.coupling, scenario.base_link)
         weights = np.ones(hand.m) if scenario.weights is None else np.asarray(scenario.weights)
         if weights.shape != (hand.m,):
             raise InputError('objective.weights',
                              f'must have {hand.m} entries (one per joint), got {weights.size}')
-        setup = cls(hand=hand, q=hand.configuration(scenario.joint_positions),
-                    contacts=scenario.contacts, object_origin=scenario.object_origin,
-                    friction=scenario.friction, external_wrench=scenario.external_wrench,
-                    weights=weights, objective=scenario.objective)
+        q = hand.configuration(scenario.joint_positions)
         # Names unknown frames, links that no joint moves and bad normals now, not at
-        # solve time.
+        # solve time; contacts given by link only (or auto) found from geometry.
         check_contact_links(hand.model, [c.link for c in scenario.contacts],
                             base=hand.base_link)
+        setup = cls(hand=hand, q=q, contacts=resolve_contacts(scenario, hand, q, urdf),
+                    object_origin=scenario.object_origin,
+                    friction=scenario.friction, external_wrench=scenario.external_wrench,
+                    weights=weights, objective=scenario.objective)
         maps = setup.maps()
         check_inward_normals(maps.positions, maps.rotations[:, :, 2], maps.links,
                              scenario.object_origin, scenario.object)
+        check_contact_points(scenario, maps.positions, [
+            i for i, c in enumerate(scenario.contacts) if c.position is not None])
         return setup
 
     @classmethod

@@ -41,12 +41,16 @@ from grasp_torque_opt.core.bounded_yaml import (  # noqa: F401 -- MAX_DEPTH: its
 from grasp_torque_opt.core.coupling import Mimic
 from grasp_torque_opt.core.exceptions import cut, InputError, PATH_LENGTH, quote
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
-from grasp_torque_opt.core.scenario_fields import (
+from grasp_torque_opt.core.scenario_fields import (  # noqa: F401 -- ContactSpec: its home
+    AUTO,
+    ContactSpec,
+    DEFAULT_CONTACT_TOLERANCE,
     mapping as _mapping,
     margin as _margin,
     MAX_JOINTS,
     names as _names,
     number as _number,
+    parse_contacts,
     parse_coupling,
     positive as _positive,
     require as _require,
@@ -64,26 +68,6 @@ MAX_CONTACTS = 32
 MAX_POLYGON_SIDES = 64
 #: Most entries of a name map (a URDF has at most 512 joints and 512 links).
 MAX_NAME_MAP = 1024
-
-
-@dataclass(frozen=True)
-class ContactSpec:
-    """
-    One contact as the scenario states it.
-
-    Attributes:
-        link: model frame that touches the object.
-        position: contact point in that frame [m], shape (3,).
-        normal: inward unit normal in base axes, shape (3,), or None for
-            "from the contact point towards the object origin".
-        tangent: x axis of the contact frame in base axes, shape (3,), or None
-            for the pinned tangent rule.
-    """
-
-    link: str
-    position: np.ndarray
-    normal: np.ndarray | None = None
-    tangent: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -150,7 +134,9 @@ class Scenario:
         torque_limits: |tau_i| bound [N m], a scalar, a list, or None (URDF effort).
         joint_positions: joint name -> position [rad or m].
         object_origin: object origin c in the base frame [m], shape (3,).
-        contacts: the contacts.
+        contacts: the contacts as written; a contact given by its link only (with an
+            ``object``) has ``position`` None: found from geometry when bound
+            (:mod:`grasp_torque_opt.core.scenario_contacts`). Empty with ``contacts: auto``.
         friction: friction model.
         external_wrench: load on the object about c, base axes, shape (6,) [N, N m]:
             the object's weight (with ``object`` and ``gravity``) plus ``extra_wrench``.
@@ -168,6 +154,9 @@ class Scenario:
         coupling: ``hand.coupling``: coupled joints besides the URDF's mimic tags.
         base_link: ``hand.base_link``: the frame the grasp, gravity and load are
             written in, or None for the model's root link.
+        contacts_auto: ``contacts: auto``: every link within the tolerance of the object.
+        contact_tolerance: ``grasp.contact_tolerance`` [m]: a link within it of the
+            object touches it; a point written by hand farther is warned about.
     """
 
     urdf: str
@@ -189,6 +178,8 @@ class Scenario:
     name_map: dict[str, str] = field(default_factory=dict)
     coupling: list[Mimic] = field(default_factory=list)
     base_link: str | None = None
+    contacts_auto: bool = False
+    contact_tolerance: float = DEFAULT_CONTACT_TOLERANCE
 
 
 def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
@@ -207,13 +198,12 @@ def weight_wrench(obj: ObjectSpec | None, gravity: np.ndarray | None,
 _SECTIONS = {
     'hand': {'urdf', 'joints', 'torque_limits', 'torque_limits_above_urdf', 'name_map',
              'coupling', 'base_link'},
-    'grasp': {'joint_positions', 'object_origin', 'contacts'},
+    'grasp': {'joint_positions', 'object_origin', 'contacts', 'contact_tolerance'},
     'friction': {'mu_tangential', 'mu_torsional', 'polygon_sides', 'min_normal_force',
                  'margin'},
     'load': {'external_wrench'},
     'objective': {'weights', 'type'},
 }
-_CONTACT_KEYS = {'link', 'position', 'normal', 'tangent'}
 _OBJECT_KEYS = {'shape', 'size', 'mass', 'position', 'rpy'}
 
 
@@ -363,39 +353,10 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
 
     origin = _vector(_require(grasp, 'object_origin', 'grasp'), 'grasp.object_origin', 3)
 
-    contacts_raw = _require(grasp, 'contacts', 'grasp')
-    if not isinstance(contacts_raw, list) or not contacts_raw:
-        raise InputError('grasp.contacts', 'must be a non-empty list of contacts')
-    if len(contacts_raw) > MAX_CONTACTS:
-        raise InputError('grasp.contacts',
-                         f'{len(contacts_raw)} contacts, more than {MAX_CONTACTS}')
-    contacts = []
-    for i, c in enumerate(contacts_raw):
-        name = f'grasp.contacts[{i}]'
-        c = _mapping(c, name, _CONTACT_KEYS)
-        link = _require(c, 'link', name)
-        if not isinstance(link, str) or not link:
-            raise InputError(f'{name}.link', f'must be a frame name, got {quote(link)}')
-        position = (_vector(c['position'], f'{name}.position', 3)
-                    if c.get('position') is not None else np.zeros(3))
-        normal = None
-        if c.get('normal') is not None:
-            normal = _vector(c['normal'], f'{name}.normal', 3)
-            norm = np.linalg.norm(normal)
-            if norm < 1e-9:
-                raise InputError(f'{name}.normal', 'must not be zero')
-            normal = normal / norm
-        tangent = None
-        if c.get('tangent') is not None:
-            tangent = _vector(c['tangent'], f'{name}.tangent', 3)
-            if np.linalg.norm(tangent) < 1e-9:
-                raise InputError(f'{name}.tangent', 'must not be zero')
-            if normal is not None:
-                t = tangent / np.linalg.norm(tangent)
-                if np.linalg.norm(t - (t @ normal) * normal) < 1e-6:
-                    raise InputError(f'{name}.tangent', 'is parallel to the normal')
-        contacts.append(ContactSpec(link=names.get(link, link), position=position,
-                                    normal=normal, tangent=tangent))
+    contacts = parse_contacts(_require(grasp, 'contacts', 'grasp'), names,
+                              top.get('object') is not None, MAX_CONTACTS)
+    tolerance = _positive(grasp.get('contact_tolerance', DEFAULT_CONTACT_TOLERANCE),
+                          'grasp.contact_tolerance')
 
     sides = _require(friction, 'polygon_sides', 'friction')
     if isinstance(sides, bool) or not isinstance(sides, int):
@@ -442,8 +403,10 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
                          "(without it the values would follow Pinocchio's joint order, which "
                          "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
     return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
-                    joint_positions=positions, object_origin=origin, contacts=contacts,
+                    joint_positions=positions, object_origin=origin,
+                    contacts=[] if contacts == AUTO else contacts,
                     friction=fric, external_wrench=wrench, weights=weights, source=source,
+                    contacts_auto=contacts == AUTO, contact_tolerance=tolerance,
                     object=obj, gravity=gravity, extra_wrench=extra, objective=kind,
                     torque_limits_above_urdf=above_urdf, name_map=names, coupling=coupling,
                     base_link=base_link)

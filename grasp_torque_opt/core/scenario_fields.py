@@ -16,6 +16,7 @@ the value cut short.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 import math
 from typing import Any
 
@@ -26,6 +27,32 @@ import numpy as np
 #: Most joints a scenario may list (the model's size is bounded where it is loaded).
 MAX_JOINTS = 64
 _COUPLING_KEYS = {'follows', 'multiplier', 'offset'}
+_CONTACT_KEYS = {'link', 'position', 'normal', 'tangent'}
+#: ``grasp.contacts: auto``: every link within the tolerance of the object.
+AUTO = 'auto'
+#: Default ``grasp.contact_tolerance`` [m].
+DEFAULT_CONTACT_TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """
+    One contact as the scenario states it.
+
+    Attributes:
+        link: model frame that touches the object.
+        position: contact point in that frame [m], shape (3,); None in a scenario for
+            "found from geometry" (a link only, with an ``object``), never once bound.
+        normal: inward unit normal in base axes, shape (3,), or None for
+            "from the contact point towards the object origin".
+        tangent: x axis of the contact frame in base axes, shape (3,), or None
+            for the pinned tangent rule.
+    """
+
+    link: str
+    position: np.ndarray | None
+    normal: np.ndarray | None = None
+    tangent: np.ndarray | None = None
 
 
 def mapping(value: Any, name: str, allowed: set[str]) -> dict:
@@ -126,3 +153,61 @@ def parse_coupling(value: Any, names: dict[str, str]) -> list[Mimic]:
         b = number(entry.get('offset', 0.0), f'{field}.offset')
         out.append(Mimic(names.get(joint, joint), names.get(target, target), k, b, field))
     return out
+
+
+def parse_contacts(value: Any, names: dict[str, str], has_object: bool, most: int
+                   ) -> list[ContactSpec] | str:
+    """
+    Validate ``grasp.contacts``: a list of contacts, or ``auto`` (with an object).
+
+    A contact given by its link only (no ``position``, no ``normal``; a ``tangent``
+    may be given) is found from geometry when the scenario has an ``object``; else, as
+    always, a missing position is the link's origin.
+
+    Args:
+        value: the field as parsed.
+        names: the scenario's name map.
+        has_object: the scenario has an ``object`` section.
+        most: the most contacts allowed.
+
+    Returns:
+        The contacts, or :data:`AUTO`.
+    """
+    if value == AUTO:
+        if not has_object:
+            raise InputError('grasp.contacts', "'auto' needs the object section (the contacts "
+                             "are found from the hand's collision shapes and the object)")
+        return AUTO
+    if not isinstance(value, list) or not value:
+        raise InputError('grasp.contacts', "must be a non-empty list of contacts or 'auto'")
+    if len(value) > most:
+        raise InputError('grasp.contacts', f'{len(value)} contacts, more than {most}')
+    contacts = []
+    for i, c in enumerate(value):
+        name = f'grasp.contacts[{i}]'
+        c = mapping(c, name, _CONTACT_KEYS)
+        link = require(c, 'link', name)
+        if not isinstance(link, str) or not link:
+            raise InputError(f'{name}.link', f'must be a frame name, got {quote(link)}')
+        found = has_object and c.get('position') is None and c.get('normal') is None
+        position = (None if found else vector(c['position'], f'{name}.position', 3)
+                    if c.get('position') is not None else np.zeros(3))
+        normal = None
+        if c.get('normal') is not None:
+            normal = vector(c['normal'], f'{name}.normal', 3)
+            norm = np.linalg.norm(normal)
+            if norm < 1e-9:
+                raise InputError(f'{name}.normal', 'must not be zero')
+            normal = normal / norm
+        tangent = None
+        if c.get('tangent') is not None:
+            tangent = vector(c['tangent'], f'{name}.tangent', 3)
+            if np.linalg.norm(tangent) < 1e-9:
+                raise InputError(f'{name}.tangent', 'must not be zero')
+            if normal is not None:
+                t = tangent / np.linalg.norm(tangent)
+                if np.linalg.norm(t - (t @ normal) * normal) < 1e-6:
+                    raise InputError(f'{name}.tangent', 'is parallel to the normal')
+        contacts.append(ContactSpec(link=names.get(link, link), position=position,
+                                    normal=normal, tangent=tangent))
+    return contacts

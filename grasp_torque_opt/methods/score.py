@@ -66,6 +66,7 @@ from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
+from grasp_torque_opt.core.scenario_contacts import resolve_contacts
 from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.methods.ranking import (  # noqa: F401 -- re-exported, as before
@@ -233,9 +234,10 @@ class Scorer:
             if weights.shape != (hand.m,):
                 raise InputError('objective.weights', f'must have {hand.m} entries (one per '
                                  f'joint), got {weights.size}')
+            q = hand.configuration(scenario.joint_positions)
             setup = GraspSetup(
-                hand=hand, q=hand.configuration(scenario.joint_positions),
-                contacts=scenario.contacts, object_origin=scenario.object_origin,
+                hand=hand, q=q, contacts=resolve_contacts(scenario, hand, q),
+                object_origin=scenario.object_origin,
                 friction=scenario.friction, external_wrench=scenario.external_wrench,
                 weights=weights, objective=self.job.objective or scenario.objective)
         except InputError as e:

@@ -256,7 +256,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
             raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
                              'MuJoCo model')
     bodies = []
-    for i, contact in enumerate(scenario.contacts):
+    for i, contact in enumerate(setup.contacts):  # found from geometry where not written
         field = f'grasp.contacts[{i}].link'
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
         if body < 0:

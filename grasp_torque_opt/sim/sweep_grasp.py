@@ -25,8 +25,9 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 from typing import Any
+import warnings
 
-from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.exceptions import GeometryWarning, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import parse_scenario
 from grasp_torque_opt.sim.model import build_model, SimModel
@@ -71,8 +72,13 @@ def sweep_grasp(doc: dict[str, Any], base_dir: Path,
             a finger reaches its closed pose without touching (field ``grasp.contacts``).
     """
     doc = copy.deepcopy(doc)
-    scenario = parse_scenario(copy.deepcopy(doc), base_dir)
-    setup = GraspSetup.from_scenario(scenario)
+    scratch = copy.deepcopy(doc)
+    for contact in scratch['grasp']['contacts']:  # a link's origin until its touch is found
+        contact.setdefault('position', [0.0, 0.0, 0.0])
+    scenario = parse_scenario(scratch, base_dir)
+    with warnings.catch_warnings():  # the placeholders are off the object, knowingly
+        warnings.simplefilter('ignore', GeometryWarning)
+        setup = GraspSetup.from_scenario(scenario)
     sim = build_model(scenario, setup=setup)
     data = mujoco.MjData(sim.model)
     joints = list(sim.joints)
