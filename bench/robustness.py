@@ -9,7 +9,8 @@
 Robustness benchmark (issue 24, item 6): the node and two baselines on a disturbed hand.
 
 Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--rate 250]
-       [--out bench/results/robustness.json] [--node-inputs on|off] [--smoke]
+       [--out bench/results/robustness.json] [--node-inputs on|imu|off]
+       [--margin K] [--controllers node preset impedance] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
 Allegro grasp, in simulated time (the rig of grasp-torque-sim, without ROS): the
@@ -21,6 +22,7 @@ controllers:
   DAQP behind it), told only the scenario: the nominal mass, gravity and ball pose;
   with --node-inputs on, also the rig's palm IMU and measured efforts at each joint
   state (imu and effort_estimation on, as config/allegro_right_node.yaml turns them on);
+  with --node-inputs imu, the IMU alone; --margin: its friction margin k;
 - preset: fixed closing torques along the normals, one level tuned once per Kp on the
   nominal load (grasp_torque_opt.sim.baselines.tune_preset);
 - impedance: the grasp pose commanded 5 mm inside the ball, position control at the
@@ -88,12 +90,13 @@ def grid(smoke: bool) -> list[tuple[str, str, dict]]:
 
 
 def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
-            preset_level: float, inputs: bool = False) -> dict:
-    """Run one episode; return its record (``inputs``: the node's IMU and efforts on)."""
+            preset_level: float, inputs: str = 'off', margin: float = 0.0) -> dict:
+    """Run one episode; return its record (``inputs``: the node's IMU and efforts: on, imu, off)."""
     setup, rig = simulated(scenario, settings)
     reference = None
     if controller == 'node':
-        command = node_controller(setup, scenario, rig, inputs)
+        command = node_controller(setup, scenario, rig, inputs != 'off', margin,
+                                  efforts=inputs == 'on')
     elif controller == 'preset':
         command = Preset(setup, scenario.gravity, preset_level)
     else:
@@ -108,29 +111,33 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
 
 
 def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0,
-        inputs: bool = False) -> dict:
+        inputs: str = 'off', margin: float = 0.0,
+        controllers: tuple[str, ...] = CONTROLLERS) -> dict:
     scenario = load_scenario(find_config('allegro_right.yaml'))
     out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
-           'presets': {}, 'node_inputs': inputs}
+           'presets': {}, 'node_inputs': inputs, 'margin': margin,
+           'controllers': list(controllers)}
     for kp in gains:
         tuned = tune_preset(scenario, kp, 0.01, rate=rate)
         out['presets'][str(kp)] = {'level_N': tuned.level, 'drift_mm': 1e3 * tuned.drift}
         for family, label, fields in grid(smoke):
             settings = EpisodeSettings(kp=kp, duration=duration, rate=rate, **fields)
             out['rows'].append({'kp': kp, 'family': family, 'case': label, **{
-                c: episode(scenario, c, settings, tuned.level, inputs) for c in CONTROLLERS}})
+                c: episode(scenario, c, settings, tuned.level, inputs, margin)
+                for c in controllers}})
     return out
 
 
 def tables(r: dict) -> str:
+    shown = r.get('controllers', CONTROLLERS)
     lines = ['Held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
              f"joint torque after release) over {r['duration_s']:g} s, controllers asked at "
              f"{r['rate_hz']:g} Hz; node inputs (IMU, efforts) "
-             f"{'on' if r.get('node_inputs') else 'off'}; preset levels: "
+             f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}; preset levels: "
              + ', '.join(f"Kp {k}: {p['level_N']:.2f} N" for k, p in r['presets'].items()),
              '', '| Kp | family | cases | ' + ' | '.join(
-                 f'{c} held | {c} effort [N m]' for c in CONTROLLERS) + ' |',
-             '|---|---|---|' + '---|---|' * len(CONTROLLERS)]
+                 f'{c} held | {c} effort [N m]' for c in shown) + ' |',
+             '|---|---|---|' + '---|---|' * len(shown)]
     keys = []
     for row in r['rows']:
         if (row['kp'], row['family']) not in keys:
@@ -138,10 +145,12 @@ def tables(r: dict) -> str:
     for kp, family in keys:
         rows = [x for x in r['rows'] if x['kp'] == kp and x['family'] == family]
         cells = []
-        for c in CONTROLLERS:
+        for c in shown:
             held = sum(x[c]['held'] for x in rows)
             cells.append(f'{held}/{len(rows)} | {np.mean([x[c]["effort_Nm"] for x in rows]):.4f}')
         lines.append(f'| {kp:g} | {family} | {len(rows)} | ' + ' | '.join(cells) + ' |')
+    if 'preset' not in shown:
+        return '\n'.join(lines)
     both = [x for x in r['rows'] if x['node']['held'] and x['preset']['held']]
     lower = sum(x['node']['effort_Nm'] < x['preset']['effort_Nm'] for x in both)
     lines += ['', f'Where node and preset both hold ({len(both)} cases), the node uses less '
@@ -157,7 +166,9 @@ def main() -> int:
                    help="how often the controllers are asked [Hz] (grasp-torque-sim's joint "
                         'state rate)')
     p.add_argument('--out', type=Path, default=Path('bench/results/robustness.json'))
-    p.add_argument('--node-inputs', choices=('on', 'off'), default='off',
+    p.add_argument('--margin', type=float, default=0.0, help="the node's friction margin k")
+    p.add_argument('--controllers', nargs='+', default=list(CONTROLLERS), choices=CONTROLLERS)
+    p.add_argument('--node-inputs', choices=('on', 'imu', 'off'), default='off',
                    help="the node's IMU and effort estimation (issue 24): on, as the "
                         'bundled params, or off (the scenario only)')
     p.add_argument('--smoke', action='store_true',
@@ -165,7 +176,7 @@ def main() -> int:
     a = p.parse_args()
     gains = (1.0,) if a.smoke else tuple(float(k) for k in a.gains.split(','))
     duration = 0.5 if a.smoke else a.duration
-    r = run(duration, gains, a.smoke, a.rate, a.node_inputs == 'on')
+    r = run(duration, gains, a.smoke, a.rate, a.node_inputs, a.margin, tuple(a.controllers))
     r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
     report(r, tables(r), None if a.smoke else a.out,
            f"commit {r['commit']}, {len(r['rows']) * len(CONTROLLERS)} episodes"

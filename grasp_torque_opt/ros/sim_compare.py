@@ -26,7 +26,7 @@ from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 
 
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
-                    margin: float = 0.0):
+                    margin: float = 0.0, efforts: bool | None = None):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -35,13 +35,15 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     scenario), DAQP as the fallback; the budget generous, as the node's tests set it.
     With ``inputs`` (issue 24's inputs on, as the bundled params turn them on): the rig's
     palm IMU and its measured efforts (effort_estimation) are given to the cycle at each
-    joint state. ``margin``: the friction margin k.
+    joint state. ``efforts``: the effort estimation alone on or off (None: as ``inputs``).
+    ``margin``: the friction margin k.
     """
+    efforts = inputs if efforts is None else efforts
     setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
                                                                     margin=margin))
     config = CycleConfig(gravity_compensation=True,
                          gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=inputs)
+                         cycle_budget=1.0, effort_estimation=efforts)
     ctrl = TorqueController(setup, config, fallback='daqp')
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
@@ -52,12 +54,13 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
         # The simulated time (the estimate's filters run on it); without a rig, any
         # increasing time: the inputs are always fresh here.
         clock['t'] = 1.0 + rig.time if rig is not None else clock['t'] + 1e-3
-        efforts = None
+        measured = None
         if inputs:
             force, omega = rig.imu()
             ctrl.update_imu('', force, omega, clock['t'])
-            efforts = rig.effort().tolist()
-        ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, efforts)
+        if efforts:
+            measured = rig.effort().tolist()
+        ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, measured)
         return ctrl.cycle(clock['t']).command
     command.controller = ctrl
     return command
