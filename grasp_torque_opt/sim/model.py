@@ -35,9 +35,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+import warnings
 import xml.etree.ElementTree as ET
 
-from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.exceptions import GeometryWarning, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.scenario import ObjectSpec, Scenario
@@ -223,7 +224,12 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         raise InputError('hand.urdf', f'MuJoCo cannot load it: '
                          f'{str(e).strip().splitlines()[0]}') from e
     if setup is None:
-        setup = GraspSetup.from_scenario(scenario, urdf_xml)
+        # The simulated object may sit where the scenario's contacts are not (an offset
+        # on purpose, --object-offset): the model is built from the hand and the object,
+        # not from the contacts, so their warning says nothing here.
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', GeometryWarning)
+            setup = GraspSetup.from_scenario(scenario, urdf_xml)
     coupled = weld_and_couple(spec, setup.hand, setup.q)
     base = base_placement(setup)
     mu1 = scenario.friction.mu1 if settings.mu_tangential is None else settings.mu_tangential
