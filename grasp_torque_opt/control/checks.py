@@ -20,7 +20,6 @@ from collections import Counter
 import math
 
 from grasp_torque_opt.control.config import CycleConfig
-from grasp_torque_opt.control.geometry import ObjectPose
 from grasp_torque_opt.control.parameters import MAX_GRAVITY
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError
 import numpy as np
@@ -239,34 +238,3 @@ def checked_gravity(base: str, frame: str, vector: np.ndarray, rotation: np.ndar
         raise InputError('gravity.vector', f'norm {norm:.6g} m/s^2 is outside '
                          f'gravity_norm_bounds [{bounds[0]:g}, {bounds[1]:g}]')
     return g
-
-
-def checked_pose(hand, frame: str, position: np.ndarray, quaternion: np.ndarray,
-                 transform: tuple[np.ndarray, np.ndarray] | None, unresolved: str):
-    """
-    Check an object pose and return it (:class:`~grasp_torque_opt.control.geometry.ObjectPose`).
-
-    Args:
-        hand: the hand (its model's frames, its base frame).
-        frame: '' or the base frame, a model frame, or another frame with ``transform``.
-        position: [m], shape (3,).
-        quaternion: (x, y, z, w), shape (4,).
-        transform: ``frame``'s rotation and origin in the base frame (tf2), or None.
-        unresolved: why ``frame`` could not be looked up (for the message).
-
-    Raises:
-        InputError: not finite, a non-unit quaternion, a frame neither in the model nor
-            transformed.
-    """
-    p = finite(position, 'object_pose.pose.position')
-    R = quaternion_matrix(np.asarray(quaternion, dtype=float), 'object_pose.pose.orientation')
-    pose = pin.SE3(R, p)
-    if frame in ('', hand.base_frame):
-        return ObjectPose('', pose)
-    if hand.model.existFrame(frame):
-        return ObjectPose(frame, pose)
-    if transform is None:
-        raise InputError('object_pose.header.frame_id', f"'{show(frame)}' is neither a frame "
-                         f'of the hand nor transformed to its base frame ({unresolved})')
-    R_t, p_t = (finite(v, 'object_pose.header.frame_id transform') for v in transform)
-    return ObjectPose('', pin.SE3(R_t, p_t) * pose)

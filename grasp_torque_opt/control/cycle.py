@@ -27,21 +27,15 @@ from grasp_torque_opt.backends.registry import is_backend, settings_for
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.effort_load import EffortLoad
-from grasp_torque_opt.control.geometry import (
-    ContactTracker,
-    moved_object,
-    moved_origin,
-    placements_at,
-    pose_in_base,
-)
 from grasp_torque_opt.control.fault_policy import CycleResult
+from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.plausible import check_on_links, points_inward
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import ContactSpec, ObjectSpec
+from grasp_torque_opt.core.scenario import ContactSpec
 from grasp_torque_opt.core.solution import Solution
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.dispatch import solve
@@ -97,11 +91,8 @@ class Cycle:
         self.imu_state = ''
         #: The load planned at the last cycle, about the origin, base axes (None: none yet).
         self.load: np.ndarray | None = None
-        #: Contacts from geometry (contact_geometry.enabled; None: the scenario's), the
-        #: scenario's object and its pose in the base frame (None: no object).
-        self.tracker: ContactTracker | None = None
-        self.object: ObjectSpec | None = None
-        self.scenario_pose: pin.SE3 | None = None
+        #: Contacts from geometry (None: the scenario's), the object and its pose (.geometry).
+        self.tracker = self.object = self.scenario_pose = None
         #: The compiled cycle in use (None: the Python cycle), and why not when None.
         self.compiled_cycle: compiled.CompiledCycle | None = None
         self.compiled_reason = ''
@@ -132,16 +123,8 @@ class Cycle:
             pin.updateFramePlacements(model, data)
         else:
             pin.framesForwardKinematics(model, data, q)
-        contacts, origin, at = setup.contacts, setup.object_origin, None
-        pose = self.scenario_pose
-        if inputs.object_pose is not None:
-            pose = pose_in_base(inputs.object_pose, pose, placements_at(hand, q, False),
-                                self.config.object_pose_max_offset)
-            origin = moved_origin(origin, self.scenario_pose, pose)
-            at = (moved_object(self.object, pose), origin)
-        if inputs.contacts is None and self.tracker is not None:
-            contacts = self.tracker.update(q, pose, self.config.contact_release)
-        elif inputs.contacts is not None:
+        contacts, origin, at = geometry_of(self, inputs, q)
+        if inputs.contacts is not None:
             cp = inputs.contacts
             oMF = data.oMf[model.getFrameId(cp.frame or hand.base_frame)]
             if hand.base_link is not None:  # the grasp is written in the base link's frame
@@ -164,8 +147,7 @@ class Cycle:
                 points.append(p_base)
                 normals.append(R_base[:, 2])
                 origins.append(oMl.translation)
-            self._check_plausible(np.array(points), np.array(normals), np.array(origins),
-                                  origin)
+            self._check_plausible(*map(np.array, (points, normals, origins)), origin)
         motion = self.motion_in_use(inputs)
         wrench = setup.external_wrench
         if inputs.wrench is not None:
@@ -174,12 +156,11 @@ class Cycle:
             if hand.base_link is not None:
                 R = data.oMf[model.getFrameId(hand.base_link)].rotation.T @ R
             wrench = np.concatenate((R @ w[:3], R @ w[3:]))
-        elif motion is not None and self.load_of_gravity is not None:
-            wrench = self.load_of_gravity(motion.gravity, motion, at)
-        elif inputs.gravity is not None and self.load_of_gravity is not None:
-            wrench = self.load_of_gravity(inputs.gravity, None, at)
-        elif at is not None and self.load_of_gravity is not None:
-            wrench = self.load_of_gravity(self.config.gravity, None, at)
+        elif self.load_of_gravity is not None and any(
+                x is not None for x in (motion, inputs.gravity, at)):
+            wrench = self.load_of_gravity(motion.gravity if motion is not None else
+                                          self.config.gravity if inputs.gravity is None
+                                          else inputs.gravity, motion, at)
         estimating = self.config.effort_estimation and self.estimating
         g = None
         gravity = self._gravity_in_use = np.asarray(
@@ -191,9 +172,8 @@ class Cycle:
             model.gravity.linear = gravity
             g = hand.actuator_torques(pin.computeGeneralizedGravity(model, data, q))
         if self.config.effort_estimation:
-            wrench = wrench + self._correction(
-                replaced(setup, q=q, contacts=contacts, object_origin=origin), g, inputs,
-                wrench, estimating)
+            at_q = replaced(setup, q=q, contacts=contacts, object_origin=origin)
+            wrench = wrench + self._correction(at_q, g, inputs, wrench, estimating)
         elif self.estimating and self.effort_load.estimate is not None:
             self.effort_load.reset()  # turned off: turned on again, it starts anew
         if not self.config.gravity_compensation:

@@ -153,7 +153,7 @@ def contact_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
     if tracker is not None:
         values += [('contacts.links', ','.join(tracker.links or ()) or 'none'),
                    ('contacts.changes', str(tracker.changes))]
-    values += [('object_pose', 'none received (the scenario\'s)' if inputs.object_pose is None
+    values += [('object_pose', "none received (the scenario's)" if inputs.object_pose is None
                 else 'in use'),
                ('age.object_pose_s', _ago(now, inputs.object_pose_time))]
     return values

@@ -33,7 +33,9 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
+from grasp_torque_opt.control.checks import finite, quaternion_matrix, show
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.geometry_contacts import ContactSet, GeometryContacts
 from grasp_torque_opt.core.object_geometry import object_pose
@@ -182,3 +184,112 @@ def moved_object(obj: ObjectSpec, pose: pin.SE3) -> ObjectSpec:
     """Give the scenario's object at ``pose``: its centre (the load's point) moved there."""
     return dataclasses.replace(obj, position=pose.translation.copy(),
                                rpy=pin.rpy.matrixToRpy(pose.rotation))
+
+
+def geometry_of(cycle, inputs, q: np.ndarray) -> tuple[list[ContactSpec], np.ndarray, Any]:
+    """
+    Give a cycle's contacts, object origin and the load's object (None: the scenario's).
+
+    The object pose in use (:func:`pose_in_base`; the hand's data placed at ``q``) moves
+    the origin and the object; the tracker (when bound, and no contacts were received)
+    finds the contacts at ``q`` and that pose, else the scenario's are given.
+
+    Args:
+        cycle: the :class:`~grasp_torque_opt.control.cycle.Cycle` (its setup, config,
+            tracker, object and scenario pose).
+        inputs: the snapshot of inputs.
+        q: the full configuration the hand's data is placed at.
+    """
+    setup = cycle.setup
+    contacts, origin, at = setup.contacts, setup.object_origin, None
+    pose = cycle.scenario_pose
+    if inputs.object_pose is not None:
+        pose = pose_in_base(inputs.object_pose, pose, placements_at(setup.hand, q, False),
+                            cycle.config.object_pose_max_offset)
+        origin = moved_origin(origin, cycle.scenario_pose, pose)
+        at = (moved_object(cycle.object, pose), origin)
+    if inputs.contacts is None and cycle.tracker is not None:
+        contacts = cycle.tracker.update(q, pose, cycle.config.contact_release)
+    return contacts, origin, at
+
+
+def checked_pose(hand, frame: str, position: np.ndarray, quaternion: np.ndarray,
+                 transform: tuple[np.ndarray, np.ndarray] | None, unresolved: str):
+    """
+    Check an object pose and return it (:class:`~grasp_torque_opt.control.geometry.ObjectPose`).
+
+    Args:
+        hand: the hand (its model's frames, its base frame).
+        frame: '' or the base frame, a model frame, or another frame with ``transform``.
+        position: [m], shape (3,).
+        quaternion: (x, y, z, w), shape (4,).
+        transform: ``frame``'s rotation and origin in the base frame (tf2), or None.
+        unresolved: why ``frame`` could not be looked up (for the message).
+
+    Raises:
+        InputError: not finite, a non-unit quaternion, a frame neither in the model nor
+            transformed.
+    """
+    p = finite(position, 'object_pose.pose.position')
+    R = quaternion_matrix(np.asarray(quaternion, dtype=float), 'object_pose.pose.orientation')
+    pose = pin.SE3(R, p)
+    if frame in ('', hand.base_frame):
+        return ObjectPose('', pose)
+    if hand.model.existFrame(frame):
+        return ObjectPose(frame, pose)
+    if transform is None:
+        raise InputError('object_pose.header.frame_id', f"'{show(frame)}' is neither a frame "
+                         f'of the hand nor transformed to its base frame ({unresolved})')
+    R_t, p_t = (finite(v, 'object_pose.header.frame_id transform') for v in transform)
+    return ObjectPose('', pin.SE3(R_t, p_t) * pose)
+
+
+def checked_object_pose(store, frame: str, position: np.ndarray, quaternion: np.ndarray,
+                        transform: tuple[np.ndarray, np.ndarray] | None,
+                        unresolved: str) -> ObjectPose:
+    """
+    Check an object pose for the input store: its form, then within the bound.
+
+    Raises:
+        InputError: as :meth:`~grasp_torque_opt.control.inputs.InputStore.update_object_pose`.
+    """
+    got = checked_pose(store.setup.hand, frame, position, quaternion, transform, unresolved)
+    if store.scenario_pose is None:
+        raise InputError('object_pose', 'the scenario has no object')
+    q = store.setup.q if store.inputs.q is None else store.inputs.q
+    pose_in_base(got, store.scenario_pose, placements_at(store.setup.hand, q),
+                 store.config.object_pose_max_offset)
+    return got
+
+
+class ObjectPoseInput:
+    """The input store's object_pose input (:class:`~.inputs.InputStore` inherits it)."""
+
+    #: The scenario's object pose in the base frame (None: no object; a pose is refused).
+    scenario_pose: pin.SE3 | None = None
+
+    def update_object_pose(self, frame: str, position: np.ndarray, quaternion: np.ndarray,
+                           now: float, stamp: float = 0.0, clock: float | None = None,
+                           transform: tuple[np.ndarray, np.ndarray] | None = None,
+                           unresolved: str = 'tf2_ros is not installed') -> None:
+        """
+        Take the object's pose (its frame in ``frame``): contacts and load follow it.
+
+        ``frame``: '' or a model frame (placed at each cycle's joint state), or another
+        with ``transform`` (its rotation and origin in the base frame, tf2's at receipt);
+        ``position`` [m], ``quaternion`` (x, y, z, w); the rest as :meth:`update_imu`'s.
+
+        Raises:
+            InputError: not finite, a non-unit quaternion, an unknown frame, no scenario
+                object, farther than ``object_pose_max_offset`` from the scenario's pose
+                at the latest joint state, a bad stamp. The pose is not kept.
+        """
+        try:
+            got = checked_object_pose(self, frame, position, quaternion, transform,
+                                      unresolved)
+            self._check_stamp('object_pose', stamp, clock, now)
+        except InputError as e:
+            self.reject('object_pose', e)
+            raise
+        self._keep_stamp('object_pose', stamp, now, clock)
+        self.inputs = dataclasses.replace(self.inputs, object_pose=got, object_pose_time=now)

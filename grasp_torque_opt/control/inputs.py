@@ -23,14 +23,13 @@ from dataclasses import dataclass, field
 from grasp_torque_opt.control.checks import (
     check_joint_limits,
     check_joint_names,
-    checked_pose,
     checked_gravity,
     checked_wrench,
     contact_rotations,
     MAX_ABS_JOINT_POSITION,
 )
 from grasp_torque_opt.control.config import CycleConfig
-from grasp_torque_opt.control.geometry import ObjectPose, placements_at, pose_in_base
+from grasp_torque_opt.control.geometry import ObjectPose, ObjectPoseInput
 from grasp_torque_opt.control.motion import checked_imu, efforts_of, ImuTracker, Motion
 from grasp_torque_opt.control.plausible import check_contacts
 from grasp_torque_opt.control.rates import turned_towards
@@ -139,7 +138,7 @@ def stamp_seconds(sec: int, nanosec: int) -> float:
     return sec + 1e-9 * nanosec
 
 
-class InputStore(StampRule):
+class InputStore(StampRule, ObjectPoseInput):
     """
     The latest valid inputs of the cycle, each checked whole before it is kept.
 
@@ -162,9 +161,6 @@ class InputStore(StampRule):
         #: (config, URDF lower and upper limits widened by joint_limit_tolerance).
         self._limits: tuple[CycleConfig, np.ndarray, np.ndarray] | None = None
         self.object: ObjectSpec | None = None  #: the scenario's object (the inward rule)
-        #: The scenario's object pose in the base frame (None: no object, and an
-        #: object_pose is refused).
-        self.scenario_pose = None
         #: The last accepted joint state's names, which of its entries are model joints,
         #: their indices in q, and the commanded joints it was checked against (a state
         #: with the same names skips the name checks).
@@ -416,42 +412,6 @@ class InputStore(StampRule):
                                                              c.imu_timeout_bounds))
         self.inputs = dataclasses.replace(self.inputs, motion=motion, motion_time=now)
 
-    def update_object_pose(self, frame: str, position: np.ndarray, quaternion: np.ndarray,
-                           now: float, stamp: float = 0.0, clock: float | None = None,
-                           transform: tuple[np.ndarray, np.ndarray] | None = None,
-                           unresolved: str = 'tf2_ros is not installed') -> None:
-        """
-        Take the object's pose (its frame in ``frame``): contacts and load follow it.
-
-        Args:
-            frame: '' or a model frame (placed at each cycle's joint state), or another
-                frame with ``transform`` (its rotation and origin in the base frame, from
-                tf2, taken at receipt).
-            position: the object's origin [m], shape (3,).
-            quaternion: its orientation (x, y, z, w), shape (4,).
-            now, stamp, clock: as :meth:`update_contacts`'s.
-            unresolved: why ``frame`` could not be looked up (for the message).
-
-        Raises:
-            InputError: not finite, a non-unit quaternion, an unknown frame, farther than
-                ``object_pose_max_offset`` from the scenario's pose at the latest joint
-                state, a bad stamp. The pose is not kept.
-        """
-        try:
-            got = checked_pose(self.setup.hand, frame, position, quaternion, transform,
-                               unresolved)
-            if self.scenario_pose is None:
-                raise InputError('object_pose', 'the scenario has no object')
-            q = self.setup.q if self.inputs.q is None else self.inputs.q
-            pose_in_base(got, self.scenario_pose, placements_at(self.setup.hand, q),
-                         self.config.object_pose_max_offset)
-            self._check_stamp('object_pose', stamp, clock, now)
-        except InputError as e:
-            self.reject('object_pose', e)
-            raise
-        self._keep_stamp('object_pose', stamp, now, clock)
-        self.inputs = dataclasses.replace(self.inputs, object_pose=got, object_pose_time=now)
-
     def reject(self, source: str, error: InputError) -> None:
         """Count a rejected message of ``source`` and keep its reason."""
         self.counters.rejected[source] = self.counters.rejected.get(source, 0) + 1
@@ -471,10 +431,8 @@ class InputStore(StampRule):
         if i.wrench_time is not None and c.wrench_timeout > 0 and \
                 now - i.wrench_time > c.wrench_timeout:
             return f'external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)'
-        if i.object_pose_time is not None and c.object_pose_timeout > 0 and \
-                now - i.object_pose_time > c.object_pose_timeout:
-            return (f'object_pose stale ({now - i.object_pose_time:.3f} s > '
-                    f'{c.object_pose_timeout} s)')
+        if i.object_pose_time is not None and 0 < c.object_pose_timeout < now - i.object_pose_time:
+            return f'object_pose stale (older than object_pose.timeout, {c.object_pose_timeout} s)'
         if i.gravity_time is not None and c.gravity_timeout > 0 and \
                 now - i.gravity_time > c.gravity_timeout:
             return f'gravity stale ({now - i.gravity_time:.3f} s > {c.gravity_timeout} s)'

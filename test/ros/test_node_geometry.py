@@ -8,8 +8,9 @@
 
 
 """
-Contacts from geometry in the node (contact_geometry.enabled), the object_pose input and
-~/contact_wrench, on the Allegro ball grasp.
+Contacts from geometry in the node, the object_pose input and ~/contact_wrench.
+
+On the Allegro ball grasp, with contact_geometry.enabled.
 
 Each command is checked against an independent solve: the contacts found by coal's
 distance (GeometryContacts with analytic=False, not the node's closed form), the grasp
@@ -134,8 +135,8 @@ def test_contacts_from_geometry_are_the_scenarios_and_the_command_the_cores():
             oMl = SETUP.hand.data.oMf[MODEL.getFrameId(link)]
             f = oMl.rotation @ [m.wrench.force.x, m.wrench.force.y, m.wrench.force.z]
             t = oMl.rotation @ [m.wrench.torque.x, m.wrench.torque.y, m.wrench.torque.z]
-            total += np.concatenate((f, t + np.cross(oMl.translation - SCENARIO.object_origin,
-                                                      f)))
+            arm = oMl.translation - SCENARIO.object_origin
+            total += np.concatenate((f, t + np.cross(arm, f)))
             assert f @ (SCENARIO.object_origin - oMl.translation) > 0  # pushes, inward
         np.testing.assert_allclose(total, -SETUP.external_wrench, atol=1e-5)
     finally:
@@ -256,8 +257,8 @@ def test_a_bad_object_pose_is_rejected_and_never_used():
         for n, (p, quat, why) in enumerate(bad, 1):
             h.send_pose(p, quat, 'nowhere' if n == 4 else '')
             np.testing.assert_allclose(h.command_at(SETUP.q), nominal, atol=1e-6)
-            h.spin_until(lambda: int(h.diagnostics[-1].get('rejected.object_pose', 0)) >= n
-                         if h.diagnostics else False, 2.0)
+            h.spin_until(lambda: bool(h.diagnostics) and int(
+                h.diagnostics[-1].get('rejected.object_pose', 0)) >= n, 2.0)
             d = h.diagnostics[-1]
             assert int(d['rejected.object_pose']) == n and why in d['last_rejection'], d
             assert d['object_pose'].startswith('none received')

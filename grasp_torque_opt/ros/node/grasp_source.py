@@ -209,7 +209,8 @@ def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | 
 
     With ``at`` (the object and its origin at the object_pose input's pose), the load is
     applied there. With a :class:`~grasp_torque_opt.control.motion.Motion` (the IMU's),
-    the load is the object's on the moving base (:func:`~grasp_torque_opt.control.motion.motion_wrench`).
+    the load is the object's on the moving base
+    (:func:`~grasp_torque_opt.control.motion.motion_wrench`).
 
     Only when the scenario's load is its object's weight (``object`` and ``gravity``
     both given): then it is ``load.external_wrench`` plus the weight under the gravity
@@ -257,8 +258,8 @@ def place_object(ctrl: TorqueController, scenario: Scenario, p: Any, urdf: str) 
     if not p.contact_geometry.enabled:
         return
     if obj is None:
-        raise InputError('contact_geometry.enabled', "needs the scenario's object (its shape "
-                         'and pose): the scenario has none')
+        raise InputError('contact_geometry.enabled', "needs the scenario's object (its "
+                         'shape and pose): the scenario has none')
     links = list(p.contact_geometry.links) or [c.link for c in scenario.contacts]
     model = GeometryContacts.bind(
         ctrl.setup.hand, urdf or resolve_urdf(scenario.urdf, scenario.base_dir), obj,
