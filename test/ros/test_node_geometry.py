@@ -172,7 +172,7 @@ def test_rolling_fingers_move_the_contacts_and_the_command_stays_certified():
         h.close()
 
 
-@pytest.mark.parametrize('rate', [1e6, 2.0])
+@pytest.mark.parametrize('rate', [1e6, 0.01])
 def test_a_lifted_finger_drops_its_contact_and_is_never_in_a_command(rate):
     h = GeometryHarness(max_torque_rate=rate)
     try:
