@@ -53,7 +53,12 @@ import time
 
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.control.geometry import ContactTracker
+from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.core.object_geometry import object_pose
+from grasp_torque_opt.core.scenario import load_scenario
 from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
 
@@ -169,13 +174,25 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jit
 
 
 def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jitter',
-                     compiled: bool = True) -> dict:
-    """Time the node's cycle without ROS: take a joint state, then run the cycle."""
+                     compiled: bool = True, scenario=None) -> dict:
+    """
+    Time the node's cycle without ROS: take a joint state, then run the cycle.
+
+    ``scenario``: its contacts found from geometry every cycle (the node's
+    contact_geometry.enabled, its scenario's contact links, 1 mm).
+    """
     backend = variant.partition('+')[0]
     ctrl = TorqueController(setup, CycleConfig(gravity_compensation=True, compiled=compiled),
                             backend=backend,
                             warm_start=variant.endswith('+warm'),
                             fallback=None if backend == 'daqp' else 'daqp')
+    if scenario is not None:  # as the node's configure binds it (grasp_source.place_object)
+        obj = scenario.object
+        ctrl.solving.object = obj
+        ctrl.solving.scenario_pose = object_pose(obj.position, obj.rpy)
+        ctrl.solving.tracker = ContactTracker(GeometryContacts.bind(
+            setup.hand, resolve_urdf(scenario.urdf, scenario.base_dir), obj, 1e-3,
+            [c.link for c in scenario.contacts]), obj)
     names = list(setup.hand.joints)
     q0 = setup.q[setup.hand.idx_q]
     samples, published = [], 0
@@ -219,6 +236,30 @@ def run(repeats: int = 3000, backends: tuple[str, ...] = VARIANTS,
                     r['controller_python'] = bench_controller(setup, b, repeats, motion,
                                                               compiled=False)
     return out
+
+
+def node_geometry(repeats: int) -> dict:
+    """Time the Allegro's node cycle (ProxSuite, warm) with contacts from geometry off and on."""
+    path = ROOT / 'config' / 'allegro_right.yaml'
+    setup, scenario = GraspSetup.from_file(path), load_scenario(path)
+    out = {}
+    for compiled in (True, False):
+        for on in (False, True):
+            r = bench_controller(setup, 'proxsuite+warm', repeats, 'jitter', compiled,
+                                 scenario if on else None)
+            kind = 'compiled' if compiled else 'Python'
+            out[f"{kind} cycle, geometry {'on' if on else 'off'}"] = r
+    return out
+
+
+def node_geometry_table(results: dict) -> str:
+    """Format the node cycle with geometry off and on: medians, p99 [us], certified."""
+    lines = ['| node cycle | median | p99 | certified |', '|---|---|---|---|']
+    for name, r in results.items():
+        t = r['total']
+        lines.append(f"| {name} | {1e6 * t['median_s']:.1f} | {1e6 * t['p99_s']:.1f} | "
+                     f"{r['certified_commands']} of {r['cycles']} |")
+    return '\n'.join(lines) + '\n\n(times in us)'
 
 
 def table(results: dict) -> str:
@@ -269,6 +310,9 @@ def main() -> None:
 
         results['geometry'] = geometry.run(args.repeats)
         text += '\n\ncontacts from geometry, per call:\n' + geometry.table(results['geometry'])
+        results['node_geometry'] = node_geometry(args.repeats)
+        text += '\n\nthe node cycle, contacts from geometry off and on:\n' + \
+            node_geometry_table(results['node_geometry'])
     report(results, text, args.out)
 
 

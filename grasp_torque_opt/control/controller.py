@@ -296,7 +296,9 @@ class TorqueController:
         ``max_torque_rate`` times the time since the command in force. The step's
         contact wrenches (the same combination of both ends') must lie in the exact
         cone, finite, with the step within the torque limits: else, or when they are
-        not known, the certified command is published whole (``slew_refused``).
+        not known (or the command in force had another contact set: a contact that is gone
+        is in none of a step's wrenches), the certified command is published whole
+        (``slew_refused``).
         """
         policy, rate = self.policy, self.config.max_torque_rate
         if policy.in_force is None or policy.in_force_time is None:
@@ -307,8 +309,11 @@ class TorqueController:
         if step is None:
             return
         cmd, s = step
-        wrenches = step_wrenches(policy.in_force_wrenches,
-                                 getattr(result.solution, 'wrenches', None), s)
+        known = policy.in_force_wrenches
+        if known is not None and known.size and (
+                result.maps is None or policy.in_force_links != tuple(result.maps.links)):
+            known = None  # another contact set (geometry's may change): no step between them
+        wrenches = step_wrenches(known, getattr(result.solution, 'wrenches', None), s)
         friction = self.setup.friction
         if (wrenches is None or not np.all(np.isfinite(cmd))
                 or not np.all(np.abs(cmd) <= self.setup.hand.torque_limits)

@@ -28,6 +28,7 @@ from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.effort_load import EffortLoad
 from grasp_torque_opt.control.fault_policy import CycleResult
+from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.plausible import check_on_links, points_inward
@@ -90,6 +91,8 @@ class Cycle:
         self.imu_state = ''
         #: The load planned at the last cycle, about the origin, base axes (None: none yet).
         self.load: np.ndarray | None = None
+        #: Contacts from geometry (None: the scenario's), the object and its pose (.geometry).
+        self.tracker = self.object = self.scenario_pose = None
         #: The compiled cycle in use (None: the Python cycle), and why not when None.
         self.compiled_cycle: compiled.CompiledCycle | None = None
         self.compiled_reason = ''
@@ -120,7 +123,7 @@ class Cycle:
             pin.updateFramePlacements(model, data)
         else:
             pin.framesForwardKinematics(model, data, q)
-        contacts = setup.contacts
+        contacts, origin, at = geometry_of(self, inputs, q)
         if inputs.contacts is not None:
             cp = inputs.contacts
             oMF = data.oMf[model.getFrameId(cp.frame or hand.base_frame)]
@@ -144,7 +147,7 @@ class Cycle:
                 points.append(p_base)
                 normals.append(R_base[:, 2])
                 origins.append(oMl.translation)
-            self._check_plausible(np.array(points), np.array(normals), np.array(origins))
+            self._check_plausible(*map(np.array, (points, normals, origins)), origin)
         motion = self.motion_in_use(inputs)
         wrench = setup.external_wrench
         if inputs.wrench is not None:
@@ -153,10 +156,11 @@ class Cycle:
             if hand.base_link is not None:
                 R = data.oMf[model.getFrameId(hand.base_link)].rotation.T @ R
             wrench = np.concatenate((R @ w[:3], R @ w[3:]))
-        elif motion is not None and self.load_of_gravity is not None:
-            wrench = self.load_of_gravity(motion.gravity, motion)
-        elif inputs.gravity is not None and self.load_of_gravity is not None:
-            wrench = self.load_of_gravity(inputs.gravity)
+        elif self.load_of_gravity is not None and any(
+                x is not None for x in (motion, inputs.gravity, at)):
+            wrench = self.load_of_gravity(motion.gravity if motion is not None else
+                                          self.config.gravity if inputs.gravity is None
+                                          else inputs.gravity, motion, at)
         estimating = self.config.effort_estimation and self.estimating
         g = None
         gravity = self._gravity_in_use = np.asarray(
@@ -168,15 +172,15 @@ class Cycle:
             model.gravity.linear = gravity
             g = hand.actuator_torques(pin.computeGeneralizedGravity(model, data, q))
         if self.config.effort_estimation:
-            wrench = wrench + self._correction(
-                replaced(setup, q=q, contacts=contacts), g, inputs, wrench, estimating)
+            at_q = replaced(setup, q=q, contacts=contacts, object_origin=origin)
+            wrench = wrench + self._correction(at_q, g, inputs, wrench, estimating)
         elif self.estimating and self.effort_load.estimate is not None:
             self.effort_load.reset()  # turned off: turned on again, it starts anew
         if not self.config.gravity_compensation:
             g = None
         self.load = wrench
         return replaced(setup, q=q, contacts=contacts, external_wrench=wrench,
-                        torque_offset=g), g
+                        torque_offset=g, object_origin=origin), g
 
     def motion_in_use(self, inputs: Inputs) -> Motion | None:
         """
@@ -225,7 +229,7 @@ class Cycle:
                           gap=c.joint_state_timeout, along=along)
 
     def _check_plausible(self, points: np.ndarray, normals: np.ndarray,
-                         origins: np.ndarray) -> None:
+                         origins: np.ndarray, origin: np.ndarray) -> None:
         """
         Check the contacts in use at this configuration: on their links, pushing inward.
 
@@ -234,7 +238,7 @@ class Cycle:
         """
         links = tuple(c.link for c in self.setup.contacts)
         check_on_links(points, origins, links, self.config.max_contact_link_distance)
-        i = points_inward(points, normals, self.setup.object_origin)
+        i = points_inward(points, normals, origin)
         if i >= 0:
             raise InputError(f'contacts.poses[{i}].orientation', 'the normal of the contact '
                              f"on '{links[i]}' points away from the object origin at this "
@@ -353,4 +357,4 @@ class Cycle:
         cmd, why = self.gate(sol, g)
         if cmd is None:
             return CycleResult(None, 'none', sol, maps, g, why)
-        return CycleResult(cmd, 'solution', sol, maps, g)
+        return CycleResult(cmd, 'solution', sol, maps, g, q=inputs.q)

@@ -110,6 +110,7 @@ def report(controller: TorqueController, now: float) -> Report:
                ('solver.compiled_solves', str(fast.solves if fast is not None else 0)),
                ('solver.compiled_handed_back', str(fast.handed_back if fast is not None else 0))]
     values += motion_values(c, now)
+    values += contact_values(c, now)
     if level == OK and c.solving.imu_state:
         level, message = WARN, f'certified torques published; {c.solving.imu_state}'
     values += [(f'rejected.{k}', str(v)) for k, v in n.rejected.items()]
@@ -139,6 +140,22 @@ def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
                        ('load.correction', _vector(est.correction))]
     if solving.load is not None:
         values.append(('load.planned', _vector(solving.load)))
+    return values
+
+
+def contact_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
+    """Give where the contacts come from, the geometry's set and changes, the object pose."""
+    solving, inputs = c.solving, c.inputs
+    tracker = solving.tracker
+    source = ('contacts topic' if inputs.contacts is not None else
+              'geometry' if tracker is not None else 'scenario')
+    values = [('contacts.source', source)]
+    if tracker is not None:
+        values += [('contacts.links', ','.join(tracker.links or ()) or 'none'),
+                   ('contacts.changes', str(tracker.changes))]
+    values += [('object_pose', "none received (the scenario's)" if inputs.object_pose is None
+                else 'in use'),
+               ('age.object_pose_s', _ago(now, inputs.object_pose_time))]
     return values
 
 

@@ -48,6 +48,8 @@ class CycleResult:
         cycle_time: wall time of the cycle [s] (0 for the watchdog's results).
         wrenches: the contact wrenches of ``command`` when it is a step of the rate rule
             (the same combination of its ends' wrenches), else None (the solution's).
+        q: the joint positions a certified command was solved at (its contact links'
+            placements, for ~/contact_wrench).
     """
 
     command: np.ndarray | None
@@ -58,6 +60,7 @@ class CycleResult:
     fault: str = ''
     cycle_time: float = 0.0
     wrenches: np.ndarray | None = None
+    q: np.ndarray | None = None
 
 
 class FaultPolicy:
@@ -85,6 +88,9 @@ class FaultPolicy:
         #: The contact wrenches of the command in force, shape (p, 4) (``NO_WRENCH`` for
         #: zero torques; None: not known).
         self.in_force_wrenches: np.ndarray | None = None
+        #: The links of those wrenches' contacts (None: not known): a step is taken only
+        #: between two commands of the same contact set (rates.step_wrenches).
+        self.in_force_links: tuple[str, ...] | None = None
         #: The last result, certified or not.
         self.last: CycleResult | None = None
 
@@ -97,6 +103,7 @@ class FaultPolicy:
         self.in_force, self.in_force_time = result.command, now
         self.in_force_wrenches = (result.wrenches if result.wrenches is not None
                                   else getattr(result.solution, 'wrenches', None))
+        self.in_force_links = None if result.maps is None else tuple(result.maps.links)
         self.counters.commands += 1
         if from_fallback:
             self.counters.fallback_solves += 1

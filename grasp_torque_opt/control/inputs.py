@@ -29,6 +29,7 @@ from grasp_torque_opt.control.checks import (
     MAX_ABS_JOINT_POSITION,
 )
 from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.geometry import ObjectPose, ObjectPoseInput
 from grasp_torque_opt.control.motion import checked_imu, efforts_of, ImuTracker, Motion
 from grasp_torque_opt.control.plausible import check_contacts
 from grasp_torque_opt.control.rates import turned_towards
@@ -70,7 +71,9 @@ class Inputs:
     until one arrives (then ``CycleConfig.gravity`` and the scenario's load are used).
     ``motion`` is the IMU's (:class:`~grasp_torque_opt.control.motion.Motion`, used while
     fresh), ``effort`` the actuators' measured torques of the joint state (only with
-    ``effort_estimation``; None when the driver reports none).
+    ``effort_estimation``; None when the driver reports none). ``object_pose`` is the
+    object's frame (:class:`~grasp_torque_opt.control.geometry.ObjectPose`), None until
+    one arrives (then the scenario's pose, fixed in the base frame).
     """
 
     q: np.ndarray | None = None
@@ -85,6 +88,8 @@ class Inputs:
     motion_time: float | None = None
     effort: np.ndarray | None = None
     effort_why: str = ''
+    object_pose: ObjectPose | None = None
+    object_pose_time: float | None = None
 
 
 @dataclass
@@ -133,7 +138,7 @@ def stamp_seconds(sec: int, nanosec: int) -> float:
     return sec + 1e-9 * nanosec
 
 
-class InputStore(StampRule):
+class InputStore(StampRule, ObjectPoseInput):
     """
     The latest valid inputs of the cycle, each checked whole before it is kept.
 
@@ -426,6 +431,8 @@ class InputStore(StampRule):
         if i.wrench_time is not None and c.wrench_timeout > 0 and \
                 now - i.wrench_time > c.wrench_timeout:
             return f'external_wrench stale ({now - i.wrench_time:.3f} s > {c.wrench_timeout} s)'
+        if i.object_pose_time is not None and 0 < c.object_pose_timeout < now - i.object_pose_time:
+            return f'object_pose stale (older than object_pose.timeout, {c.object_pose_timeout} s)'
         if i.gravity_time is not None and c.gravity_timeout > 0 and \
                 now - i.gravity_time > c.gravity_timeout:
             return f'gravity stale ({now - i.gravity_time:.3f} s > {c.gravity_timeout} s)'

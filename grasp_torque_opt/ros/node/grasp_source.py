@@ -22,12 +22,17 @@ from collections.abc import Callable
 import dataclasses
 from dataclasses import dataclass
 import time
+from typing import Any
 
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.geometry import ContactTracker
 from grasp_torque_opt.control.motion import Motion, motion_wrench
 from grasp_torque_opt.control.parameters import name_map_of
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
+from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.hand import MAX_URDF_BYTES
+from grasp_torque_opt.core.hand import MAX_URDF_BYTES, resolve_urdf
+from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
 from grasp_torque_opt.core.scenario import load_scenario, Scenario, weight_wrench
 from grasp_torque_opt.ros.node.parameters import PARAMETERS
@@ -202,8 +207,10 @@ def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | 
     """
     Give the scenario's load as a function of gravity [m/s^2], or None.
 
-    With a :class:`~grasp_torque_opt.control.motion.Motion` (the IMU's), the load is
-    the object's on the moving base (:func:`~grasp_torque_opt.control.motion.motion_wrench`).
+    With ``at`` (the object and its origin at the object_pose input's pose), the load is
+    applied there. With a :class:`~grasp_torque_opt.control.motion.Motion` (the IMU's),
+    the load is the object's on the moving base
+    (:func:`~grasp_torque_opt.control.motion.motion_wrench`).
 
     Only when the scenario's load is its object's weight (``object`` and ``gravity``
     both given): then it is ``load.external_wrench`` plus the weight under the gravity
@@ -215,10 +222,13 @@ def load_of_gravity(scenario: Scenario) -> Callable[[np.ndarray], np.ndarray] | 
     obj, origin = scenario.object, scenario.object_origin.copy()
     extra = scenario.extra_wrench.copy()
 
-    def load(g: np.ndarray, motion: Motion | None = None) -> np.ndarray:
+    def load(g: np.ndarray, motion: Motion | None = None,
+             at: tuple[Any, np.ndarray] | None = None) -> np.ndarray:
+        # at: the object and its origin moved (the object_pose input), else the scenario's.
+        o, c = (obj, origin) if at is None else at
         if motion is not None:  # the apparent gravity g and the base's rotation
-            return extra + motion_wrench(obj, origin, motion)
-        return extra + weight_wrench(obj, np.asarray(g, dtype=float), origin)
+            return extra + motion_wrench(o, c, motion)
+        return extra + weight_wrench(o, np.asarray(g, dtype=float), c)
     return load
 
 
@@ -227,3 +237,32 @@ def weight_of(scenario: Scenario) -> float | None:
     if scenario.object is None or scenario.gravity is None:
         return None
     return float(scenario.object.mass * np.linalg.norm(scenario.gravity))
+
+
+def place_object(ctrl: TorqueController, scenario: Scenario, p: Any, urdf: str) -> None:
+    """
+    Give a controller the scenario's object, its pose, and the contacts from geometry.
+
+    With ``contact_geometry.enabled`` the contact model is bound here, once (each
+    controller its own: it keeps a Pinocchio workspace).
+
+    Raises:
+        InputError: ``contact_geometry.enabled`` without the scenario's object; a
+            candidate link unknown or without collision geometry; a bad URDF.
+    """
+    obj = scenario.object
+    pose = None if obj is None else object_pose(obj.position, obj.rpy)
+    ctrl.solving.object, ctrl.solving.scenario_pose = obj, pose
+    ctrl.store.scenario_pose = pose
+    ctrl.solving.tracker = None
+    if not p.contact_geometry.enabled:
+        return
+    if obj is None:
+        raise InputError('contact_geometry.enabled', "needs the scenario's object (its "
+                         'shape and pose): the scenario has none')
+    links = list(p.contact_geometry.links) or [c.link for c in scenario.contacts]
+    model = GeometryContacts.bind(
+        ctrl.setup.hand, urdf or resolve_urdf(scenario.urdf, scenario.base_dir), obj,
+        p.contact_geometry.tolerance, None if links == ['auto'] else links,
+        field='contact_geometry.links')
+    ctrl.solving.tracker = ContactTracker(model, obj)

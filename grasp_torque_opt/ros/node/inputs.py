@@ -23,7 +23,7 @@ from __future__ import annotations
 import time
 from typing import Any, TYPE_CHECKING
 
-from geometry_msgs.msg import PoseArray, Vector3Stamped, WrenchStamped
+from geometry_msgs.msg import PoseArray, PoseStamped, Vector3Stamped, WrenchStamped
 from grasp_torque_opt.control.controller import stamp_seconds
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
@@ -71,7 +71,8 @@ class Inputs:
         topics = [(JointState, 'joint_states', self.on_joint_state),
                   (PoseArray, 'contacts', self.on_contacts),
                   (WrenchStamped, 'external_wrench', self.on_wrench),
-                  (Vector3Stamped, 'gravity', self.on_gravity)]
+                  (Vector3Stamped, 'gravity', self.on_gravity),
+                  (PoseStamped, 'object_pose', self.on_object_pose)]
         if self.root.params.imu.enabled:
             topics.append((Imu, 'imu', self.on_imu))
         for msg_type, topic, take in topics:
@@ -205,6 +206,31 @@ class Inputs:
             try:
                 self.root.controller.update_gravity(frame, [v.x, v.y, v.z], now, stamp,
                                                     self.clock_now(), rotation, why)
+            except InputError as e:
+                self._rejected(e)
+
+    def on_object_pose(self, msg: PoseStamped, receipt: float | None = None) -> None:
+        """
+        Take the object's pose: in the base frame, a model frame, or any frame tf2 resolves.
+
+        The contacts from geometry and the load's point follow it; rejected (counted,
+        logged, not kept): the last accepted pose is used while fresh.
+        """
+        now = time.monotonic() if receipt is None else receipt
+        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        frame, p, o = msg.header.frame_id, msg.pose.position, msg.pose.orientation
+        with self.root.lock:
+            hand = self.root.controller.setup.hand
+            known = frame in ('', hand.base_frame) or hand.model.existFrame(frame)
+            base = hand.base_frame
+        transform, why = None, 'tf2_ros is not installed'
+        if not known and self.root.tf.running:
+            transform, why = self.root.tf.transform(base, frame)
+        with self.root.lock:
+            try:
+                self.root.controller.store.update_object_pose(
+                    frame, [p.x, p.y, p.z], [o.x, o.y, o.z, o.w], now, stamp,
+                    self.clock_now(), transform, why)
             except InputError as e:
                 self._rejected(e)
 

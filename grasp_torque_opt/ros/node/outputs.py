@@ -21,8 +21,9 @@ from __future__ import annotations
 from array import array
 from typing import Any, TYPE_CHECKING
 
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, WrenchStamped
 from grasp_torque_opt.control.controller import CycleResult
+from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.ros.node.qos import COMMAND_QOS
 from grasp_torque_opt.ros.peers import quiet_publisher
 import numpy as np
@@ -45,6 +46,7 @@ class Outputs:
         self.command_pub: Any = None
         self.stamped_pub: Any = None
         self.marker_pub: Any = None
+        self.wrench_pub: Any = None
 
     def start(self) -> list[tuple[str, Any]]:
         """Make the publishers; give them as (kind, publisher) for :meth:`stop`."""
@@ -61,6 +63,10 @@ class Outputs:
                                                 event_callbacks=quiet_publisher())
         made.append(('publisher', self.marker_pub))
         peers.watch(self.marker_pub, MarkerArray)
+        self.wrench_pub = node.create_publisher(WrenchStamped, '~/contact_wrench', 10,
+                                                event_callbacks=quiet_publisher())
+        made.append(('publisher', self.wrench_pub))
+        peers.watch(self.wrench_pub, WrenchStamped)
         return made
 
     def _command_publisher(self, msg_type: type, topic: str) -> Any:
@@ -79,7 +85,7 @@ class Outputs:
 
     def stop(self) -> None:
         """Forget the publishers (destroyed by the root)."""
-        self.command_pub = self.stamped_pub = self.marker_pub = None
+        self.command_pub = self.stamped_pub = self.marker_pub = self.wrench_pub = None
 
     def publish(self, result: CycleResult, stamp: Any = None) -> None:
         """
@@ -116,11 +122,43 @@ class Outputs:
     def on_markers(self) -> None:
         """Publish the last solution's contact forces as arrows (none when it has none)."""
         root = self.root
+        stamp = self.node.get_clock().now().to_msg()
         with root.lock:
             last = root.controller.last if root.commanding else None
-            base = root.controller.setup.hand.base_frame
-        self.marker_pub.publish(markers(last, base, self.node.get_clock().now().to_msg(),
+            hand = root.controller.setup.hand
+            wrenches = link_wrenches(last, hand)
+        self.marker_pub.publish(markers(last, hand.base_frame, stamp,
                                         root.params.marker_scale, root.params.marker_period))
+        for link, w in wrenches:
+            msg = WrenchStamped()
+            msg.header.frame_id, msg.header.stamp = link, stamp
+            f, t = msg.wrench.force, msg.wrench.torque
+            f.x, f.y, f.z, t.x, t.y, t.z = (float(v) for v in w)
+            self.wrench_pub.publish(msg)
+
+
+def link_wrenches(last: CycleResult | None, hand: Any) -> list[tuple[str, np.ndarray]]:
+    """
+    Give a certified command's contact wrenches in their links' frames (~/contact_wrench).
+
+    Each is the wrench the link applies to the object at its contact (the force, and the
+    torsional moment about the normal), moved to the link frame's origin and expressed
+    in its axes: [F, M about the link origin], a frame tf knows (robot_state_publisher's).
+    The command's own wrenches: a rate-rule step's when it was one. Call under the lock
+    (it places the links in the hand's data).
+    """
+    if last is None or last.kind != 'solution' or last.q is None or last.maps is None:
+        return []
+    w = last.wrenches if last.wrenches is not None else last.solution.wrenches
+    placement = placements_at(hand, last.q)
+    out = []
+    for frame, wi in zip(last.maps.contacts, w):
+        oMl = placement(frame.link)
+        force = frame.rotation @ wi[:3]
+        torque = np.cross(frame.position - oMl.translation, force) + frame.rotation[:, 2] * wi[3]
+        R = oMl.rotation
+        out.append((frame.link, np.concatenate((R.T @ force, R.T @ torque))))
+    return out
 
 
 def markers(last: CycleResult | None, base: str, stamp: Any, scale: float,

@@ -33,6 +33,7 @@ from grasp_torque_opt.ros.node.grasp_source import (
     bind,
     Grasp,
     load_of_gravity,
+    place_object,
     urdf_document,
     weight_of,
 )
@@ -141,6 +142,8 @@ class GraspTorque:
         service = controllers.configure(None, setup, p, service=True, obj=grasp.scenario.object)
         ctrl.load_of_gravity = service.load_of_gravity = load_of_gravity(grasp.scenario)
         ctrl.store.object = service.store.object = grasp.scenario.object
+        for c in (ctrl, service):
+            place_object(c, grasp.scenario, p, self._urdf)
         ctrl.solving.weight = service.solving.weight = weight_of(grasp.scenario)
         # The service plans for the model's load (the scenario's, the IMU's): it does not
         # estimate, and a transient correction of the loop's is not its prediction.
