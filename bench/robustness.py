@@ -10,7 +10,8 @@ Robustness benchmark (issue 24, item 6): the node and two baselines on a disturb
 
 Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--rate 250]
        [--out bench/results/robustness.json] [--node-inputs on|imu|off]
-       [--margin K] [--controllers node preset impedance] [--smoke]
+       [--margin K] [--imu-rate HZ] [--imu-latency S]
+       [--controllers node preset impedance] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
 Allegro grasp, in simulated time (the rig of grasp-torque-sim, without ROS): the
@@ -90,13 +91,15 @@ def grid(smoke: bool) -> list[tuple[str, str, dict]]:
 
 
 def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
-            preset_level: float, inputs: str = 'off', margin: float = 0.0) -> dict:
-    """Run one episode; return its record (``inputs``: the node's IMU and efforts: on, imu, off)."""
+            preset_level: float, inputs: str = 'off', margin: float = 0.0,
+            imu: tuple[float | None, float] = (None, 0.0)) -> dict:
+    """Run one episode; return its record (``inputs``: the node's IMU and efforts, on/imu/off)."""
     setup, rig = simulated(scenario, settings)
     reference = None
     if controller == 'node':
         command = node_controller(setup, scenario, rig, inputs != 'off', margin,
-                                  efforts=inputs == 'on')
+                                  efforts=inputs == 'on', imu_rate=imu[0],
+                                  imu_latency=imu[1])
     elif controller == 'preset':
         command = Preset(setup, scenario.gravity, preset_level)
     else:
@@ -112,18 +115,19 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
 
 def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0,
         inputs: str = 'off', margin: float = 0.0,
-        controllers: tuple[str, ...] = CONTROLLERS) -> dict:
+        controllers: tuple[str, ...] = CONTROLLERS,
+        imu: tuple[float | None, float] = (None, 0.0)) -> dict:
     scenario = load_scenario(find_config('allegro_right.yaml'))
     out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
            'presets': {}, 'node_inputs': inputs, 'margin': margin,
-           'controllers': list(controllers)}
+           'controllers': list(controllers), 'imu_rate_hz': imu[0], 'imu_latency_s': imu[1]}
     for kp in gains:
         tuned = tune_preset(scenario, kp, 0.01, rate=rate)
         out['presets'][str(kp)] = {'level_N': tuned.level, 'drift_mm': 1e3 * tuned.drift}
         for family, label, fields in grid(smoke):
             settings = EpisodeSettings(kp=kp, duration=duration, rate=rate, **fields)
             out['rows'].append({'kp': kp, 'family': family, 'case': label, **{
-                c: episode(scenario, c, settings, tuned.level, inputs, margin)
+                c: episode(scenario, c, settings, tuned.level, inputs, margin, imu)
                 for c in controllers}})
     return out
 
@@ -133,7 +137,9 @@ def tables(r: dict) -> str:
     lines = ['Held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
              f"joint torque after release) over {r['duration_s']:g} s, controllers asked at "
              f"{r['rate_hz']:g} Hz; node inputs (IMU, efforts) "
-             f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}; preset levels: "
+             f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}, IMU "
+             f"{r.get('imu_rate_hz') or r['rate_hz']:g} Hz "
+             f"{1e3 * (r.get('imu_latency_s') or 0.0):g} ms late; preset levels: "
              + ', '.join(f"Kp {k}: {p['level_N']:.2f} N" for k, p in r['presets'].items()),
              '', '| Kp | family | cases | ' + ' | '.join(
                  f'{c} held | {c} effort [N m]' for c in shown) + ' |',
@@ -166,6 +172,10 @@ def main() -> int:
                    help="how often the controllers are asked [Hz] (grasp-torque-sim's joint "
                         'state rate)')
     p.add_argument('--out', type=Path, default=Path('bench/results/robustness.json'))
+    p.add_argument('--imu-rate', type=float, default=None,
+                   help='the IMU sampled at this rate [Hz] (default: at every joint state)')
+    p.add_argument('--imu-latency', type=float, default=0.0,
+                   help='the IMU delivered this late [s]')
     p.add_argument('--margin', type=float, default=0.0, help="the node's friction margin k")
     p.add_argument('--controllers', nargs='+', default=list(CONTROLLERS), choices=CONTROLLERS)
     p.add_argument('--node-inputs', choices=('on', 'imu', 'off'), default='off',
@@ -176,7 +186,8 @@ def main() -> int:
     a = p.parse_args()
     gains = (1.0,) if a.smoke else tuple(float(k) for k in a.gains.split(','))
     duration = 0.5 if a.smoke else a.duration
-    r = run(duration, gains, a.smoke, a.rate, a.node_inputs, a.margin, tuple(a.controllers))
+    r = run(duration, gains, a.smoke, a.rate, a.node_inputs, a.margin, tuple(a.controllers),
+            (a.imu_rate, a.imu_latency))
     r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
     report(r, tables(r), None if a.smoke else a.out,
            f"commit {r['commit']}, {len(r['rows']) * len(CONTROLLERS)} episodes"

@@ -37,7 +37,7 @@ from cycle import machine, machine_line
 import numpy as np
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import HistoryPolicy, QoSProfile, qos_profile_sensor_data, ReliabilityPolicy
+from rclpy.qos import HistoryPolicy, qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
@@ -143,7 +143,7 @@ def main() -> None:
           f"{q['max_gap_ms']:.1f} ms (joint states at {a.rate:g} Hz)")
     for k, b in enumerate(r['bursts']):
         ans = ', '.join(f'{n} {v}' for n, v in b['answered'].items())
-        print(f"burst {k + 1} of {a.calls} calls, first {WINDOW_S:g} s: commands "
+        print(f'burst {k + 1} of {a.calls} calls, first {WINDOW_S:g} s: commands '
               f"{b['rate_hz']:.0f} Hz, longest gap {b['max_gap_ms']:.1f} ms; {ans}")
     if a.out:
         a.out.write_text(json.dumps({'machine': m, **r}, indent=1))

@@ -17,6 +17,7 @@ bench/robustness.py drives every episode of its grid through :func:`node_control
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 
 from grasp_torque_opt.control.controller import CycleConfig, TorqueController
@@ -26,7 +27,8 @@ from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 
 
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
-                    margin: float = 0.0, efforts: bool | None = None):
+                    margin: float = 0.0, efforts: bool | None = None,
+                    imu_rate: float | None = None, imu_latency: float = 0.0):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -36,7 +38,9 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     With ``inputs`` (issue 24's inputs on, as the bundled params turn them on): the rig's
     palm IMU and its measured efforts (effort_estimation) are given to the cycle at each
     joint state. ``efforts``: the effort estimation alone on or off (None: as ``inputs``).
-    ``margin``: the friction margin k.
+    ``margin``: the friction margin k. ``imu_rate`` [Hz] (None: at every joint state)
+    and ``imu_latency`` [s]: the IMU sampled at that rate and delivered that late (the
+    readings are kept at every physics step asked, the one of ``imu_latency`` ago given).
     """
     efforts = inputs if efforts is None else efforts
     setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
@@ -48,7 +52,8 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
     names = list(setup.hand.joints)
-    clock = {'t': 0.0}
+    clock = {'t': 0.0, 'imu': -1.0}
+    readings: collections.deque = collections.deque()
 
     def command(reading):
         # The simulated time (the estimate's filters run on it); without a rig, any
@@ -56,8 +61,14 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
         clock['t'] = 1.0 + rig.time if rig is not None else clock['t'] + 1e-3
         measured = None
         if inputs:
-            force, omega = rig.imu()
-            ctrl.update_imu('', force, omega, clock['t'])
+            readings.append((clock['t'], *rig.imu()))
+            while len(readings) > 1 and readings[1][0] <= clock['t'] - imu_latency:
+                readings.popleft()
+            sampled, force, omega = readings[0]
+            due = imu_rate is None or sampled - clock['imu'] >= 1.0 / imu_rate - 1e-9
+            if sampled <= clock['t'] - imu_latency + 1e-12 and due:
+                clock['imu'] = sampled
+                ctrl.update_imu('', force, omega, clock['t'])
         if efforts:
             measured = rig.effort().tolist()
         ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, measured)
