@@ -17,7 +17,7 @@ object's surface, every other shape at least ``clearance`` from it, joints withi
 their limits). A solution is kept only if an independent check passes: the contacts
 found by :class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed
 forms where they apply) are every contact link's, each within ``tolerance`` of the
-surface with its inward normal; every other link of the hand (the palm included) is
+surface with its inward normal, none within :data:`EDGE` of an edge; every other link of the hand (the palm included) is
 at least ``clearance`` away; every joint is within its URDF limits. Each candidate
 is a line that ``grasp-torque-opt score`` reads (docs/planner.md, "Planning
 candidates").
@@ -44,6 +44,8 @@ from scipy.spatial.transform import Rotation
 
 #: Most candidates one call plans.
 MAX_COUNT = 100_000
+#: A contact this close to a box's edge or a cylinder's rim is refused [m].
+EDGE = 3e-3
 #: Contact modes of the output: points and normals written, or the links only.
 CONTACT_MODES = ('points', 'links')
 
@@ -81,7 +83,7 @@ class PlanSettings:
     clearance: float = 2e-3
     tolerance: float = 5e-4
     joint_margin: float = 0.02
-    attempts: int = 20
+    attempts: int = 50
     contacts: str = 'points'
     extra_load: tuple[float, ...] | None = None
 
@@ -175,7 +177,7 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
     check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
                                   max_penetration=1.0, field='links')
-    ik = SurfaceIK(hand, urdf, shape, links)
+    ik = SurfaceIK(hand, urdf, shape, links, EDGE)
     model = hand.model
     lower = model.lowerPositionLimit[hand.idx_q] + settings.joint_margin
     upper = model.upperPositionLimit[hand.idx_q] - settings.joint_margin
@@ -221,10 +223,28 @@ def _reject(check: GeometryContacts, ik: SurfaceIK, q: np.ndarray, pose: pin.SE3
         return 'overlap'
     if found.links != tuple(links) or np.any(np.abs(found.distances) > settings.tolerance):
         return 'contact off the surface'
+    if any(on_edge(check.object, pose.actInv(p), EDGE) for p in found.object_points):
+        return 'contact at an edge'
     others = {k: d for k, d in ik.distances(q, pose).items() if k not in links}
     if others and min(others.values()) < settings.clearance:
         return 'another link too close'
     return None
+
+
+def on_edge(shape: ObjectShape, x: np.ndarray, margin: float) -> bool:
+    """
+    Tell whether a surface point (object frame) is within ``margin`` of an edge.
+
+    A box's edges and a cylinder's rims: a contact there has no one normal (a finger
+    on an edge is not the grasp the statics planned). A sphere and a mesh have none.
+    """
+    size = shape.size
+    if shape.kind == 'box':
+        return int(np.sum(np.abs(x) > 0.5 * size - margin)) > 1
+    if shape.kind == 'cylinder':
+        return bool(np.hypot(x[0], x[1]) > size[0] - margin
+                    and abs(x[2]) > 0.5 * size[1] - margin)
+    return False
 
 
 def _floats(values, digits: int = 9) -> list[float]:

@@ -40,6 +40,8 @@ from scipy.optimize import least_squares
 PULL_JOINTS = 2e-3
 #: Weight of the pull towards the sampled object position [-].
 PULL_OBJECT = 2e-2
+#: Weight of a contact's distance past the keep-off band of an edge [-].
+EDGE_WEIGHT = 1.0
 
 
 @dataclass(frozen=True)
@@ -55,9 +57,12 @@ class IKResult:
 class SurfaceIK:
     """Every collision shape of one hand against one object: distances, Jacobians, the IK."""
 
-    def __init__(self, hand: Hand, urdf, shape: ObjectShape, contact_links: list[str]) -> None:
-        """Bind the hand's collision shapes and the object once."""
+    def __init__(self, hand: Hand, urdf, shape: ObjectShape, contact_links: list[str],
+                 edge: float = 0.0) -> None:
+        """Bind the hand's collision shapes and the object once (``edge``: keep off edges)."""
         self.hand = hand
+        self.shape = shape
+        self.edge = edge
         self.model = hand.model
         self.data = hand.model.createData()
         self.geom = collision_model(hand, urdf)
@@ -92,10 +97,11 @@ class SurfaceIK:
 
     def evaluate(self, q: np.ndarray, pose: pin.SE3, jacobians: bool = False) -> list[tuple]:
         """
-        Per collision shape: (signed distance [m], d(distance)/d(theta), d/d(p)).
+        Per collision shape: (signed distance [m], d(distance)/d(theta), d/d(p), the
+        object's nearest point in its frame, that point's velocity columns there).
 
-        The derivatives are None unless ``jacobians``; p is the object's position in the
-        base frame.
+        All but the distance are None unless ``jacobians``; p is the object's position
+        in the base frame; the point is taken as moving with the link.
         """
         model, data = self.model, self.data
         pin.forwardKinematics(model, data, q)
@@ -116,7 +122,7 @@ class SurfaceIK:
             d = self.computes[i](coal.Transform3s(oMg.rotation, oMg.translation), tf,
                                  self.request, res)
             if not jacobians:
-                out.append((float(d), None, None))
+                out.append((float(d), None, None, None, None))
                 continue
             n = np.asarray(res.normal, dtype=float)
             n = n / max(np.linalg.norm(n), 1e-12)
@@ -129,15 +135,51 @@ class SurfaceIK:
                 rb = np.asarray(res.getNearestPoint2(), dtype=float) - oMb.translation
                 dq = dq + n @ (Jb[:3] - np.cross(rb, Jb[3:].T).T)
             dtheta = dq[self.hand.idx_v] if self.C is None else dq @ self.C
-            out.append((float(d), dtheta, oMb.rotation.T @ n))
+            vtheta = v[:, self.hand.idx_v] if self.C is None else v @ self.C
+            local = oMo.actInv(np.asarray(res.getNearestPoint2(), dtype=float))
+            out.append((float(d), dtheta, oMb.rotation.T @ n, local,
+                        oMo.rotation.T @ vtheta))
         return out
 
     def distances(self, q: np.ndarray, pose: pin.SE3) -> dict[str, float]:
         """Return every link's least signed distance to the object [m] (palm included)."""
         out: dict[str, float] = {}
-        for link, (d, _, _) in zip(self.shape_link, self.evaluate(q, pose)):
+        for link, (d, *_) in zip(self.shape_link, self.evaluate(q, pose)):
             out[link] = min(d, out.get(link, np.inf))
         return out
+
+    def _edge_rows(self, x, vx, rotation, f, J, row) -> None:
+        """
+        Two rows that keep a contact's object point ``x`` off the edges (box, cylinder).
+
+        For each direction along the contact's face: how far the point is past
+        ``2 edge`` from the face's border (0 inside), with its derivative (the point
+        moving with the link, ``vx`` its velocity columns in the object's axes, and
+        against the object's translation).
+        """
+        size, keep = self.shape.size, 2.0 * self.edge
+        if self.shape.kind == 'box':
+            half = 0.5 * size
+            face = int(np.argmax(np.abs(x) - half))
+            axes = [a for a in range(3) if a != face]
+            grads = []
+            for a in axes:
+                unit = np.zeros(3)
+                unit[a] = np.sign(x[a])
+                grads.append((abs(x[a]) - (half[a] - keep), unit))
+        else:
+            r, h = size[0], 0.5 * size[1]
+            rho = float(np.hypot(x[0], x[1]))
+            if r - rho < h - abs(x[2]):  # on the side: keep off the rims
+                grads = [(abs(x[2]) - (h - keep), np.array([0.0, 0.0, np.sign(x[2])]))]
+            else:  # on a cap: keep inside its rim
+                radial = np.array([x[0], x[1], 0.0]) / max(rho, 1e-12)
+                grads = [(rho - (r - keep), radial)]
+        for j, (gap, unit) in enumerate(grads):
+            if gap > 0.0:
+                f[row + j] = EDGE_WEIGHT * gap
+                J[row + j, :vx.shape[1]] = EDGE_WEIGHT * (unit @ vx)
+                J[row + j, -3:] = -EDGE_WEIGHT * (rotation @ unit)
 
     def solve(self, theta0: np.ndarray, p0: np.ndarray, rotation: np.ndarray,
               q_base: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
@@ -163,16 +205,22 @@ class SurfaceIK:
         def split(x):
             return x[:m], x[m:]
 
+        edges = self.edge > 0.0 and self.shape.kind in ('box', 'cylinder')
+
         def residuals(x, want_jac=False):
+            want_jac = want_jac or edges  # the edge rows need the object point
             theta, p = split(x)
             rows = self.evaluate(self.full_q(theta, q_base), pin.SE3(rotation, p), want_jac)
-            f = np.empty(c + len(self.other_shapes) + m + 3)
+            f = np.zeros(c + len(self.other_shapes) + m + 3 + 2 * c)
             J = np.zeros((f.size, m + 3)) if want_jac else None
+            e = f.size - 2 * c
             for k, shapes in enumerate(self.contact_shapes):
                 i = min(shapes, key=lambda s: rows[s][0])
                 f[k] = rows[i][0]
                 if want_jac:
                     J[k, :m], J[k, m:] = rows[i][1], rows[i][2]
+                if edges:
+                    self._edge_rows(rows[i][3], rows[i][4], rotation, f, J, e + 2 * k)
             for k, i in enumerate(self.other_shapes, c):
                 gap = target - rows[i][0]
                 f[k] = max(gap, 0.0)
@@ -180,10 +228,10 @@ class SurfaceIK:
                     J[k, :m], J[k, m:] = -rows[i][1], -rows[i][2]
             k = c + len(self.other_shapes)
             f[k:k + m] = PULL_JOINTS * (theta - theta0)
-            f[k + m:] = PULL_OBJECT * (p - p0)
+            f[k + m:k + m + 3] = PULL_OBJECT * (p - p0)
             if want_jac:
                 J[k:k + m, :m] = PULL_JOINTS * np.eye(m)
-                J[k + m:, m:] = PULL_OBJECT * np.eye(3)
+                J[k + m:k + m + 3, m:] = PULL_OBJECT * np.eye(3)
             return f, J
 
         lower = np.concatenate([bounds[0], region[0]])
