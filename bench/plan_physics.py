@@ -61,7 +61,7 @@ LOOSE, STRICT = (0.05, math.radians(15.0)), (2e-3, math.radians(2.0))
 
 
 def merged(line: dict, **over) -> dict:
-    """The base scenario with a candidate line merged (score's rule) and ``over`` set."""
+    """Return the base scenario with a candidate line merged (as score merges it)."""
     from grasp_torque_opt.methods.score import merge
 
     doc = merge(yaml.safe_load(SCENARIO.read_text()),

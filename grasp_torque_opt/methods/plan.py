@@ -17,8 +17,9 @@ object's surface, every other shape at least ``clearance`` from it, joints withi
 their limits). A solution is kept only if an independent check passes: the contacts
 found by :class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed
 forms where they apply) are every contact link's, each within ``tolerance`` of the
-surface with its inward normal, none within :data:`EDGE` of an edge; every other link of the hand (the palm included) is
-at least ``clearance`` away; every joint is within its URDF limits. Each candidate
+surface with its inward normal, none within :data:`EDGE` of an edge; every other
+link of the hand (the palm included) is at least ``clearance`` away; every joint is
+within its URDF limits. Each candidate
 is a line that ``grasp-torque-opt score`` reads (docs/planner.md, "Planning
 candidates").
 """
@@ -135,7 +136,7 @@ def _object_shape(scenario: Scenario, shape: ObjectShape | None) -> ObjectShape:
         return shape
     if scenario.object is None:
         raise InputError('object', 'the planner needs an object: give one (shape, size, '
-                         "mass) or a base scenario with one")
+                         'mass) or a base scenario with one')
     return ObjectShape.from_spec(scenario.object)
 
 

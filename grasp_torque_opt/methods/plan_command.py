@@ -54,7 +54,7 @@ def add_parser(sub, formatter, scenario_help: str, count) -> None:
                        'written), 2 bad input, 4 any other error.')
     p.add_argument('scenario', help=scenario_help + ': the hand, friction, torque limits, '
                    'gravity, the grasp the draws start from')
-    p.add_argument('--object', choices=tuple(SIZES), help="object shape (default: the "
+    p.add_argument('--object', choices=tuple(SIZES), help='object shape (default: the '
                    "scenario's object)")
     p.add_argument('--size', type=_numbers(None), help='sphere R, box X,Y,Z or cylinder R,L '
                    '[m]')
@@ -68,7 +68,7 @@ def add_parser(sub, formatter, scenario_help: str, count) -> None:
     p.add_argument('--count', type=count(1, 100_000), default=d.count, help='candidates')
     p.add_argument('--seed', type=count(0, 2**32 - 1), default=d.seed,
                    help='seed of every draw: the same seed gives the same candidates')
-    p.add_argument('--region', type=float, default=d.region, help="half edge of the cube, "
+    p.add_argument('--region', type=float, default=d.region, help='half edge of the cube, '
                    "about the scenario's object origin, the object's centre stays in [m]")
     p.add_argument('--centre', type=_numbers(3), metavar='X,Y,Z',
                    help="the region's centre [m] (default: the scenario's object origin)")

@@ -97,8 +97,10 @@ class SurfaceIK:
 
     def evaluate(self, q: np.ndarray, pose: pin.SE3, jacobians: bool = False) -> list[tuple]:
         """
-        Per collision shape: (signed distance [m], d(distance)/d(theta), d/d(p), the
-        object's nearest point in its frame, that point's velocity columns there).
+        Return per collision shape its distance, derivatives and nearest point.
+
+        Each row: (signed distance [m], d(distance)/d(theta), d/d(p), the object's
+        nearest point in its frame, that point's velocity columns there).
 
         All but the distance are None unless ``jacobians``; p is the object's position
         in the base frame; the point is taken as moving with the link.
