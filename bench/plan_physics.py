@@ -40,6 +40,7 @@ import subprocess
 import sys
 import time
 
+from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import parse_scenario
@@ -77,7 +78,16 @@ def episode(doc: dict, force: np.ndarray, duration: float = 2.0, picture: str | 
     settings = EpisodeSettings(duration=duration, drift_limit=LOOSE[0],
                                object_force=tuple(float(f) for f in force))
     setup, rig = simulated(scenario, settings, GraspSetup.from_scenario(scenario))
-    report = run_episode(rig, node_controller(setup, scenario, rig), settings)
+    node = node_controller(setup, scenario, rig)
+
+    def guarded(reading):
+        # A finger pushed past its URDF limit (the object knocked away) is input the
+        # node refuses: it sends nothing new, the driver holds the last command.
+        try:
+            return node(reading)
+        except InputError:
+            return None
+    report = run_episode(rig, guarded, settings)
     if picture:
         from grasp_torque_opt.sim.render import render_grasp
 
