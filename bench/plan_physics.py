@@ -62,7 +62,7 @@ LOOSE, STRICT = (0.05, math.radians(15.0)), (2e-3, math.radians(2.0))
 
 
 def merged(line: dict, **over) -> dict:
-    """Return the base scenario with a candidate line merged (as score merges it)."""
+    """Return the base scenario with a candidate line in it, by score's merge rule."""
     from grasp_torque_opt.methods.score import merge
 
     doc = merge(yaml.safe_load(SCENARIO.read_text()),
