@@ -21,7 +21,7 @@ grasp benchmarks' protocol: gravity off, a force of the object's weight on its
 centre along +x, -x, +y, -y, +z, -z in turn (one episode of 2 s each after 0.3 s
 of settling), the node told that load. Success: the object moves < 5 cm and turns
 < 15 deg; strict: < 2 mm and < 2 deg. The prediction of an episode: the candidate
-is optimal and its axis capacity along the force is at least the force.
+has an axis capacity along the force (certified) of at least the force.
 
 ``--simulate-best`` is the loop's last step (README): the best-ranked line of SCORES
 (``score --out``) from PLAN, simulated on the base scenario's own load (its weight,
@@ -121,7 +121,9 @@ def run_object(kind: str, count: int, per_band: int, seed: int) -> dict:
                 doc['load'] = {'external_wrench': [*force.tolist(), 0.0, 0.0, 0.0]}
                 rep = episode(doc, force)
                 cap = (rec.get('capacities') or {}).get(name)
-                predicted = rec['status'] == 'optimal' and cap is not None and cap >= weight
+                # The axis capacity is that direction's own LP (the status is the
+                # candidate's own load's, the weight along base +x: not this one).
+                predicted = cap is not None and cap >= weight
                 loose = rep.max_drift < LOOSE[0] and rep.max_rotation < LOOSE[1]
                 strict = rep.max_drift < STRICT[0] and rep.max_rotation < STRICT[1]
                 episodes.append({'object': kind, 'band': band, 'id': rec['id'],
@@ -134,7 +136,8 @@ def run_object(kind: str, count: int, per_band: int, seed: int) -> dict:
         rows[band] = {'candidates': len(chosen), 'episodes': len(mine),
                       'held': sum(e['held'] for e in mine),
                       'strict': sum(e['strict'] for e in mine),
-                      'agree': sum(e['held'] == e['predicted'] for e in mine)}
+                      'agree': sum(e['held'] == e['predicted'] for e in mine),
+                      'agree_strict': sum(e['strict'] == e['predicted'] for e in mine)}
     feasible = sum(r['status'] == 'optimal' for r in records)
     return {'object': kind, 'planned': len(plan.candidates), 'iks': plan.attempts,
             'feasible': feasible, 'bands': rows, 'episodes': episodes}
@@ -142,14 +145,15 @@ def run_object(kind: str, count: int, per_band: int, seed: int) -> dict:
 
 def table(results: list[dict]) -> str:
     lines = ['| object | planned (IKs) | feasible by score | band | candidates | held (5 cm, '
-             '15 deg) | strict (2 mm, 2 deg) | prediction agrees |', '|---|---|---|---|---:|'
-             '---:|---:|---:|']
+             '15 deg) | strict (2 mm, 2 deg) | prediction agrees (5 cm / 2 mm) |',
+             '|---|---|---|---|---:|---:|---:|---:|']
     for res in results:
         for band, row in res['bands'].items():
             n = row['episodes']
             lines.append(f"| {res['object']} | {res['planned']} ({res['iks']}) | "
                          f"{res['feasible']} | {band} | {row['candidates']} | "
-                         f"{row['held']}/{n} | {row['strict']}/{n} | {row['agree']}/{n} |")
+                         f"{row['held']}/{n} | {row['strict']}/{n} | {row['agree']}/{n} / "
+                         f"{row['agree_strict']}/{n} |")
     return '\n'.join(lines)
 
 
@@ -193,11 +197,12 @@ def main() -> int:
           f'{time.time() - t0:.0f} s')
     print(table(results))
     episodes = [e for r in results for e in r['episodes']]
-    agree = sum(e['held'] == e['predicted'] for e in episodes)
-    print(f'agreement: {agree} of {len(episodes)} episodes '
-          f'({100 * agree / max(1, len(episodes)):.1f}%)')
+    for key in ('held', 'strict'):
+        agree = sum(e[key] == e['predicted'] for e in episodes)
+        print(f"agreement ({'5 cm, 15 deg' if key == 'held' else '2 mm, 2 deg'}): {agree} "
+              f'of {len(episodes)} episodes ({100 * agree / max(1, len(episodes)):.1f}%)')
     for e in episodes:
-        if e['held'] != e['predicted']:
+        if e['strict'] != e['predicted']:
             cap = 'none' if e['capacity_N'] is None else f"{e['capacity_N']:.3g} N"
             print(f"  disagree: {e['object']} {e['id']} (rank {e['rank']}, {e['status']}) "
                   f"{e['direction']}: capacity {cap}, predicted "
