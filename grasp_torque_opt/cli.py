@@ -7,7 +7,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-Command line: ``grasp-torque-opt solve|compare SCENARIO``, ``grasp-torque-opt score CANDIDATES``.
+Command line: ``grasp-torque-opt solve|compare|plan SCENARIO``, ``... score CANDIDATES``.
 
 Exit codes: 0 optimal, 3 infeasible, 2 bad input (one line on stderr naming
 the field), 4 the solver gave nothing certifiable (no torque is printed).
@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
+from pathlib import Path
 import shutil
 import sys
 import time
@@ -92,6 +93,9 @@ def _parser() -> argparse.ArgumentParser:
     p_cmp.add_argument('scenario', help=SCENARIO_HELP)
     p_cmp.add_argument('--json', action='store_true', help='print one JSON object')
     _score_parser(sub)
+    from grasp_torque_opt.methods.plan_command import add_parser
+
+    add_parser(sub, HelpFormatter, SCENARIO_HELP, _count)
     return parser
 
 
@@ -230,6 +234,8 @@ def _main(argv: list[str] | None) -> int:
     single_threaded_math()
     if args.command == 'score':
         return _score(args)
+    if args.command == 'plan':
+        return _plan(args)
     try:
         setup = _overridden(GraspSetup.from_file(find_config(args.scenario)), args)
         if args.command == 'solve':
@@ -391,6 +397,31 @@ def _score(args: argparse.Namespace) -> int:
         print(format_table(ranked, args.top))
         print(summary(records, seconds))
     return EXIT_BAD_INPUT if bad else EXIT_OPTIMAL
+
+
+def _plan(args: argparse.Namespace) -> int:
+    from grasp_torque_opt.methods.plan_command import run
+
+    try:
+        result = run(args)
+    except InputError as e:
+        print(_one_line(f'{PROG}: error: {args.scenario}: {e}'), file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except GraspTorqueError as e:
+        print(_one_line(f'{PROG}: error: {e}'), file=sys.stderr)
+        return EXIT_FAILED
+    text = ''.join(line + '\n' for line in result.lines())
+    if args.out:
+        try:
+            Path(args.out).write_text(text)
+        except OSError as e:
+            print(_one_line(f'{PROG}: error: --out: cannot write {args.out}: {e.strerror}'),
+                  file=sys.stderr)
+            return EXIT_FAILED
+    else:
+        sys.stdout.write(text)
+    print(result.summary(args.count, args.seed), file=sys.stderr)
+    return EXIT_OPTIMAL if len(result.candidates) == args.count else EXIT_INFEASIBLE
 
 
 if __name__ == '__main__':

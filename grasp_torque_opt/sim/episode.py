@@ -49,6 +49,8 @@ class EpisodeSettings:
         disturbances: base motion and encoder noise.
         mass_scale: the simulated object's mass over the scenario's [-].
         object_offset: the simulated object's centre minus the scenario's, base frame [m].
+        object_force: a constant force on the object's centre from release on, base
+            axes [N] (the controller is not told).
     """
 
     kp: float = 1.0
@@ -60,6 +62,7 @@ class EpisodeSettings:
     disturbances: Disturbances = field(default_factory=Disturbances)
     mass_scale: float = 1.0
     object_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    object_force: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -75,6 +78,7 @@ class EpisodeReport:
         rotation: rotation at the end [rad].
         time: simulated time after release [s] (shorter once the object fell).
         mean_effort: RMS applied joint torque since release [N m].
+        max_rotation: largest rotation since release [rad].
     """
 
     held: bool
@@ -84,6 +88,7 @@ class EpisodeReport:
     rotation: float
     time: float
     mean_effort: float
+    max_rotation: float = 0.0
 
     @property
     def fell(self) -> bool:
@@ -107,6 +112,7 @@ def simulated(scenario: Scenario, settings: EpisodeSettings, setup: GraspSetup |
     sim = dataclasses.replace(sim, mass=settings.mass_scale * scenario.object.mass)
     rig = RigSim(build_model(truth, sim), setup.q[setup.hand.idx_q], settings.kp, settings.kd,
                  settings.disturbances, setup.hand.base_frame)
+    rig.object_force = np.asarray(settings.object_force, dtype=float)
     return setup, rig
 
 
@@ -131,6 +137,8 @@ def run_episode(rig: RigSim, controller: Controller, settings: EpisodeSettings,
     every = max(1, round(1.0 / (settings.rate * dt)))
     fallen = max(20e-3, 10 * settings.drift_limit)
 
+    turned = [0.0]
+
     def steps(n: int, watch: bool) -> tuple[float | None, float]:
         passed, most = None, 0.0
         for k in range(n):
@@ -140,7 +148,8 @@ def run_episode(rig: RigSim, controller: Controller, settings: EpisodeSettings,
                     rig.command = np.asarray(command, dtype=float)
             rig.step()
             if watch:
-                drift, _ = rig.motion()
+                drift, rotation = rig.motion()
+                turned[0] = max(turned[0], rotation)
                 if trace is not None and k % every == 0:
                     applied = rig.effort()
                     trace.append((rig.time - rig.release_time, drift,
@@ -162,4 +171,4 @@ def run_episode(rig: RigSim, controller: Controller, settings: EpisodeSettings,
     drift, rotation = rig.motion()
     return EpisodeReport(held=passed is None, passed_at=passed, max_drift=most, drift=drift,
                          rotation=rotation, time=rig.time - rig.release_time,
-                         mean_effort=rig.mean_effort())
+                         mean_effort=rig.mean_effort(), max_rotation=turned[0])

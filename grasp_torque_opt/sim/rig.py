@@ -20,7 +20,9 @@ The simulated hand as a test rig: a moving base, encoder noise, and the torques 
   and the damping -Kd qdot that MuJoCo integrates implicitly (at the velocity the
   step ends with), so that :meth:`RigSim.effort` is what the joints got;
 - keeps the mean effort since release: the RMS of the applied joint torques over
-  every step and joint [N m].
+  every step and joint [N m];
+- pushes the object, once released, with a constant force at its centre
+  (:attr:`RigSim.object_force`, base axes [N]): the grasp benchmarks' disturbance.
 """
 
 from __future__ import annotations
@@ -90,6 +92,8 @@ class RigSim(HandSim):
         self.reading = self.q
         self.applied = self.command + kp * (self.q_ref - self.reading)
         self._square_sum, self._count = 0.0, 0
+        #: Force on the object's centre after release, base axes [N].
+        self.object_force = np.zeros(3)
 
     def _encoder(self) -> np.ndarray:
         noise = self.disturbances.joint_noise
@@ -111,6 +115,9 @@ class RigSim(HandSim):
                 # Kp (q_ref - reading) = Kp (q_ref - q) - Kp noise: the noise goes in the command.
                 self.command = command - self.kp * (self.reading - self.q)
                 applied = command + self.kp * (self.q_ref - self.reading)
+                if self.release_time is not None:
+                    self.data.xfrc_applied[self.sim.object_body, :3] = (
+                        self.sim.base_rotation @ self.object_force)
                 super().step(1)
                 self.applied = applied - self.kd * self.qdot
                 if self.release_time is not None:

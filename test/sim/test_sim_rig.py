@@ -79,3 +79,29 @@ def test_the_efforts_are_the_torques_mujoco_applied(scenario):
         efforts.append(rig.effort())
     assert rig.mean_effort() == pytest.approx(float(np.sqrt(np.mean(np.square(efforts)))),
                                               rel=1e-12)
+
+
+def test_a_force_on_the_object_pushes_it_as_its_weight_does(scenario):
+    """The fingers only carry their own weight: the ball falls; minus its weight floats it."""
+    weight = scenario.object.mass * np.asarray(scenario.gravity)
+
+    def run(force, duration, drift_limit=1e-3):
+        settings = EpisodeSettings(duration=duration, object_force=force,
+                                   drift_limit=drift_limit)
+        setup, rig = simulated(scenario, settings)
+        hand = setup.hand
+
+        def own_weight(reading):  # g(q): the fingers neither sag nor squeeze
+            q = setup.q.copy()
+            q[hand.idx_q] = reading
+            return hand.gravity_torques(hand.complete(q), scenario.gravity)
+        start = rig.object_pose()[0]
+        return run_episode(rig, own_weight, settings), rig.object_pose()[0] - start
+
+    fell, _ = run((0.0, 0.0, 0.0), 0.3)
+    assert not fell.held, fell
+    floated, _ = run(tuple(-weight), 0.3)
+    assert floated.held and floated.max_drift < 2e-4 and floated.max_rotation < 1e-2, floated
+    # Twice the weight's opposite lifts it towards the palm (base -x).
+    _, moved = run(tuple(-2 * weight), 0.1, drift_limit=1.0)
+    assert moved[0] < -1e-3 and abs(moved[1]) < 0.5 * abs(moved[0]), moved

@@ -1,0 +1,282 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+Candidate grasps from geometry: the object placed near the palm, the fingers on it.
+
+:func:`plan_grasps` draws, from one seed, an object pose in a reach region about the
+base scenario's object origin (its orientation uniform at random for a box, cylinder
+or mesh) and joint positions about the base scenario's grasp, then solves the IK of
+:mod:`~grasp_torque_opt.methods.plan_ik` (the contact links' collision shapes on the
+object's surface, every other shape at least ``clearance`` from it, joints within
+their limits). A solution is kept only if an independent check passes: the contacts
+found by :class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed
+forms where they apply) are every contact link's, each within ``tolerance`` of the
+surface with its inward normal, none within :data:`EDGE` of an edge; every other
+link of the hand (the palm included) is at least ``clearance`` away; every joint is
+within its URDF limits. Each candidate
+is a line that ``grasp-torque-opt score`` reads (docs/planner.md, "Planning
+candidates").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from grasp_torque_opt.core.exceptions import GeometryError, InputError
+from grasp_torque_opt.core.geometry_contacts import GeometryContacts
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.core.object_geometry import ObjectShape
+from grasp_torque_opt.core.scenario import load_scenario, Scenario
+from grasp_torque_opt.methods.plan_ik import SurfaceIK
+import numpy as np
+import pinocchio as pin
+from scipy.spatial.transform import Rotation
+
+#: Most candidates one call plans.
+MAX_COUNT = 100_000
+#: A contact this close to a box's edge or a cylinder's rim is refused [m].
+EDGE = 3e-3
+#: Contact modes of the output: points and normals written, or the links only.
+CONTACT_MODES = ('points', 'links')
+
+
+@dataclass(frozen=True)
+class PlanSettings:
+    """
+    What to plan.
+
+    Attributes:
+        count: candidates wanted.
+        seed: the seed of every draw (same seed, same candidates).
+        links: the contact links; None: the base scenario's contacts' links.
+        region: half the edge of the cube the object's centre is drawn in and kept in,
+            about ``centre`` [m].
+        centre: the region's centre, base frame [m]; None: the base's object origin.
+        rotate: draw the object's orientation (a sphere's is never drawn).
+        joint_spread: standard deviation of the start joints about the base grasp [rad].
+        clearance: every other link keeps at least this from the object [m].
+        tolerance: a contact link within this of the surface (either side) [m].
+        joint_margin: the IK keeps the joints this far inside their limits [rad].
+        attempts: IKs at most per candidate wanted.
+        contacts: ``points`` (each contact's point and normal written) or ``links``
+            (the link only: ``score`` finds them from geometry).
+        extra_load: a wrench added to the object's weight [N, N m], or None.
+    """
+
+    count: int = 10
+    seed: int = 0
+    links: tuple[str, ...] | None = None
+    region: float = 0.02
+    centre: tuple[float, float, float] | None = None
+    rotate: bool = True
+    joint_spread: float = 0.2
+    clearance: float = 2e-3
+    tolerance: float = 5e-4
+    joint_margin: float = 0.02
+    attempts: int = 50
+    contacts: str = 'points'
+    extra_load: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        """Refuse a setting out of its range, naming it."""
+        if not (isinstance(self.count, int) and 1 <= self.count <= MAX_COUNT):
+            raise InputError('count', f'must be an integer in [1, {MAX_COUNT}], got '
+                             f'{self.count!r}')
+        for name in ('region', 'clearance', 'tolerance'):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0.0 < value <= 1.0):
+                raise InputError(name, f'must be in (0, 1] m, got {value!r}')
+        for name in ('joint_spread', 'joint_margin'):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0.0 <= value <= 10.0):
+                raise InputError(name, f'must be in [0, 10] rad, got {value!r}')
+        if not (isinstance(self.attempts, int) and 1 <= self.attempts <= 1000):
+            raise InputError('attempts', f'must be an integer in [1, 1000], got '
+                             f'{self.attempts!r}')
+        if self.contacts not in CONTACT_MODES:
+            raise InputError('contacts', f"must be one of {', '.join(CONTACT_MODES)}, got "
+                             f'{self.contacts!r}')
+        if self.extra_load is not None and (len(self.extra_load) != 6 or not all(
+                math.isfinite(v) for v in self.extra_load)):
+            raise InputError('load', f'must be 6 finite numbers, got {self.extra_load!r}')
+
+
+@dataclass
+class PlanResult:
+    """The candidates (score's JSON objects) and how many IKs it took."""
+
+    candidates: list[dict[str, Any]]
+    attempts: int
+    rejected: dict[str, int] = field(default_factory=dict)
+
+    def summary(self, count: int, seed: int) -> str:
+        """Return one line: how many were found, in how many IKs, why others were not."""
+        why = ', '.join(f'{n} {k}' for k, n in sorted(self.rejected.items())) or 'none'
+        return (f'planned {len(self.candidates)} of {count} candidates in {self.attempts} '
+                f'IKs (seed {seed}; rejected: {why})')
+
+    def lines(self) -> list[str]:
+        """Return the candidates as JSON Lines (without line breaks)."""
+        return [json.dumps(c, separators=(', ', ': ')) for c in self.candidates]
+
+
+def _object_shape(scenario: Scenario, shape: ObjectShape | None) -> ObjectShape:
+    if shape is not None:
+        return shape
+    if scenario.object is None:
+        raise InputError('object', 'the planner needs an object: give one (shape, size, '
+                         'mass) or a base scenario with one')
+    return ObjectShape.from_spec(scenario.object)
+
+
+def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSettings(),
+                shape: ObjectShape | None = None, mass: float | None = None) -> PlanResult:
+    """
+    Plan candidate grasps of an object by a hand (see the module docstring).
+
+    Args:
+        scenario: the base scenario (a file or a validated one): the hand, its torque
+            limits, friction, gravity and the grasp the draws start from.
+        settings: what to plan.
+        shape: the object's shape; None: the base scenario's object.
+        mass: the object's mass [kg]; None: the base scenario's object's.
+
+    Returns:
+        At most ``settings.count`` candidates, fewer when ``count * attempts`` IKs did
+        not find them.
+
+    Raises:
+        InputError: a bad setting, object or link (naming it).
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    setup = GraspSetup.from_scenario(scenario)
+    hand = setup.hand
+    shape = _object_shape(scenario, shape)
+    if mass is None:
+        if scenario.object is None:
+            raise InputError('object.mass', 'give the mass of the object')
+        mass = scenario.object.mass
+    if not (math.isfinite(mass) and mass > 0.0):
+        raise InputError('object.mass', f'must be finite and > 0 [kg], got {mass!r}')
+    if scenario.gravity is None and settings.extra_load is None:
+        raise InputError('load', 'the base scenario has no gravity: give the load')
+    links = list(settings.links or [c.link for c in scenario.contacts])
+    if not links:
+        raise InputError('links', 'no contact links: give them (the base scenario has none)')
+    urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
+    check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
+                                  max_penetration=1.0, field='links')
+    ik = SurfaceIK(hand, urdf, shape, links, EDGE)
+    model = hand.model
+    lower = model.lowerPositionLimit[hand.idx_q] + settings.joint_margin
+    upper = model.upperPositionLimit[hand.idx_q] - settings.joint_margin
+    lower, upper = np.minimum(lower, upper), np.maximum(lower, upper)
+    centre = np.asarray(settings.centre if settings.centre is not None
+                        else scenario.object_origin, dtype=float)
+    region = (centre - settings.region, centre + settings.region)
+    rng = np.random.default_rng(settings.seed)
+    theta_base = setup.q[hand.idx_q]
+    out: list[dict[str, Any]] = []
+    rejected: dict[str, int] = {}
+    tries = 0
+    while len(out) < settings.count and tries < settings.count * settings.attempts:
+        tries += 1
+        p0 = rng.uniform(region[0], region[1])
+        R = (Rotation.random(random_state=rng).as_matrix()
+             if settings.rotate and shape.kind != 'sphere' else np.eye(3))
+        theta0 = np.clip(theta_base + rng.normal(0.0, settings.joint_spread, hand.m),
+                         lower, upper)
+        sol = ik.solve(theta0, p0, R, setup.q, (lower, upper), region, settings.clearance)
+        q = ik.full_q(sol.theta, setup.q)
+        why = _reject(check, ik, q, pin.SE3(R, sol.position), links, settings)
+        if why is not None:
+            rejected[why] = rejected.get(why, 0) + 1
+            continue
+        found = check.contacts(q, pin.SE3(R, sol.position))
+        out.append(_candidate(f'plan-{settings.seed}-{len(out)}', hand, sol.theta,
+                              sol.position, R, shape, mass, found, settings,
+                              scenario.gravity))
+    return PlanResult(out, tries, rejected)
+
+
+def _reject(check: GeometryContacts, ik: SurfaceIK, q: np.ndarray, pose: pin.SE3,
+            links: list[str], settings: PlanSettings) -> str | None:
+    """Return why a solution is not a candidate, or None (the independent check)."""
+    model = check.hand.model
+    if np.any(q < model.lowerPositionLimit - 1e-12) or np.any(
+            q > model.upperPositionLimit + 1e-12):
+        return 'joint limits'
+    try:
+        found = check.contacts(q, pose)
+    except GeometryError:
+        return 'overlap'
+    if found.links != tuple(links) or np.any(np.abs(found.distances) > settings.tolerance):
+        return 'contact off the surface'
+    if any(on_edge(check.object, pose.actInv(p), EDGE) for p in found.object_points):
+        return 'contact at an edge'
+    others = {k: d for k, d in ik.distances(q, pose).items() if k not in links}
+    if others and min(others.values()) < settings.clearance:
+        return 'another link too close'
+    return None
+
+
+def on_edge(shape: ObjectShape, x: np.ndarray, margin: float) -> bool:
+    """
+    Tell whether a surface point (object frame) is within ``margin`` of an edge.
+
+    A box's edges and a cylinder's rims: a contact there has no one normal (a finger
+    on an edge is not the grasp the statics planned). A sphere and a mesh have none.
+    """
+    size = shape.size
+    if shape.kind == 'box':
+        return int(np.sum(np.abs(x) > 0.5 * size - margin)) > 1
+    if shape.kind == 'cylinder':
+        return bool(np.hypot(x[0], x[1]) > size[0] - margin
+                    and abs(x[2]) > 0.5 * size[1] - margin)
+    return False
+
+
+def _floats(values, digits: int = 9) -> list[float]:
+    return [round(float(v), digits) for v in values]
+
+
+def _candidate(cid: str, hand, theta: np.ndarray, position: np.ndarray, R: np.ndarray,
+               shape: ObjectShape, mass: float, found, settings: PlanSettings,
+               gravity) -> dict[str, Any]:
+    """Return one candidate: a partial scenario (docs/planner.md, "Batch scoring")."""
+    if settings.contacts == 'points' or shape.kind == 'mesh':
+        contacts = [{'link': link, 'position': _floats(pt), 'normal': _floats(n)}
+                    for link, pt, n in zip(found.links, found.points_link, found.normals)]
+    else:
+        contacts = [{'link': link} for link in found.links]
+    grasp = {'joint_positions': dict(zip(hand.joints, _floats(theta))),
+             'object_origin': _floats(position), 'contacts': contacts,
+             'contact_tolerance': 2.0 * settings.tolerance}
+    out: dict[str, Any] = {'id': cid, 'grasp': grasp}
+    extra = np.asarray(settings.extra_load or [0.0] * 6, dtype=float)
+    if shape.kind == 'mesh':
+        # A scenario's object is a primitive: a mesh's weight (at its frame's origin,
+        # taken as its centre of mass) is written out as the whole load.
+        weight = np.zeros(6)
+        if gravity is not None:
+            weight[:3] = mass * np.asarray(gravity, dtype=float)
+        out.update({'object': None, 'gravity': None,
+                    'load': {'external_wrench': _floats(weight + extra)}})
+        return out
+    out['object'] = {'shape': shape.kind, 'size': _floats(shape.size), 'mass': float(mass),
+                     'position': _floats(position),
+                     'rpy': _floats(pin.rpy.matrixToRpy(R))}
+    out['load'] = {'external_wrench': _floats(extra)}
+    return out

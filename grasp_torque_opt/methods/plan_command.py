@@ -1,0 +1,116 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""``grasp-torque-opt plan``'s options, and the plan they ask for (the CLI prints it)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.object_geometry import ObjectShape
+from grasp_torque_opt.core.resources import find_config
+from grasp_torque_opt.core.scenario import load_scenario
+from grasp_torque_opt.methods.plan import CONTACT_MODES, plan_grasps, PlanResult, PlanSettings
+import numpy as np
+
+#: Sizes of each primitive's ``--size``.
+SIZES = {'sphere': 1, 'box': 3, 'cylinder': 2}
+
+
+def _numbers(count: int | None):
+    """Make an argparse type: ``count`` (None: any number of) comma-separated finite numbers."""
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(','))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f'must be numbers separated by commas, got '
+                                             f'{text!r}') from None
+        if (count is not None and len(values) != count) or not all(
+                math.isfinite(v) for v in values):
+            raise argparse.ArgumentTypeError(f'must be {count or "finite"} numbers separated '
+                                             f'by commas, got {text!r}')
+        return values
+    return parse
+
+
+def add_parser(sub, formatter, scenario_help: str, count) -> None:
+    """Add the ``plan`` subcommand to the CLI's subparsers."""
+    d = PlanSettings()
+    p = sub.add_parser('plan', help='candidate grasps of an object: the contact links on its '
+                       'surface (JSON Lines that score reads)', formatter_class=formatter,
+                       description=(
+                           'Plan candidate grasps: the object placed in a region about the '
+                           "scenario's object origin, an IK puts the contact links on its "
+                           'surface and keeps every other link clear; each candidate is a '
+                           'line that score reads (docs/planner.md).'),
+                       epilog='exit codes: 0 every candidate asked found, 3 fewer found (those '
+                       'written), 2 bad input, 4 any other error.')
+    p.add_argument('scenario', help=scenario_help + ': the hand, friction, torque limits, '
+                   'gravity, the grasp the draws start from')
+    p.add_argument('--object', choices=tuple(SIZES), help='object shape (default: the '
+                   "scenario's object)")
+    p.add_argument('--size', type=_numbers(None), help='sphere R, box X,Y,Z or cylinder R,L '
+                   '[m]')
+    p.add_argument('--mesh', help='an object mesh file (.stl, .obj, .dae) instead')
+    p.add_argument('--scale', type=float, default=1.0, help="the mesh's units in m")
+    p.add_argument('--mass', type=float, help="object mass [kg] (default: the scenario's)")
+    p.add_argument('--load', type=_numbers(6), metavar='FX,FY,FZ,MX,MY,MZ',
+                   help="wrench added to the object's weight [N, N m], base axes")
+    p.add_argument('--links', help="contact links, comma-separated (default: the scenario's "
+                   "contacts' links; any links with collision shapes, phalanges too)")
+    p.add_argument('--count', type=count(1, 100_000), default=d.count, help='candidates')
+    p.add_argument('--seed', type=count(0, 2**32 - 1), default=d.seed,
+                   help='seed of every draw: the same seed gives the same candidates')
+    p.add_argument('--region', type=float, default=d.region, help='half edge of the cube, '
+                   "about the scenario's object origin, the object's centre stays in [m]")
+    p.add_argument('--centre', type=_numbers(3), metavar='X,Y,Z',
+                   help="the region's centre [m] (default: the scenario's object origin)")
+    p.add_argument('--no-rotate', action='store_true',
+                   help="keep the object's axes the base's (else drawn at random)")
+    p.add_argument('--clearance', type=float, default=d.clearance,
+                   help='every other link at least this far from the object [m]')
+    p.add_argument('--tolerance', type=float, default=d.tolerance,
+                   help="each contact link within this of the object's surface [m]")
+    p.add_argument('--attempts', type=count(1, 1000), default=d.attempts,
+                   help='IKs at most per candidate asked')
+    p.add_argument('--contacts', choices=CONTACT_MODES, default=d.contacts,
+                   help='points: write each point and normal; links: the links only')
+    p.add_argument('--out', help='write the candidates here (JSON Lines) instead of stdout')
+
+
+def run(args: argparse.Namespace) -> PlanResult:
+    """
+    Plan what the parsed options ask.
+
+    Raises:
+        InputError: a bad scenario, object or option (naming it).
+    """
+    scenario = load_scenario(find_config(args.scenario))
+    shape = None
+    if args.mesh:
+        if args.object or args.size:
+            raise InputError('--mesh', 'give either --mesh or --object/--size')
+        shape = ObjectShape.mesh_file(args.mesh, args.scale, field='--mesh')
+    elif args.object or args.size:
+        kind = args.object or (scenario.object.shape if scenario.object else None)
+        if kind is None or args.size is None:
+            raise InputError('--object', 'give both --object and --size')
+        if len(args.size) != SIZES[kind] or min(args.size) <= 0.0:
+            raise InputError('--size', f'a {kind} takes {SIZES[kind]} sizes > 0 [m], got '
+                             f'{list(args.size)}')
+        shape = ObjectShape(kind, np.asarray(args.size, dtype=float), field='--object')
+    if args.mass is not None and not (math.isfinite(args.mass) and args.mass > 0.0):
+        raise InputError('--mass', f'must be finite and > 0 [kg], got {args.mass!r}')
+    settings = PlanSettings(
+        count=args.count, seed=args.seed, region=args.region,
+        links=tuple(args.links.split(',')) if args.links else None, centre=args.centre,
+        rotate=not args.no_rotate, clearance=args.clearance, tolerance=args.tolerance,
+        attempts=args.attempts, contacts=args.contacts, extra_load=args.load)
+    return plan_grasps(scenario, settings, shape, args.mass)
