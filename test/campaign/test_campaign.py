@@ -32,6 +32,7 @@ from grasp_torque_opt.cli import main as cli_main
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.parameters import cycle_config
 from grasp_torque_opt.core import scenario as schema
+from grasp_torque_opt.core import scenario_fields as fields
 from grasp_torque_opt.ros.node import controllers, GraspTorqueNode, PARAMETERS
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -303,7 +304,7 @@ def scenario_fields(doc: dict) -> list[tuple]:
     out = [(section, key) for section, keys in sorted(schema._SECTIONS.items())
            for key in sorted(keys)]
     for i in range(len(doc['grasp']['contacts'])):
-        out += [('grasp', 'contacts', i, key) for key in sorted(schema._CONTACT_KEYS)]
+        out += [('grasp', 'contacts', i, key) for key in sorted(fields._CONTACT_KEYS)]
     return out
 
 
