@@ -52,7 +52,7 @@ import numpy as np
 import pinocchio as pin
 
 #: The interface of src/fast_cycle.hpp this module speaks (its ``API``).
-API = 2
+API = 3
 
 
 def cpu_has_avx2() -> bool:

@@ -1,0 +1,392 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+Batch scoring at the solver's speed: many candidates of one hand, bound once.
+
+:class:`BatchScorer` scores a chunk of candidate lines (:mod:`.score`'s) in stages,
+each over the whole chunk: a cheap parse of the fields that vary (joint positions,
+contacts, load); the kinematics of every configuration in one compiled call
+(:mod:`grasp_torque_opt.core.tree_kinematics`); the maps and the tau-QP of every
+candidate in one compiled call (``build_batch``, the compiled cycle's maps and build
+stages); one DAQP solve per candidate, each warm-started from its neighbour's
+active set (a warm answer off the KKT check or the certificate is solved again
+cold); then the KKT check, the certificate against the exact cone and the planner's
+numbers of every answer in one compiled call (``finish_batch``). Full metrics then
+run :mod:`.capacity`'s LPs on the candidate's maps, as the single path does.
+
+Everything else goes to the single path (:meth:`Scorer.score_line`), whose answer is
+then the record, so a record never depends on the path: a line with another field
+(``friction``, ``object``, ``objective``, ``grasp.object_origin``, a ``gravity``
+other than null) or anything the cheap parse does not accept (bad JSON, an unknown
+joint or link, a value that is not a finite number, ...: the single path then names
+the error), a candidate the compiled stages hand back (a contact frame that cannot be
+made, A = [G; J^T] not of full column rank), and every answer that is not certified
+optimal here (infeasible, failed: the single path confirms an infeasible load with
+its LP). The whole batch takes the single path when the job or the base scenario is
+outside what the stages do (:attr:`BatchScorer.why_not` says why): a backend other
+than DAQP, the min-max objective, coupled joints, ``hand.base_link``, a name map, a
+joint other than 1-DoF revolute or prismatic, or no compiled cycle.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+import json
+import math
+import time
+from typing import Any
+
+from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
+from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
+from grasp_torque_opt.core.friction import contact_block
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.margin import planned_friction
+from grasp_torque_opt.core.scenario import MAX_CONTACTS, parse_scenario, weight_wrench
+from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
+from grasp_torque_opt.core.tree_kinematics import supported, TreeKinematics
+from grasp_torque_opt.methods.score import MAX_LINE, Scorer
+import numpy as np
+
+#: Keys a line may hold for the batch stages (anything else: the single path).
+FAST_KEYS = frozenset(('id', 'grasp', 'load', 'gravity'))
+_CONTACT_KEYS = frozenset(('link', 'position', 'normal', 'tangent'))
+
+
+class _Skip(Exception):
+    """The cheap parse does not take this line: the single path scores it."""
+
+
+def _num(v: Any) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise _Skip
+    x = float(v)  # an int of more than 308 digits raises OverflowError: not caught here
+    if not math.isfinite(x):
+        raise _Skip
+    return x
+
+
+def _vec3(v: Any) -> list[float]:
+    if not isinstance(v, list) or len(v) != 3:
+        raise _Skip
+    return [_num(x) for x in v]
+
+
+class BatchScorer:
+    """
+    Scores chunks of candidates of one job: the batch stages, the single path for the rest.
+
+    Args:
+        scorer: the job's single-path scorer (its bound hand, solver and options).
+    """
+
+    def __init__(self, scorer: Scorer) -> None:
+        self.scorer = scorer
+        self.why_not = self._why_not()
+        if self.why_not:
+            return
+        from grasp_torque_opt.control import compiled  # the compiled stages
+
+        job, setup = scorer.job, scorer.base
+        hand = setup.hand
+        self.scenario = sc = parse_scenario(scorer.doc, scorer.base_dir, job.source)
+        model = hand.model
+        self.joint_q = {name: model.joints[model.getJointId(name)].idx_q
+                        for name in hand.one_dof_joints(model)}
+        self.q0 = setup.q
+        self.contacts = self._contact_arrays(setup.contacts)
+        self.origin = np.asarray(setup.object_origin, dtype=float)
+        self.base_extra = np.asarray(sc.extra_wrench, dtype=float)
+        self.base_has_extra = (isinstance(scorer.doc.get('load'), dict)
+                               and scorer.doc['load'].get('external_wrench') is not None)
+        self.has_gravity = sc.gravity is not None
+        self.weight = weight_wrench(sc.object, sc.gravity, sc.object_origin)
+        self.module = compiled._fast_cycle
+        self.kinematics = TreeKinematics(model, self.module)
+        self.kinematics.check(np.array([self.q0]), self.contacts[0])
+        friction = planned_friction(setup.friction)
+        S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
+                                 friction.min_normal_force)
+        s = self.module.Settings()
+        s.certificate_tolerance, s.qr_rtol, s.box_margin = DEFAULT_TOLERANCE, QR_RTOL, BOX_MARGIN
+        s.eps_abs, s.eps_rel, s.eps_primal_inf = 1e-9, 0.0, 1e-12  # ProxSuite's: unused here
+        s.max_iter, s.max_iter_in, s.kkt_tolerance = 1, 1, KKT_TOLERANCE
+        s.inner_iteration_s, s.estimate_decay, s.primary_share = 1e-6, 0.5, 1.0
+        self.cycle = self.module.FastCycle(
+            np.asarray(hand.idx_v, dtype=np.int64), S_i, b_i,
+            np.asarray(setup.weights, dtype=float), np.asarray(hand.torque_limits, dtype=float),
+            friction.mu1, friction.mu2, setup.friction.mu1, setup.friction.mu2,
+            friction.min_normal_force, False, s)
+        self.H = np.diag(2.0 * np.asarray(setup.weights, dtype=float))
+        self.daqp = scorer.solver.settings
+        import daqp
+
+        self._daqp = daqp
+
+    def _why_not(self) -> str:
+        """Say why this job takes the single path for every line ('' if it does not)."""
+        from grasp_torque_opt.control import compiled
+
+        job, setup, hand = self.scorer.job, self.scorer.base, self.scorer.base.hand
+        module = compiled._fast_cycle
+        if module is None or not hasattr(module, 'kinematics_batch'):
+            return compiled.IMPORT_ERROR or 'the compiled cycle has no batch stages'
+        if job.backend != 'daqp':
+            return f'backend {job.backend} (the batch stages solve with DAQP)'
+        if (job.objective or setup.objective) != 'sum-of-squares':
+            return 'objective min-max (the batch stages solve the sum of squares)'
+        if hand.velocity_map is not None or hand.coupling.mimics:
+            return 'coupled joints'
+        if hand.base_link is not None:
+            return 'hand.base_link'
+        if isinstance(self.scorer.doc.get('hand'), dict) and \
+                self.scorer.doc['hand'].get('name_map'):
+            return 'hand.name_map'
+        return supported(hand.model)
+
+    def _contact_arrays(self, specs) -> tuple:
+        """(frame ids, links, points, normals, has_normal, tangents, has_tangent) of specs."""
+        hand = self.scorer.base.hand
+        p = len(specs)
+        normals, tangents = np.zeros((p, 3)), np.zeros((p, 3))
+        has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+        for i, spec in enumerate(specs):
+            if spec.normal is not None:
+                normals[i], has_n[i] = spec.normal, True
+            if spec.tangent is not None:
+                tangents[i], has_t[i] = spec.tangent, True
+        links = tuple(spec.link for spec in specs)
+        fids = tuple(hand.frame_index(link, 'link') for link in links)
+        points = np.array([spec.position for spec in specs], dtype=float).reshape(p, 3)
+        return fids, links, points, normals, has_n, tangents, has_t
+
+    # -- the cheap parse ---------------------------------------------------------------
+    def parse(self, lineno: int, text: Any) -> tuple:
+        """
+        Return (id, q, contacts, w_ext) of a line the batch stages take.
+
+        Raises:
+            _Skip: the single path scores this line.
+        """
+        if isinstance(text, str):
+            if len(text) > MAX_LINE:
+                raise _Skip
+            try:
+                data = json.loads(text)
+            except (ValueError, RecursionError) as e:
+                raise _Skip from e
+        elif isinstance(text, dict):
+            data = text
+        else:
+            raise _Skip
+        if not isinstance(data, dict) or not FAST_KEYS.issuperset(data):
+            raise _Skip
+        gravity = self.has_gravity
+        if 'gravity' in data:
+            if data['gravity'] is not None:
+                raise _Skip
+            gravity = False
+        q, contacts = self.q0, self.contacts
+        grasp = data.get('grasp', {})
+        if not isinstance(grasp, dict) or not {'joint_positions', 'contacts'}.issuperset(grasp):
+            raise _Skip
+        if 'joint_positions' in grasp:
+            positions = grasp['joint_positions']
+            if not isinstance(positions, dict):
+                raise _Skip
+            q = q.copy()
+            joint_q = self.joint_q
+            for name, value in positions.items():
+                iq = joint_q.get(name)
+                if iq is None:
+                    raise _Skip
+                q[iq] = _num(value)
+        if 'contacts' in grasp:
+            contacts = self._contacts(grasp['contacts'])
+        extra = self.base_extra if self.base_has_extra else None
+        if 'load' in data:
+            load = data['load']
+            if not isinstance(load, dict) or set(load) != {'external_wrench'}:
+                raise _Skip
+            w = load['external_wrench']
+            if not isinstance(w, list) or len(w) != 6:
+                raise _Skip
+            extra = np.array([_num(x) for x in w])
+        weighed = gravity and self.scenario.object is not None
+        if extra is None:
+            if not weighed:
+                raise _Skip  # the single path says the load is missing
+            extra = np.zeros(6)
+        wrench = extra + (self.weight if gravity else np.zeros(6))
+        return data.get('id', lineno), q, contacts, wrench
+
+    def _contacts(self, raw: Any) -> tuple:
+        """The contact arrays of a line's ``grasp.contacts`` (as parse_scenario reads them)."""
+        if not isinstance(raw, list) or not 0 < len(raw) <= MAX_CONTACTS:
+            raise _Skip
+        model = self.scorer.base.hand.model
+        p = len(raw)
+        points, normals, tangents = np.zeros((p, 3)), np.zeros((p, 3)), np.zeros((p, 3))
+        has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+        links, fids = [], []
+        for i, c in enumerate(raw):
+            if not isinstance(c, dict) or not _CONTACT_KEYS.issuperset(c):
+                raise _Skip
+            link = c.get('link')
+            if not isinstance(link, str) or not link or not model.existFrame(link):
+                raise _Skip
+            links.append(link)
+            fids.append(self.scorer.base.hand.frame_index(link, 'link'))
+            if c.get('position') is not None:
+                points[i] = _vec3(c['position'])
+            if c.get('normal') is not None:
+                n = np.array(_vec3(c['normal']))
+                norm = np.linalg.norm(n)
+                if norm < 1e-9:
+                    raise _Skip
+                normals[i], has_n[i] = n / norm, True
+            if c.get('tangent') is not None:
+                t = np.array(_vec3(c['tangent']))
+                if np.linalg.norm(t) < 1e-9:
+                    raise _Skip
+                if has_n[i]:
+                    u = t / np.linalg.norm(t)
+                    if np.linalg.norm(u - (u @ normals[i]) * normals[i]) < 1e-6:
+                        raise _Skip
+                tangents[i], has_t[i] = t, True
+        return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
+
+    # -- the stages ----------------------------------------------------------------------
+    def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
+        """Score (line number, candidate) pairs into records, in order (never raises)."""
+        lines = list(lines)
+        if self.why_not:
+            return self.scorer.score_lines(lines)
+        records: list[dict | None] = [None] * len(lines)
+        groups: dict[tuple, list] = {}
+        t0 = time.perf_counter()
+        for k, (lineno, text) in enumerate(lines):
+            try:
+                ident, q, contacts, wrench = self.parse(lineno, text)
+            except (_Skip, OverflowError):
+                continue
+            groups.setdefault(contacts[1], []).append((k, lineno, ident, q, contacts, wrench))
+        parse_s = (time.perf_counter() - t0) / max(1, len(lines))
+        for members in groups.values():
+            self._group(members, records, parse_s)
+        for k, (lineno, text) in enumerate(lines):
+            if records[k] is None:
+                records[k] = self.scorer.score_line(lineno, text)
+        return records
+
+    def _group(self, members: list, records: list, parse_s: float) -> None:
+        """Score candidates with the same contact links through the batch stages."""
+        t0 = time.perf_counter()
+        n = len(members)
+        first = members[0][4]
+        fids = first[0]
+        Q = np.array([m[3] for m in members])
+        W = np.array([m[5] for m in members])
+        arrays = [np.array([m[4][j] for m in members]) for j in range(2, 7)]
+        oMf, J6 = self.kinematics.frames(Q, fids)
+        b = self.cycle.build_batch(oMf, J6, arrays[0], arrays[1], arrays[2], arrays[3],
+                                   arrays[4], self.origin, W)
+        ok = b['ok']
+        m = self.scorer.base.hand.m
+        A, bu, bl = b['A'], b['bupper'], b['blower']
+        rows = A.shape[1]
+        X = np.zeros((n, m))
+        LAM = np.zeros((n, m + rows))
+        solved = np.zeros(n, dtype=bool)
+        times = np.zeros(n)
+        sense = np.zeros(m + rows, dtype=np.int32)
+        sense[m:m + b['n_eq']] = 5  # equality
+        stage_s = time.perf_counter() - t0
+        model = self._model(A, bu, bl, sense, ok)
+        for i in np.flatnonzero(ok):
+            ts = time.perf_counter()
+            x, lam, flag = self._solve(model, A[i], bu[i], bl[i], None)
+            times[i] = time.perf_counter() - ts
+            if flag == 1:
+                X[i], LAM[i], solved[i] = x, lam, True
+        t1 = time.perf_counter()
+        fin = self.cycle.finish_batch(b['G'], b['J'], W, b['M1w'], b['M2'], A, bu, bl, X, LAM,
+                                      solved, KKT_TOLERANCE)
+        redo = np.flatnonzero(ok & ~fin['passes'])
+        if redo.size:  # warm answers off the KKT check or the certificate: cold
+            for i in redo:
+                ts = time.perf_counter()
+                x, lam, flag = self._solve(model, A[i], bu[i], bl[i], sense)
+                times[i] += time.perf_counter() - ts
+                X[i], LAM[i], solved[i] = x, lam, flag == 1
+            again = self.cycle.finish_batch(
+                b['G'][redo], b['J'][redo], W[redo], b['M1w'][redo], b['M2'][redo], A[redo],
+                bu[redo], bl[redo], X[redo], LAM[redo], solved[redo], KKT_TOLERANCE)
+            for key in ('passes', 'f', 'usage', 'ratio'):
+                fin[key][redo] = again[key]
+        share = parse_s + (stage_s + time.perf_counter() - t1) / n
+        job = self.scorer.job
+        passes, F, usage, ratio = fin['passes'], fin['f'], fin['usage'], fin['ratio']
+        for i, (k, lineno, ident, q, contacts, wrench) in enumerate(members):
+            if not passes[i]:
+                continue  # the single path answers (and confirms an infeasible load)
+            ts = time.perf_counter()
+            tau = X[i]
+            u = usage[i]
+            rec = {'line': lineno, 'id': ident, 'status': 'optimal', 'error': None,
+                   'torque_norm': float(np.linalg.norm(tau)),
+                   'max_torque_ratio': float(ratio[i]),
+                   'friction_usage_max': float(u.max()), 'friction_usage': u.tolist(),
+                   'backend': 'daqp', 'solve_time_s': float(times[i])}
+            if job.solutions:
+                rec['tau'] = tau.tolist()
+                rec['wrenches'] = F[i].reshape(-1, 4).tolist()
+            if job.metrics == 'full':
+                setup, maps = self._bound(q, contacts, wrench, b, i)
+                rec.update(self.scorer.capacities(setup, maps, 'optimal'))
+            rec['time_s'] = share + times[i] + time.perf_counter() - ts
+            records[k] = rec
+
+    def _model(self, A, bu, bl, sense, ok):
+        """A DAQP workspace of the group's size, set up on its first candidate."""
+        i = int(np.flatnonzero(ok)[0]) if ok.any() else 0
+        model = self._daqp.Model()
+        model.setup(self.H.copy(), np.zeros(self.H.shape[0]), A[i].copy(), bu[i].copy(),
+                    bl[i].copy(), sense)
+        s = model.settings
+        s.update(primal_tol=self.daqp.primal_tol, iter_limit=self.daqp.iter_limit, eps_prox=0.0)
+        model.settings = s
+        self._f = np.zeros(self.H.shape[0])
+        self._keep = ()
+        return model
+
+    def _solve(self, model, A, bu, bl, sense):
+        """One DAQP solve: warm from the last active set (``sense`` None), else cold."""
+        model.update(H=self.H, f=self._f, A=A, bupper=bu, blower=bl, sense=sense)
+        self._keep = (A, bu, bl)  # buffers DAQP may point to
+        x, _, flag, info = model.solve()
+        return x, info['lam'], int(flag)
+
+    def _bound(self, q, contacts, wrench, b, i) -> tuple[GraspSetup, GraspMaps]:
+        """The candidate as the single path binds it, with the batch stages' maps."""
+        base = self.scorer.base
+        fids, links, points, normals, has_n, tangents, has_t = contacts
+        specs = base.contacts if contacts is self.contacts else [
+            type(base.contacts[0])(link=link, position=points[j],
+                                   normal=normals[j] if has_n[j] else None,
+                                   tangent=tangents[j] if has_t[j] else None)
+            for j, link in enumerate(links)]
+        setup = GraspSetup(hand=base.hand, q=q, contacts=specs, object_origin=self.origin,
+                           friction=base.friction, external_wrench=wrench,
+                           weights=base.weights, objective='sum-of-squares')
+        maps = GraspMaps(G=b['G'][i], J=b['J'][i], links=links, frame_ids=fids,
+                         positions=b['positions'][i], rotations=b['rotations'][i],
+                         object_origin=self.origin)
+        return setup, maps
+
