@@ -88,6 +88,9 @@ class BatchScorer:
 
     def __init__(self, scorer: Scorer) -> None:
         self.scorer = scorer
+        #: Candidates answered by the batch stages, and by the single path.
+        self.staged = 0
+        self.single = 0
         self.why_not = self._why_not()
         if self.why_not:
             return
@@ -282,6 +285,7 @@ class BatchScorer:
             self._group(members, records, parse_s)
         for k, (lineno, text) in enumerate(lines):
             if records[k] is None:
+                self.single += 1
                 records[k] = self.scorer.score_line(lineno, text)
         return records
 
@@ -352,6 +356,7 @@ class BatchScorer:
                 rec.update(self.scorer.capacities(setup, maps, 'optimal'))
             rec['time_s'] = share + times[i] + time.perf_counter() - ts
             records[k] = rec
+            self.staged += 1
 
     def _model(self, A, bu, bl, sense, ok):
         """A DAQP workspace of the group's size, set up on its first candidate."""
