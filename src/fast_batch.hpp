@@ -67,7 +67,9 @@ py::dict build_batch(
     has_normal.size() == N * p && has_tangent.size() == N * p,
     "has_normal or has_tangent of the wrong shape");
   expect(c.size() == 3, "c of the wrong shape");
-  expect(w_ext.ndim() == 2 && w_ext.shape(0) == N && w_ext.shape(1) == 6, "w_ext of the wrong shape");
+  expect(
+    w_ext.ndim() == 2 && w_ext.shape(0) == N && w_ext.shape(1) == 6,
+    "w_ext of the wrong shape");
   const int m = fc.m();
   const py::ssize_t nf = 4 * p, rows = 6 + m;
   expect(rows >= nf, "A = [G; J^T] has more columns than rows");
@@ -179,8 +181,9 @@ double daqp_kkt(
 }
 
 // After the DAQP solves: for each candidate with solved[i] (DAQP's exit flag 1), the KKT
-// violation of x[i] with lam[i] (an answer over kkt_tolerance is not taken), the wrenches f = M1 w + M2 tau, the certificate
-// against the exact problem, the friction usage (unreduced cone) and max |tau| / limit.
+// violation of x[i] with lam[i] (an answer over kkt_tolerance is not taken), the
+// wrenches f = M1 w + M2 tau, the certificate against the exact problem, the friction
+// usage (unreduced cone) and max |tau| / limit.
 // Returns a dict: kkt (N; inf where not solved), certificate (N, 6: equilibrium,
 // torque, cone, normal_force, limit, finite), passes (N: finite and every residual within
 // the tolerance), f (N, 4p), usage (N, p), ratio (N).
@@ -235,7 +238,8 @@ py::dict finish_batch(
       double * ui = usage.mutable_data() + p * i;
       for (py::ssize_t j = 0; j < p; ++j) {
         const double fx = fi(4 * j), fy = fi(4 * j + 1), fz = fi(4 * j + 2), mz = fi(4 * j + 3);
-        const double demand = std::hypot(fx, fy) / fc.mu1_usage() + std::abs(mz) / fc.mu2_usage();
+        const double demand =
+          std::hypot(fx, fy) / fc.mu1_usage() + std::abs(mz) / fc.mu2_usage();
         ui[j] = fz > 0.0 ? demand / fz : inf;
       }
       ratio.mutable_data()[i] = (tau.cwiseAbs().array() / fc.limits().array()).maxCoeff();

@@ -78,6 +78,48 @@ def _vec3(v: Any) -> list[float]:
     return [_num(x) for x in v]
 
 
+def parse_contacts(raw: Any, hand) -> tuple:
+    """
+    Return the contact arrays of a line's ``grasp.contacts``, read as parse_scenario does.
+
+    Raises:
+        _Skip: anything it does not take.
+    """
+    if not isinstance(raw, list) or not 0 < len(raw) <= MAX_CONTACTS:
+        raise _Skip
+    model = hand.model
+    p = len(raw)
+    points, normals, tangents = np.zeros((p, 3)), np.zeros((p, 3)), np.zeros((p, 3))
+    has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+    links, fids = [], []
+    for i, c in enumerate(raw):
+        if not isinstance(c, dict) or not _CONTACT_KEYS.issuperset(c):
+            raise _Skip
+        link = c.get('link')
+        if not isinstance(link, str) or not link or not model.existFrame(link):
+            raise _Skip
+        links.append(link)
+        fids.append(hand.frame_index(link, 'link'))
+        if c.get('position') is not None:
+            points[i] = _vec3(c['position'])
+        if c.get('normal') is not None:
+            n = np.array(_vec3(c['normal']))
+            norm = np.linalg.norm(n)
+            if norm < 1e-9:
+                raise _Skip
+            normals[i], has_n[i] = n / norm, True
+        if c.get('tangent') is not None:
+            t = np.array(_vec3(c['tangent']))
+            if np.linalg.norm(t) < 1e-9:
+                raise _Skip
+            if has_n[i]:
+                u = t / np.linalg.norm(t)
+                if np.linalg.norm(u - (u @ normals[i]) * normals[i]) < 1e-6:
+                    raise _Skip
+            tangents[i], has_t[i] = t, True
+    return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
+
+
 class BatchScorer:
     """
     Scores chunks of candidates of one job: the batch stages, the single path for the rest.
@@ -94,7 +136,7 @@ class BatchScorer:
         self.why_not = self._why_not()
         if self.why_not:
             return
-        from grasp_torque_opt.control import compiled  # the compiled stages
+        from grasp_torque_opt.core import compiled_module as compiled  # the compiled stages
 
         job, setup = scorer.job, scorer.base
         hand = setup.hand
@@ -134,7 +176,7 @@ class BatchScorer:
 
     def _why_not(self) -> str:
         """Say why this job takes the single path for every line ('' if it does not)."""
-        from grasp_torque_opt.control import compiled
+        from grasp_torque_opt.core import compiled_module as compiled
 
         job, setup, hand = self.scorer.job, self.scorer.base, self.scorer.base.hand
         module = compiled._fast_cycle
@@ -211,7 +253,7 @@ class BatchScorer:
                     raise _Skip
                 q[iq] = _num(value)
         if 'contacts' in grasp:
-            contacts = self._contacts(grasp['contacts'])
+            contacts = parse_contacts(grasp['contacts'], self.scorer.base.hand)
         extra = self.base_extra if self.base_has_extra else None
         if 'load' in data:
             load = data['load']
@@ -228,42 +270,6 @@ class BatchScorer:
             extra = np.zeros(6)
         wrench = extra + (self.weight if gravity else np.zeros(6))
         return data.get('id', lineno), q, contacts, wrench
-
-    def _contacts(self, raw: Any) -> tuple:
-        """The contact arrays of a line's ``grasp.contacts`` (as parse_scenario reads them)."""
-        if not isinstance(raw, list) or not 0 < len(raw) <= MAX_CONTACTS:
-            raise _Skip
-        model = self.scorer.base.hand.model
-        p = len(raw)
-        points, normals, tangents = np.zeros((p, 3)), np.zeros((p, 3)), np.zeros((p, 3))
-        has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
-        links, fids = [], []
-        for i, c in enumerate(raw):
-            if not isinstance(c, dict) or not _CONTACT_KEYS.issuperset(c):
-                raise _Skip
-            link = c.get('link')
-            if not isinstance(link, str) or not link or not model.existFrame(link):
-                raise _Skip
-            links.append(link)
-            fids.append(self.scorer.base.hand.frame_index(link, 'link'))
-            if c.get('position') is not None:
-                points[i] = _vec3(c['position'])
-            if c.get('normal') is not None:
-                n = np.array(_vec3(c['normal']))
-                norm = np.linalg.norm(n)
-                if norm < 1e-9:
-                    raise _Skip
-                normals[i], has_n[i] = n / norm, True
-            if c.get('tangent') is not None:
-                t = np.array(_vec3(c['tangent']))
-                if np.linalg.norm(t) < 1e-9:
-                    raise _Skip
-                if has_n[i]:
-                    u = t / np.linalg.norm(t)
-                    if np.linalg.norm(u - (u @ normals[i]) * normals[i]) < 1e-6:
-                        raise _Skip
-                tangents[i], has_t[i] = t, True
-        return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
 
     # -- the stages ----------------------------------------------------------------------
     def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
@@ -359,7 +365,7 @@ class BatchScorer:
             self.staged += 1
 
     def _model(self, A, bu, bl, sense, ok):
-        """A DAQP workspace of the group's size, set up on its first candidate."""
+        """Return a DAQP workspace of the group's size, set up on its first candidate."""
         i = int(np.flatnonzero(ok)[0]) if ok.any() else 0
         model = self._daqp.Model()
         model.setup(self.H.copy(), np.zeros(self.H.shape[0]), A[i].copy(), bu[i].copy(),
@@ -379,7 +385,7 @@ class BatchScorer:
         return x, info['lam'], int(flag)
 
     def _bound(self, q, contacts, wrench, b, i) -> tuple[GraspSetup, GraspMaps]:
-        """The candidate as the single path binds it, with the batch stages' maps."""
+        """Return the candidate as the single path binds it, with the batch stages' maps."""
         base = self.scorer.base
         fids, links, points, normals, has_n, tangents, has_t = contacts
         specs = base.contacts if contacts is self.contacts else [
@@ -394,4 +400,3 @@ class BatchScorer:
                          positions=b['positions'][i], rotations=b['rotations'][i],
                          object_origin=self.origin)
         return setup, maps
-
