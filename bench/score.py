@@ -74,21 +74,21 @@ def raw_daqp(job, lines) -> dict:
     import daqp
 
     batch = BatchScorer(Scorer(job))
-    problems = []
+    parsed = []
     for n, text in lines:
         try:
-            _, q, contacts, w = batch.parse(n, text)
+            item = batch.parse(n, text)
         except Exception:  # noqa: BLE001 -- lines the stages do not take
             continue
-        if contacts is batch.contacts:
-            problems.append((q, w))
+        if item[2] is batch.contacts:
+            parsed.append(item)
     fids, _, points, normals, has_n, tangents, has_t = batch.contacts
-    Q = np.array([q for q, _ in problems])
-    k = len(problems)
+    Q, W = batch.inputs(parsed)
+    k = len(parsed)
     oMf, J6 = batch.kinematics.frames(Q, fids)
     b = batch.cycle.build_batch(oMf, J6, *(np.repeat(a[None], k, 0) for a in
                                            (points, normals, has_n, tangents, has_t)),
-                                batch.origin, np.array([w for _, w in problems]))
+                                batch.origin, W)
     A, bu, bl = b['A'][b['ok']], b['bupper'][b['ok']], b['blower'][b['ok']]
     m = batch.H.shape[0]
     H, f = batch.H.copy(), np.zeros(m)

@@ -63,19 +63,36 @@ class _Skip(Exception):
     """The cheap parse does not take this line: the single path scores it."""
 
 
-def _num(v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
+#: Markers of :meth:`BatchScorer.parse`: the base has no load section, and a zero one.
+_NO_LOAD = object()
+_ZERO_LOAD = [0.0] * 6
+#: The JSON number types (a bool is not one: ``type(True)`` is ``bool``).
+_NUMBER_TYPES = frozenset((int, float))
+
+
+def _numbers(values: list) -> list:
+    """
+    Return ``values`` if every one is a finite JSON number (int or float, not bool).
+
+    Raises:
+        _Skip: any other (a sum that overflows is skipped as well: the single path
+            then decides).
+    """
+    if not _NUMBER_TYPES.issuperset(map(type, values)):
         raise _Skip
-    x = float(v)  # an int of more than 308 digits raises OverflowError: not caught here
-    if not math.isfinite(x):
+    try:
+        total = sum(values, 0.0)  # NaN or inf anywhere makes it non-finite
+    except OverflowError as e:  # an int of more than 308 digits
+        raise _Skip from e
+    if not math.isfinite(total):
         raise _Skip
-    return x
+    return values
 
 
 def _vec3(v: Any) -> list[float]:
     if not isinstance(v, list) or len(v) != 3:
         raise _Skip
-    return [_num(x) for x in v]
+    return _numbers(v)
 
 
 def parse_contacts(raw: Any, hand) -> tuple:
@@ -214,7 +231,12 @@ class BatchScorer:
     # -- the cheap parse ---------------------------------------------------------------
     def parse(self, lineno: int, text: Any) -> tuple:
         """
-        Return (id, q, contacts, w_ext) of a line the batch stages take.
+        Return (id, joints, contacts, extra, gravity) of a line the batch stages take.
+
+        ``joints``: (indices in q, positions) or None for the base's; ``contacts``: the
+        contact arrays (the base's object when not given); ``extra``: the load besides
+        the weight (6 numbers); ``gravity``: whether the object's weight is added.
+        :meth:`inputs` makes the configurations and loads of many.
 
         Raises:
             _Skip: the single path scores this line.
@@ -237,7 +259,7 @@ class BatchScorer:
             if data['gravity'] is not None:
                 raise _Skip
             gravity = False
-        q, contacts = self.q0, self.contacts
+        joints, contacts = None, self.contacts
         grasp = data.get('grasp', {})
         if not isinstance(grasp, dict) or not {'joint_positions', 'contacts'}.issuperset(grasp):
             raise _Skip
@@ -245,16 +267,14 @@ class BatchScorer:
             positions = grasp['joint_positions']
             if not isinstance(positions, dict):
                 raise _Skip
-            q = q.copy()
-            joint_q = self.joint_q
-            for name, value in positions.items():
-                iq = joint_q.get(name)
-                if iq is None:
-                    raise _Skip
-                q[iq] = _num(value)
+            try:
+                index = tuple(self.joint_q[name] for name in positions)
+            except (KeyError, TypeError) as e:
+                raise _Skip from e
+            joints = (index, _numbers(list(positions.values())))
         if 'contacts' in grasp:
             contacts = parse_contacts(grasp['contacts'], self.scorer.base.hand)
-        extra = self.base_extra if self.base_has_extra else None
+        extra = None if self.base_has_extra else _NO_LOAD
         if 'load' in data:
             load = data['load']
             if not isinstance(load, dict) or set(load) != {'external_wrench'}:
@@ -262,14 +282,37 @@ class BatchScorer:
             w = load['external_wrench']
             if not isinstance(w, list) or len(w) != 6:
                 raise _Skip
-            extra = np.array([_num(x) for x in w])
-        weighed = gravity and self.scenario.object is not None
-        if extra is None:
-            if not weighed:
+            extra = _numbers(w)
+        if extra is _NO_LOAD:
+            if not (gravity and self.scenario.object is not None):
                 raise _Skip  # the single path says the load is missing
-            extra = np.zeros(6)
-        wrench = extra + (self.weight if gravity else np.zeros(6))
-        return data.get('id', lineno), q, contacts, wrench
+            extra = _ZERO_LOAD
+        return data.get('id', lineno), joints, contacts, extra, gravity
+
+    def inputs(self, parsed: list[tuple]) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return the configurations and loads of parsed lines (:meth:`parse`).
+
+        Returns:
+            (Q, shape (N, nq); W, w_ext = extra + the weight where gravity, shape (N, 6)).
+        """
+        n = len(parsed)
+        Q = np.repeat(self.q0[None], n, axis=0)
+        rows: dict[tuple, list[int]] = {}
+        for r, item in enumerate(parsed):
+            if item[1] is not None:
+                rows.setdefault(item[1][0], []).append(r)
+        for index, rs in rows.items():
+            values = np.array([parsed[r][1][1] for r in rs], dtype=float)
+            if len(rs) == n:
+                Q[:, list(index)] = values
+            else:
+                Q[np.ix_(rs, index)] = values
+        W = np.array([self.base_extra if item[3] is None else item[3] for item in parsed],
+                     dtype=float)
+        gravity = np.array([item[4] for item in parsed], dtype=bool)
+        W[gravity] += self.weight
+        return Q, W
 
     # -- the stages ----------------------------------------------------------------------
     def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
@@ -282,10 +325,10 @@ class BatchScorer:
         t0 = time.perf_counter()
         for k, (lineno, text) in enumerate(lines):
             try:
-                ident, q, contacts, wrench = self.parse(lineno, text)
+                parsed = self.parse(lineno, text)
             except (_Skip, OverflowError):
                 continue
-            groups.setdefault(contacts[1], []).append((k, lineno, ident, q, contacts, wrench))
+            groups.setdefault(parsed[2][1], []).append((k, lineno, parsed))
         parse_s = (time.perf_counter() - t0) / max(1, len(lines))
         for members in groups.values():
             self._group(members, records, parse_s)
@@ -299,11 +342,13 @@ class BatchScorer:
         """Score candidates with the same contact links through the batch stages."""
         t0 = time.perf_counter()
         n = len(members)
-        first = members[0][4]
-        fids = first[0]
-        Q = np.array([m[3] for m in members])
-        W = np.array([m[5] for m in members])
-        arrays = [np.array([m[4][j] for m in members]) for j in range(2, 7)]
+        parsed = [m[2] for m in members]
+        fids = parsed[0][2][0]
+        Q, W = self.inputs(parsed)
+        if all(item[2] is self.contacts for item in parsed):
+            arrays = [np.repeat(a[None], n, axis=0) for a in self.contacts[2:]]
+        else:
+            arrays = [np.array([item[2][j] for item in parsed]) for j in range(2, 7)]
         oMf, J6 = self.kinematics.frames(Q, fids)
         b = self.cycle.build_batch(oMf, J6, arrays[0], arrays[1], arrays[2], arrays[3],
                                    arrays[4], self.origin, W)
@@ -313,24 +358,28 @@ class BatchScorer:
         rows = A.shape[1]
         X = np.zeros((n, m))
         LAM = np.zeros((n, m + rows))
-        solved = np.zeros(n, dtype=bool)
-        times = np.zeros(n)
         sense = np.zeros(m + rows, dtype=np.int32)
         sense[m:m + b['n_eq']] = 5  # equality
         stage_s = time.perf_counter() - t0
         model = self._model(A, bu, bl, sense, ok)
-        for i in np.flatnonzero(ok):
-            ts = time.perf_counter()
-            x, lam, flag = self._solve(model, A[i], bu[i], bl[i], None)
-            times[i] = time.perf_counter() - ts
+        update, solve, H, f = model.update, model.solve, self.H, self._f
+        clock = time.perf_counter
+        times = [0.0] * n
+        flags = [0] * n
+        for i in np.flatnonzero(ok).tolist():  # the solver's loop: nothing else in it
+            ts = clock()
+            update(H=H, f=f, A=A[i], bupper=bu[i], blower=bl[i], sense=None)  # warm
+            x, _, flag, info = solve()
+            times[i] = clock() - ts
             if flag == 1:
-                X[i], LAM[i], solved[i] = x, lam, True
+                X[i], LAM[i], flags[i] = x, info['lam'], 1
         t1 = time.perf_counter()
+        solved = np.array(flags) == 1
         fin = self.cycle.finish_batch(b['G'], b['J'], W, b['M1w'], b['M2'], A, bu, bl, X, LAM,
                                       solved, KKT_TOLERANCE)
         redo = np.flatnonzero(ok & ~fin['passes'])
         if redo.size:  # warm answers off the KKT check or the certificate: cold
-            for i in redo:
+            for i in redo.tolist():
                 ts = time.perf_counter()
                 x, lam, flag = self._solve(model, A[i], bu[i], bl[i], sense)
                 times[i] += time.perf_counter() - ts
@@ -342,25 +391,27 @@ class BatchScorer:
                 fin[key][redo] = again[key]
         share = parse_s + (stage_s + time.perf_counter() - t1) / n
         job = self.scorer.job
-        passes, F, usage, ratio = fin['passes'], fin['f'], fin['usage'], fin['ratio']
-        for i, (k, lineno, ident, q, contacts, wrench) in enumerate(members):
+        passes = fin['passes'].tolist()
+        usage, ratio = fin['usage'], fin['ratio'].tolist()
+        usage_max = usage.max(axis=1).tolist()
+        usage = usage.tolist()
+        norms = np.sqrt(np.einsum('ij,ij->i', X, X)).tolist()
+        full, solutions = job.metrics == 'full', job.solutions
+        for i, (k, lineno, (ident, _, contacts, _, _)) in enumerate(members):
             if not passes[i]:
                 continue  # the single path answers (and confirms an infeasible load)
-            ts = time.perf_counter()
-            tau = X[i]
-            u = usage[i]
+            ts = clock()
             rec = {'line': lineno, 'id': ident, 'status': 'optimal', 'error': None,
-                   'torque_norm': float(np.linalg.norm(tau)),
-                   'max_torque_ratio': float(ratio[i]),
-                   'friction_usage_max': float(u.max()), 'friction_usage': u.tolist(),
-                   'backend': 'daqp', 'solve_time_s': float(times[i])}
-            if job.solutions:
-                rec['tau'] = tau.tolist()
-                rec['wrenches'] = F[i].reshape(-1, 4).tolist()
-            if job.metrics == 'full':
-                setup, maps = self._bound(q, contacts, wrench, b, i)
+                   'torque_norm': norms[i], 'max_torque_ratio': ratio[i],
+                   'friction_usage_max': usage_max[i], 'friction_usage': usage[i],
+                   'backend': 'daqp', 'solve_time_s': times[i]}
+            if solutions:
+                rec['tau'] = X[i].tolist()
+                rec['wrenches'] = fin['f'][i].reshape(-1, 4).tolist()
+            if full:
+                setup, maps = self._bound(Q[i], contacts, W[i], b, i)
                 rec.update(self.scorer.capacities(setup, maps, 'optimal'))
-            rec['time_s'] = share + times[i] + time.perf_counter() - ts
+            rec['time_s'] = share + times[i] + clock() - ts
             records[k] = rec
             self.staged += 1
 
