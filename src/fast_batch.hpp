@@ -78,9 +78,12 @@ py::dict build_batch(
   const py::ssize_t n_rows = n_eq + n_in, n_bounds = m + n_rows;
   py::array_t<bool> ok(N);
   std::vector<std::string> why(N);
-  auto G = zeros({N, 6, nf}), J = zeros({N, nf, m}), M1w = zeros({N, nf});
-  auto M2 = zeros({N, nf, m}), positions = zeros({N, p, 3}), rotations = zeros({N, p, 3, 3});
-  auto A = zeros({N, n_rows, m}), bupper = zeros({N, n_bounds}), blower = zeros({N, n_bounds});
+  // Written for every candidate below (zeros where it is not ok): not filled first.
+  using Out = py::array_t<double>;
+  Out G({N, py::ssize_t(6), nf}), J({N, nf, py::ssize_t(m)}), M1w({N, nf});
+  Out M2({N, nf, py::ssize_t(m)}), positions({N, p, py::ssize_t(3)});
+  Out rotations({N, p, py::ssize_t(3), py::ssize_t(3)});
+  Out A({N, n_rows, py::ssize_t(m)}), bupper({N, n_bounds}), blower({N, n_bounds});
   const Vec off = Vec::Zero(m);
   {
     py::gil_scoped_release release;
@@ -106,6 +109,10 @@ py::dict build_batch(
       }
       ok.mutable_data()[i] = good;
       if (!good) {
+        for (Out * a : {&G, &J, &M1w, &M2, &positions, &rotations, &A, &bupper, &blower}) {
+          const py::ssize_t per = a->size() / N;
+          std::fill(a->mutable_data() + per * i, a->mutable_data() + per * (i + 1), 0.0);
+        }
         continue;
       }
       std::copy(maps.G.data(), maps.G.data() + maps.G.size(), G.mutable_data() + 6 * nf * i);
@@ -156,15 +163,18 @@ py::dict build_batch(
   return d;
 }
 
-// backends/daqp.kkt_violation of min 1/2 x'Hx, H = 2 diag(weights), blower <= [x; A x] <=
-// bupper, with DAQP's multipliers lam (bounds on x first).
+// backends/daqp.kkt_violation of min 1/2 x'Hx + g'x, H = diag(hdiag), blower <= [x; A x]
+// <= bupper, with DAQP's multipliers lam (bounds on x first).
 double daqp_kkt(
-  const Vec & weights, const double * A, const double * up, const double * lo,
-  const double * x, const double * lam, int n, int rows)
+  const Vec & hdiag, const double * g, const double * A, const double * up,
+  const double * lo, const double * x, const double * lam, int n, int rows)
 {
   Eigen::Map<const RowMat> Am(A, rows, n);
   Eigen::Map<const Vec> xv(x, n), lv(lam, n + rows);
-  const Vec grad = 2.0 * weights.cwiseProduct(xv);
+  Vec grad = hdiag.cwiseProduct(xv);
+  if (g != nullptr) {
+    grad += Eigen::Map<const Vec>(g, n);
+  }
   Vec residual = Am.transpose() * lv.tail(rows) + lv.head(n) + grad;
   const Vec Ax = Am * xv;
   double infeasible = -std::numeric_limits<double>::infinity();
@@ -209,6 +219,7 @@ py::dict finish_batch(
   auto ratio = zeros({N});
   py::array_t<bool> passes(N);
   const Vec tau_max = fc.limits(), tau_min = -fc.limits();
+  const Vec hdiag = 2.0 * fc.weights();
   {
     py::gil_scoped_release release;
     const double inf = std::numeric_limits<double>::infinity();
@@ -216,7 +227,7 @@ py::dict finish_batch(
       bool good = solved.data()[i];
       double * ci = cert.mutable_data() + 6 * i;
       kkt.mutable_data()[i] = good ? daqp_kkt(
-        fc.weights(), A.data() + rows * m * i, bupper.data() + nb * i,
+        hdiag, nullptr, A.data() + rows * m * i, bupper.data() + nb * i,
         blower.data() + nb * i, x.data() + m * i, lam.data() + nb * i, m, rows) : inf;
       good = good && kkt.data()[i] <= kkt_tolerance;
       if (!good) {
@@ -334,6 +345,69 @@ py::tuple kinematics_batch(
     }
   }
   return py::make_tuple(oMf, J6);
+}
+
+// The capacity LPs' answers (methods/capacity.CapacityLP, solved by DAQP as
+// methods/lp.solve_lp solves them): LP k is candidate cand[k]'s (its G (6, nf) and J
+// (nf, m)) for the load loads[k], over x = [f; alpha] with the rows A[k] (rows, nf + 1),
+// the bounds blower, bupper (nf + 1 + rows, DAQP's form) and the cost c. Where ok[k]
+// (DAQP's flag 1 or 2, x finite): the KKT violation of (x[k], lam[k]) with a zero
+// Hessian, then alpha = x[k][-1] / scale[k] and the certificate of (J^T f, f) at the load
+// alpha loads[k] (the planned cone). passes[k]: KKT within kkt_tolerance, alpha below
+// (1 - 1e-9) alpha_max (else unbounded) and the certificate within the tolerance.
+py::dict lp_finish_batch(
+  const FastCycle & fc, Array G, Array J, py::array_t<int64_t> cand, Array loads,
+  Array scale, Array A, Array blower, Array bupper, Array c, Array x, Array lam,
+  py::array_t<bool, py::array::c_style | py::array::forcecast> ok, double kkt_tolerance,
+  double alpha_max)
+{
+  const int m = fc.m();
+  expect(G.ndim() == 3 && G.shape(1) == 6, "G of the wrong shape");
+  const py::ssize_t N = G.shape(0), nf = G.shape(2), n = nf + 1;
+  expect(J.size() == N * nf * m, "J of the wrong shape");
+  const py::ssize_t K = cand.size();
+  expect(A.ndim() == 3 && A.shape(0) == K && A.shape(2) == n, "A of the wrong shape");
+  const int rows = static_cast<int>(A.shape(1));
+  const py::ssize_t nb = n + rows;
+  expect(
+    loads.size() == 6 * K && scale.size() == K && x.size() == K * n && lam.size() == K * nb &&
+    ok.size() == K && blower.size() == nb && bupper.size() == nb && c.size() == n,
+    "LP arrays of the wrong shape");
+  for (py::ssize_t k = 0; k < K; ++k) {
+    expect(cand.data()[k] >= 0 && cand.data()[k] < N, "candidate index out of range");
+  }
+  auto kkt = zeros({K}), alpha = zeros({K});
+  py::array_t<bool> passes(K);
+  const Vec tau_max = fc.limits(), tau_min = -fc.limits(), hdiag = Vec::Zero(n);
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t k = 0; k < K; ++k) {
+      const int64_t i = cand.data()[k];
+      const double * xk = x.data() + n * k;
+      bool good = ok.data()[k];
+      kkt.mutable_data()[k] = good ? daqp_kkt(
+        hdiag, c.data(), A.data() + rows * n * k, bupper.data(), blower.data(), xk,
+        lam.data() + nb * k, static_cast<int>(n), rows) :
+        std::numeric_limits<double>::infinity();
+      good = good && kkt.data()[k] <= kkt_tolerance && xk[nf] < (1.0 - 1e-9) * alpha_max;
+      const double a = xk[nf] / scale.data()[k];
+      alpha.mutable_data()[k] = a;
+      if (good) {
+        const Vec f = Eigen::Map<const Vec>(xk, nf);
+        const RowMat Gi = Eigen::Map<const RowMat>(G.data() + 6 * nf * i, 6, nf);
+        const RowMat Ji = Eigen::Map<const RowMat>(J.data() + nf * m * i, nf, m);
+        const Vec tau = Ji.transpose() * f;
+        const Wrench w = a * Eigen::Map<const Wrench>(loads.data() + 6 * k);
+        good = fc.passes(fc.certify(Gi, Ji, w, tau_min, tau_max, tau, f));
+      }
+      passes.mutable_data()[k] = good;
+    }
+  }
+  py::dict d;
+  d["kkt"] = kkt;
+  d["alpha"] = alpha;
+  d["passes"] = passes;
+  return d;
 }
 
 }  // namespace

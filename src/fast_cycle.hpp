@@ -957,7 +957,12 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
   .def("finish_batch", &finish_batch, py::arg("G"), py::arg("J"), py::arg("w_ext"),
     py::arg("M1w"), py::arg("M2"), py::arg("A"), py::arg("bupper"), py::arg("blower"),
     py::arg("x"), py::arg("lam"), py::arg("solved"), py::arg("kkt_tolerance"),
-    "KKT check, wrenches, certificate and planner numbers of N DAQP answers.");
+    "KKT check, wrenches, certificate and planner numbers of N DAQP answers.")
+  .def("lp_finish_batch", &lp_finish_batch, py::arg("G"), py::arg("J"), py::arg("cand"),
+    py::arg("loads"), py::arg("scale"), py::arg("A"), py::arg("blower"), py::arg("bupper"),
+    py::arg("c"), py::arg("x"), py::arg("lam"), py::arg("ok"), py::arg("kkt_tolerance"),
+    py::arg("alpha_max"),
+    "KKT check, alpha and certificate of K capacity-LP answers.");
   mod.def("kinematics_batch", &kinematics_batch, py::arg("Q"), py::arg("parents"),
     py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"),
     py::arg("idx_v"), py::arg("fparent"), py::arg("Rf"), py::arg("tf"), py::arg("nv"),

@@ -18,7 +18,8 @@ stages); one DAQP solve per candidate, each warm-started from its neighbour's
 active set (a warm answer off the KKT check or the certificate is solved again
 cold); then the KKT check, the certificate against the exact cone and the planner's
 numbers of every answer in one compiled call (``finish_batch``). Full metrics then
-run :mod:`.capacity`'s LPs on the candidate's maps, as the single path does.
+solve :mod:`.capacity`'s LPs as the single path does, their checks in one compiled
+call (:mod:`.batch_capacity`).
 
 Everything else goes to the single path (:meth:`Scorer.score_line`), whose answer is
 then the record, so a record never depends on the path: a line with another field
@@ -51,6 +52,7 @@ from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.scenario import MAX_CONTACTS, parse_scenario, weight_wrench
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
 from grasp_torque_opt.core.tree_kinematics import supported, TreeKinematics
+from grasp_torque_opt.methods.batch_capacity import CapacityBatch
 from grasp_torque_opt.methods.score import MAX_LINE, Scorer
 import numpy as np
 
@@ -137,6 +139,43 @@ def parse_contacts(raw: Any, hand) -> tuple:
     return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
 
 
+def why_not(scorer: Scorer) -> str:
+    """Say why a job takes the single path for every line ('' if it does not)."""
+    from grasp_torque_opt.core import compiled_module as compiled
+
+    job, setup, hand = scorer.job, scorer.base, scorer.base.hand
+    module = compiled._fast_cycle
+    if module is None or not hasattr(module, 'kinematics_batch'):
+        return compiled.IMPORT_ERROR or 'the compiled cycle has no batch stages'
+    if job.backend != 'daqp':
+        return f'backend {job.backend} (the batch stages solve with DAQP)'
+    if (job.objective or setup.objective) != 'sum-of-squares':
+        return 'objective min-max (the batch stages solve the sum of squares)'
+    if hand.velocity_map is not None or hand.coupling.mimics:
+        return 'coupled joints'
+    if hand.base_link is not None:
+        return 'hand.base_link'
+    if isinstance(scorer.doc.get('hand'), dict) and scorer.doc['hand'].get('name_map'):
+        return 'hand.name_map'
+    return supported(hand.model)
+
+
+def contact_arrays(hand, specs) -> tuple:
+    """(frame ids, links, points, normals, has_normal, tangents, has_tangent) of specs."""
+    p = len(specs)
+    normals, tangents = np.zeros((p, 3)), np.zeros((p, 3))
+    has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+    for i, spec in enumerate(specs):
+        if spec.normal is not None:
+            normals[i], has_n[i] = spec.normal, True
+        if spec.tangent is not None:
+            tangents[i], has_t[i] = spec.tangent, True
+    links = tuple(spec.link for spec in specs)
+    fids = tuple(hand.frame_index(link, 'link') for link in links)
+    points = np.array([spec.position for spec in specs], dtype=float).reshape(p, 3)
+    return fids, links, points, normals, has_n, tangents, has_t
+
+
 class BatchScorer:
     """
     Scores chunks of candidates of one job: the batch stages, the single path for the rest.
@@ -150,7 +189,7 @@ class BatchScorer:
         #: Candidates answered by the batch stages, and by the single path.
         self.staged = 0
         self.single = 0
-        self.why_not = self._why_not()
+        self.why_not = why_not(scorer)
         if self.why_not:
             return
         from grasp_torque_opt.core import compiled_module as compiled  # the compiled stages
@@ -162,7 +201,7 @@ class BatchScorer:
         self.joint_q = {name: model.joints[model.getJointId(name)].idx_q
                         for name in hand.one_dof_joints(model)}
         self.q0 = setup.q
-        self.contacts = self._contact_arrays(setup.contacts)
+        self.contacts = contact_arrays(hand, setup.contacts)
         self.origin = np.asarray(setup.object_origin, dtype=float)
         self.base_extra = np.asarray(sc.extra_wrench, dtype=float)
         self.base_has_extra = (isinstance(scorer.doc.get('load'), dict)
@@ -186,47 +225,11 @@ class BatchScorer:
             friction.mu1, friction.mu2, setup.friction.mu1, setup.friction.mu2,
             friction.min_normal_force, False, s)
         self.H = np.diag(2.0 * np.asarray(setup.weights, dtype=float))
+        self.capacity = CapacityBatch(self.cycle)
         self.daqp = scorer.solver.settings
         import daqp
 
         self._daqp = daqp
-
-    def _why_not(self) -> str:
-        """Say why this job takes the single path for every line ('' if it does not)."""
-        from grasp_torque_opt.core import compiled_module as compiled
-
-        job, setup, hand = self.scorer.job, self.scorer.base, self.scorer.base.hand
-        module = compiled._fast_cycle
-        if module is None or not hasattr(module, 'kinematics_batch'):
-            return compiled.IMPORT_ERROR or 'the compiled cycle has no batch stages'
-        if job.backend != 'daqp':
-            return f'backend {job.backend} (the batch stages solve with DAQP)'
-        if (job.objective or setup.objective) != 'sum-of-squares':
-            return 'objective min-max (the batch stages solve the sum of squares)'
-        if hand.velocity_map is not None or hand.coupling.mimics:
-            return 'coupled joints'
-        if hand.base_link is not None:
-            return 'hand.base_link'
-        if isinstance(self.scorer.doc.get('hand'), dict) and \
-                self.scorer.doc['hand'].get('name_map'):
-            return 'hand.name_map'
-        return supported(hand.model)
-
-    def _contact_arrays(self, specs) -> tuple:
-        """(frame ids, links, points, normals, has_normal, tangents, has_tangent) of specs."""
-        hand = self.scorer.base.hand
-        p = len(specs)
-        normals, tangents = np.zeros((p, 3)), np.zeros((p, 3))
-        has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
-        for i, spec in enumerate(specs):
-            if spec.normal is not None:
-                normals[i], has_n[i] = spec.normal, True
-            if spec.tangent is not None:
-                tangents[i], has_t[i] = spec.tangent, True
-        links = tuple(spec.link for spec in specs)
-        fids = tuple(hand.frame_index(link, 'link') for link in links)
-        points = np.array([spec.position for spec in specs], dtype=float).reshape(p, 3)
-        return fids, links, points, normals, has_n, tangents, has_t
 
     # -- the cheap parse ---------------------------------------------------------------
     def parse(self, lineno: int, text: Any) -> tuple:
@@ -362,13 +365,14 @@ class BatchScorer:
         sense[m:m + b['n_eq']] = 5  # equality
         stage_s = time.perf_counter() - t0
         model = self._model(A, bu, bl, sense, ok)
-        update, solve, H, f = model.update, model.solve, self.H, self._f
+        update, solve = model.update, model.solve
         clock = time.perf_counter
         times = [0.0] * n
         flags = [0] * n
         for i in np.flatnonzero(ok).tolist():  # the solver's loop: nothing else in it
             ts = clock()
-            update(H=H, f=f, A=A[i], bupper=bu[i], blower=bl[i], sense=None)  # warm
+            # Warm: DAQP keeps H, f and the last active set (every answer is KKT-checked).
+            update(A=A[i], bupper=bu[i], blower=bl[i])
             x, _, flag, info = solve()
             times[i] = clock() - ts
             if flag == 1:
@@ -396,7 +400,15 @@ class BatchScorer:
         usage_max = usage.max(axis=1).tolist()
         usage = usage.tolist()
         norms = np.sqrt(np.einsum('ij,ij->i', X, X)).tolist()
-        full, solutions = job.metrics == 'full', job.solutions
+        full = None
+        if job.metrics == 'full':  # the capacity LPs of the certified candidates
+            t2 = clock()
+            good = [i for i in range(n) if passes[i]]
+            full = dict(zip(good, self.capacity.metrics(
+                b['G'][good], b['J'][good], W[good],
+                lambda j: self._bound(Q[good[j]], members[good[j]][2][2], W[good[j]], b,
+                                      good[j]))))
+            share += (clock() - t2) / max(1, len(good))
         for i, (k, lineno, (ident, _, contacts, _, _)) in enumerate(members):
             if not passes[i]:
                 continue  # the single path answers (and confirms an infeasible load)
@@ -405,12 +417,11 @@ class BatchScorer:
                    'torque_norm': norms[i], 'max_torque_ratio': ratio[i],
                    'friction_usage_max': usage_max[i], 'friction_usage': usage[i],
                    'backend': 'daqp', 'solve_time_s': times[i]}
-            if solutions:
+            if job.solutions:
                 rec['tau'] = X[i].tolist()
                 rec['wrenches'] = fin['f'][i].reshape(-1, 4).tolist()
-            if full:
-                setup, maps = self._bound(Q[i], contacts, W[i], b, i)
-                rec.update(self.scorer.capacities(setup, maps, 'optimal'))
+            if full is not None:
+                rec.update(full[i])
             rec['time_s'] = share + times[i] + clock() - ts
             records[k] = rec
             self.staged += 1

@@ -149,3 +149,36 @@ def test_tree_kinematics_equal_pinocchios(module):
     Q = setup.q + rng.uniform(-1.5, 1.5, (25, setup.hand.model.nq))
     frames = tuple(range(1, setup.hand.model.nframes))  # every frame, not only the tips
     assert kin.check(Q, frames, tol=1e-12) <= 1e-12
+
+
+CHAIN = """<robot name="chain">
+  <link name="base"/><link name="a"/><link name="b"/><link name="c"/>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="a"/>
+    <origin xyz="0.1 0.02 0" rpy="0.3 0 0.2"/><axis xyz="0.6 0 0.8"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <joint name="hinge" type="revolute"><parent link="a"/><child link="b"/>
+    <origin xyz="0 0.05 0.01" rpy="0 0.4 0"/><axis xyz="0.2 0.5 -0.3"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="tip" type="fixed"><parent link="b"/><child link="c"/>
+    <origin xyz="0.03 0 0.04" rpy="0.1 0.2 0.3"/></joint>
+</robot>"""
+
+
+@pytest.mark.parametrize('module', [None, 'compiled'])
+def test_tree_kinematics_take_prismatic_joints_and_unaligned_axes(module):
+    import pinocchio as pin
+
+    model = pin.buildModelFromXML(CHAIN)
+    kin = TreeKinematics(model, compiled._fast_cycle if module else None)
+    Q = np.random.default_rng(8).uniform(-1.0, 1.0, (30, model.nq))
+    assert kin.check(Q, tuple(range(model.nframes)), tol=1e-12) <= 1e-12
+
+
+def test_a_hand_with_coupled_joints_takes_the_single_path():
+    from conftest import CONFIG
+
+    job = ScoreJob.from_file(CONFIG / 'ability_right.yaml', metrics='basic')
+    batch = BatchScorer(Scorer(job))
+    assert batch.why_not  # coupled joints, or a joint the stages do not take
+    lines = [(1, '{}'), (2, '{"gravity": null, "load": {"external_wrench": [0, 0, 1, 0, 0, 0]}}')]
+    assert_same(batch.score_lines(lines), Scorer(job).score_lines(lines))
