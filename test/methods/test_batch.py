@@ -182,3 +182,18 @@ def test_a_hand_with_coupled_joints_takes_the_single_path():
     assert batch.why_not  # coupled joints, or a joint the stages do not take
     lines = [(1, '{}'), (2, '{"gravity": null, "load": {"external_wrench": [0, 0, 1, 0, 0, 0]}}')]
     assert_same(batch.score_lines(lines), Scorer(job).score_lines(lines))
+
+
+def test_the_planar_hand_scores_as_the_single_path():
+    from conftest import CONFIG
+
+    job = ScoreJob.from_file(CONFIG / 'planar_two_finger.yaml', metrics='full')
+    rng = np.random.default_rng(9)
+    lines = [(i + 1, json.dumps({'gravity': None, 'load': {
+        'external_wrench': (rng.normal(size=6) * [2, 2, 2, 0.01, 0.01, 0.01]).tolist()}}))
+        for i in range(40)]
+    batch = BatchScorer(Scorer(job))
+    assert_same(batch.score_lines(lines), Scorer(job).score_lines(lines), tol=1e-6)
+    # Two contacts: A = [G; J^T] has internal-force directions (not of full column rank),
+    # which the compiled build hands back: every line takes the single path.
+    assert batch.single == len(lines) and batch.staged == 0
