@@ -37,6 +37,64 @@ py::array_t<double> zeros(std::vector<py::ssize_t> shape)
   return out;
 }
 
+
+// The build stage of FastCycle::build (core/tau_qp.build_tau_qp, the QR branch) for the
+// batch, with no torque offset, computing only what the batch needs and reusing its
+// storage: with A = [G; J^T] = Q [R; 0], Q^T applied once to [[0, w]; [I_m, 0]] gives
+// Q1^T and U_perp^T on those columns, so M2 = R^-1 (Q1^T [0; I_m]), M1 w = R^-1 (Q1^T [w; 0]),
+// A_eq = U_perp[6:]^T and b = -U_perp[:6]^T w without forming Q or pinv(A).
+struct LeanBuild
+{
+  Mat A_full, T, X;
+  Eigen::HouseholderQR<Mat> qr;
+  RowMat C;
+  Vec u;
+
+  // false and why where FastCycle::build hands back (not of full column rank, not finite).
+  bool run(
+    const FastCycle & fc, const RowMat & G, const RowMat & J, const Wrench & w_ext,
+    std::string & why)
+  {
+    const int m = fc.m(), cols = static_cast<int>(G.cols()), p = cols / 4, rows = 6 + m;
+    if (rows < cols) {
+      why = "A = [G; J^T] has more columns than rows";
+      return false;
+    }
+    A_full.resize(rows, cols);
+    A_full.topRows(6) = G;
+    A_full.bottomRows(m) = J.transpose();
+    if (!A_full.allFinite()) {
+      why = "maps not finite";
+      return false;
+    }
+    qr.compute(A_full);
+    const Mat & packed = qr.matrixQR();
+    const Vec d = packed.diagonal().head(cols).cwiseAbs();
+    if (!(d.minCoeff() > fc.settings().qr_rtol * d.maxCoeff())) {
+      why = "A = [G; J^T] is not of full column rank";
+      return false;
+    }
+    T.setZero(rows, m + 1);
+    T.bottomLeftCorner(m, m).setIdentity();
+    T.col(m).head<6>() = -w_ext;  // w
+    T.applyOnTheLeft(qr.householderQ().adjoint());
+    X = packed.topRows(cols).triangularView<Eigen::Upper>().solve(T.topRows(cols));
+    const RowMat & S = fc.S_i();
+    const int block = static_cast<int>(S.rows());
+    C.resize(block * p, m);
+    u.resize(block * p);
+    for (int i = 0; i < p; ++i) {
+      C.middleRows(block * i, block) = S * X.block(4 * i, 0, 4, m);
+      u.segment(block * i, block) = fc.b_i() - S * X.col(m).segment<4>(4 * i);
+    }
+    return true;
+  }
+  auto M2() const {return X.leftCols(X.cols() - 1);}
+  auto M1w() const {return X.col(X.cols() - 1);}
+  auto A_eq() const {return T.bottomLeftCorner(T.rows() - X.rows(), T.cols() - 1);}
+  auto b_neg() const {return T.bottomRightCorner(T.rows() - X.rows(), 1);}  // -b
+};
+
 // The maps and build stages for N candidates with p contacts each. oMf (N, p, 4, 4),
 // J6 (N, p, 6, nv), points, normals, tangents (N, p, 3), has_normal, has_tangent (N, p),
 // c (3), w_ext (N, 6). Returns a dict: ok (N) and why (N strings: '' where ok), and for
@@ -84,7 +142,6 @@ py::dict build_batch(
   Out M2({N, nf, py::ssize_t(m)}), positions({N, p, py::ssize_t(3)});
   Out rotations({N, p, py::ssize_t(3), py::ssize_t(3)});
   Out A({N, n_rows, py::ssize_t(m)}), bupper({N, n_bounds}), blower({N, n_bounds});
-  const Vec off = Vec::Zero(m);
   {
     py::gil_scoped_release release;
     Kinematics k;
@@ -92,7 +149,8 @@ py::dict build_batch(
     k.nv = static_cast<int>(nv);
     k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
     Maps maps;
-    QPData qp;
+    LeanBuild lean;
+    const double box_margin = fc.settings().box_margin;
     for (py::ssize_t i = 0; i < N; ++i) {
       k.oMf = oMf.data() + 16 * p * i;
       k.J6 = J6.data() + 6 * nv * p * i;
@@ -102,8 +160,8 @@ py::dict build_batch(
       k.has_normal = has_normal.data() + p * i;
       k.has_tangent = has_tangent.data() + p * i;
       const Wrench w = Eigen::Map<const Wrench>(w_ext.data() + 6 * i);
-      bool good = fc.maps(k, maps, why[i]) && fc.build(maps.G, maps.J, w, off, qp, why[i]);
-      if (good && qp.A.rows() != n_eq) {
+      bool good = fc.maps(k, maps, why[i]) && lean.run(fc, maps.G, maps.J, w, why[i]);
+      if (good && lean.T.rows() - lean.X.rows() != n_eq) {
         why[i] = "A = [G; J^T] is not of full column rank";
         good = false;
       }
@@ -123,22 +181,22 @@ py::dict build_batch(
       std::copy(
         maps.rotations.data(), maps.rotations.data() + maps.rotations.size(),
         rotations.mutable_data() + 9 * p * i);
-      Eigen::Map<Vec>(M1w.mutable_data() + nf * i, nf) = qp.M1() * qp.w;
-      Eigen::Map<RowMat>(M2.mutable_data() + nf * m * i, nf, m) = qp.M2();
+      Eigen::Map<Vec>(M1w.mutable_data() + nf * i, nf) = lean.M1w();
+      Eigen::Map<RowMat>(M2.mutable_data() + nf * m * i, nf, m) = lean.M2();
       Eigen::Map<RowMat> Ai(A.mutable_data() + n_rows * m * i, n_rows, m);
-      Ai.topRows(n_eq) = qp.A;
-      Ai.bottomRows(n_in) = qp.C;
+      Ai.topRows(n_eq) = lean.A_eq();
+      Ai.bottomRows(n_in) = lean.C;
       double * up = bupper.mutable_data() + n_bounds * i;
       double * lo = blower.mutable_data() + n_bounds * i;
-      for (int j = 0; j < m; ++j) {
-        up[j] = std::min(qp.u_box(j), DAQP_INF);
-        lo[j] = std::max(qp.l_box(j), -DAQP_INF);
+      for (int j = 0; j < m; ++j) {  // the box: tau_min, tau_max = -+limits, BOX_MARGIN in
+        up[j] = std::min(fc.limits()(j) - box_margin, DAQP_INF);
+        lo[j] = std::max(-fc.limits()(j) + box_margin, -DAQP_INF);
       }
       for (py::ssize_t j = 0; j < n_eq; ++j) {
-        up[m + j] = lo[m + j] = qp.b(j);
+        up[m + j] = lo[m + j] = -lean.b_neg()(j, 0);
       }
       for (py::ssize_t j = 0; j < n_in; ++j) {
-        up[m + n_eq + j] = qp.u(j);
+        up[m + n_eq + j] = lean.u(j);
         lo[m + n_eq + j] = -DAQP_INF;
       }
     }

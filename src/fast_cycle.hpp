@@ -512,6 +512,9 @@ public:
   const Vec & weights() const {return weights_;}
   const Vec & limits() const {return limits_;}
   double mu1_usage() const {return mu1_usage_;}
+  const RowMat & S_i() const {return S_i_;}
+  const Vec & b_i() const {return b_i_;}
+  const Settings & settings() const {return s_;}
   double mu2_usage() const {return mu2_usage_;}
 
   bool passes(const Certificate & c) const

@@ -359,8 +359,6 @@ class BatchScorer:
         m = self.scorer.base.hand.m
         A, bu, bl = b['A'], b['bupper'], b['blower']
         rows = A.shape[1]
-        X = np.zeros((n, m))
-        LAM = np.zeros((n, m + rows))
         sense = np.zeros(m + rows, dtype=np.int32)
         sense[m:m + b['n_eq']] = 5  # equality
         stage_s = time.perf_counter() - t0
@@ -369,15 +367,19 @@ class BatchScorer:
         clock = time.perf_counter
         times = [0.0] * n
         flags = [0] * n
+        zero_x, zero_lam = np.zeros(m), np.zeros(m + rows)
+        xs, lams = [zero_x] * n, [zero_lam] * n
+        A_rows, bu_rows, bl_rows = list(A), list(bu), list(bl)
         for i in np.flatnonzero(ok).tolist():  # the solver's loop: nothing else in it
             ts = clock()
             # Warm: DAQP keeps H, f and the last active set (every answer is KKT-checked).
-            update(A=A[i], bupper=bu[i], blower=bl[i])
+            update(A=A_rows[i], bupper=bu_rows[i], blower=bl_rows[i])
             x, _, flag, info = solve()
             times[i] = clock() - ts
             if flag == 1:
-                X[i], LAM[i], flags[i] = x, info['lam'], 1
+                xs[i], lams[i], flags[i] = x, info['lam'], 1
         t1 = time.perf_counter()
+        X, LAM = np.array(xs), np.array(lams)
         solved = np.array(flags) == 1
         fin = self.cycle.finish_batch(b['G'], b['J'], W, b['M1w'], b['M2'], A, bu, bl, X, LAM,
                                       solved, KKT_TOLERANCE)
