@@ -13,11 +13,11 @@ Batch scoring at the solver's speed: many candidates of one hand, bound once.
 each over the whole chunk: a cheap parse of the fields that vary (joint positions,
 contacts, load); the kinematics of every configuration in one compiled call
 (:mod:`grasp_torque_opt.core.tree_kinematics`); the maps and the tau-QP of every
-candidate in one compiled call (``build_batch``, the compiled cycle's maps and build
-stages); one DAQP solve per candidate, each warm-started from its neighbour's
-active set (a warm answer off the KKT check or the certificate is solved again
-cold); then the KKT check, the certificate against the exact cone and the planner's
-numbers of every answer in one compiled call (``finish_batch``). Full metrics then
+candidate in one compiled call (``build_batch``: the compiled cycle's maps stage and
+its QR build written for the batch); one DAQP solve per candidate, each warm-started
+from its neighbour's active set (a warm answer off the KKT check or the certificate is
+solved again cold); then the KKT check, the certificate against the exact cone and
+the planner's numbers of every answer in one compiled call (``finish_batch``). Full metrics then
 solve :mod:`.capacity`'s LPs as the single path does, their checks in one compiled
 call (:mod:`.batch_capacity`).
 
