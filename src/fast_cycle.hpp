@@ -507,6 +507,20 @@ public:
 
   int dims_changes() const {return inits_;}
   int m() const {return m_;}
+  // What the batch stages (fast_batch.hpp) read.
+  int cone_rows() const {return static_cast<int>(S_i_.rows());}
+  const Vec & weights() const {return weights_;}
+  const Vec & limits() const {return limits_;}
+  double mu1_usage() const {return mu1_usage_;}
+  const RowMat & S_i() const {return S_i_;}
+  const Vec & b_i() const {return b_i_;}
+  const Settings & settings() const {return s_;}
+  double mu2_usage() const {return mu2_usage_;}
+
+  bool passes(const Certificate & c) const
+  {
+    return c.finite && *std::max_element(c.r, c.r + 5) <= s_.certificate_tolerance;
+  }
 
 private:
   // One cycle: maps, build, solve_qp, certify (a warm answer off the certificate solved
@@ -558,11 +572,6 @@ private:
     if (a.code == CERTIFIED) {
       planner_metrics(a, off);
     }
-  }
-
-  bool passes(const Certificate & c) const
-  {
-    return c.finite && *std::max_element(c.r, c.r + 5) <= s_.certificate_tolerance;
   }
 
   // dispatch.planner_metrics: usage on the unreduced cone, max |tau + offset| / limit.
@@ -781,6 +790,8 @@ Wrench wrench(const Array & a)
 
 }  // namespace
 
+#include "fast_batch.hpp"
+
 // The module's name comes from the file that includes this one: fast_cycle.cpp
 // (_fast_cycle, for any CPU) or fast_cycle_avx2.cpp (_fast_cycle_avx2, built with AVX2
 // and FMA; compiled.py loads it only where the CPU has them).
@@ -788,7 +799,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 2;
+  mod.attr("API") = 3;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -940,7 +951,25 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
       return py::make_tuple(c.r[0], c.r[1], c.r[2], c.r[3], c.r[4], c.finite);
     }, py::arg("G"), py::arg("J"), py::arg("w_ext"), py::arg("tau_min"), py::arg("tau_max"),
     py::arg("tau"), py::arg("f"),
-    "The certify stage: (equilibrium, torque, cone, normal_force, limit, finite).");
+    "The certify stage: (equilibrium, torque, cone, normal_force, limit, finite).")
+  // Batch scoring (fast_batch.hpp, grasp_torque_opt.methods.batch).
+  .def("build_batch", &build_batch, py::arg("oMf"), py::arg("J6"), py::arg("points"),
+    py::arg("normals"), py::arg("has_normal"), py::arg("tangents"), py::arg("has_tangent"),
+    py::arg("c"), py::arg("w_ext"),
+    "The maps and build stages of N candidates, each tau-QP in DAQP's form.")
+  .def("finish_batch", &finish_batch, py::arg("G"), py::arg("J"), py::arg("w_ext"),
+    py::arg("M1w"), py::arg("M2"), py::arg("A"), py::arg("bupper"), py::arg("blower"),
+    py::arg("x"), py::arg("lam"), py::arg("solved"), py::arg("kkt_tolerance"),
+    "KKT check, wrenches, certificate and planner numbers of N DAQP answers.")
+  .def("lp_finish_batch", &lp_finish_batch, py::arg("G"), py::arg("J"), py::arg("cand"),
+    py::arg("loads"), py::arg("scale"), py::arg("A"), py::arg("blower"), py::arg("bupper"),
+    py::arg("c"), py::arg("x"), py::arg("lam"), py::arg("ok"), py::arg("kkt_tolerance"),
+    py::arg("alpha_max"),
+    "KKT check, alpha and certificate of K capacity-LP answers.");
+  mod.def("kinematics_batch", &kinematics_batch, py::arg("Q"), py::arg("parents"),
+    py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"),
+    py::arg("idx_v"), py::arg("fparent"), py::arg("Rf"), py::arg("tf"), py::arg("nv"),
+    "Frame placements and LOCAL_WORLD_ALIGNED Jacobians of N configurations of a tree.");
 }
 
 #endif  // FAST_CYCLE_HPP_

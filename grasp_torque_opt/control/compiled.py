@@ -32,8 +32,6 @@ one to.
 from __future__ import annotations
 
 from dataclasses import dataclass
-import importlib
-import platform
 
 from grasp_torque_opt.backends.proxsuite import (
     ESTIMATE_DECAY,
@@ -42,6 +40,16 @@ from grasp_torque_opt.backends.proxsuite import (
     TauQPSolver,
 )
 from grasp_torque_opt.core.certificate import Certificate
+# The compiled modules are found and loaded in core (batch scoring, in methods, uses
+# them too); their names stay here.
+from grasp_torque_opt.core.compiled_module import (  # noqa: F401 -- re-exported
+    _fast_cycle,
+    API,
+    cpu_has_avx2,
+    IMPORT_ERROR,
+    load,
+    MODULES,
+)
 from grasp_torque_opt.core.friction import contact_block
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -50,44 +58,6 @@ from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
 import numpy as np
 import pinocchio as pin
-
-#: The interface of src/fast_cycle.hpp this module speaks (its ``API``).
-API = 2
-
-
-def cpu_has_avx2() -> bool:
-    """Tell whether this CPU and its OS run AVX2 and FMA code (ProxSuite's own cpuid check)."""
-    if platform.machine().lower() not in ('x86_64', 'amd64'):
-        return False
-    try:
-        from proxsuite import instructionset
-        return bool(instructionset.has_AVX2() and instructionset.has_FMA()
-                    and instructionset.has_OSXSAVE())
-    except (ImportError, AttributeError):
-        return False
-
-
-def load(name: str):
-    """Return the module ``name`` of the compiled cycle and '', or None and why not."""
-    try:
-        module = importlib.import_module(f'grasp_torque_opt.control.{name}')
-    except ImportError as e:  # not built (no compiler, or a colcon build without pybind11)
-        return None, f'grasp_torque_opt.control.{name} is not built ({e})'
-    if getattr(module, 'API', None) != API:
-        return None, (f'grasp_torque_opt.control.{name} was built from another '
-                      'src/fast_cycle.hpp: run scripts/setup.sh again')
-    return module, ''
-
-
-#: The modules built (``_fast_cycle_avx2`` only where this CPU runs it), best first.
-MODULES = ('_fast_cycle_avx2', '_fast_cycle') if cpu_has_avx2() else ('_fast_cycle',)
-_fast_cycle, IMPORT_ERROR = None, ''
-for _name in MODULES:
-    _fast_cycle, _why = load(_name)
-    if _fast_cycle is not None:
-        IMPORT_ERROR = ''
-        break
-    IMPORT_ERROR = IMPORT_ERROR or _why
 
 #: Share of the time left that the compiled ProxSuite solve may use; the fallback gets
 #: the rest (as :data:`grasp_torque_opt.methods.dispatch.PRIMARY_SHARE`).

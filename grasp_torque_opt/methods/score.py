@@ -88,8 +88,8 @@ ENGINES = ('serial', 'processes', 'dask')
 CANDIDATE_KEYS = ('id', 'grasp', 'friction', 'load', 'gravity', 'object', 'objective')
 #: A longer line is refused unread (bounded memory per candidate) [characters].
 MAX_LINE = 1_000_000
-#: Candidates per task sent to a worker.
-CHUNK = 64
+#: Candidates per task sent to a worker (the batch stages run over a task at once).
+CHUNK = 256
 
 
 @dataclass(frozen=True)
@@ -285,30 +285,44 @@ class Scorer:
             out['wrenches'] = (None if sol.wrenches is None
                                else [[float(v) for v in w] for w in sol.wrenches])
         if self.job.metrics == 'full':
-            lp = CapacityLP(setup, maps)
-            cap = lp.solve(setup.external_wrench, binding=False)
-            out['capacity'] = cap.value
-            out['capacity_status'] = cap.status
-            out['holdable_fraction'] = (cap.value if sol.status == 'infeasible' else None)
-            out['capacities'] = {k: c.value for k, c in
-                                 direction_capacities(setup, maps, lp, binding=False).items()}
+            out.update(self.capacities(setup, maps, sol.status))
         return out
+
+    def capacities(self, setup: GraspSetup, maps, status: str) -> dict[str, Any]:
+        """Return the full metrics of a bound candidate solved with ``status`` (plain data)."""
+        lp = CapacityLP(setup, maps)
+        cap = lp.solve(setup.external_wrench, binding=False)
+        return {'capacity': cap.value, 'capacity_status': cap.status,
+                'holdable_fraction': cap.value if status == 'infeasible' else None,
+                'capacities': {k: c.value for k, c in
+                               direction_capacities(setup, maps, lp, binding=False).items()}}
 
     def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
         """Score (line number, candidate) pairs into records, in order."""
         return [self.score_line(n, t) for n, t in lines]
 
 
-_SCORERS: dict[str, Scorer] = {}
+_SCORERS: dict[str, Any] = {}
+
+
+def batch_scorer(job: ScoreJob):
+    """Return this process's :class:`~.batch.BatchScorer` of the job, bound on first use."""
+    scorer = _SCORERS.get(job.key)
+    if scorer is None:
+        from grasp_torque_opt.methods.batch import BatchScorer  # it imports this module
+
+        single_threaded_math()
+        scorer = _SCORERS[job.key] = BatchScorer(Scorer(job))
+    return scorer
 
 
 def score_chunk(job: ScoreJob, chunk: Sequence[tuple[int, Any]]) -> list[dict[str, Any]]:
-    """Score a chunk in this process, binding the job's hand on first use (any engine's task)."""
-    scorer = _SCORERS.get(job.key)
-    if scorer is None:
-        single_threaded_math()
-        scorer = _SCORERS[job.key] = Scorer(job)
-    return scorer.score_lines(chunk)
+    """
+    Score a chunk in this process, binding the job's hand on first use (any engine's task).
+
+    The batch stages (:mod:`.batch`) score what they take, the single path the rest.
+    """
+    return batch_scorer(job).score_lines(chunk)
 
 
 def read_candidates(path: str | Path) -> list[tuple[int, str]]:

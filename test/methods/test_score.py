@@ -144,17 +144,30 @@ def test_the_process_pool_gives_the_serial_records(job, lines):
     pooled = score_batch(job, lines, engine='processes', workers=2, chunk=2,
                          progress=lambda done, total: seen.append((done, total)))
     drop = ('time_s', 'solve_time_s')
-    assert [{k: v for k, v in r.items() if k not in drop} for r in pooled] == \
-        [{k: v for k, v in r.items() if k not in drop} for r in serial]
+    # Equal to the solvers' precision: the batch stages warm-start each QP from its
+    # neighbour in the chunk, and the chunks differ.
+    assert [{k: rounded(v) for k, v in r.items() if k not in drop} for r in pooled] == \
+        [{k: rounded(v) for k, v in r.items() if k not in drop} for r in serial]
     assert seen[-1] == (len(lines), len(lines))
+
+
+def rounded(v):
+    """Return v with every float to 9 significant digits (lists and dicts too)."""
+    if isinstance(v, float):
+        return float(f'{v:.9g}')
+    if isinstance(v, (list, tuple)):
+        return [rounded(x) for x in v]
+    if isinstance(v, dict):
+        return {k: rounded(x) for k, x in v.items()}
+    return v
 
 
 def test_a_local_dask_cluster_gives_the_serial_records(job, lines):
     pytest.importorskip('distributed')
     serial = score_batch(job, lines, engine='serial')
     dask = score_batch(job, lines, engine='dask', workers=2, chunk=3)
-    assert [(r['id'], r['status'], r['capacity'], r['torque_norm']) for r in dask] == \
-        [(r['id'], r['status'], r['capacity'], r['torque_norm']) for r in serial]
+    assert [rounded((r['id'], r['status'], r['capacity'], r['torque_norm'])) for r in dask] == \
+        [rounded((r['id'], r['status'], r['capacity'], r['torque_norm'])) for r in serial]
 
 
 def test_in_memory_candidates_score_as_their_lines(allegro):

@@ -1,0 +1,59 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+Find and load the compiled cycle's module (src/fast_cycle.hpp) for this CPU.
+
+The extension modules are built into ``grasp_torque_opt/control/``
+(``_fast_cycle``, and on x86-64 ``_fast_cycle_avx2``); the node's compiled cycle
+(:mod:`grasp_torque_opt.control.compiled`) and batch scoring
+(:mod:`grasp_torque_opt.methods.batch`) both take the module from here.
+"""
+
+from __future__ import annotations
+
+import importlib
+import platform
+
+#: The interface of src/fast_cycle.hpp this module speaks (its ``API``).
+API = 3
+
+
+def cpu_has_avx2() -> bool:
+    """Tell whether this CPU and its OS run AVX2 and FMA code (ProxSuite's own cpuid check)."""
+    if platform.machine().lower() not in ('x86_64', 'amd64'):
+        return False
+    try:
+        from proxsuite import instructionset
+        return bool(instructionset.has_AVX2() and instructionset.has_FMA()
+                    and instructionset.has_OSXSAVE())
+    except (ImportError, AttributeError):
+        return False
+
+
+def load(name: str):
+    """Return the module ``name`` of the compiled cycle and '', or None and why not."""
+    try:
+        module = importlib.import_module(f'grasp_torque_opt.control.{name}')
+    except ImportError as e:  # not built (no compiler, or a colcon build without pybind11)
+        return None, f'grasp_torque_opt.control.{name} is not built ({e})'
+    if getattr(module, 'API', None) != API:
+        return None, (f'grasp_torque_opt.control.{name} was built from another '
+                      'src/fast_cycle.hpp: run scripts/setup.sh again')
+    return module, ''
+
+
+#: The modules built (``_fast_cycle_avx2`` only where this CPU runs it), best first.
+MODULES = ('_fast_cycle_avx2', '_fast_cycle') if cpu_has_avx2() else ('_fast_cycle',)
+_fast_cycle, IMPORT_ERROR = None, ''
+for _name in MODULES:
+    _fast_cycle, _why = load(_name)
+    if _fast_cycle is not None:
+        IMPORT_ERROR = ''
+        break
+    IMPORT_ERROR = IMPORT_ERROR or _why

@@ -1,0 +1,466 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+Batch scoring at the solver's speed: many candidates of one hand, bound once.
+
+:class:`BatchScorer` scores a chunk of candidate lines (:mod:`.score`'s) in stages,
+each over the whole chunk: a cheap parse of the fields that vary (joint positions,
+contacts, load); the kinematics of every configuration in one compiled call
+(:mod:`grasp_torque_opt.core.tree_kinematics`); the maps and the tau-QP of every
+candidate in one compiled call (``build_batch``: the compiled cycle's maps stage and
+its QR build written for the batch); one DAQP solve per candidate, each warm-started
+from its neighbour's active set (a warm answer off the KKT check or the certificate is
+solved again cold); then the KKT check, the certificate against the exact cone and
+the planner's numbers of every answer in one compiled call (``finish_batch``). Full metrics then
+solve :mod:`.capacity`'s LPs as the single path does, their checks in one compiled
+call (:mod:`.batch_capacity`).
+
+Everything else goes to the single path (:meth:`Scorer.score_line`), whose answer is
+then the record, so a record never depends on the path: a line with another field
+(``friction``, ``object``, ``objective``, ``grasp.object_origin``, a ``gravity``
+other than null) or anything the cheap parse does not accept (bad JSON, an unknown
+joint or link, a value that is not a finite number, ...: the single path then names
+the error), a candidate the compiled stages hand back (a contact frame that cannot be
+made, A = [G; J^T] not of full column rank), and every answer that is not certified
+optimal here (infeasible, failed: the single path confirms an infeasible load with
+its LP). The whole batch takes the single path when the job or the base scenario is
+outside what the stages do (:attr:`BatchScorer.why_not` says why): a backend other
+than DAQP, the min-max objective, coupled joints, ``hand.base_link``, a name map, a
+joint other than 1-DoF revolute or prismatic, or no compiled cycle.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+import json
+import math
+import time
+from typing import Any
+
+from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
+from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
+from grasp_torque_opt.core.friction import contact_block
+from grasp_torque_opt.core.grasp_maps import GraspMaps
+from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.margin import planned_friction
+from grasp_torque_opt.core.scenario import MAX_CONTACTS, parse_scenario, weight_wrench
+from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
+from grasp_torque_opt.core.tree_kinematics import supported, TreeKinematics
+from grasp_torque_opt.methods.batch_capacity import CapacityBatch
+from grasp_torque_opt.methods.score import MAX_LINE, Scorer
+import numpy as np
+
+#: Keys a line may hold for the batch stages (anything else: the single path).
+FAST_KEYS = frozenset(('id', 'grasp', 'load', 'gravity'))
+_CONTACT_KEYS = frozenset(('link', 'position', 'normal', 'tangent'))
+
+
+class _Skip(Exception):
+    """The cheap parse does not take this line: the single path scores it."""
+
+
+#: Markers of :meth:`BatchScorer.parse`: the base has no load section, and a zero one.
+_NO_LOAD = object()
+_ZERO_LOAD = [0.0] * 6
+#: The JSON number types (a bool is not one: ``type(True)`` is ``bool``).
+_NUMBER_TYPES = frozenset((int, float))
+
+
+def _numbers(values: list) -> list:
+    """
+    Return ``values`` if every one is a finite JSON number (int or float, not bool).
+
+    Raises:
+        _Skip: any other (a sum that overflows is skipped as well: the single path
+            then decides).
+    """
+    if not _NUMBER_TYPES.issuperset(map(type, values)):
+        raise _Skip
+    try:
+        total = sum(values, 0.0)  # NaN or inf anywhere makes it non-finite
+    except OverflowError as e:  # an int of more than 308 digits
+        raise _Skip from e
+    if not math.isfinite(total):
+        raise _Skip
+    return values
+
+
+def _vec3(v: Any) -> list[float]:
+    if not isinstance(v, list) or len(v) != 3:
+        raise _Skip
+    return _numbers(v)
+
+
+def parse_contacts(raw: Any, hand) -> tuple:
+    """
+    Return the contact arrays of a line's ``grasp.contacts``, read as parse_scenario does.
+
+    Raises:
+        _Skip: anything it does not take.
+    """
+    if not isinstance(raw, list) or not 0 < len(raw) <= MAX_CONTACTS:
+        raise _Skip
+    model = hand.model
+    p = len(raw)
+    points, normals, tangents = np.zeros((p, 3)), np.zeros((p, 3)), np.zeros((p, 3))
+    has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+    links, fids = [], []
+    for i, c in enumerate(raw):
+        if not isinstance(c, dict) or not _CONTACT_KEYS.issuperset(c):
+            raise _Skip
+        link = c.get('link')
+        if not isinstance(link, str) or not link or not model.existFrame(link):
+            raise _Skip
+        links.append(link)
+        fids.append(hand.frame_index(link, 'link'))
+        if c.get('position') is not None:
+            points[i] = _vec3(c['position'])
+        if c.get('normal') is not None:
+            n = np.array(_vec3(c['normal']))
+            norm = np.linalg.norm(n)
+            if norm < 1e-9:
+                raise _Skip
+            normals[i], has_n[i] = n / norm, True
+        if c.get('tangent') is not None:
+            t = np.array(_vec3(c['tangent']))
+            if np.linalg.norm(t) < 1e-9:
+                raise _Skip
+            if has_n[i]:
+                u = t / np.linalg.norm(t)
+                if np.linalg.norm(u - (u @ normals[i]) * normals[i]) < 1e-6:
+                    raise _Skip
+            tangents[i], has_t[i] = t, True
+    return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
+
+
+def why_not(scorer: Scorer) -> str:
+    """Say why a job takes the single path for every line ('' if it does not)."""
+    from grasp_torque_opt.core import compiled_module as compiled
+
+    job, setup, hand = scorer.job, scorer.base, scorer.base.hand
+    module = compiled._fast_cycle
+    if module is None or not hasattr(module, 'kinematics_batch'):
+        return compiled.IMPORT_ERROR or 'the compiled cycle has no batch stages'
+    if job.backend != 'daqp':
+        return f'backend {job.backend} (the batch stages solve with DAQP)'
+    if (job.objective or setup.objective) != 'sum-of-squares':
+        return 'objective min-max (the batch stages solve the sum of squares)'
+    if hand.velocity_map is not None or hand.coupling.mimics:
+        return 'coupled joints'
+    if hand.base_link is not None:
+        return 'hand.base_link'
+    if isinstance(scorer.doc.get('hand'), dict) and scorer.doc['hand'].get('name_map'):
+        return 'hand.name_map'
+    return supported(hand.model)
+
+
+def contact_arrays(hand, specs) -> tuple:
+    """(frame ids, links, points, normals, has_normal, tangents, has_tangent) of specs."""
+    p = len(specs)
+    normals, tangents = np.zeros((p, 3)), np.zeros((p, 3))
+    has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
+    for i, spec in enumerate(specs):
+        if spec.normal is not None:
+            normals[i], has_n[i] = spec.normal, True
+        if spec.tangent is not None:
+            tangents[i], has_t[i] = spec.tangent, True
+    links = tuple(spec.link for spec in specs)
+    fids = tuple(hand.frame_index(link, 'link') for link in links)
+    points = np.array([spec.position for spec in specs], dtype=float).reshape(p, 3)
+    return fids, links, points, normals, has_n, tangents, has_t
+
+
+class BatchScorer:
+    """
+    Scores chunks of candidates of one job: the batch stages, the single path for the rest.
+
+    Args:
+        scorer: the job's single-path scorer (its bound hand, solver and options).
+    """
+
+    def __init__(self, scorer: Scorer) -> None:
+        self.scorer = scorer
+        #: Candidates answered by the batch stages, and by the single path.
+        self.staged = 0
+        self.single = 0
+        self.why_not = why_not(scorer)
+        if self.why_not:
+            return
+        from grasp_torque_opt.core import compiled_module as compiled  # the compiled stages
+
+        job, setup = scorer.job, scorer.base
+        hand = setup.hand
+        self.scenario = sc = parse_scenario(scorer.doc, scorer.base_dir, job.source)
+        model = hand.model
+        self.joint_q = {name: model.joints[model.getJointId(name)].idx_q
+                        for name in hand.one_dof_joints(model)}
+        self.q0 = setup.q
+        self.contacts = contact_arrays(hand, setup.contacts)
+        self.origin = np.asarray(setup.object_origin, dtype=float)
+        self.base_extra = np.asarray(sc.extra_wrench, dtype=float)
+        self.base_has_extra = (isinstance(scorer.doc.get('load'), dict)
+                               and scorer.doc['load'].get('external_wrench') is not None)
+        self.has_gravity = sc.gravity is not None
+        self.weight = weight_wrench(sc.object, sc.gravity, sc.object_origin)
+        self.module = compiled._fast_cycle
+        self.kinematics = TreeKinematics(model, self.module)
+        self.kinematics.check(np.array([self.q0]), self.contacts[0])
+        friction = planned_friction(setup.friction)
+        S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
+                                 friction.min_normal_force)
+        s = self.module.Settings()
+        s.certificate_tolerance, s.qr_rtol, s.box_margin = DEFAULT_TOLERANCE, QR_RTOL, BOX_MARGIN
+        s.eps_abs, s.eps_rel, s.eps_primal_inf = 1e-9, 0.0, 1e-12  # ProxSuite's: unused here
+        s.max_iter, s.max_iter_in, s.kkt_tolerance = 1, 1, KKT_TOLERANCE
+        s.inner_iteration_s, s.estimate_decay, s.primary_share = 1e-6, 0.5, 1.0
+        self.cycle = self.module.FastCycle(
+            np.asarray(hand.idx_v, dtype=np.int64), S_i, b_i,
+            np.asarray(setup.weights, dtype=float), np.asarray(hand.torque_limits, dtype=float),
+            friction.mu1, friction.mu2, setup.friction.mu1, setup.friction.mu2,
+            friction.min_normal_force, False, s)
+        self.H = np.diag(2.0 * np.asarray(setup.weights, dtype=float))
+        self.capacity = CapacityBatch(self.cycle)
+        self.daqp = scorer.solver.settings
+        import daqp
+
+        self._daqp = daqp
+
+    # -- the cheap parse ---------------------------------------------------------------
+    def parse(self, lineno: int, text: Any) -> tuple:
+        """
+        Return (id, joints, contacts, extra, gravity) of a line the batch stages take.
+
+        ``joints``: (indices in q, positions) or None for the base's; ``contacts``: the
+        contact arrays (the base's object when not given); ``extra``: the load besides
+        the weight (6 numbers); ``gravity``: whether the object's weight is added.
+        :meth:`inputs` makes the configurations and loads of many.
+
+        Raises:
+            _Skip: the single path scores this line.
+        """
+        if isinstance(text, str):
+            if len(text) > MAX_LINE:
+                raise _Skip
+            try:
+                data = json.loads(text)
+            except (ValueError, RecursionError) as e:
+                raise _Skip from e
+        elif isinstance(text, dict):
+            data = text
+        else:
+            raise _Skip
+        if not isinstance(data, dict) or not FAST_KEYS.issuperset(data):
+            raise _Skip
+        gravity = self.has_gravity
+        if 'gravity' in data:
+            if data['gravity'] is not None:
+                raise _Skip
+            gravity = False
+        joints, contacts = None, self.contacts
+        grasp = data.get('grasp', {})
+        if not isinstance(grasp, dict) or not {'joint_positions', 'contacts'}.issuperset(grasp):
+            raise _Skip
+        if 'joint_positions' in grasp:
+            positions = grasp['joint_positions']
+            if not isinstance(positions, dict):
+                raise _Skip
+            try:
+                index = tuple(self.joint_q[name] for name in positions)
+            except (KeyError, TypeError) as e:
+                raise _Skip from e
+            joints = (index, _numbers(list(positions.values())))
+        if 'contacts' in grasp:
+            contacts = parse_contacts(grasp['contacts'], self.scorer.base.hand)
+        extra = None if self.base_has_extra else _NO_LOAD
+        if 'load' in data:
+            load = data['load']
+            if not isinstance(load, dict) or set(load) != {'external_wrench'}:
+                raise _Skip
+            w = load['external_wrench']
+            if not isinstance(w, list) or len(w) != 6:
+                raise _Skip
+            extra = _numbers(w)
+        if extra is _NO_LOAD:
+            if not (gravity and self.scenario.object is not None):
+                raise _Skip  # the single path says the load is missing
+            extra = _ZERO_LOAD
+        return data.get('id', lineno), joints, contacts, extra, gravity
+
+    def inputs(self, parsed: list[tuple]) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return the configurations and loads of parsed lines (:meth:`parse`).
+
+        Returns:
+            (Q, shape (N, nq); W, w_ext = extra + the weight where gravity, shape (N, 6)).
+        """
+        n = len(parsed)
+        Q = np.repeat(self.q0[None], n, axis=0)
+        rows: dict[tuple, list[int]] = {}
+        for r, item in enumerate(parsed):
+            if item[1] is not None:
+                rows.setdefault(item[1][0], []).append(r)
+        for index, rs in rows.items():
+            values = np.array([parsed[r][1][1] for r in rs], dtype=float)
+            if len(rs) == n:
+                Q[:, list(index)] = values
+            else:
+                Q[np.ix_(rs, index)] = values
+        W = np.array([self.base_extra if item[3] is None else item[3] for item in parsed],
+                     dtype=float)
+        gravity = np.array([item[4] for item in parsed], dtype=bool)
+        W[gravity] += self.weight
+        return Q, W
+
+    # -- the stages ----------------------------------------------------------------------
+    def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
+        """Score (line number, candidate) pairs into records, in order (never raises)."""
+        lines = list(lines)
+        if self.why_not:
+            return self.scorer.score_lines(lines)
+        records: list[dict | None] = [None] * len(lines)
+        groups: dict[tuple, list] = {}
+        t0 = time.perf_counter()
+        for k, (lineno, text) in enumerate(lines):
+            try:
+                parsed = self.parse(lineno, text)
+            except (_Skip, OverflowError):
+                continue
+            groups.setdefault(parsed[2][1], []).append((k, lineno, parsed))
+        parse_s = (time.perf_counter() - t0) / max(1, len(lines))
+        for members in groups.values():
+            self._group(members, records, parse_s)
+        for k, (lineno, text) in enumerate(lines):
+            if records[k] is None:
+                self.single += 1
+                records[k] = self.scorer.score_line(lineno, text)
+        return records
+
+    def _group(self, members: list, records: list, parse_s: float) -> None:
+        """Score candidates with the same contact links through the batch stages."""
+        t0 = time.perf_counter()
+        n = len(members)
+        parsed = [m[2] for m in members]
+        fids = parsed[0][2][0]
+        Q, W = self.inputs(parsed)
+        if all(item[2] is self.contacts for item in parsed):
+            arrays = [np.repeat(a[None], n, axis=0) for a in self.contacts[2:]]
+        else:
+            arrays = [np.array([item[2][j] for item in parsed]) for j in range(2, 7)]
+        oMf, J6 = self.kinematics.frames(Q, fids)
+        b = self.cycle.build_batch(oMf, J6, arrays[0], arrays[1], arrays[2], arrays[3],
+                                   arrays[4], self.origin, W)
+        ok = b['ok']
+        m = self.scorer.base.hand.m
+        A, bu, bl = b['A'], b['bupper'], b['blower']
+        rows = A.shape[1]
+        sense = np.zeros(m + rows, dtype=np.int32)
+        sense[m:m + b['n_eq']] = 5  # equality
+        stage_s = time.perf_counter() - t0
+        model = self._model(A, bu, bl, sense, ok)
+        update, solve = model.update, model.solve
+        clock = time.perf_counter
+        times = [0.0] * n
+        flags = [0] * n
+        zero_x, zero_lam = np.zeros(m), np.zeros(m + rows)
+        xs, lams = [zero_x] * n, [zero_lam] * n
+        A_rows, bu_rows, bl_rows = list(A), list(bu), list(bl)
+        for i in np.flatnonzero(ok).tolist():  # the solver's loop: nothing else in it
+            ts = clock()
+            # Warm: DAQP keeps H, f and the last active set (every answer is KKT-checked).
+            update(A=A_rows[i], bupper=bu_rows[i], blower=bl_rows[i])
+            x, _, flag, info = solve()
+            times[i] = clock() - ts
+            if flag == 1:
+                xs[i], lams[i], flags[i] = x, info['lam'], 1
+        t1 = time.perf_counter()
+        X, LAM = np.array(xs), np.array(lams)
+        solved = np.array(flags) == 1
+        fin = self.cycle.finish_batch(b['G'], b['J'], W, b['M1w'], b['M2'], A, bu, bl, X, LAM,
+                                      solved, KKT_TOLERANCE)
+        redo = np.flatnonzero(ok & ~fin['passes'])
+        if redo.size:  # warm answers off the KKT check or the certificate: cold
+            for i in redo.tolist():
+                ts = time.perf_counter()
+                x, lam, flag = self._solve(model, A[i], bu[i], bl[i], sense)
+                times[i] += time.perf_counter() - ts
+                X[i], LAM[i], solved[i] = x, lam, flag == 1
+            again = self.cycle.finish_batch(
+                b['G'][redo], b['J'][redo], W[redo], b['M1w'][redo], b['M2'][redo], A[redo],
+                bu[redo], bl[redo], X[redo], LAM[redo], solved[redo], KKT_TOLERANCE)
+            for key in ('passes', 'f', 'usage', 'ratio'):
+                fin[key][redo] = again[key]
+        share = parse_s + (stage_s + time.perf_counter() - t1) / n
+        job = self.scorer.job
+        passes = fin['passes'].tolist()
+        usage, ratio = fin['usage'], fin['ratio'].tolist()
+        usage_max = usage.max(axis=1).tolist()
+        usage = usage.tolist()
+        norms = np.sqrt(np.einsum('ij,ij->i', X, X)).tolist()
+        full = None
+        if job.metrics == 'full':  # the capacity LPs of the certified candidates
+            t2 = clock()
+            good = [i for i in range(n) if passes[i]]
+            full = dict(zip(good, self.capacity.metrics(
+                b['G'][good], b['J'][good], W[good],
+                lambda j: self._bound(Q[good[j]], members[good[j]][2][2], W[good[j]], b,
+                                      good[j]))))
+            share += (clock() - t2) / max(1, len(good))
+        for i, (k, lineno, (ident, _, contacts, _, _)) in enumerate(members):
+            if not passes[i]:
+                continue  # the single path answers (and confirms an infeasible load)
+            ts = clock()
+            rec = {'line': lineno, 'id': ident, 'status': 'optimal', 'error': None,
+                   'torque_norm': norms[i], 'max_torque_ratio': ratio[i],
+                   'friction_usage_max': usage_max[i], 'friction_usage': usage[i],
+                   'backend': 'daqp', 'solve_time_s': times[i]}
+            if job.solutions:
+                rec['tau'] = X[i].tolist()
+                rec['wrenches'] = fin['f'][i].reshape(-1, 4).tolist()
+            if full is not None:
+                rec.update(full[i])
+            rec['time_s'] = share + times[i] + clock() - ts
+            records[k] = rec
+            self.staged += 1
+
+    def _model(self, A, bu, bl, sense, ok):
+        """Return a DAQP workspace of the group's size, set up on its first candidate."""
+        i = int(np.flatnonzero(ok)[0]) if ok.any() else 0
+        model = self._daqp.Model()
+        model.setup(self.H.copy(), np.zeros(self.H.shape[0]), A[i].copy(), bu[i].copy(),
+                    bl[i].copy(), sense)
+        s = model.settings
+        s.update(primal_tol=self.daqp.primal_tol, iter_limit=self.daqp.iter_limit, eps_prox=0.0)
+        model.settings = s
+        self._f = np.zeros(self.H.shape[0])
+        self._keep = ()
+        return model
+
+    def _solve(self, model, A, bu, bl, sense):
+        """One DAQP solve: warm from the last active set (``sense`` None), else cold."""
+        model.update(H=self.H, f=self._f, A=A, bupper=bu, blower=bl, sense=sense)
+        self._keep = (A, bu, bl)  # buffers DAQP may point to
+        x, _, flag, info = model.solve()
+        return x, info['lam'], int(flag)
+
+    def _bound(self, q, contacts, wrench, b, i) -> tuple[GraspSetup, GraspMaps]:
+        """Return the candidate as the single path binds it, with the batch stages' maps."""
+        base = self.scorer.base
+        fids, links, points, normals, has_n, tangents, has_t = contacts
+        specs = base.contacts if contacts is self.contacts else [
+            type(base.contacts[0])(link=link, position=points[j],
+                                   normal=normals[j] if has_n[j] else None,
+                                   tangent=tangents[j] if has_t[j] else None)
+            for j, link in enumerate(links)]
+        setup = GraspSetup(hand=base.hand, q=q, contacts=specs, object_origin=self.origin,
+                           friction=base.friction, external_wrench=wrench,
+                           weights=base.weights, objective='sum-of-squares')
+        maps = GraspMaps(G=b['G'][i], J=b['J'][i], links=links, frame_ids=fids,
+                         positions=b['positions'][i], rotations=b['rotations'][i],
+                         object_origin=self.origin)
+        return setup, maps

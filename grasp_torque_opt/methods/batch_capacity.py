@@ -1,0 +1,144 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+Full metrics of many candidates: their 13 capacity LPs, the checks in one compiled call.
+
+For each candidate the batch stages (:mod:`.batch`) certified: the load capacity and
+the 12 axis capacities of :mod:`.capacity`, the same LPs solved the same way (DAQP,
+as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the rows and bounds of
+:class:`~grasp_torque_opt.methods.capacity.CapacityLP`). What the single path does
+after each DAQP call in Python (the KKT check, alpha, the certificate of the answer
+at alpha times the load) runs for all the LPs of a few candidates in one compiled
+call (``lp_finish_batch``). An LP whose answer does not pass, or that DAQP does not
+call optimal, is solved again by the single path's :meth:`CapacityLP.solve` (HiGHS
+behind DAQP, the unbounded and infeasible verdicts), whose answer is then the value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+import math
+
+from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
+from grasp_torque_opt.methods.capacity import ALPHA_MAX, CapacityLP, DIRECTIONS
+from grasp_torque_opt.methods.lp import EPS_PROX, MAX_ITER, PRIMAL_TOL
+import numpy as np
+
+#: The 13 loads: the candidate's own (None here), then the 12 axis directions.
+LOADS = (('load', None, '-'),) + tuple(
+    (name, (i, sign), 'N' if i < 3 else 'N m') for name, (i, sign) in DIRECTIONS.items())
+#: Candidates whose LPs are checked in one compiled call (bounded memory).
+PER_CALL = 16
+
+
+class CapacityBatch:
+    """
+    The capacity LPs of many candidates of one hand (one contact count per call).
+
+    Args:
+        cycle: the batch stages' compiled cycle (its friction, limits, tolerance).
+    """
+
+    def __init__(self, cycle) -> None:
+        import daqp
+
+        self._solve = daqp.solve
+        self.cycle = cycle
+        self._forms: dict[int, CapacityLP] = {}
+
+    def metrics(self, G: np.ndarray, J: np.ndarray, W: np.ndarray,
+                bound: Callable[[int], tuple]) -> list[dict]:
+        """
+        Return the full metrics of candidates (as :meth:`Scorer.capacities` of optimal ones).
+
+        Args:
+            G: their grasp matrices, shape (n, 6, 4p).
+            J: their hand Jacobians, shape (n, 4p, m).
+            W: their loads, shape (n, 6).
+            bound: candidate index -> (setup, maps) as the single path binds it (for
+                :class:`CapacityLP`, the template and the LPs that do not pass).
+        """
+        n = G.shape[0]
+        out = []
+        for start in range(0, n, PER_CALL):
+            stop = min(n, start + PER_CALL)
+            out.extend(self._some(G, J, W, bound, start, stop))
+        return out
+
+    def _template(self, bound, p: int) -> CapacityLP:
+        lp = self._forms.get(p)
+        if lp is None:
+            lp = self._forms[p] = CapacityLP(*bound(0))
+        return lp
+
+    def _some(self, G, J, W, bound, start: int, stop: int) -> list[dict]:
+        nf = G.shape[2]
+        m = J.shape[2]
+        t = self._template(lambda _: bound(start), nf // 4)
+        form, c = t.form, t.c
+        rows, cols = t.A.shape
+        count = (stop - start) * len(LOADS)
+        A = np.zeros((count, rows, cols))
+        A[:, :6, :nf] = np.repeat(G[start:stop], len(LOADS), axis=0)
+        A[:, 6:6 + m, :nf] = np.repeat(J[start:stop].transpose(0, 2, 1), len(LOADS), axis=0)
+        A[:, 6 + m:, :nf] = t.A[6 + m:, :nf]
+        loads = np.zeros((count, 6))
+        scale = np.ones(count)
+        x = np.zeros((count, cols))
+        lam = np.zeros((count, cols + rows))
+        ok = np.zeros(count, dtype=bool)
+        usable = np.ones(count, dtype=bool)
+        solve, H, bu, bl, sense = self._solve, form.H, form.bu, form.bl, form.sense
+        for k in range(count):
+            i, j = divmod(k, len(LOADS))
+            axis = LOADS[j][1]
+            if axis is None:
+                load = W[start + i]
+                s = float(np.abs(load).max())
+                if not (math.isfinite(s) and s > 0.0):
+                    usable[k] = False  # failed or unbounded: the single path says which
+                    continue
+                loads[k], scale[k] = load, s
+                A[k, :6, -1] = load / s
+            else:
+                loads[k, axis[0]] = A[k, axis[0], -1] = axis[1]
+            try:
+                xk, _, flag, info = solve(H, c, A[k], bu, bl, sense, primal_tol=PRIMAL_TOL,
+                                          iter_limit=MAX_ITER, eps_prox=EPS_PROX)
+            except (RuntimeError, ValueError):
+                continue
+            if flag in (1, 2) and xk is not None:
+                x[k], lam[k] = xk, info['lam']
+                ok[k] = bool(np.isfinite(x[k]).all())
+        cand = np.repeat(np.arange(start, stop, dtype=np.int64), len(LOADS))
+        fin = self.cycle.lp_finish_batch(G, J, cand, loads, scale, A, bl, bu, c, x, lam, ok,
+                                         KKT_TOLERANCE, ALPHA_MAX)
+        passes, alpha = fin['passes'].tolist(), fin['alpha'].tolist()
+        out = []
+        for i in range(stop - start):
+            lp = None
+            values, statuses = {}, {}
+            for j, (name, axis, unit) in enumerate(LOADS):
+                k = i * len(LOADS) + j
+                if passes[k] and usable[k]:
+                    values[name], statuses[name] = alpha[k], 'optimal'
+                    continue
+                if lp is None:  # the single path's LP of this candidate, and its verdict
+                    lp = CapacityLP(*bound(start + i))
+                if axis is None:
+                    load = W[start + i]
+                else:
+                    load = np.zeros(6)
+                    load[axis[0]] = axis[1]
+                cap = lp.solve(load, unit, binding=False)
+                values[name], statuses[name] = cap.value, cap.status
+            out.append({'capacity': values['load'], 'capacity_status': statuses['load'],
+                        'holdable_fraction': None,
+                        'capacities': {name: values[name] for name in DIRECTIONS}})
+        return out

@@ -1,0 +1,473 @@
+// Copyright 2026 grasp_torque_opt developers
+//
+// Use of this source code is governed by a BSD-style
+// license that can be found in the LICENSE file or at
+// https://developers.google.com/open-source/licenses/bsd
+//
+// SPDX-License-Identifier: BSD-3-Clause
+
+// Batch scoring's compiled stages (grasp_torque_opt.methods.batch): the maps and build
+// stages of fast_cycle.hpp for many candidates of one hand in one call, with each
+// tau-QP written in DAQP's form, and after the DAQP solves the KKT check, the wrenches,
+// the certificate and the planner's numbers of every answer in one call. Included by
+// fast_cycle.hpp after FastCycle; the same rules, nothing of its own.
+
+#ifndef FAST_BATCH_HPP_
+#define FAST_BATCH_HPP_
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace
+{
+
+//: DAQP's "infinite" bound (backends/daqp.DAQP_INF).
+constexpr double DAQP_INF = 1e30;
+
+py::array_t<double> zeros(std::vector<py::ssize_t> shape)
+{
+  py::array_t<double> out(shape);
+  std::fill(out.mutable_data(), out.mutable_data() + out.size(), 0.0);
+  return out;
+}
+
+
+// The build stage of FastCycle::build (core/tau_qp.build_tau_qp, the QR branch) for the
+// batch, with no torque offset, computing only what the batch needs and reusing its
+// storage: with A = [G; J^T] = Q [R; 0], Q^T applied once to [[0, w]; [I_m, 0]] gives
+// Q1^T and U_perp^T on those columns, so M2 = R^-1 (Q1^T [0; I_m]), M1 w = R^-1 (Q1^T [w; 0]),
+// A_eq = U_perp[6:]^T and b = -U_perp[:6]^T w without forming Q or pinv(A).
+struct LeanBuild
+{
+  Mat A_full, T, X;
+  Eigen::HouseholderQR<Mat> qr;
+  RowMat C;
+  Vec u;
+
+  // false and why where FastCycle::build hands back (not of full column rank, not finite).
+  bool run(
+    const FastCycle & fc, const RowMat & G, const RowMat & J, const Wrench & w_ext,
+    std::string & why)
+  {
+    const int m = fc.m(), cols = static_cast<int>(G.cols()), p = cols / 4, rows = 6 + m;
+    if (rows < cols) {
+      why = "A = [G; J^T] has more columns than rows";
+      return false;
+    }
+    A_full.resize(rows, cols);
+    A_full.topRows(6) = G;
+    A_full.bottomRows(m) = J.transpose();
+    if (!A_full.allFinite()) {
+      why = "maps not finite";
+      return false;
+    }
+    qr.compute(A_full);
+    const Mat & packed = qr.matrixQR();
+    const Vec d = packed.diagonal().head(cols).cwiseAbs();
+    if (!(d.minCoeff() > fc.settings().qr_rtol * d.maxCoeff())) {
+      why = "A = [G; J^T] is not of full column rank";
+      return false;
+    }
+    T.setZero(rows, m + 1);
+    T.bottomLeftCorner(m, m).setIdentity();
+    T.col(m).head<6>() = -w_ext;  // w
+    T.applyOnTheLeft(qr.householderQ().adjoint());
+    X = packed.topRows(cols).triangularView<Eigen::Upper>().solve(T.topRows(cols));
+    const RowMat & S = fc.S_i();
+    const int block = static_cast<int>(S.rows());
+    C.resize(block * p, m);
+    u.resize(block * p);
+    for (int i = 0; i < p; ++i) {
+      C.middleRows(block * i, block) = S * X.block(4 * i, 0, 4, m);
+      u.segment(block * i, block) = fc.b_i() - S * X.col(m).segment<4>(4 * i);
+    }
+    return true;
+  }
+  auto M2() const {return X.leftCols(X.cols() - 1);}
+  auto M1w() const {return X.col(X.cols() - 1);}
+  auto A_eq() const {return T.bottomLeftCorner(T.rows() - X.rows(), T.cols() - 1);}
+  auto b_neg() const {return T.bottomRightCorner(T.rows() - X.rows(), 1);}  // -b
+};
+
+// The maps and build stages for N candidates with p contacts each. oMf (N, p, 4, 4),
+// J6 (N, p, 6, nv), points, normals, tangents (N, p, 3), has_normal, has_tangent (N, p),
+// c (3), w_ext (N, 6). Returns a dict: ok (N) and why (N strings: '' where ok), and for
+// each candidate G (6, 4p), J (4p, m), M1w = M1 w (4p), M2 (4p, m), positions (p, 3),
+// rotations (p, 3, 3), and its tau-QP in DAQP's form (backends/daqp.DaqpSolver): A =
+// [A_eq; C] (n_eq + n_in, m), bupper and blower (m + n_eq + n_in): the box (within
+// DAQP_INF), the equalities, the cone rows. A candidate that is not ok (a frame that
+// cannot be made, A = [G; J^T] not of full column rank) has zeros there.
+py::dict build_batch(
+  const FastCycle & fc, Array oMf, Array J6, Array points, Array normals,
+  py::array_t<bool, py::array::c_style | py::array::forcecast> has_normal, Array tangents,
+  py::array_t<bool, py::array::c_style | py::array::forcecast> has_tangent, Array c,
+  Array w_ext)
+{
+  expect(oMf.ndim() == 4 && oMf.shape(2) == 4 && oMf.shape(3) == 4, "oMf of the wrong shape");
+  const py::ssize_t N = oMf.shape(0), p = oMf.shape(1);
+  expect(p > 0, "no contacts");
+  expect(
+    J6.ndim() == 4 && J6.shape(0) == N && J6.shape(1) == p && J6.shape(2) == 6,
+    "J6 of the wrong shape");
+  const py::ssize_t nv = J6.shape(3);
+  for (const Array * a : {&points, &normals, &tangents}) {
+    expect(
+      a->ndim() == 3 && a->shape(0) == N && a->shape(1) == p && a->shape(2) == 3,
+      "points, normals or tangents of the wrong shape");
+  }
+  expect(
+    has_normal.size() == N * p && has_tangent.size() == N * p,
+    "has_normal or has_tangent of the wrong shape");
+  expect(c.size() == 3, "c of the wrong shape");
+  expect(
+    w_ext.ndim() == 2 && w_ext.shape(0) == N && w_ext.shape(1) == 6,
+    "w_ext of the wrong shape");
+  const int m = fc.m();
+  const py::ssize_t nf = 4 * p, rows = 6 + m;
+  expect(rows >= nf, "A = [G; J^T] has more columns than rows");
+  const py::ssize_t n_eq = rows - nf;
+  const py::ssize_t n_in = static_cast<py::ssize_t>(fc.cone_rows()) * p;
+  const py::ssize_t n_rows = n_eq + n_in, n_bounds = m + n_rows;
+  py::array_t<bool> ok(N);
+  std::vector<std::string> why(N);
+  // Written for every candidate below (zeros where it is not ok): not filled first.
+  using Out = py::array_t<double>;
+  Out G({N, py::ssize_t(6), nf}), J({N, nf, py::ssize_t(m)}), M1w({N, nf});
+  Out M2({N, nf, py::ssize_t(m)}), positions({N, p, py::ssize_t(3)});
+  Out rotations({N, p, py::ssize_t(3), py::ssize_t(3)});
+  Out A({N, n_rows, py::ssize_t(m)}), bupper({N, n_bounds}), blower({N, n_bounds});
+  {
+    py::gil_scoped_release release;
+    Kinematics k;
+    k.p = static_cast<int>(p);
+    k.nv = static_cast<int>(nv);
+    k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
+    Maps maps;
+    LeanBuild lean;
+    const double box_margin = fc.settings().box_margin;
+    for (py::ssize_t i = 0; i < N; ++i) {
+      k.oMf = oMf.data() + 16 * p * i;
+      k.J6 = J6.data() + 6 * nv * p * i;
+      k.points = points.data() + 3 * p * i;
+      k.normals = normals.data() + 3 * p * i;
+      k.tangents = tangents.data() + 3 * p * i;
+      k.has_normal = has_normal.data() + p * i;
+      k.has_tangent = has_tangent.data() + p * i;
+      const Wrench w = Eigen::Map<const Wrench>(w_ext.data() + 6 * i);
+      bool good = fc.maps(k, maps, why[i]) && lean.run(fc, maps.G, maps.J, w, why[i]);
+      if (good && lean.T.rows() - lean.X.rows() != n_eq) {
+        why[i] = "A = [G; J^T] is not of full column rank";
+        good = false;
+      }
+      ok.mutable_data()[i] = good;
+      if (!good) {
+        for (Out * a : {&G, &J, &M1w, &M2, &positions, &rotations, &A, &bupper, &blower}) {
+          const py::ssize_t per = a->size() / N;
+          std::fill(a->mutable_data() + per * i, a->mutable_data() + per * (i + 1), 0.0);
+        }
+        continue;
+      }
+      std::copy(maps.G.data(), maps.G.data() + maps.G.size(), G.mutable_data() + 6 * nf * i);
+      std::copy(maps.J.data(), maps.J.data() + maps.J.size(), J.mutable_data() + nf * m * i);
+      std::copy(
+        maps.positions.data(), maps.positions.data() + maps.positions.size(),
+        positions.mutable_data() + 3 * p * i);
+      std::copy(
+        maps.rotations.data(), maps.rotations.data() + maps.rotations.size(),
+        rotations.mutable_data() + 9 * p * i);
+      Eigen::Map<Vec>(M1w.mutable_data() + nf * i, nf) = lean.M1w();
+      Eigen::Map<RowMat>(M2.mutable_data() + nf * m * i, nf, m) = lean.M2();
+      Eigen::Map<RowMat> Ai(A.mutable_data() + n_rows * m * i, n_rows, m);
+      Ai.topRows(n_eq) = lean.A_eq();
+      Ai.bottomRows(n_in) = lean.C;
+      double * up = bupper.mutable_data() + n_bounds * i;
+      double * lo = blower.mutable_data() + n_bounds * i;
+      for (int j = 0; j < m; ++j) {  // the box: tau_min, tau_max = -+limits, BOX_MARGIN in
+        up[j] = std::min(fc.limits()(j) - box_margin, DAQP_INF);
+        lo[j] = std::max(-fc.limits()(j) + box_margin, -DAQP_INF);
+      }
+      for (py::ssize_t j = 0; j < n_eq; ++j) {
+        up[m + j] = lo[m + j] = -lean.b_neg()(j, 0);
+      }
+      for (py::ssize_t j = 0; j < n_in; ++j) {
+        up[m + n_eq + j] = lean.u(j);
+        lo[m + n_eq + j] = -DAQP_INF;
+      }
+    }
+  }
+  py::list why_list;
+  for (const std::string & w : why) {
+    why_list.append(w);
+  }
+  py::dict d;
+  d["ok"] = ok;
+  d["why"] = why_list;
+  d["G"] = G;
+  d["J"] = J;
+  d["M1w"] = M1w;
+  d["M2"] = M2;
+  d["positions"] = positions;
+  d["rotations"] = rotations;
+  d["A"] = A;
+  d["bupper"] = bupper;
+  d["blower"] = blower;
+  d["n_eq"] = n_eq;
+  return d;
+}
+
+// backends/daqp.kkt_violation of min 1/2 x'Hx + g'x, H = diag(hdiag), blower <= [x; A x]
+// <= bupper, with DAQP's multipliers lam (bounds on x first).
+double daqp_kkt(
+  const Vec & hdiag, const double * g, const double * A, const double * up,
+  const double * lo, const double * x, const double * lam, int n, int rows)
+{
+  Eigen::Map<const RowMat> Am(A, rows, n);
+  Eigen::Map<const Vec> xv(x, n), lv(lam, n + rows);
+  Vec grad = hdiag.cwiseProduct(xv);
+  if (g != nullptr) {
+    grad += Eigen::Map<const Vec>(g, n);
+  }
+  Vec residual = Am.transpose() * lv.tail(rows) + lv.head(n) + grad;
+  const Vec Ax = Am * xv;
+  double infeasible = -std::numeric_limits<double>::infinity();
+  double complementarity = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n + rows; ++i) {
+    const double v = i < n ? xv(i) : Ax(i - n);
+    const double to_upper = up[i] - v, to_lower = v - lo[i];
+    infeasible = std::max(infeasible, -std::min(to_upper, to_lower));
+    complementarity = std::max(
+      complementarity, std::max(lam[i] * to_upper, -lam[i] * to_lower));
+  }
+  return std::max(
+    {max_abs(residual) / std::max(1.0, max_abs(grad)), infeasible, complementarity});
+}
+
+// After the DAQP solves: for each candidate with solved[i] (DAQP's exit flag 1), the KKT
+// violation of x[i] with lam[i] (an answer over kkt_tolerance is not taken), the
+// wrenches f = M1 w + M2 tau, the certificate against the exact problem, the friction
+// usage (unreduced cone) and max |tau| / limit.
+// Returns a dict: kkt (N; inf where not solved), certificate (N, 6: equilibrium,
+// torque, cone, normal_force, limit, finite), passes (N: finite and every residual within
+// the tolerance), f (N, 4p), usage (N, p), ratio (N).
+py::dict finish_batch(
+  const FastCycle & fc, Array G, Array J, Array w_ext, Array M1w, Array M2, Array A,
+  Array bupper, Array blower, Array x, Array lam,
+  py::array_t<bool, py::array::c_style | py::array::forcecast> solved, double kkt_tolerance)
+{
+  const int m = fc.m();
+  expect(G.ndim() == 3 && G.shape(1) == 6, "G of the wrong shape");
+  const py::ssize_t N = G.shape(0), nf = G.shape(2), p = nf / 4;
+  expect(nf % 4 == 0 && nf > 0, "G of the wrong shape");
+  expect(J.size() == N * nf * m && M2.size() == N * nf * m, "J or M2 of the wrong shape");
+  expect(M1w.size() == N * nf && w_ext.size() == N * 6, "M1w or w_ext of the wrong shape");
+  expect(A.ndim() == 3 && A.shape(0) == N && A.shape(2) == m, "A of the wrong shape");
+  const int rows = static_cast<int>(A.shape(1));
+  const py::ssize_t nb = m + rows;
+  expect(
+    bupper.size() == N * nb && blower.size() == N * nb && lam.size() == N * nb,
+    "bupper, blower or lam of the wrong shape");
+  expect(x.size() == N * m && solved.size() == N, "x or solved of the wrong shape");
+  auto kkt = zeros({N}), cert = zeros({N, 6}), f = zeros({N, nf}), usage = zeros({N, p});
+  auto ratio = zeros({N});
+  py::array_t<bool> passes(N);
+  const Vec tau_max = fc.limits(), tau_min = -fc.limits();
+  const Vec hdiag = 2.0 * fc.weights();
+  {
+    py::gil_scoped_release release;
+    const double inf = std::numeric_limits<double>::infinity();
+    for (py::ssize_t i = 0; i < N; ++i) {
+      bool good = solved.data()[i];
+      double * ci = cert.mutable_data() + 6 * i;
+      kkt.mutable_data()[i] = good ? daqp_kkt(
+        hdiag, nullptr, A.data() + rows * m * i, bupper.data() + nb * i,
+        blower.data() + nb * i, x.data() + m * i, lam.data() + nb * i, m, rows) : inf;
+      good = good && kkt.data()[i] <= kkt_tolerance;
+      if (!good) {
+        std::fill(ci, ci + 5, inf);
+        passes.mutable_data()[i] = false;
+        continue;
+      }
+      const Vec tau = Eigen::Map<const Vec>(x.data() + m * i, m);
+      Eigen::Map<Vec> fi(f.mutable_data() + nf * i, nf);
+      fi = Eigen::Map<const Vec>(M1w.data() + nf * i, nf) +
+        Eigen::Map<const RowMat>(M2.data() + nf * m * i, nf, m) * tau;
+      const RowMat Gi = Eigen::Map<const RowMat>(G.data() + 6 * nf * i, 6, nf);
+      const RowMat Ji = Eigen::Map<const RowMat>(J.data() + nf * m * i, nf, m);
+      const Certificate c = fc.certify(
+        Gi, Ji, Eigen::Map<const Wrench>(w_ext.data() + 6 * i), tau_min, tau_max, tau, fi);
+      std::copy(c.r, c.r + 5, ci);
+      ci[5] = c.finite ? 1.0 : 0.0;
+      passes.mutable_data()[i] = fc.passes(c);
+      double * ui = usage.mutable_data() + p * i;
+      for (py::ssize_t j = 0; j < p; ++j) {
+        const double fx = fi(4 * j), fy = fi(4 * j + 1), fz = fi(4 * j + 2), mz = fi(4 * j + 3);
+        const double demand =
+          std::hypot(fx, fy) / fc.mu1_usage() + std::abs(mz) / fc.mu2_usage();
+        ui[j] = fz > 0.0 ? demand / fz : inf;
+      }
+      ratio.mutable_data()[i] = (tau.cwiseAbs().array() / fc.limits().array()).maxCoeff();
+    }
+  }
+  py::dict d;
+  d["kkt"] = kkt;
+  d["certificate"] = cert;
+  d["passes"] = passes;
+  d["f"] = f;
+  d["usage"] = usage;
+  d["ratio"] = ratio;
+  return d;
+}
+
+// The kinematics of N configurations Q (N, nq) of a tree of 1-DoF joints
+// (core/tree_kinematics.TreeKinematics, whose numpy twin this is): joint j (1..nj-1)
+// has parent parents[j] (< j), revolute (kinds[j] = 0) or prismatic (1) along axes[j]
+// (joint frame), placement (Rp[j], tp[j]) in its parent, position Q[:, idx_q[j]] and
+// velocity column idx_v[j]. Frame i is placed at (Rf[i], tf[i]) in joint fparent[i].
+// Returns (oMf (N, p, 4, 4), J6 (N, p, 6, nv)): LOCAL_WORLD_ALIGNED at each frame's
+// origin, as Pinocchio's getFrameJacobian.
+py::tuple kinematics_batch(
+  Array Q, py::array_t<int64_t> parents, py::array_t<int64_t> kinds, Array axes, Array Rp,
+  Array tp, py::array_t<int64_t> idx_q, py::array_t<int64_t> idx_v,
+  py::array_t<int64_t> fparent, Array Rf, Array tf, int64_t nv)
+{
+  expect(Q.ndim() == 2, "Q of the wrong shape");
+  const py::ssize_t N = Q.shape(0), nq = Q.shape(1), nj = parents.size();
+  const py::ssize_t p = fparent.size();
+  expect(
+    kinds.size() == nj && axes.size() == 3 * nj && Rp.size() == 9 * nj &&
+    tp.size() == 3 * nj && idx_q.size() == nj && idx_v.size() == nj &&
+    Rf.size() == 9 * p && tf.size() == 3 * p && nv > 0, "joint or frame tables of the wrong shape");
+  const int64_t * par = parents.data(), * kind = kinds.data(), * iq = idx_q.data();
+  const int64_t * iv = idx_v.data(), * fp = fparent.data();
+  for (py::ssize_t j = 1; j < nj; ++j) {
+    expect(
+      par[j] >= 0 && par[j] < j && iq[j] >= 0 && iq[j] < nq && iv[j] >= 0 && iv[j] < nv,
+      "joint table out of range");
+  }
+  for (py::ssize_t i = 0; i < p; ++i) {
+    expect(fp[i] >= 0 && fp[i] < nj, "frame table out of range");
+  }
+  using M3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  using V3 = Eigen::Vector3d;
+  auto oMf = zeros({N, p, 4, 4}), J6 = zeros({N, p, 6, nv});
+  {
+    py::gil_scoped_release release;
+    std::vector<M3> R(nj);
+    std::vector<V3> t(nj), axis(nj);
+    std::vector<std::vector<int64_t>> support(nj);
+    for (py::ssize_t j = 1; j < nj; ++j) {
+      support[j] = support[par[j]];
+      support[j].push_back(j);
+    }
+    for (py::ssize_t n = 0; n < N; ++n) {
+      const double * q = Q.data() + nq * n;
+      R[0].setIdentity();
+      t[0].setZero();
+      for (py::ssize_t j = 1; j < nj; ++j) {
+        const M3 base = R[par[j]] * Eigen::Map<const M3>(Rp.data() + 9 * j);
+        const V3 a = Eigen::Map<const V3>(axes.data() + 3 * j);
+        t[j] = t[par[j]] + R[par[j]] * Eigen::Map<const V3>(tp.data() + 3 * j);
+        if (kind[j] == 0) {
+          R[j] = base * Eigen::AngleAxisd(q[iq[j]], a).toRotationMatrix();
+        } else {
+          R[j] = base;
+          t[j] += q[iq[j]] * (base * a);
+        }
+        axis[j] = R[j] * a;
+      }
+      for (py::ssize_t i = 0; i < p; ++i) {
+        const int64_t j = fp[i];
+        const M3 Rw = R[j] * Eigen::Map<const M3>(Rf.data() + 9 * i);
+        const V3 o = t[j] + R[j] * Eigen::Map<const V3>(tf.data() + 3 * i);
+        Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(
+          oMf.mutable_data() + 16 * (p * n + i));
+        M.topLeftCorner<3, 3>() = Rw;
+        M.topRightCorner<3, 1>() = o;
+        M(3, 3) = 1.0;
+        Eigen::Map<RowMat> Jm(J6.mutable_data() + 6 * nv * (p * n + i), 6, nv);
+        for (int64_t s : support[j]) {
+          if (kind[s] == 0) {
+            Jm.block<3, 1>(0, iv[s]) = axis[s].cross(o - t[s]);
+            Jm.block<3, 1>(3, iv[s]) = axis[s];
+          } else {
+            Jm.block<3, 1>(0, iv[s]) = axis[s];
+          }
+        }
+      }
+    }
+  }
+  return py::make_tuple(oMf, J6);
+}
+
+// The capacity LPs' answers (methods/capacity.CapacityLP, solved by DAQP as
+// methods/lp.solve_lp solves them): LP k is candidate cand[k]'s (its G (6, nf) and J
+// (nf, m)) for the load loads[k], over x = [f; alpha] with the rows A[k] (rows, nf + 1),
+// the bounds blower, bupper (nf + 1 + rows, DAQP's form) and the cost c. Where ok[k]
+// (DAQP's flag 1 or 2, x finite): the KKT violation of (x[k], lam[k]) with a zero
+// Hessian, then alpha = x[k][-1] / scale[k] and the certificate of (J^T f, f) at the load
+// alpha loads[k] (the planned cone). passes[k]: KKT within kkt_tolerance, alpha below
+// (1 - 1e-9) alpha_max (else unbounded) and the certificate within the tolerance.
+py::dict lp_finish_batch(
+  const FastCycle & fc, Array G, Array J, py::array_t<int64_t> cand, Array loads,
+  Array scale, Array A, Array blower, Array bupper, Array c, Array x, Array lam,
+  py::array_t<bool, py::array::c_style | py::array::forcecast> ok, double kkt_tolerance,
+  double alpha_max)
+{
+  const int m = fc.m();
+  expect(G.ndim() == 3 && G.shape(1) == 6, "G of the wrong shape");
+  const py::ssize_t N = G.shape(0), nf = G.shape(2), n = nf + 1;
+  expect(J.size() == N * nf * m, "J of the wrong shape");
+  const py::ssize_t K = cand.size();
+  expect(A.ndim() == 3 && A.shape(0) == K && A.shape(2) == n, "A of the wrong shape");
+  const int rows = static_cast<int>(A.shape(1));
+  const py::ssize_t nb = n + rows;
+  expect(
+    loads.size() == 6 * K && scale.size() == K && x.size() == K * n && lam.size() == K * nb &&
+    ok.size() == K && blower.size() == nb && bupper.size() == nb && c.size() == n,
+    "LP arrays of the wrong shape");
+  for (py::ssize_t k = 0; k < K; ++k) {
+    expect(cand.data()[k] >= 0 && cand.data()[k] < N, "candidate index out of range");
+  }
+  auto kkt = zeros({K}), alpha = zeros({K});
+  py::array_t<bool> passes(K);
+  const Vec tau_max = fc.limits(), tau_min = -fc.limits(), hdiag = Vec::Zero(n);
+  {
+    py::gil_scoped_release release;
+    for (py::ssize_t k = 0; k < K; ++k) {
+      const int64_t i = cand.data()[k];
+      const double * xk = x.data() + n * k;
+      bool good = ok.data()[k];
+      kkt.mutable_data()[k] = good ? daqp_kkt(
+        hdiag, c.data(), A.data() + rows * n * k, bupper.data(), blower.data(), xk,
+        lam.data() + nb * k, static_cast<int>(n), rows) :
+        std::numeric_limits<double>::infinity();
+      good = good && kkt.data()[k] <= kkt_tolerance && xk[nf] < (1.0 - 1e-9) * alpha_max;
+      const double a = xk[nf] / scale.data()[k];
+      alpha.mutable_data()[k] = a;
+      if (good) {
+        const Vec f = Eigen::Map<const Vec>(xk, nf);
+        const RowMat Gi = Eigen::Map<const RowMat>(G.data() + 6 * nf * i, 6, nf);
+        const RowMat Ji = Eigen::Map<const RowMat>(J.data() + nf * m * i, nf, m);
+        const Vec tau = Ji.transpose() * f;
+        const Wrench w = a * Eigen::Map<const Wrench>(loads.data() + 6 * k);
+        good = fc.passes(fc.certify(Gi, Ji, w, tau_min, tau_max, tau, f));
+      }
+      passes.mutable_data()[k] = good;
+    }
+  }
+  py::dict d;
+  d["kkt"] = kkt;
+  d["alpha"] = alpha;
+  d["passes"] = passes;
+  return d;
+}
+
+}  // namespace
+
+#endif  // FAST_BATCH_HPP_
