@@ -192,9 +192,9 @@ class TorqueController:
         """Reject a message by its serialized length (:meth:`InputStore.check_bytes`)."""
         self.store.check_bytes(source, n)
 
-    def check_size(self, source: str, n: int) -> None:
+    def check_size(self, source: str, n: int, frame_id: str = '') -> None:
         """Reject a message by its size alone (:meth:`InputStore.check_size`)."""
-        self.store.check_size(source, n)
+        self.store.check_size(source, n, frame_id)
 
     def update_joint_state(self, names: list[str], positions: list[float], now: float,
                            stamp: float = 0.0, clock: float | None = None,

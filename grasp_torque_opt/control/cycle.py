@@ -31,11 +31,10 @@ from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
-from grasp_torque_opt.control.plausible import check_on_links, points_inward
+from grasp_torque_opt.control.named_contacts import topic_contacts
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import ContactSpec
 from grasp_torque_opt.core.solution import Solution
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.dispatch import solve
@@ -96,6 +95,10 @@ class Cycle:
         #: The compiled cycle in use (None: the Python cycle), and why not when None.
         self.compiled_cycle: compiled.CompiledCycle | None = None
         self.compiled_reason = ''
+        #: The links of the contacts topic's set at the last cycle that used it, and how
+        #: many times that set changed (the first set is not a change).
+        self.topic_links: tuple[str, ...] | None = None
+        self.topic_changes = 0
 
     def grasp_at(self, inputs: Inputs, jacobians: bool = False
                  ) -> tuple[GraspSetup, np.ndarray | None]:
@@ -124,30 +127,8 @@ class Cycle:
         else:
             pin.framesForwardKinematics(model, data, q)
         contacts, origin, at = geometry_of(self, inputs, q)
-        if inputs.contacts is not None:
-            cp = inputs.contacts
-            oMF = data.oMf[model.getFrameId(cp.frame or hand.base_frame)]
-            if hand.base_link is not None:  # the grasp is written in the base link's frame
-                oMF = data.oMf[model.getFrameId(hand.base_link)].actInv(oMF)
-            contacts, points, normals, origins = [], [], [], []
-            limit = self.config.max_contact_distance
-            for i, (spec, p, R) in enumerate(zip(setup.contacts, cp.positions, cp.rotations)):
-                p_base = oMF.act(p)
-                distance = float(np.linalg.norm(p_base))
-                if distance > limit:
-                    raise InputError(f'contacts.poses[{i}].position',
-                                     f'is {distance:.6g} m from the base origin, beyond '
-                                     f'max_contact_distance ({limit} m)')
-                R_base = oMF.rotation @ R
-                oMl = data.oMf[model.getFrameId(spec.link)]
-                if hand.base_link is not None:
-                    oMl = data.oMf[model.getFrameId(hand.base_link)].actInv(oMl)
-                contacts.append(ContactSpec(link=spec.link, position=oMl.actInv(p_base),
-                                            normal=R_base[:, 2], tangent=R_base[:, 0]))
-                points.append(p_base)
-                normals.append(R_base[:, 2])
-                origins.append(oMl.translation)
-            self._check_plausible(*map(np.array, (points, normals, origins)), origin)
+        if inputs.contacts is not None:  # the topic's, on its links (named or by index)
+            contacts = topic_contacts(self, inputs.contacts, origin)
         motion = self.motion_in_use(inputs)
         wrench = setup.external_wrench
         if inputs.wrench is not None:
@@ -227,22 +208,6 @@ class Cycle:
         return est.update(est.measured(maps.G, maps.J, inputs.effort, g), model,
                           inputs.q_time, c.effort_filter, c.effort_time_constant, bounds,
                           gap=c.joint_state_timeout, along=along)
-
-    def _check_plausible(self, points: np.ndarray, normals: np.ndarray,
-                         origins: np.ndarray, origin: np.ndarray) -> None:
-        """
-        Check the contacts in use at this configuration: on their links, pushing inward.
-
-        The message was checked whole on receipt (at the joint state of then); here the
-        cheap, vectorized part runs again, since the links have moved since.
-        """
-        links = tuple(c.link for c in self.setup.contacts)
-        check_on_links(points, origins, links, self.config.max_contact_link_distance)
-        i = points_inward(points, normals, origin)
-        if i >= 0:
-            raise InputError(f'contacts.poses[{i}].orientation', 'the normal of the contact '
-                             f"on '{links[i]}' points away from the object origin at this "
-                             'configuration: the torques would pull')
 
     def budget(self) -> float:
         """

@@ -144,13 +144,17 @@ def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
 
 
 def contact_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
-    """Give where the contacts come from, the geometry's set and changes, the object pose."""
+    """Give where the contacts come from, their set and its changes, the object pose."""
     solving, inputs = c.solving, c.inputs
     tracker = solving.tracker
     source = ('contacts topic' if inputs.contacts is not None else
               'geometry' if tracker is not None else 'scenario')
     values = [('contacts.source', source)]
-    if tracker is not None:
+    if inputs.contacts is not None:  # the set in force: named, or the scenario's by index
+        links = inputs.contacts.links or tuple(s.link for s in c.setup.contacts)
+        values += [('contacts.links', ','.join(links)),
+                   ('contacts.changes', str(solving.topic_changes))]
+    elif tracker is not None:
         values += [('contacts.links', ','.join(tracker.links or ()) or 'none'),
                    ('contacts.changes', str(tracker.changes))]
     values += [('object_pose', "none received (the scenario's)" if inputs.object_pose is None

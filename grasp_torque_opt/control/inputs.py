@@ -31,6 +31,7 @@ from grasp_torque_opt.control.checks import (
 from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.geometry import ObjectPose, ObjectPoseInput
 from grasp_torque_opt.control.motion import checked_imu, efforts_of, ImuTracker, Motion
+from grasp_torque_opt.control.named_contacts import named_frame, split_frame_id
 from grasp_torque_opt.control.plausible import check_contacts
 from grasp_torque_opt.control.rates import turned_towards
 from grasp_torque_opt.control.stamps import StampRule
@@ -53,11 +54,14 @@ class ContactPoses:
         frame: model frame the poses are expressed in ('' = the base frame).
         positions: contact points, shape (p, 3) [m].
         rotations: contact frame axes (columns x, y, z = inward normal), shape (p, 3, 3).
+        links: the link of each pose, as named in the message (None: the scenario's
+            contacts, by index).
     """
 
     frame: str
     positions: np.ndarray
     rotations: np.ndarray
+    links: tuple[str, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -185,14 +189,14 @@ class InputStore(StampRule, ObjectPoseInput):
             self.reject(source, e)
             raise e
 
-    def check_size(self, source: str, n: int) -> None:
+    def check_size(self, source: str, n: int, frame_id: str = '') -> None:
         """
         Reject a message by its size alone, before it is read.
 
         Args:
             source: ``joint_states`` (``n`` names or positions, at most
-                ``max_joint_state_entries``) or ``contacts`` (``n`` poses, exactly
-                one per scenario contact).
+                ``max_joint_state_entries``) or ``contacts`` (``n`` poses, one per link
+                named in ``frame_id``, else per scenario contact: :mod:`.named_contacts`).
 
         Raises:
             InputError: the size is out of bounds (counted as a rejection).
@@ -202,9 +206,8 @@ class InputStore(StampRule, ObjectPoseInput):
                 limit = self.config.max_joint_state_entries
                 raise InputError('joint_states', f'{n} entries, more than '
                                  f'max_joint_state_entries ({limit})')
-            p = len(self.setup.contacts)
-            if source == 'contacts' and n != p:
-                raise InputError('contacts', f'{n} poses for {p} contacts')
+            if source == 'contacts':
+                split_frame_id(frame_id, n, len(self.setup.contacts))
         except InputError as e:
             self.reject(source, e)
             raise
@@ -282,10 +285,12 @@ class InputStore(StampRule, ObjectPoseInput):
     def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
                         now: float, stamp: float = 0.0, clock: float | None = None) -> None:
         """
-        Take contact frames: one pose per scenario contact, in model frame ``frame``.
+        Take contact frames: one pose per scenario contact, or per named link.
 
         Args:
-            frame: model frame of the poses ('' = the base frame).
+            frame: model frame of the poses ('' = the base frame), or
+                ``FRAME;LINK_1,...,LINK_n``: one pose per named link, in order
+                (:mod:`.named_contacts`).
             positions: contact points, shape (p, 3) [m].
             quaternions: contact frame orientations (x, y, z, w), shape (p, 4).
             now: monotonic receipt time [s].
@@ -293,32 +298,29 @@ class InputStore(StampRule, ObjectPoseInput):
             clock: the clock the stamps are on, now [s] (None: not checked ahead).
 
         Raises:
-            InputError: wrong count or shape, unknown frame, non-finite values, a
+            InputError: wrong count or shape, unknown frame, a bad frame_id or named
+                link (:func:`.named_contacts.named_frame`), non-finite values, a
                 non-unit quaternion, an implausible contact at the latest joint state
                 (:func:`.plausible.check_contacts`), a bad stamp. The contacts are not
                 kept. (The cycle checks them again, where the frame is placed.)
         """
         positions = np.asarray(positions, dtype=float)
         quaternions = np.asarray(quaternions, dtype=float)
-        self.check_size('contacts', len(positions))
         try:
-            rotations = contact_rotations(self.setup.hand.model, len(self.setup.contacts),
-                                          frame, positions, quaternions)
-            self._check_plausible(frame, positions, rotations)
+            frame, links = named_frame(self.setup, frame, len(positions))
+            rotations = contact_rotations(self.setup.hand.model, len(positions), frame,
+                                          positions, quaternions)
+            q = self.setup.q if self.inputs.q is None else self.inputs.q  # the latest
+            check_contacts(self.setup, self.object, q, frame, positions, rotations,
+                           self.config.max_contact_link_distance, links)
             self._check_stamp('contacts', stamp, clock, now)
         except InputError as e:
             self.reject('contacts', e)
             raise
         self._keep_stamp('contacts', stamp, now, clock)
         self.inputs = dataclasses.replace(
-            self.inputs, contacts=ContactPoses(frame, positions, rotations), contacts_time=now)
-
-    def _check_plausible(self, frame: str, positions: np.ndarray,
-                         rotations: np.ndarray) -> None:
-        """Check contacts on their links and pushing inward, at the latest joint state."""
-        q = self.setup.q if self.inputs.q is None else self.inputs.q
-        check_contacts(self.setup, self.object, q, frame, positions, rotations,
-                       self.config.max_contact_link_distance)
+            self.inputs, contacts=ContactPoses(frame, positions, rotations, links),
+            contacts_time=now)
 
     def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
                       now: float, stamp: float = 0.0, clock: float | None = None) -> None:

@@ -33,7 +33,8 @@ import pinocchio as pin
 
 
 def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, frame: str,
-                   positions: np.ndarray, rotations: np.ndarray, limit: float) -> None:
+                   positions: np.ndarray, rotations: np.ndarray, limit: float,
+                   links: tuple[str, ...] | None = None) -> None:
     """
     Check contact poses at configuration ``q``: on their own links, pushing into the object.
 
@@ -45,6 +46,7 @@ def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, fra
         positions: contact points, shape (p, 3) [m].
         rotations: contact frame axes, shape (p, 3, 3).
         limit: ``max_contact_link_distance`` [m].
+        links: each pose's link (None: the scenario's contacts', by index).
 
     Raises:
         InputError: naming the contact (:func:`check_on_links`, :func:`check_inward`).
@@ -60,7 +62,7 @@ def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, fra
     oMF = base.actInv(oMF) if base is not None else oMF
     R = oMF.rotation
     points, normals = positions @ R.T + oMF.translation, rotations[:, :, 2] @ R.T
-    links = tuple(c.link for c in setup.contacts)
+    links = links or tuple(c.link for c in setup.contacts)
     placements = [data.oMf[model.getFrameId(link)] for link in links]
     origins = np.array([(base.actInv(m) if base is not None else m).translation
                         for m in placements])

@@ -158,13 +158,19 @@ class Inputs:
                     self.node.get_logger().warn(load.off)
 
     def on_contacts(self, msg: PoseArray, receipt: float | None = None) -> None:
-        """Take contact frames in a model frame: one pose per scenario contact."""
+        """
+        Take contact frames in a model frame: one per scenario contact, or per named link.
+
+        ``header.frame_id`` is ``FRAME`` (one pose per scenario contact, by index) or
+        ``FRAME;LINK_1,...`` (one pose per named link:
+        :mod:`grasp_torque_opt.control.named_contacts`).
+        """
         now = time.monotonic() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self.root.lock:
             ctrl = self.root.controller
             try:
-                ctrl.check_size('contacts', len(msg.poses))
+                ctrl.check_size('contacts', len(msg.poses), msg.header.frame_id)
                 positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
                 quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
                          for p in msg.poses]
