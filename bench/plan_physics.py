@@ -38,6 +38,7 @@ from pathlib import Path
 import platform
 import subprocess
 import sys
+import tempfile
 import time
 
 from grasp_torque_opt.core.exceptions import InputError
@@ -78,7 +79,7 @@ def episode(doc: dict, force: np.ndarray, duration: float = 2.0, picture: str | 
     settings = EpisodeSettings(duration=duration, drift_limit=LOOSE[0],
                                object_force=tuple(float(f) for f in force))
     setup, rig = simulated(scenario, settings, GraspSetup.from_scenario(scenario))
-    node = node_controller(setup, scenario, rig)
+    node = node_controller(setup, scenario, rig, margin=scenario.friction.margin)
 
     def guarded(reading):
         # A finger pushed past its URDF limit (the object knocked away) is input the
@@ -184,7 +185,17 @@ def main() -> int:
     p.add_argument('--out')
     p.add_argument('--simulate-best', nargs=2, metavar=('PLAN', 'SCORES'))
     p.add_argument('--picture', default='best.png')
+    p.add_argument('--margin', type=float, default=0.0,
+                   help="the friction margin k of the scenario: the plan's scores, the "
+                        "capacities predicted and the node's torques all use it")
     args = p.parse_args()
+    if args.margin:
+        global SCENARIO
+        doc = yaml.safe_load(SCENARIO.read_text())
+        doc.setdefault('friction', {})['margin'] = args.margin
+        margined = Path(tempfile.mkdtemp()) / SCENARIO.name
+        margined.write_text(yaml.safe_dump(doc))
+        SCENARIO = margined
     if args.simulate_best:
         return simulate_best(*args.simulate_best, args.picture)
     t0 = time.time()
