@@ -56,6 +56,7 @@ from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
+from grasp_torque_opt.methods.batch import contact_arrays
 import numpy as np
 import pinocchio as pin
 
@@ -191,21 +192,10 @@ class CompiledCycle:
         c = self._contacts
         if c is not None and c.specs is setup.contacts:
             return c
-        hand, specs = setup.hand, setup.contacts
-        p = len(specs)
-        normals, tangents = np.zeros((p, 3)), np.zeros((p, 3))
-        has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
-        for i, spec in enumerate(specs):
-            if spec.normal is not None:
-                normals[i], has_n[i] = spec.normal, True
-            if spec.tangent is not None:
-                tangents[i], has_t[i] = spec.tangent, True
+        fids, links, points, normals, has_n, tangents, has_t = contact_arrays(
+            setup.hand, setup.contacts)
         self._contacts = c = _Contacts(
-            specs=specs,
-            frame_ids=tuple(hand.frame_index(s.link, f'grasp.contacts[{i}].link')
-                            for i, s in enumerate(specs)),
-            links=tuple(s.link for s in specs),
-            points=np.array([s.position for s in specs], dtype=float).reshape(p, 3),
+            specs=setup.contacts, frame_ids=fids, links=links, points=points,
             normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t)
         return c
 

@@ -171,7 +171,8 @@ def contact_arrays(hand, specs) -> tuple:
         if spec.tangent is not None:
             tangents[i], has_t[i] = spec.tangent, True
     links = tuple(spec.link for spec in specs)
-    fids = tuple(hand.frame_index(link, 'link') for link in links)
+    fids = tuple(hand.frame_index(link, f'grasp.contacts[{i}].link')
+                 for i, link in enumerate(links))
     points = np.array([spec.position for spec in specs], dtype=float).reshape(p, 3)
     return fids, links, points, normals, has_n, tangents, has_t
 
