@@ -96,7 +96,7 @@ package_name = 'grasp_torque_opt'
 
 setup(
     name=package_name,
-    version='0.5.0',
+    version='0.6.0',
     packages=find_packages(exclude=['test', 'bench']),
     # The node's parameter schema, read at import (grasp_torque_opt.control.parameters).
     package_data={'grasp_torque_opt.control': ['grasp_torque_node_parameters.yaml']},
