@@ -150,9 +150,11 @@ def test_flapping_gravity_does_not_chatter(planar):
         commands = flapping(h, names, pos, lambda odd: h.send_gravity(
             '', [-9.81 if odd else 9.81, 0.0, 0.0]))
         assert len(commands) > 50
-        # The gravity in use stays within max_gravity_rate (100 m/s^3) of the first.
+        # The gravity in use turns (never cuts through zero): its norm stays within the
+        # bounds both ends meet. How far it turned depends on the time between the
+        # messages (max_gravity_rate times it), which a loaded machine stretches.
         g = h.node.controller.inputs.gravity
-        assert np.linalg.norm(g - [9.81, 0.0, 0.0]) < 100.0 * 0.05
+        assert abs(np.linalg.norm(g) - 9.81) < 1e-9
         assert steps(commands).max() < 0.25 * full
     finally:
         h.close()
