@@ -219,8 +219,10 @@ def test_stale_joint_states_apply_the_zero_policy(planar):
         assert first is not None and np.linalg.norm(first) > 0
         zero = h.next_command(1.0)
         assert zero is not None and np.all(zero == 0.0)
+        # 'in', not a prefix: a namesake left on the domain by an earlier test (discovery
+        # forgets it late) puts its ERROR in front (seen twice in full runs).
         assert h.spin_until(lambda: h.diagnostics and
-                            h.diagnostics[-1]['_message'].startswith('zero torques'), 2.0)
+                            'zero torques published' in h.diagnostics[-1]['_message'], 2.0)
     finally:
         h.close()
 
