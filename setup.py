@@ -78,14 +78,14 @@ def fast_cycle_extensions() -> list[Extension]:
     common = ['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden', '-g0',
               '-isystem', eigen, '-isystem', proxsuite]
     header = [_source('src/fast_cycle.hpp'), _source('src/fast_batch.hpp')]
-    out = [Extension('grasp_torque_opt.control._fast_cycle', [_source('src/fast_cycle.cpp')],
+    out = [Extension('grasp_torque_opt.native._fast_cycle', [_source('src/fast_cycle.cpp')],
                      include_dirs=[pybind11.get_include()], language='c++',
                      extra_compile_args=common, depends=header, optional=True)]
     if platform.machine().lower() in ('x86_64', 'amd64'):
         # As ProxSuite's own wheel does: a second build with AVX2 and FMA, loaded only on
-        # a CPU that has them (grasp_torque_opt/control/compiled.py). About 15% faster.
+        # a CPU that has them (grasp_torque_opt/native/loader.py). About 15% faster.
         out.append(Extension(
-            'grasp_torque_opt.control._fast_cycle_avx2', [_source('src/fast_cycle_avx2.cpp')],
+            'grasp_torque_opt.native._fast_cycle_avx2', [_source('src/fast_cycle_avx2.cpp')],
             include_dirs=[pybind11.get_include()], language='c++',
             extra_compile_args=[*common, '-mavx2', '-mfma'], depends=header,
             optional=True))

@@ -34,9 +34,11 @@ import time
 from cycle import machine, report
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.scenario import ContactSpec, MAX_CONTACTS
+from grasp_torque_opt.core.scenario import MAX_CONTACTS
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 from grasp_torque_opt.core.tau_qp import build_tau_qp
 import numpy as np
 

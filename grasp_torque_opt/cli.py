@@ -279,7 +279,8 @@ def _main(argv: list[str] | None) -> int:
 
 
 def _score_parser(sub) -> None:
-    from grasp_torque_opt.methods.score import ENGINES, METRICS, RANK_KEYS
+    from grasp_torque_opt.methods.ranking import RANK_KEYS
+    from grasp_torque_opt.methods.score import ENGINES, METRICS
 
     p = sub.add_parser('score', help='score candidate grasps of one hand (JSON Lines), in '
                        'parallel, ranked', formatter_class=HelpFormatter,
@@ -343,16 +344,8 @@ class _Progress:
 
 
 def _score(args: argparse.Namespace) -> int:
-    from grasp_torque_opt.methods.score import (
-        format_table,
-        rank,
-        rank_key,
-        read_candidates,
-        record_json,
-        score_batch,
-        ScoreJob,
-        summary,
-    )
+    from grasp_torque_opt.methods.ranking import format_table, rank, rank_key, record_json, summary
+    from grasp_torque_opt.methods.score import read_candidates, score_batch, ScoreJob
 
     where = args.scenario
     try:

@@ -15,8 +15,8 @@ from conftest import ROOT
 
 PACKAGE = ROOT / 'grasp_torque_opt'
 #: Family -> rank; a module may import its own family and families of a lower rank.
-RANKS = {'core': 0, 'backends': 1, 'reference': 1, 'methods': 2, 'control': 3, 'sim': 3,
-         'ros': 4, 'cli': 4}
+RANKS = {'core': 0, 'backends': 1, 'native': 1, 'reference': 1, 'methods': 2, 'control': 3,
+         'sim': 3, 'ros': 4, 'cli': 4}
 
 
 def family(module: str) -> str:
@@ -24,10 +24,38 @@ def family(module: str) -> str:
     return module.split('.')[1]
 
 
+def loaded_by_name(node: ast.AST) -> str | None:
+    """
+    Return the module that an ``importlib.import_module(...)`` or ``__import__(...)`` names.
+
+    A constant name, or the constant head of an f-string
+    (``f'grasp_torque_opt.native.{name}'`` -> ``grasp_torque_opt.native``); None for
+    any other node or a name that is not the package's.
+    """
+    if not isinstance(node, ast.Call) or not node.args:
+        return None
+    f = node.func
+    called = f.attr if isinstance(f, ast.Attribute) else getattr(f, 'id', '')
+    if called not in ('import_module', '__import__'):
+        return None
+    arg = node.args[0]
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+        name = arg.value
+    elif isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0], ast.Constant):
+        name = str(arg.values[0].value).rstrip('.')
+    else:
+        return None
+    return name if name.startswith('grasp_torque_opt.') else None
+
+
 def imports(path: Path) -> set[str]:
-    """Every grasp_torque_opt module that ``path`` imports, at any depth of its code."""
+    """Every grasp_torque_opt module that ``path`` imports, at any depth, by name too."""
     found = set()
     for node in ast.walk(ast.parse(path.read_text())):
+        by_name = loaded_by_name(node)
+        if by_name:
+            found.add(by_name)
+            continue
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             names = [node.module] + [f'{node.module}.{a.name}' for a in node.names]
         elif isinstance(node, ast.Import):
@@ -75,6 +103,14 @@ def test_the_parser_sees_imports_at_module_and_function_level():
     assert 'grasp_torque_opt.ros.node' in imports(sample)
 
 
+def test_the_parser_sees_modules_loaded_by_name():
+    """importlib.import_module with the package's name (an f-string's head too) counts."""
+    assert 'grasp_torque_opt.native' in imports(PACKAGE / 'native' / 'loader.py')
+    call = ast.parse("importlib.import_module(f'grasp_torque_opt.ros.{x}')").body[0].value
+    assert loaded_by_name(call) == 'grasp_torque_opt.ros'
+    assert loaded_by_name(ast.parse("__import__('numpy')").body[0].value) is None
+
+
 #: The size rule (docs/architecture.md): a module a newcomer reads in one sitting.
 MAX_MODULE_LINES = 500
 MAX_CLASS_LINES = 300
@@ -92,3 +128,155 @@ def test_no_module_or_class_is_too_long_to_read():
                 if n > MAX_CLASS_LINES:
                     long.append(f'{module}.{node.name}: {n} lines (at most {MAX_CLASS_LINES})')
     assert not long, '\n'.join(long)
+
+
+def _type_checking_only(tree: ast.Module) -> set[int]:
+    """Return the ids of the nodes under ``if TYPE_CHECKING:`` (type hints, never run)."""
+    skip = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and getattr(node.test, 'id', None) == 'TYPE_CHECKING':
+            skip.update(id(n) for part in node.body for n in ast.walk(part))
+    return skip
+
+
+def import_graph() -> dict[str, set[str]]:
+    """
+    Map each module to the package's modules it imports when run (any level).
+
+    ``from a.b import c`` is the module ``a.b.c`` where that is a module, else ``a.b``;
+    imports under ``if TYPE_CHECKING:`` are left out (a composition root's parts may
+    name its type), and so is the package's own ``__init__`` (it maps names lazily).
+    """
+    mods = modules()
+    graph = {}
+    for module, path in mods.items():
+        tree = ast.parse(path.read_text())
+        skip = _type_checking_only(tree)
+        out = set()
+        for node in ast.walk(tree):
+            if id(node) in skip:
+                continue
+            if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [f'{node.module}.{a.name}' if f'{node.module}.{a.name}' in mods
+                         else node.module for a in node.names]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            else:
+                names = [loaded_by_name(node)] if loaded_by_name(node) else []
+            for name in names:
+                while name and name not in mods:
+                    name = name.rpartition('.')[0]
+                if name and name != module:
+                    out.add(name)
+        graph[module] = out
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Return the import circles: strongly connected components of two modules or more."""
+    index, low, stack, on, found = {}, {}, [], set(), []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            part = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                part.append(w)
+                if w == v:
+                    break
+            if len(part) > 1:
+                found.append(sorted(part))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def test_no_import_circle():
+    """No module imports itself through others, at module or function level."""
+    found = cycles(import_graph())
+    assert not found, '\n'.join(' <-> '.join(c) for c in found)
+
+
+def test_the_circle_finder_finds_one():
+    assert cycles({'a': {'b'}, 'b': {'c'}, 'c': {'a'}, 'd': {'a'}}) == [['a', 'b', 'c']]
+
+
+def defined_names(path: Path) -> tuple[set[str], set[str]]:
+    """Return (names a module defines, names it imports from the package), top level."""
+    defined, imported = set(), set()
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            defined.add(node.name)
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            for target in node.targets if isinstance(node, ast.Assign) else [node.target]:
+                defined.update(n.id for n in ast.walk(target) if isinstance(n, ast.Name))
+        elif isinstance(node, ast.ImportFrom) and (node.module or '').startswith(
+                'grasp_torque_opt'):
+            imported.update(a.asname or a.name for a in node.names)
+    return defined, imported
+
+
+def test_no_module_but_an_init_re_exports_another_modules_names():
+    """
+    A name is imported from the module that defines it, never through another module.
+
+    A package's ``__init__`` may gather its family's names; no other module passes on
+    what it imported (a shim left 'to keep imports working' becomes the real path).
+    """
+    mods = modules()
+    files = [*PACKAGE.rglob('*.py'), *(ROOT / 'test').rglob('*.py'),
+             *(ROOT / 'bench').glob('*.py')]
+    wrong = []
+    for path in files:
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.ImportFrom) and node.level == 0
+                    and node.module in mods and mods[node.module].name != '__init__.py'):
+                continue
+            defined, imported = defined_names(mods[node.module])
+            wrong.extend(f'{path.relative_to(ROOT)}:{node.lineno} takes {a.name} from '
+                         f'{node.module}, which imports it' for a in node.names
+                         if a.name in imported and a.name not in defined)
+    assert not wrong, '\n'.join(wrong)
+
+
+def architecture_rows() -> set[str]:
+    """
+    Return the modules that docs/architecture.md's tables name, as ``family.module``.
+
+    A row is ``| family | modules | holds |``; an empty family cell is the row above's
+    (``ros/node/`` is a family of its own there), modules are backticked, commas apart.
+    """
+    listed, family = set(), ''
+    for line in (ROOT / 'docs' / 'architecture.md').read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip('|').split('|')]
+        if not line.startswith('|') or len(cells) < 3 or set(cells[1]) <= set('-: '):
+            continue
+        family = cells[0].strip('`').strip('/').replace('/', '.') or family
+        listed.update(f'{family}.{name.strip("`")}' for name in cells[1].split(', ')
+                      if name.startswith('`'))
+    return listed
+
+
+def test_every_module_is_in_the_architecture_table():
+    """docs/architecture.md's table names every module of the package, each in its row."""
+    listed = architecture_rows()
+    missing = []
+    for module, path in modules().items():
+        key = module.split('.', 1)[1]
+        if path.name == '__init__.py':
+            key += '.__init__'
+        if path.name != '__main__.py' and key not in listed:
+            missing.append(module)
+    assert not missing, 'not in docs/architecture.md: ' + ', '.join(sorted(missing))

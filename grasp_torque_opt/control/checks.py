@@ -19,11 +19,12 @@ from __future__ import annotations
 from collections import Counter
 import math
 
-from grasp_torque_opt.control.config import CycleConfig
-from grasp_torque_opt.control.parameters import MAX_GRAVITY
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError
 import numpy as np
 import pinocchio as pin
+
+#: Largest accepted norm of a gravity input [m/s^2] (about 10 g), parameter or message.
+MAX_GRAVITY = 100.0
 
 #: A quaternion is accepted when | ||q|| - 1 | is at most this, then normalized.
 QUATERNION_TOLERANCE = 1e-3
@@ -174,7 +175,7 @@ def contact_rotations(model: pin.Model, p: int, frame: str, positions: np.ndarra
 
 
 def checked_wrench(model: pin.Model, frame: str, force: np.ndarray, torque: np.ndarray,
-                   config: CycleConfig) -> np.ndarray:
+                   max_force: float, max_torque: float) -> np.ndarray:
     """
     Check a load and return it as [F, M] in the axes of ``frame``.
 
@@ -189,10 +190,9 @@ def checked_wrench(model: pin.Model, frame: str, force: np.ndarray, torque: np.n
                         finite(torque, 'external_wrench.wrench.torque')))
     if w.shape != (6,):
         raise InputError('external_wrench.wrench', f'{w.size} values, expected 6')
-    c = config
     for part, v, bound, key, unit in ((
-            'force', w[:3], c.max_wrench_force, 'max_wrench_force', 'N'), (
-            'torque', w[3:], c.max_wrench_torque, 'max_wrench_torque', 'N m')):
+            'force', w[:3], max_force, 'max_wrench_force', 'N'), (
+            'torque', w[3:], max_torque, 'max_wrench_torque', 'N m')):
         with np.errstate(over='ignore'):  # 1e308 entries: an infinite norm
             norm = float(np.linalg.norm(v))
         if norm > bound:

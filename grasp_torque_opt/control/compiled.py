@@ -9,7 +9,7 @@
 """
 The node's cycle compiled: maps, build, warm ProxSuite solve and certificate in C++.
 
-``grasp_torque_opt.control._fast_cycle`` (``src/fast_cycle.hpp``, built by ``setup.py`` with
+``grasp_torque_opt.native._fast_cycle`` (``src/fast_cycle.hpp``, built by ``setup.py`` with
 pybind11, Eigen and ProxSuite's C++ headers; on x86-64 also ``_fast_cycle_avx2``, used
 where the CPU runs AVX2 and FMA) is the Python cycle written again, rule for rule, for
 the case the node runs on every joint state (docs/design.md section 2.6):
@@ -40,16 +40,6 @@ from grasp_torque_opt.backends.proxsuite import (
     TauQPSolver,
 )
 from grasp_torque_opt.core.certificate import Certificate
-# The compiled modules are found and loaded in core (batch scoring, in methods, uses
-# them too); their names stay here.
-from grasp_torque_opt.core.compiled_module import (  # noqa: F401 -- re-exported
-    _fast_cycle,
-    API,
-    cpu_has_avx2,
-    IMPORT_ERROR,
-    load,
-    MODULES,
-)
 from grasp_torque_opt.core.friction import contact_block
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -57,6 +47,7 @@ from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
 from grasp_torque_opt.methods.batch import contact_arrays
+from grasp_torque_opt.native.loader import fast_cycle, IMPORT_ERROR
 import numpy as np
 import pinocchio as pin
 
@@ -65,8 +56,8 @@ import pinocchio as pin
 PRIMARY_SHARE = 0.8
 #: Outcome codes after which ProxSuite was tried (warm, and cold if the warm answer
 #: failed): the controller asks its fallback backend next, not ProxSuite again.
-SOLVER_CODES = () if _fast_cycle is None else (
-    _fast_cycle.NOT_SOLVED, _fast_cycle.NOT_CERTIFIED, _fast_cycle.TIMED_OUT)
+SOLVER_CODES = () if fast_cycle is None else (
+    fast_cycle.NOT_SOLVED, fast_cycle.NOT_CERTIFIED, fast_cycle.TIMED_OUT)
 #: After this many cycles in a row handed back as not of full column rank (a grasp
 #: with internal-force variables), the compiled cycle is not tried again for the grasp.
 RANK_GIVE_UP = 10
@@ -74,7 +65,7 @@ RANK_GIVE_UP = 10
 
 def available() -> bool:
     """Tell whether the compiled cycle was built and imports."""
-    return _fast_cycle is not None
+    return fast_cycle is not None
 
 
 def unsupported(setup: GraspSetup, method: str, solver) -> str:
@@ -84,7 +75,7 @@ def unsupported(setup: GraspSetup, method: str, solver) -> str:
     Only what is known before a cycle: a grasp whose A turns out rank-deficient at some
     configuration is handed back by :meth:`CompiledCycle.solve` instead.
     """
-    if _fast_cycle is None:
+    if fast_cycle is None:
         return IMPORT_ERROR
     if setup.hand.velocity_map is not None:
         return 'coupled joints (the compiled cycle takes a column selection of J)'
@@ -146,7 +137,7 @@ class CompiledCycle:
         S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
                                  friction.min_normal_force)
         st = solver.settings
-        s = (module or _fast_cycle).Settings()
+        s = (module or fast_cycle).Settings()
         s.eps_abs, s.eps_rel, s.eps_primal_inf = st.eps_abs, st.eps_rel, st.eps_primal_inf
         s.max_iter, s.max_iter_in = st.max_iter, st.max_iter_in
         s.kkt_tolerance, s.certificate_tolerance = KKT_TOLERANCE, tolerance
@@ -154,7 +145,7 @@ class CompiledCycle:
         s.inner_iteration_s, s.estimate_decay = INNER_ITERATION_S, ESTIMATE_DECAY
         s.primary_share = PRIMARY_SHARE
         #: The compiled module in use (``_fast_cycle`` or ``_fast_cycle_avx2``).
-        self.module = module or _fast_cycle
+        self.module = module or fast_cycle
         self._cycle = self.module.FastCycle(
             np.asarray(hand.idx_v, dtype=np.int64), S_i, b_i,
             np.asarray(setup.weights, dtype=float), np.asarray(hand.torque_limits, dtype=float),
@@ -168,7 +159,7 @@ class CompiledCycle:
         self.handed_back = 0
         #: Why the last cycle was handed back ('' if it was not).
         self.last_reason = ''
-        #: The last cycle's outcome code (``_fast_cycle.CERTIFIED`` ... ``TIMED_OUT``).
+        #: The last cycle's outcome code (``fast_cycle.CERTIFIED`` ... ``TIMED_OUT``).
         self.last_code = 0
         #: Cycles in a row handed back for A's rank; at :data:`RANK_GIVE_UP`, ``gave_up``
         #: says why the compiled cycle is no longer tried for this grasp.

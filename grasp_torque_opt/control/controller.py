@@ -37,8 +37,7 @@ frames, magnitudes, header stamps); a rejected message changes nothing.
 :class:`TorqueController` composes three parts: the input store
 (:mod:`~grasp_torque_opt.control.inputs`, with the checks of
 :mod:`~grasp_torque_opt.control.checks`), the solve (:mod:`~grasp_torque_opt.control.cycle`)
-and the fault policy (:mod:`~grasp_torque_opt.control.fault_policy`). The names
-this module has always exported are exported from here still.
+and the fault policy (:mod:`~grasp_torque_opt.control.fault_policy`).
 """
 
 from __future__ import annotations
@@ -49,25 +48,10 @@ import time
 
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-from grasp_torque_opt.control.checks import (
-    MAX_ABS_JOINT_POSITION,
-    MAX_GRAVITY,
-    quaternion_matrix,
-    QUATERNION_TOLERANCE,
-    show,
-    SHOWN_NAME_LENGTH,
-)
-from grasp_torque_opt.control.config import CycleConfig, POLICIES
 from grasp_torque_opt.control.cycle import Cycle
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
-from grasp_torque_opt.control.inputs import (
-    ContactPoses,
-    Counters,
-    Inputs,
-    InputStore,
-    SOURCES,
-    stamp_seconds,
-)
+from grasp_torque_opt.control.inputs import Counters, Inputs, InputStore
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.control.rates import slewed, step_wrenches
 from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -78,11 +62,6 @@ import numpy as np
 #: How far a rate-rule step's contact wrenches may lie outside the exact cone [N]: the
 #: certificate's tolerance (a convex combination of two certified wrenches is inside).
 STEP_CONE_TOLERANCE = 1e-6
-
-__all__ = ['ContactPoses', 'Counters', 'CycleConfig', 'CycleResult', 'Inputs',
-           'MAX_ABS_JOINT_POSITION', 'MAX_GRAVITY', 'POLICIES', 'QUATERNION_TOLERANCE',
-           'quaternion_matrix', 'show', 'SHOWN_NAME_LENGTH', 'SOURCES', 'stamp_seconds',
-           'TorqueController']
 
 
 class _In:

@@ -25,13 +25,13 @@ from grasp_torque_opt.backends.daqp import DaqpSettings
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.backends.registry import is_backend, settings_for
 from grasp_torque_opt.control import compiled
-from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.effort_load import EffortLoad
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.named_contacts import topic_contacts
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup

@@ -39,7 +39,8 @@ from grasp_torque_opt.control.checks import finite, quaternion_matrix, show
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.geometry_contacts import ContactSet, GeometryContacts
 from grasp_torque_opt.core.object_geometry import object_pose
-from grasp_torque_opt.core.scenario import ContactSpec, ObjectSpec
+from grasp_torque_opt.core.scenario import ObjectSpec
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 import pinocchio as pin
 

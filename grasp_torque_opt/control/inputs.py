@@ -28,10 +28,10 @@ from grasp_torque_opt.control.checks import (
     contact_rotations,
     MAX_ABS_JOINT_POSITION,
 )
-from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.geometry import ObjectPose, ObjectPoseInput
 from grasp_torque_opt.control.motion import checked_imu, efforts_of, ImuTracker, Motion
 from grasp_torque_opt.control.named_contacts import named_frame, split_frame_id
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.control.plausible import check_contacts
 from grasp_torque_opt.control.rates import turned_towards
 from grasp_torque_opt.control.stamps import StampRule
@@ -341,7 +341,8 @@ class InputStore(StampRule, ObjectPoseInput):
                 The load is not kept.
         """
         try:
-            w = checked_wrench(self.setup.hand.model, frame, force, torque, self.config)
+            w = checked_wrench(self.setup.hand.model, frame, force, torque,
+                               self.config.max_wrench_force, self.config.max_wrench_torque)
             self._check_stamp('external_wrench', stamp, clock, now)
         except InputError as e:
             self.reject('external_wrench', e)

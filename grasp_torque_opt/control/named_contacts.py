@@ -30,7 +30,7 @@ from grasp_torque_opt.control.checks import show
 from grasp_torque_opt.control.plausible import check_on_links, points_inward
 from grasp_torque_opt.core.contact_links import check_contact_links
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError
-from grasp_torque_opt.core.scenario import ContactSpec
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 
 #: The most links one message may name (unless the scenario has more contacts).

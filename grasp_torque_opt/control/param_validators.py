@@ -24,13 +24,13 @@ import math
 from typing import Any
 
 from grasp_torque_opt.backends import available
+from grasp_torque_opt.control.checks import MAX_GRAVITY
+from grasp_torque_opt.control.motion import tilt_radius, uncertainty_margin
 from grasp_torque_opt.core.exceptions import cut, InputError, quote
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.scenario import MAX_NAME_MAP, parse_name_map
 import numpy as np
 
-#: Largest accepted norm of a gravity input [m/s^2] (about 10 g), parameter or message.
-MAX_GRAVITY = 100.0
 #: Each weight's range, and the largest ratio of two weights: W's condition number
 #: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
 WEIGHT_RANGE = (1e-6, 1e6)
@@ -231,9 +231,6 @@ def stated_margin(values: Mapping[str, Any], obj: Any) -> float | None:
         InputError: the uncertainty leaves no friction, or uncertainty.pose without the
             scenario's object.
     """
-    # Here, not at the top: motion imports checks, which imports this module's family.
-    from grasp_torque_opt.control.motion import tilt_radius, uncertainty_margin
-
     friction = values.get('uncertainty.friction') or 0.0
     pose = values.get('uncertainty.pose') or 0.0
     if friction <= 0.0 and pose <= 0.0:

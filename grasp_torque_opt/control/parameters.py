@@ -37,17 +37,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from grasp_torque_opt.control.param_validators import (  # noqa: F401 -- its public names
-    BUILT_IN,
-    check_pairs,
-    Context,
-    MAX_GRAVITY,
-    MAX_WEIGHT_RATIO,
-    name_map_of,
-    Validator,
-    VALIDATORS,
-    WEIGHT_RANGE,
-)
+from grasp_torque_opt.control.param_validators import BUILT_IN, Context, Validator, VALIDATORS
 from grasp_torque_opt.core.exceptions import InputError
 import yaml
 
@@ -315,6 +305,8 @@ def _cycle_config(specs: list[ParamSpec]) -> type:
 
 #: The node's parameters.
 SCHEMA = Schema.load()
+#: The fault policies: keep the last certified command, or publish zero torques.
+POLICIES = SCHEMA['fault_policy'].choices
 #: The frozen classes of :meth:`Schema.params` (``Params``, ``ParamsSolver``).
 PARAMS_CLASSES = _classes('Params', _tree(list(SCHEMA.specs.values())))
 #: The cycle's settings: one field per schema entry with a ``cycle`` key.

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 
-from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 
 

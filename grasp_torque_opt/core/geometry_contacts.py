@@ -48,7 +48,8 @@ from grasp_torque_opt.core.hand import bounded_urdf, frame_names, Hand, MAX_URDF
 from grasp_torque_opt.core.meshes import resolve_meshes
 from grasp_torque_opt.core.object_geometry import coal_shape, nearest, ObjectShape
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
-from grasp_torque_opt.core.scenario import ContactSpec, ObjectSpec
+from grasp_torque_opt.core.scenario import ObjectSpec
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 import pinocchio as pin
 

@@ -30,7 +30,7 @@ from functools import cached_property
 from grasp_torque_opt.core.contact_frame import contact_rotations
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import Hand
-from grasp_torque_opt.core.scenario import ContactSpec
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 import pinocchio as pin
 

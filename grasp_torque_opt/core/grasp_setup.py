@@ -18,13 +18,9 @@ from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps, GraspMaps
 from grasp_torque_opt.core.hand import Hand, resolve_urdf
 from grasp_torque_opt.core.inward import check_inward_normals
-from grasp_torque_opt.core.scenario import (
-    ContactSpec,
-    Friction,
-    load_scenario,
-    Scenario,
-)
+from grasp_torque_opt.core.scenario import Friction, load_scenario, Scenario
 from grasp_torque_opt.core.scenario_contacts import check_contact_points, resolve_contacts
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 
 

@@ -33,15 +33,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from grasp_torque_opt.core.bounded_yaml import (  # noqa: F401 -- MAX_DEPTH: its bound
-    BoundedLoader,
-    MAX_DEPTH,
-    yaml_problem,
-)
+from grasp_torque_opt.core.bounded_yaml import BoundedLoader, yaml_problem
 from grasp_torque_opt.core.coupling import Mimic
 from grasp_torque_opt.core.exceptions import cut, InputError, PATH_LENGTH, quote
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
-from grasp_torque_opt.core.scenario_fields import (  # noqa: F401 -- ContactSpec: its home
+from grasp_torque_opt.core.scenario_fields import (
     AUTO,
     ContactSpec,
     DEFAULT_CONTACT_TOLERANCE,

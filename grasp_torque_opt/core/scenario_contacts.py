@@ -28,7 +28,8 @@ from grasp_torque_opt.core.exceptions import GeometryError, GeometryWarning
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.hand import Hand, resolve_urdf
 from grasp_torque_opt.core.object_geometry import object_pose, ObjectShape, point_distance
-from grasp_torque_opt.core.scenario import ContactSpec, Scenario
+from grasp_torque_opt.core.scenario import Scenario
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 
 

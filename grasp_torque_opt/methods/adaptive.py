@@ -59,12 +59,7 @@ from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.tau_qp import TauQP
-from grasp_torque_opt.methods.adaptive_candidate import ACTIVE, APEX, RESTORE_MARGIN, STRICT
-from grasp_torque_opt.methods.adaptive_qp import INFLATION
-from grasp_torque_opt.methods.adaptive_rounds import FIRST_SIDES, Refined, Rounds
-
-__all__ = ['ACTIVE', 'APEX', 'AdaptiveSettings', 'FIRST_SIDES', 'INFLATION', 'RESTORE_MARGIN',
-           'Refined', 'Refiner', 'STRICT']
+from grasp_torque_opt.methods.adaptive_rounds import Refined, Rounds
 
 
 @dataclass(frozen=True)

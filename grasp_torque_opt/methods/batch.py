@@ -54,6 +54,7 @@ from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
 from grasp_torque_opt.core.tree_kinematics import supported, TreeKinematics
 from grasp_torque_opt.methods.batch_capacity import CapacityBatch
 from grasp_torque_opt.methods.score import MAX_LINE, Scorer
+from grasp_torque_opt.native import loader
 import numpy as np
 
 #: Keys a line may hold for the batch stages (anything else: the single path).
@@ -141,12 +142,10 @@ def parse_contacts(raw: Any, hand) -> tuple:
 
 def why_not(scorer: Scorer) -> str:
     """Say why a job takes the single path for every line ('' if it does not)."""
-    from grasp_torque_opt.core import compiled_module as compiled
-
     job, setup, hand = scorer.job, scorer.base, scorer.base.hand
-    module = compiled._fast_cycle
+    module = loader.fast_cycle
     if module is None or not hasattr(module, 'kinematics_batch'):
-        return compiled.IMPORT_ERROR or 'the compiled cycle has no batch stages'
+        return loader.IMPORT_ERROR or 'the compiled cycle has no batch stages'
     if job.backend != 'daqp':
         return f'backend {job.backend} (the batch stages solve with DAQP)'
     if (job.objective or setup.objective) != 'sum-of-squares':
@@ -193,8 +192,6 @@ class BatchScorer:
         self.why_not = why_not(scorer)
         if self.why_not:
             return
-        from grasp_torque_opt.core import compiled_module as compiled  # the compiled stages
-
         job, setup = scorer.job, scorer.base
         hand = setup.hand
         self.scenario = sc = parse_scenario(scorer.doc, scorer.base_dir, job.source)
@@ -209,7 +206,7 @@ class BatchScorer:
                                and scorer.doc['load'].get('external_wrench') is not None)
         self.has_gravity = sc.gravity is not None
         self.weight = weight_wrench(sc.object, sc.gravity, sc.object_origin)
-        self.module = compiled._fast_cycle
+        self.module = loader.fast_cycle
         self.kinematics = TreeKinematics(model, self.module)
         self.kinematics.check(np.array([self.q0]), self.contacts[0])
         friction = planned_friction(setup.friction)

@@ -69,14 +69,6 @@ from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
 from grasp_torque_opt.core.scenario_contacts import resolve_contacts
 from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 from grasp_torque_opt.methods.dispatch import solve
-from grasp_torque_opt.methods.ranking import (  # noqa: F401 -- re-exported, as before
-    format_table,
-    rank,
-    rank_key,
-    RANK_KEYS,
-    record_json,
-    summary,
-)
 import numpy as np
 import yaml
 

@@ -20,7 +20,8 @@ from __future__ import annotations
 import collections
 import dataclasses
 
-from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.scenario import Scenario
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated

@@ -41,8 +41,9 @@ import xml.etree.ElementTree as ET
 from grasp_torque_opt.core.exceptions import GeometryWarning, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import resolve_urdf
+from grasp_torque_opt.core.meshes import resolve_meshes
 from grasp_torque_opt.core.scenario import ObjectSpec, Scenario
-from grasp_torque_opt.sim.robot import resolve_meshes, weld_and_couple
+from grasp_torque_opt.sim.robot import weld_and_couple
 import mujoco
 import numpy as np
 import pinocchio as pin

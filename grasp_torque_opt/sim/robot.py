@@ -22,11 +22,6 @@ Any URDF the solver accepts, made simulable: meshes found, the robot welded, cou
 from __future__ import annotations
 
 from grasp_torque_opt.core.hand import Hand
-from grasp_torque_opt.core.meshes import (  # noqa: F401 -- the simulation's names
-    package_roots,
-    resolve_mesh,
-    resolve_meshes,
-)
 import mujoco
 import numpy as np
 

@@ -399,7 +399,7 @@ def test_a_deadline_caps_daqps_iterations(allegro):
     ratio bound.
     """
     from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-    from grasp_torque_opt.core.scenario import ContactSpec
+    from grasp_torque_opt.core.scenario_fields import ContactSpec
 
     rng = np.random.default_rng(0)
     contacts = [ContactSpec(link=c.link, position=c.position + rng.normal(0, 2e-3, 3))

@@ -18,7 +18,7 @@ from grasp_torque_opt.control.checks import (
     show,
     SHOWN_NAME_LENGTH,
 )
-from grasp_torque_opt.control.config import CycleConfig
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import numpy as np
 import pytest
@@ -84,14 +84,15 @@ def test_quaternion_near_unit_is_normalized():
 def test_wrench_bounds_name_the_part(planar):
     config = CycleConfig(max_wrench_force=10.0, max_wrench_torque=1.0)
     model = planar.hand.model
-    w = checked_wrench(model, '', [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], config)
+    limits = config.max_wrench_force, config.max_wrench_torque
+    w = checked_wrench(model, '', [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], *limits)
     np.testing.assert_allclose(w, [1.0, 2.0, 3.0, 0.1, 0.2, 0.3])
     with pytest.raises(InputError, match='external_wrench.wrench.force: norm 11 N exceeds'):
-        checked_wrench(model, '', [11.0, 0.0, 0.0], [0.0, 0.0, 0.0], config)
+        checked_wrench(model, '', [11.0, 0.0, 0.0], [0.0, 0.0, 0.0], *limits)
     with pytest.raises(InputError, match='external_wrench.wrench.torque: norm 2 N m'):
-        checked_wrench(model, '', [0.0, 0.0, 0.0], [0.0, 2.0, 0.0], config)
+        checked_wrench(model, '', [0.0, 0.0, 0.0], [0.0, 2.0, 0.0], *limits)
     with pytest.raises(InputError, match='external_wrench.wrench.force: must be finite'):
-        checked_wrench(model, '', [np.nan, 0.0, 0.0], [0.0, 0.0, 0.0], config)
+        checked_wrench(model, '', [np.nan, 0.0, 0.0], [0.0, 0.0, 0.0], *limits)
 
 
 def test_gravity_is_turned_to_base_axes_and_bounded():

@@ -27,6 +27,7 @@ from grasp_torque_opt.core.certificate import certify
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.tau_qp import build_tau_qp
 from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.native import loader
 from independent import assert_holds
 import numpy as np
 import pinocchio as pin
@@ -69,10 +70,10 @@ def reference(setup, q, g):
 
 def test_the_compiled_cycle_is_built():
     # The README's setup builds it; without it the node runs 3 to 4 times slower.
-    assert compiled.available(), compiled.IMPORT_ERROR
-    for name in compiled.MODULES:  # and the AVX2 build where this CPU runs it
-        assert compiled.load(name)[0] is not None, compiled.load(name)[1]
-    assert compiled._fast_cycle.__name__.endswith(compiled.MODULES[0])
+    assert compiled.available(), loader.IMPORT_ERROR
+    for name in loader.MODULES:  # and the AVX2 build where this CPU runs it
+        assert loader.load(name)[0] is not None, loader.load(name)[1]
+    assert loader.fast_cycle.__name__.endswith(loader.MODULES[0])
 
 
 @pytest.mark.parametrize('gravity', [False, True])
@@ -191,10 +192,10 @@ def test_inputs_of_the_wrong_shape_are_handed_back_not_a_crash(allegro):
     z = np.zeros
     a = raw.solve(z((4, 4, 4)), z((4, 6, 3)), z((4, 3)), z((4, 3)), z(4, dtype=bool),
                   z((4, 3)), z(4, dtype=bool), z(3), z(6), z(0), -1.0)
-    assert a.code == compiled._fast_cycle.NOT_HANDLED and a.message == 'joint index out of range'
+    assert a.code == loader.fast_cycle.NOT_HANDLED and a.message == 'joint index out of range'
     a = raw.solve(z((4, 4, 3)), z((4, 6, 16)), z((4, 3)), z((4, 3)), z(4, dtype=bool),
                   z((4, 3)), z(4, dtype=bool), z(3), z(6), z(0), -1.0)
-    assert a.code == compiled._fast_cycle.NOT_HANDLED and a.message == 'inputs of the wrong shape'
+    assert a.code == loader.fast_cycle.NOT_HANDLED and a.message == 'inputs of the wrong shape'
 
 
 def test_a_grasp_with_internal_forces_runs_the_python_cycle(planar):
@@ -271,10 +272,10 @@ def test_a_contact_list_of_another_size_is_taken_cold(allegro_doc, allegro):
     assert fast.compiled_cycle.solves == certified and fast.compiled_cycle._cycle.inits == 3
 
 
-@pytest.mark.parametrize('name', compiled.MODULES)
+@pytest.mark.parametrize('name', loader.MODULES)
 def test_every_module_built_for_this_cpu_gives_the_python_optimum(allegro, name):
     # The node loads the best of them; the other must be right as well (another CPU).
-    module, why = compiled.load(name)
+    module, why = loader.load(name)
     assert module is not None, why
     cycle = compiled.CompiledCycle(allegro, TauQPSolver(warm_start=True), 1e-6, module=module)
     assert cycle.module is module

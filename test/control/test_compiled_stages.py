@@ -25,6 +25,7 @@ from grasp_torque_opt.core.certificate import certify
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.tau_qp import build_tau_qp
+from grasp_torque_opt.native import loader
 import numpy as np
 import pytest
 
@@ -90,10 +91,10 @@ def solve_stage(cycle, qp, **kw):
                                  qp.M1, qp.M2, qp.w, **kw)
 
 
-@pytest.fixture(params=compiled.MODULES)
+@pytest.fixture(params=loader.MODULES)
 def module(request):
     """Each build of the compiled cycle this CPU can load."""
-    module, why = compiled.load(request.param)
+    module, why = loader.load(request.param)
     assert module is not None, why
     return module
 
@@ -194,12 +195,12 @@ def test_solve_refuses_what_the_python_solver_refuses(allegro):
              'inverted-bounds': dataclasses.replace(qp, l_box=qp.u_box + 1.0)}
     for case, bad in cases.items():
         got, ref = solve_stage(cycle, bad), python.solve(bad)
-        assert not got['solved'] and got['code'] == compiled._fast_cycle.BAD_DATA, case
+        assert not got['solved'] and got['code'] == loader.fast_cycle.BAD_DATA, case
         assert ref.status == 'error' and got['message'] == ref.message, case
     # No time left: both stop before solving.
     got = solve_stage(cycle, qp, time_left=0.0)
     ref = python.solve(qp, deadline=time.perf_counter())
-    assert got['code'] == compiled._fast_cycle.TIMED_OUT and ref.status == 'error'
+    assert got['code'] == loader.fast_cycle.TIMED_OUT and ref.status == 'error'
     assert got['message'].startswith('time budget spent')
     assert ref.message.startswith('time budget spent')
 

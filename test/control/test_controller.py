@@ -15,7 +15,7 @@ import time
 
 from conftest import ALLEGRO_URDF
 from cycle_inputs import base_poses, FAULT_MODES, fresh, Injected, joint_state, Slow
-from grasp_torque_opt.control.controller import CycleConfig
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.methods.dispatch import solve
@@ -347,7 +347,7 @@ def test_the_adaptive_method_keeps_the_budget_too(allegro):
     """
     from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
     from grasp_torque_opt.control.controller import TorqueController
-    from grasp_torque_opt.core.scenario import ContactSpec
+    from grasp_torque_opt.core.scenario_fields import ContactSpec
 
     rng = np.random.default_rng(0)
     contacts = [ContactSpec(link=c.link, position=c.position + rng.normal(0, 2e-3, 3))

@@ -13,9 +13,9 @@ import time
 
 from cycle_inputs import Injected
 from grasp_torque_opt.backends import DaqpSettings, make_solver, ProxSuiteSettings
-from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.cycle import Cycle, round_settings
 from grasp_torque_opt.control.inputs import Counters, Inputs
+from grasp_torque_opt.control.parameters import CycleConfig
 import pytest
 
 

@@ -11,8 +11,9 @@
 import dataclasses
 
 from cycle_inputs import fresh, joint_state
-from grasp_torque_opt.control.controller import CycleConfig, TorqueController
+from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.diagnostics import ERROR, OK, report, STALE, WARN
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import numpy as np
 import pytest

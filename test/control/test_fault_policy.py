@@ -10,9 +10,9 @@
 
 import dataclasses
 
-from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
 from grasp_torque_opt.control.inputs import Counters
+from grasp_torque_opt.control.parameters import CycleConfig
 import numpy as np
 import pytest
 

@@ -9,8 +9,8 @@
 """The input store alone: a message is kept whole or not at all; stamps; staleness."""
 
 from cycle_inputs import joint_state
-from grasp_torque_opt.control.config import CycleConfig
 from grasp_torque_opt.control.inputs import Counters, Inputs, InputStore
+from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import pytest
 

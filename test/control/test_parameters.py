@@ -14,12 +14,11 @@ import re
 from conftest import ROOT
 from grasp_torque_opt.backends import BACKENDS
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-from grasp_torque_opt.control.controller import POLICIES
+from grasp_torque_opt.control.param_validators import check_pairs, Context
 from grasp_torque_opt.control.parameters import (
-    check_pairs,
-    Context,
     cycle_config,
     CycleConfig,
+    POLICIES,
     SCHEMA,
     Schema,
     SCHEMA_FILE,

@@ -10,7 +10,7 @@
 
 from grasp_torque_opt.core.exceptions import FrameNotFound
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
-from grasp_torque_opt.core.scenario import ContactSpec
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 import pinocchio as pin
 import pytest

@@ -14,7 +14,7 @@ import warnings
 from conftest import ALLEGRO, scenario_doc, setup_from_doc
 from grasp_torque_opt.core.exceptions import GeometryError, GeometryWarning, InputError
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
-from grasp_torque_opt.core.scenario import ContactSpec
+from grasp_torque_opt.core.scenario_fields import ContactSpec
 from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
 import pytest

@@ -23,10 +23,11 @@ from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.tree_kinematics import TreeKinematics
 from grasp_torque_opt.methods.batch import BatchScorer
 from grasp_torque_opt.methods.score import score_batch, ScoreJob, Scorer
+from grasp_torque_opt.native import loader
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.skipif(not compiled.available(), reason=compiled.IMPORT_ERROR)
+pytestmark = pytest.mark.skipif(not compiled.available(), reason=loader.IMPORT_ERROR)
 
 THREE = [{'link': 'link_3.0_tip', 'position': [0.0072, -0.0051, 0.0081]},
          {'link': 'link_7.0_tip', 'position': [0.0120, 0.0, -0.0011],
@@ -144,7 +145,7 @@ def test_jobs_outside_the_stages_take_the_single_path_and_say_why():
 @pytest.mark.parametrize('module', [None, 'compiled'])
 def test_tree_kinematics_equal_pinocchios(module):
     setup = GraspSetup.from_file(ALLEGRO)
-    kin = TreeKinematics(setup.hand.model, compiled._fast_cycle if module else None)
+    kin = TreeKinematics(setup.hand.model, loader.fast_cycle if module else None)
     rng = np.random.default_rng(7)
     Q = setup.q + rng.uniform(-1.5, 1.5, (25, setup.hand.model.nq))
     frames = tuple(range(1, setup.hand.model.nframes))  # every frame, not only the tips
@@ -169,7 +170,7 @@ def test_tree_kinematics_take_prismatic_joints_and_unaligned_axes(module):
     import pinocchio as pin
 
     model = pin.buildModelFromXML(CHAIN)
-    kin = TreeKinematics(model, compiled._fast_cycle if module else None)
+    kin = TreeKinematics(model, loader.fast_cycle if module else None)
     Q = np.random.default_rng(8).uniform(-1.0, 1.0, (30, model.nq))
     assert kin.check(Q, tuple(range(model.nframes)), tol=1e-12) <= 1e-12
 

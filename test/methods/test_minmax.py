@@ -115,7 +115,7 @@ def test_the_min_max_lp_keeps_a_deadline(allegro):
     """
     import time
 
-    from grasp_torque_opt.core.scenario import ContactSpec
+    from grasp_torque_opt.core.scenario_fields import ContactSpec
     from grasp_torque_opt.core.tau_qp import build_tau_qp
     from grasp_torque_opt.methods.minmax import minmax_stage
 

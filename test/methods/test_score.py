@@ -22,7 +22,8 @@ from conftest import ALLEGRO
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.capacity import direction_capacities, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
-from grasp_torque_opt.methods.score import merge, rank, score_batch, ScoreJob
+from grasp_torque_opt.methods.ranking import rank
+from grasp_torque_opt.methods.score import merge, score_batch, ScoreJob
 from independent import assert_holds
 import numpy as np
 import pytest

@@ -16,10 +16,10 @@ from g1_grasp import ARM_Q, g1_doc, ORIGIN, PALM
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import example_robot_data_dir
+from grasp_torque_opt.core.meshes import resolve_mesh
 from grasp_torque_opt.core.scenario import load_scenario, parse_scenario
 from grasp_torque_opt.sim.hold import certified_torques, hold, HoldSettings
 from grasp_torque_opt.sim.model import build_model
-from grasp_torque_opt.sim.robot import resolve_mesh
 from grasp_torque_opt.sim.simulator import HandSim
 import mujoco
 import numpy as np

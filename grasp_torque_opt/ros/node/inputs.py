@@ -24,7 +24,7 @@ import time
 from typing import Any, TYPE_CHECKING
 
 from geometry_msgs.msg import PoseArray, PoseStamped, Vector3Stamped, WrenchStamped
-from grasp_torque_opt.control.controller import stamp_seconds
+from grasp_torque_opt.control.inputs import stamp_seconds
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
 from grasp_torque_opt.ros.peers import quiet_subscription

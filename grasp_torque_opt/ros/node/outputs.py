@@ -22,7 +22,7 @@ from array import array
 from typing import Any, TYPE_CHECKING
 
 from geometry_msgs.msg import Point, WrenchStamped
-from grasp_torque_opt.control.controller import CycleResult
+from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.ros.node.qos import COMMAND_QOS
 from grasp_torque_opt.ros.peers import quiet_publisher

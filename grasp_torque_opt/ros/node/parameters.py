@@ -22,7 +22,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from grasp_torque_opt.control.parameters import Context, ParamSpec, SCHEMA
+from grasp_torque_opt.control.param_validators import Context
+from grasp_torque_opt.control.parameters import ParamSpec, SCHEMA
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import Hand, MAX_TORQUE_LIMIT
 from grasp_torque_opt.core.scenario import Scenario

@@ -21,7 +21,7 @@ import importlib.util
 import threading
 from typing import Any
 
-from grasp_torque_opt.control.controller import quaternion_matrix
+from grasp_torque_opt.control.checks import quaternion_matrix
 from grasp_torque_opt.core.exceptions import cut, InputError
 from grasp_torque_opt.ros import realtime
 import numpy as np

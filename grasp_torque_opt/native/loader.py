@@ -9,10 +9,10 @@
 """
 Find and load the compiled cycle's module (src/fast_cycle.hpp) for this CPU.
 
-The extension modules are built into ``grasp_torque_opt/control/``
+The extension modules are built into this package, ``grasp_torque_opt/native/``
 (``_fast_cycle``, and on x86-64 ``_fast_cycle_avx2``); the node's compiled cycle
 (:mod:`grasp_torque_opt.control.compiled`) and batch scoring
-(:mod:`grasp_torque_opt.methods.batch`) both take the module from here.
+(:mod:`grasp_torque_opt.methods.batch`) both take :data:`fast_cycle` from here.
 """
 
 from __future__ import annotations
@@ -39,21 +39,29 @@ def cpu_has_avx2() -> bool:
 def load(name: str):
     """Return the module ``name`` of the compiled cycle and '', or None and why not."""
     try:
-        module = importlib.import_module(f'grasp_torque_opt.control.{name}')
+        module = importlib.import_module(f'grasp_torque_opt.native.{name}')
     except ImportError as e:  # not built (no compiler, or a colcon build without pybind11)
-        return None, f'grasp_torque_opt.control.{name} is not built ({e})'
+        return None, f'grasp_torque_opt.native.{name} is not built ({e})'
     if getattr(module, 'API', None) != API:
-        return None, (f'grasp_torque_opt.control.{name} was built from another '
+        return None, (f'grasp_torque_opt.native.{name} was built from another '
                       'src/fast_cycle.hpp: run scripts/setup.sh again')
     return module, ''
 
 
 #: The modules built (``_fast_cycle_avx2`` only where this CPU runs it), best first.
 MODULES = ('_fast_cycle_avx2', '_fast_cycle') if cpu_has_avx2() else ('_fast_cycle',)
-_fast_cycle, IMPORT_ERROR = None, ''
-for _name in MODULES:
-    _fast_cycle, _why = load(_name)
-    if _fast_cycle is not None:
-        IMPORT_ERROR = ''
-        break
-    IMPORT_ERROR = IMPORT_ERROR or _why
+
+
+def _best() -> tuple[object, str]:
+    """Return the best module of :data:`MODULES` that loads, or None and why none does."""
+    why = ''
+    for name in MODULES:
+        module, reason = load(name)
+        if module is not None:
+            return module, ''
+        why = why or reason
+    return None, why
+
+
+#: The compiled cycle's module in use (None: none loads) and, if none, why not.
+fast_cycle, IMPORT_ERROR = _best()
