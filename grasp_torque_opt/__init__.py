@@ -20,6 +20,7 @@ below it:
 - :mod:`~grasp_torque_opt.methods`: :func:`solve` over every method, and the comparison;
 - :mod:`~grasp_torque_opt.control`: the node's cycle on plain arrays, its diagnostics;
   beside it :mod:`~grasp_torque_opt.sim`, the hand in MuJoCo (optional extra ``sim``);
+- :mod:`~grasp_torque_opt.native`: the compiled cycle's extension and its loader;
 - :mod:`~grasp_torque_opt.ros` (the ROS 2 node and demo driver) and
   :mod:`~grasp_torque_opt.cli` (the command line).
 
@@ -63,6 +64,12 @@ _EXPORTS = {
     'ScoreJob': 'grasp_torque_opt.methods.score',
     'score_batch': 'grasp_torque_opt.methods.score',
     'read_candidates': 'grasp_torque_opt.methods.score',
+    'rank': 'grasp_torque_opt.methods.ranking',
+    'rank_key': 'grasp_torque_opt.methods.ranking',
+    'format_table': 'grasp_torque_opt.methods.ranking',
+    'plan_grasps': 'grasp_torque_opt.methods.plan',
+    'PlanSettings': 'grasp_torque_opt.methods.plan',
+    'PlanResult': 'grasp_torque_opt.methods.plan',
 }
 
 __all__ = sorted(_EXPORTS)

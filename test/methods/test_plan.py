@@ -220,4 +220,4 @@ def test_too_few_found_exits_3(capsys):
     code = main(['plan', str(ALLEGRO), '--count', '1', '--attempts', '2', '--object',
                  'sphere', '--size', '0.2', '--no-rotate'])
     out, err = capsys.readouterr()
-    assert code == 3 and out == '' and 'planned 0 of 1 candidates in 2 IKs' in err
+    assert code == 5 and out == '' and 'planned 0 of 1 candidates in 2 IKs' in err

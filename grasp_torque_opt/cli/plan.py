@@ -6,13 +6,23 @@
 #
 # SPDX-License-Identifier: BSD-3-Clause
 
-"""``grasp-torque-opt plan``'s options, and the plan they ask for (the CLI prints it)."""
+"""``grasp-torque-opt plan SCENARIO``: candidate grasps of an object, as score's lines."""
 
 from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
+import sys
 
+from grasp_torque_opt.cli.args import count, numbers, PROG, SCENARIO_HELP
+from grasp_torque_opt.core.command_line import (
+    EXIT_FAILED,
+    EXIT_FEWER,
+    EXIT_OK,
+    HelpFormatter,
+    one_line,
+)
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.resources import find_config
@@ -24,44 +34,28 @@ import numpy as np
 SIZES = {'sphere': 1, 'box': 3, 'cylinder': 2}
 
 
-def _numbers(count: int | None):
-    """Make an argparse type: ``count`` (None: any number of) comma-separated finite numbers."""
-    def parse(text: str) -> tuple[float, ...]:
-        try:
-            values = tuple(float(v) for v in text.split(','))
-        except ValueError:
-            raise argparse.ArgumentTypeError(f'must be numbers separated by commas, got '
-                                             f'{text!r}') from None
-        if (count is not None and len(values) != count) or not all(
-                math.isfinite(v) for v in values):
-            raise argparse.ArgumentTypeError(f'must be {count or "finite"} numbers separated '
-                                             f'by commas, got {text!r}')
-        return values
-    return parse
-
-
-def add_parser(sub, formatter, scenario_help: str, count) -> None:
-    """Add the ``plan`` subcommand to the CLI's subparsers."""
+def add_parser(sub) -> None:
+    """Add ``plan`` to the CLI's subparsers."""
     d = PlanSettings()
     p = sub.add_parser('plan', help='candidate grasps of an object: the contact links on its '
-                       'surface (JSON Lines that score reads)', formatter_class=formatter,
+                       'surface (JSON Lines that score reads)', formatter_class=HelpFormatter,
                        description=(
                            'Plan candidate grasps: the object placed in a region about the '
                            "scenario's object origin, an IK puts the contact links on its "
                            'surface and keeps every other link clear; each candidate is a '
                            'line that score reads (docs/planner.md).'),
-                       epilog='exit codes: 0 every candidate asked found, 3 fewer found (those '
+                       epilog='exit codes: 0 every candidate asked found, 5 fewer found (those '
                        'written), 2 bad input, 4 any other error.')
-    p.add_argument('scenario', help=scenario_help + ': the hand, friction, torque limits, '
+    p.add_argument('scenario', help=SCENARIO_HELP + ': the hand, friction, torque limits, '
                    'gravity, the grasp the draws start from')
     p.add_argument('--object', choices=tuple(SIZES), help='object shape (default: the '
                    "scenario's object)")
-    p.add_argument('--size', type=_numbers(None), help='sphere R, box X,Y,Z or cylinder R,L '
+    p.add_argument('--size', type=numbers(None), help='sphere R, box X,Y,Z or cylinder R,L '
                    '[m]')
     p.add_argument('--mesh', help='an object mesh file (.stl, .obj, .dae) instead')
     p.add_argument('--scale', type=float, default=1.0, help="the mesh's units in m")
     p.add_argument('--mass', type=float, help="object mass [kg] (default: the scenario's)")
-    p.add_argument('--load', type=_numbers(6), metavar='FX,FY,FZ,MX,MY,MZ',
+    p.add_argument('--load', type=numbers(6), metavar='FX,FY,FZ,MX,MY,MZ',
                    help="wrench added to the object's weight [N, N m], base axes")
     p.add_argument('--links', help="contact links, comma-separated (default: the scenario's "
                    "contacts' links; any links with collision shapes, phalanges too)")
@@ -70,7 +64,7 @@ def add_parser(sub, formatter, scenario_help: str, count) -> None:
                    help='seed of every draw: the same seed gives the same candidates')
     p.add_argument('--region', type=float, default=d.region, help='half edge of the cube, '
                    "about the scenario's object origin, the object's centre stays in [m]")
-    p.add_argument('--centre', type=_numbers(3), metavar='X,Y,Z',
+    p.add_argument('--centre', type=numbers(3), metavar='X,Y,Z',
                    help="the region's centre [m] (default: the scenario's object origin)")
     p.add_argument('--no-rotate', action='store_true',
                    help="keep the object's axes the base's (else drawn at random)")
@@ -85,7 +79,7 @@ def add_parser(sub, formatter, scenario_help: str, count) -> None:
     p.add_argument('--out', help='write the candidates here (JSON Lines) instead of stdout')
 
 
-def run(args: argparse.Namespace) -> PlanResult:
+def plan(args: argparse.Namespace) -> PlanResult:
     """
     Plan what the parsed options ask.
 
@@ -114,3 +108,20 @@ def run(args: argparse.Namespace) -> PlanResult:
         rotate=not args.no_rotate, clearance=args.clearance, tolerance=args.tolerance,
         attempts=args.attempts, contacts=args.contacts, extra_load=args.load)
     return plan_grasps(scenario, settings, shape, args.mass)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Plan, write the lines (stdout or --out), the summary on stderr; return the exit code."""
+    result = plan(args)
+    text = ''.join(line + '\n' for line in result.lines())
+    if args.out:
+        try:
+            Path(args.out).write_text(text)
+        except OSError as e:
+            print(one_line(f'{PROG}: error: --out: cannot write {args.out}: {e.strerror}'),
+                  file=sys.stderr)
+            return EXIT_FAILED
+    else:
+        sys.stdout.write(text)
+    print(result.summary(args.count, args.seed), file=sys.stderr)
+    return EXIT_OK if len(result.candidates) == args.count else EXIT_FEWER
