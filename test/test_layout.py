@@ -272,3 +272,8 @@ def test_the_public_api_holds_what_a_planner_and_a_driver_need():
         assert name in grasp_torque_opt.__all__, name
     for name in grasp_torque_opt.__all__:
         assert getattr(grasp_torque_opt, name) is not None, name
+
+
+def test_the_readme_is_read_in_one_sitting():
+    """README.md at most 200 lines: the two commands, a tour, the pages (figures live in docs/)."""
+    assert (ROOT / 'README.md').read_text().count('\n') <= 200
