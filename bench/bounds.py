@@ -35,6 +35,7 @@ from cycle import machine, report
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import MAX_CONTACTS
@@ -117,7 +118,8 @@ def main() -> int:
                         CycleConfig(cycle_budget=budget, joint_state_timeout=1.0),
                         BOUNDS, 'proxsuite', True, 'daqp')
                     names = list(s.hand.joints)
-                    ctrl.update_joint_state(names, [float(s.q[i]) for i in s.hand.idx_q], 0.0)
+                    ctrl.take('joint_states',
+                              JointStateReading(names, [float(s.q[i]) for i in s.hand.idx_q]), 0.0)
                     r = ctrl.cycle(0.0)
                     row['cycles'] += 1
                     row['commands'] += r.kind == 'solution'

@@ -54,6 +54,7 @@ import time
 from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_math
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.geometry import ContactTracker
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -201,7 +202,7 @@ def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str 
         positions = (q0 + dq).tolist()
         now = time.monotonic()
         t0 = time.perf_counter()
-        ctrl.update_joint_state(names, positions, now)
+        ctrl.take('joint_states', JointStateReading(names, positions), now)
         result = ctrl.cycle(now)
         elapsed = time.perf_counter() - t0
         if i >= 50:

@@ -45,12 +45,13 @@ from __future__ import annotations
 import copy
 from operator import attrgetter
 import time
+from typing import Any
 
 from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control.cycle import Cycle
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
-from grasp_torque_opt.control.inputs import Counters, Inputs, InputStore
+from grasp_torque_opt.control.inputs.store import Counters, Inputs, InputStore
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.control.rates import slewed, step_wrenches
 from grasp_torque_opt.core.friction import cone_margin
@@ -175,35 +176,10 @@ class TorqueController:
         """Reject a message by its size alone (:meth:`InputStore.check_size`)."""
         self.store.check_size(source, n, frame_id)
 
-    def update_joint_state(self, names: list[str], positions: list[float], now: float,
-                           stamp: float = 0.0, clock: float | None = None,
-                           efforts: list[float] | None = None) -> None:
-        """Take a joint state (:meth:`InputStore.update_joint_state`)."""
-        self.store.update_joint_state(names, positions, now, stamp, clock, efforts)
-
-    def update_imu(self, frame: str, specific_force: np.ndarray, omega: np.ndarray,
-                   now: float, stamp: float = 0.0, clock: float | None = None,
-                   transform: tuple[np.ndarray, np.ndarray] | None = None,
-                   unresolved: str = 'tf2_ros is not installed') -> None:
-        """Take the base's IMU (:meth:`InputStore.update_imu`)."""
-        self.store.update_imu(frame, specific_force, omega, now, stamp, clock, transform,
-                              unresolved)
-
-    def update_contacts(self, frame: str, positions: np.ndarray, quaternions: np.ndarray,
-                        now: float, stamp: float = 0.0, clock: float | None = None) -> None:
-        """Take contact frames (:meth:`InputStore.update_contacts`)."""
-        self.store.update_contacts(frame, positions, quaternions, now, stamp, clock)
-
-    def update_wrench(self, frame: str, force: np.ndarray, torque: np.ndarray,
-                      now: float, stamp: float = 0.0, clock: float | None = None) -> None:
-        """Take the load on the object (:meth:`InputStore.update_wrench`)."""
-        self.store.update_wrench(frame, force, torque, now, stamp, clock)
-
-    def update_gravity(self, frame: str, vector: np.ndarray, now: float, stamp: float = 0.0,
-                       clock: float | None = None, rotation: np.ndarray | None = None,
-                       unresolved: str = 'tf2_ros is not installed') -> None:
-        """Take gravity (:meth:`InputStore.update_gravity`)."""
-        self.store.update_gravity(frame, vector, now, stamp, clock, rotation, unresolved)
+    def take(self, source: str, reading: Any, now: float, stamp: float = 0.0,
+             clock: float | None = None) -> None:
+        """Take a message of the input ``source``, or reject it (:meth:`InputStore.take`)."""
+        self.store.take(source, reading, now, stamp, clock)
 
     def stale(self, now: float, inputs: Inputs | None = None) -> str:
         """Why the inputs cannot be used at time ``now`` ('' if they can)."""

@@ -28,7 +28,7 @@ from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.effort_load import EffortLoad
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import geometry_of
-from grasp_torque_opt.control.inputs import Counters, Inputs, replaced
+from grasp_torque_opt.control.inputs.store import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.named_contacts import topic_contacts
 from grasp_torque_opt.control.parameters import CycleConfig

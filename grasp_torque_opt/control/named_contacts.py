@@ -132,7 +132,7 @@ def topic_contacts(cycle, cp, origin: np.ndarray) -> list[ContactSpec]:
 
     Args:
         cycle: the :class:`~grasp_torque_opt.control.cycle.Cycle`.
-        cp: the :class:`~grasp_torque_opt.control.inputs.ContactPoses` in force.
+        cp: the :class:`~grasp_torque_opt.control.inputs.contacts.ContactPoses` in force.
         origin: the object origin in use (base frame).
 
     Raises:

@@ -21,6 +21,8 @@ import collections
 import dataclasses
 
 from grasp_torque_opt.control.controller import TorqueController
+from grasp_torque_opt.control.inputs.imu import ImuReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.scenario import Scenario
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
@@ -69,10 +71,11 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
             due = imu_rate is None or sampled - clock['imu'] >= 1.0 / imu_rate - 1e-9
             if sampled <= clock['t'] - imu_latency + 1e-12 and due:
                 clock['imu'] = sampled
-                ctrl.update_imu('', force, omega, clock['t'])
+                ctrl.take('imu', ImuReading('', force, omega), clock['t'])
         if efforts:
             measured = rig.effort().tolist()
-        ctrl.update_joint_state(names, reading.tolist(), clock['t'], 0.0, None, measured)
+        ctrl.take('joint_states', JointStateReading(names, reading.tolist(), efforts=measured),
+                  clock['t'], 0.0, None)
         return ctrl.cycle(clock['t']).command
     command.controller = ctrl
     return command

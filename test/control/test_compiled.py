@@ -23,6 +23,9 @@ from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.diagnostics import report
+from grasp_torque_opt.control.inputs.contacts import ContactsReading
+from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.core.certificate import certify
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.tau_qp import build_tau_qp
@@ -53,7 +56,7 @@ def run(ctrl, setup, qs):
     out = []
     for i, q in enumerate(qs):
         now = 1.0 + 1e-3 * i
-        ctrl.update_joint_state(names, q.tolist(), now)
+        ctrl.take('joint_states', JointStateReading(names, q.tolist()), now)
         out.append(ctrl.cycle(now))
     return out
 
@@ -134,9 +137,9 @@ def test_contact_poses_and_a_load_from_the_topics(allegro):
         results = []
         for ctrl in (fast, slow):
             now = 1.0 + 0.01 * k
-            ctrl.update_joint_state(*joint_state(allegro), now)
-            ctrl.update_contacts('', moved, turned, now)
-            ctrl.update_wrench('', force, torque, now)
+            ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), now)
+            ctrl.take('contacts', ContactsReading('', moved, turned), now)
+            ctrl.take('external_wrench', WrenchReading('', force, torque), now)
             results.append(ctrl.cycle(now))
         a, b = results
         assert a.kind == b.kind == 'solution', (a.fault, b.fault)
@@ -156,7 +159,7 @@ def test_an_infeasible_load_is_handed_back_and_confirmed_by_the_lp(allegro):
     slow.fallback = make_solver('daqp')
     names, pos = joint_state(heavy)
     for ctrl in (fast, slow):
-        ctrl.update_joint_state(names, pos, 1.0)
+        ctrl.take('joint_states', JointStateReading(names, pos), 1.0)
     a, b = fast.cycle(1.0), slow.cycle(1.0)
     assert a.kind != 'solution' and b.kind != 'solution'
     assert a.solution.status == b.solution.status == 'infeasible'
@@ -165,7 +168,7 @@ def test_an_infeasible_load_is_handed_back_and_confirmed_by_the_lp(allegro):
     # Then a holdable load again: the compiled cycle answers.
     for ctrl in (fast, slow):
         ctrl.setup = allegro
-        ctrl.update_joint_state(names, pos, 1.1)
+        ctrl.take('joint_states', JointStateReading(names, pos), 1.1)
     a, b = fast.cycle(1.1), slow.cycle(1.1)
     assert a.kind == b.kind == 'solution'
     np.testing.assert_allclose(a.command, b.command, atol=1e-6)
@@ -221,7 +224,7 @@ def test_what_the_compiled_cycle_does_not_solve_is_said(allegro_doc, allegro):
     # A DAQP controller runs the Python cycle and says why.
     ctrl = fresh(allegro)
     ctrl.solver = make_solver('daqp')
-    ctrl.update_joint_state(*joint_state(allegro), 1.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 1.0)
     assert ctrl.cycle(1.0).kind == 'solution' and ctrl.compiled_cycle is None
     assert dict(report(ctrl, 2.0).values)['solver.compiled'].startswith('false: backend daqp')
 
@@ -230,14 +233,14 @@ def test_a_new_friction_or_weights_make_a_new_compiled_cycle(allegro):
     fast, slow = fresh(allegro), fresh(allegro, compiled=False)
     names, pos = joint_state(allegro)
     for ctrl in (fast, slow):
-        ctrl.update_joint_state(names, pos, 1.0)
+        ctrl.take('joint_states', JointStateReading(names, pos), 1.0)
         ctrl.cycle(1.0)
     first = fast.compiled_cycle
     weights = np.linspace(1.0, 3.0, allegro.hand.m)
     friction = dataclasses.replace(allegro.friction, mu1=0.6, margin=0.2)
     for ctrl in (fast, slow):
         ctrl.setup = dataclasses.replace(ctrl.setup, weights=weights, friction=friction)
-        ctrl.update_joint_state(names, pos, 1.1)
+        ctrl.take('joint_states', JointStateReading(names, pos), 1.1)
     a, b = fast.cycle(1.1), slow.cycle(1.1)
     assert fast.compiled_cycle is not first and fast.compiled_cycle.solves == 1
     assert a.kind == b.kind == 'solution'
@@ -260,7 +263,7 @@ def test_a_contact_list_of_another_size_is_taken_cold(allegro_doc, allegro):
         results = []
         for ctrl in (fast, slow):
             ctrl.setup = dataclasses.replace(ctrl.setup, contacts=contacts)
-            ctrl.update_joint_state(names, pos, 1.0 + k)
+            ctrl.take('joint_states', JointStateReading(names, pos), 1.0 + k)
             results.append(ctrl.cycle(1.0 + k))
         a, b = results
         assert a.kind == b.kind and a.solution.status == b.solution.status

@@ -15,6 +15,9 @@ import time
 
 from conftest import ALLEGRO_URDF
 from cycle_inputs import base_poses, FAULT_MODES, fresh, Injected, joint_state, Slow
+from grasp_torque_opt.control.inputs.contacts import ContactsReading
+from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import resolve_urdf
@@ -29,7 +32,7 @@ import pytest
 def test_command_is_the_cores_solution(name, request):
     setup = request.getfixturevalue(name)
     ctrl = fresh(setup)
-    ctrl.update_joint_state(*joint_state(setup), now=0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(setup)), 0.0)
     r = ctrl.cycle(0.0)
     assert r.kind == 'solution' and r.fault == ''
     ref = solve(setup)
@@ -40,9 +43,9 @@ def test_joint_order_and_extra_joints_do_not_matter(allegro):
     names, pos = joint_state(allegro)
     order = np.random.default_rng(3).permutation(len(names))
     a, b = fresh(allegro), fresh(allegro)
-    a.update_joint_state(names, pos, 0.0)
-    b.update_joint_state([names[i] for i in order] + ['conveyor'],
-                         [pos[i] for i in order] + [float('nan')], 0.0)
+    a.take('joint_states', JointStateReading(names, pos), 0.0)
+    b.take('joint_states', JointStateReading([names[i] for i in order] + ['conveyor'],
+                                             [pos[i] for i in order] + [float('nan')]), 0.0)
     np.testing.assert_allclose(a.cycle(0.0).command, b.cycle(0.0).command, atol=1e-12)
 
 
@@ -57,7 +60,7 @@ def test_joint_order_and_extra_joints_do_not_matter(allegro):
 def test_malformed_joint_states_are_rejected(planar, names, positions, match):
     ctrl = fresh(planar)
     with pytest.raises(InputError, match=match):
-        ctrl.update_joint_state(names, positions, 0.0)
+        ctrl.take('joint_states', JointStateReading(names, positions), 0.0)
     assert ctrl.inputs.q is None and ctrl.counters.rejected['joint_states'] == 1
     assert ctrl.last_rejection.startswith('joint_states: ') and match.split('.')[0][:8] in \
         ctrl.last_rejection
@@ -67,12 +70,12 @@ def test_contacts_in_any_model_frame_give_the_same_grasp(allegro):
     q = allegro.q.copy()
     q[allegro.hand.idx_q[1]] += 0.02
     ref = fresh(allegro)
-    ref.update_joint_state(*joint_state(allegro, q), 0.0)
+    ref.take('joint_states', JointStateReading(*joint_state(allegro, q)), 0.0)
     expected = ref.cycle(0.0).command
     pos, quat = base_poses(allegro, q)
     in_base = fresh(allegro)
-    in_base.update_joint_state(*joint_state(allegro, q), 0.0)
-    in_base.update_contacts('', pos, quat, 0.0)
+    in_base.take('joint_states', JointStateReading(*joint_state(allegro, q)), 0.0)
+    in_base.take('contacts', ContactsReading('', pos, quat), 0.0)
     np.testing.assert_allclose(in_base.cycle(0.0).command, expected, atol=1e-9)
     # The same frames expressed in the thumb's distal link.
     model = allegro.hand.model
@@ -83,8 +86,9 @@ def test_contacts_in_any_model_frame_give_the_same_grasp(allegro):
     local_quat = [pin.Quaternion(oMl.rotation.T @ pin.Quaternion(*np.roll(qt, 1)).matrix()
                                  ).coeffs() for qt in quat]
     in_link = fresh(allegro)
-    in_link.update_joint_state(*joint_state(allegro, q), 0.0)
-    in_link.update_contacts('link_15.0', np.array(local_pos), np.array(local_quat), 0.0)
+    in_link.take('joint_states', JointStateReading(*joint_state(allegro, q)), 0.0)
+    in_link.take('contacts',
+                 ContactsReading('link_15.0', np.array(local_pos), np.array(local_quat)), 0.0)
     np.testing.assert_allclose(in_link.cycle(0.0).command, expected, atol=1e-9)
 
 
@@ -99,7 +103,7 @@ def test_malformed_contacts_are_rejected(allegro, frame, change, match):
     ctrl = fresh(allegro)
     pos, quat = change(*base_poses(allegro))
     with pytest.raises(InputError, match=match):
-        ctrl.update_contacts(frame, pos, quat, 0.0)
+        ctrl.take('contacts', ContactsReading(frame, pos, quat), 0.0)
     assert ctrl.inputs.contacts is None and ctrl.counters.rejected['contacts'] == 1
 
 
@@ -111,12 +115,12 @@ def test_wrench_axes_follow_its_frame(allegro):
     w = allegro.external_wrench * 1.3
     a, b = fresh(allegro), fresh(allegro)
     for c in (a, b):
-        c.update_joint_state(*joint_state(allegro), 0.0)
-    a.update_wrench('', w[:3], w[3:], 0.0)
-    b.update_wrench('link_13.0', R.T @ w[:3], R.T @ w[3:], 0.0)
+        c.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
+    a.take('external_wrench', WrenchReading('', w[:3], w[3:]), 0.0)
+    b.take('external_wrench', WrenchReading('link_13.0', R.T @ w[:3], R.T @ w[3:]), 0.0)
     np.testing.assert_allclose(a.cycle(0.0).command, b.cycle(0.0).command, atol=1e-9)
     with pytest.raises(InputError, match='external_wrench.wrench.force: must be finite'):
-        a.update_wrench('', [0, np.inf, 0], [0, 0, 0], 0.0)
+        a.take('external_wrench', WrenchReading('', [0, np.inf, 0], [0, 0, 0]), 0.0)
 
 
 @pytest.mark.parametrize('policy', ['hold', 'zero'])
@@ -124,11 +128,11 @@ def test_stale_contacts_stop_commands_then_policy(planar, policy):
     ctrl = fresh(planar, contacts_timeout=0.2, joint_state_timeout=0.1, hold_time=0.3,
                  fault_policy=policy)
     pos, quat = base_poses(planar)
-    ctrl.update_contacts('', pos, quat, 0.0)
+    ctrl.take('contacts', ContactsReading('', pos, quat), 0.0)
     js = joint_state(planar)
     t, kinds = 0.0, []
     while t < 1.0:
-        ctrl.update_joint_state(*js, t)
+        ctrl.take('joint_states', JointStateReading(*js), t)
         kinds.append((t, ctrl.cycle(t).kind))
         t += 0.01
     last_solution = max(tt for tt, k in kinds if k == 'solution')
@@ -139,8 +143,8 @@ def test_stale_contacts_stop_commands_then_policy(planar, policy):
     assert after and set(after) == ({'zero'} if policy == 'zero' else {'none'})
     assert all(k == 'none' for tt, k in kinds if last_solution < tt < last_solution + 0.3 - 1e-9)
     # Fresh contacts: the next joint state recovers at once.
-    ctrl.update_contacts('', pos, quat, t)
-    ctrl.update_joint_state(*js, t)
+    ctrl.take('contacts', ContactsReading('', pos, quat), t)
+    ctrl.take('joint_states', JointStateReading(*js), t)
     assert ctrl.cycle(t).kind == 'solution'
     assert ctrl.counters.recoveries == 1 and ctrl.fault == ''
 
@@ -148,7 +152,7 @@ def test_stale_contacts_stop_commands_then_policy(planar, policy):
 def test_watchdog_sees_stale_joint_states(planar):
     ctrl = fresh(planar, joint_state_timeout=0.05, hold_time=0.0, fault_policy='zero')
     assert ctrl.watchdog(0.0) is None  # not started
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
     assert ctrl.cycle(0.0).kind == 'solution'
     assert ctrl.watchdog(0.04) is None
     r = ctrl.watchdog(0.06)
@@ -158,8 +162,8 @@ def test_watchdog_sees_stale_joint_states(planar):
 
 def test_infeasible_load_gives_no_command(planar):
     ctrl = fresh(planar)
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
-    ctrl.update_wrench('', [0.0, -500.0, 0.0], [0.0, 0.0, 0.0], 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
+    ctrl.take('external_wrench', WrenchReading('', [0.0, -500.0, 0.0], [0.0, 0.0, 0.0]), 0.0)
     r = ctrl.cycle(0.0)
     assert r.command is None and r.solution.status == 'infeasible'
     assert 'no certified solution (infeasible' in r.fault
@@ -168,7 +172,7 @@ def test_infeasible_load_gives_no_command(planar):
 def test_gravity_compensation_adds_g(allegro):
     gravity = np.array([9.81, 0.0, 0.0])
     ctrl = fresh(allegro, gravity_compensation=True, gravity=tuple(gravity))
-    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     r = ctrl.cycle(0.0)
     assert r.kind == 'solution'
     model = pin.buildModelFromUrdf(str(resolve_urdf(ALLEGRO_URDF, Path('.'))))
@@ -191,8 +195,9 @@ def test_oversized_joint_state_is_rejected_unread(planar):
     extra = [f'j{i}' for i in range(5)]
     with pytest.raises(InputError, match=r'^joint_states: 9 entries, more than '
                        r'max_joint_state_entries \(8\)$'):
-        ctrl.update_joint_state(names + extra, pos + [0.0] * 5, 0.0)
-    ctrl.update_joint_state(names + extra[:4], pos + [0.0] * 4, 0.0)  # 8 is within
+        ctrl.take('joint_states', JointStateReading(names + extra, pos + [0.0] * 5), 0.0)
+    ctrl.take('joint_states', JointStateReading(names + extra[:4], pos + [0.0] * 4),
+              0.0)  # 8 is within
     assert ctrl.counters.rejected['joint_states'] == 1
 
 
@@ -200,7 +205,7 @@ def test_absurd_joint_position_is_rejected(planar):
     names, pos = joint_state(planar)
     pos[2] = 1e6
     with pytest.raises(InputError, match="position of 'joint3' is 1e\\+06, beyond"):
-        fresh(planar).update_joint_state(names, pos, 0.0)
+        fresh(planar).take('joint_states', JointStateReading(names, pos), 0.0)
 
 
 @pytest.mark.parametrize('force,torque,match', [
@@ -211,7 +216,7 @@ def test_absurd_joint_position_is_rejected(planar):
 def test_wrench_magnitude_is_bounded(planar, force, torque, match):
     ctrl = fresh(planar)
     with pytest.raises(InputError, match=match):
-        ctrl.update_wrench('', force, torque, 0.0)
+        ctrl.take('external_wrench', WrenchReading('', force, torque), 0.0)
     assert ctrl.inputs.wrench is None and ctrl.counters.rejected['external_wrench'] == 1
 
 
@@ -219,32 +224,32 @@ def test_far_contact_stops_commands_until_good_contacts_return(planar):
     # A link distance that lets the far point reach the cycle's check of the base distance.
     ctrl = fresh(planar, max_contact_distance=0.5, max_contact_link_distance=1.0)
     pos, quat = base_poses(planar)
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
     far = pos.copy()
     far[1] = [0.6, 0.11, 0.0]  # its normal (-x) still points at the object origin
-    ctrl.update_contacts('', far, quat, 0.0)
+    ctrl.take('contacts', ContactsReading('', far, quat), 0.0)
     r = ctrl.cycle(0.0)
     assert r.command is None
     assert 'contacts.poses[1].position: is 0.61 m from the base origin, beyond ' \
            'max_contact_distance (0.5 m)' in r.fault
     # Once the far contacts in use are stale (contacts_timeout), good ones are taken whole
     # (the rate rule moves the contacts in use only from fresh ones).
-    ctrl.update_joint_state(*joint_state(planar), 1.0)
-    ctrl.update_contacts('', pos, quat, 1.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 1.0)
+    ctrl.take('contacts', ContactsReading('', pos, quat), 1.0)
     assert ctrl.cycle(1.0).kind == 'solution'
 
 
 def test_contacts_of_the_wrong_shape_are_rejected(planar):
     pos, quat = base_poses(planar)
     with pytest.raises(InputError, match=r'quaternions of shape \(2, 3\), expected'):
-        fresh(planar).update_contacts('', pos, quat[:, :3], 0.0)
+        fresh(planar).take('contacts', ContactsReading('', pos, quat[:, :3]), 0.0)
 
 
 def test_long_names_are_cut_in_messages(planar):
     names, pos = joint_state(planar)
     pos, quat = base_poses(planar)
     with pytest.raises(InputError) as e:
-        fresh(planar).update_contacts('x' * 100000, pos, quat, 0.0)
+        fresh(planar).take('contacts', ContactsReading('x' * 100000, pos, quat), 0.0)
     assert "'" + 'x' * 64 + "...'" in str(e.value) and len(str(e.value)) < 1000
 
 
@@ -258,22 +263,23 @@ def test_stamp_rule(planar):
     """
     ctrl = fresh(planar, joint_state_timeout=0.1, stamp_future_tolerance=0.5)
     js = joint_state(planar)
-    ctrl.update_joint_state(*js, now=0.0, stamp=0.0, clock=100.0)
-    ctrl.update_joint_state(*js, now=0.01, stamp=100.4, clock=100.0)  # within tolerance
+    ctrl.take('joint_states', JointStateReading(*js), 0.0, 0.0, 100.0)
+    ctrl.take('joint_states', JointStateReading(*js), 0.01, 100.4, 100.0)  # within tolerance
     with pytest.raises(InputError, match=r'^joint_states.header.stamp: is 0.600 s ahead of '
                        r'the clock \(stamp_future_tolerance 0.5 s\)$'):
-        ctrl.update_joint_state(*js, now=0.02, stamp=100.6, clock=100.0)
+        ctrl.take('joint_states', JointStateReading(*js), 0.02, 100.6, 100.0)
     # The mark is 100.0 (the clock when 100.4 was accepted), not 100.4.
-    ctrl.update_joint_state(*js, now=0.03, stamp=100.02, clock=100.03)
+    ctrl.take('joint_states', JointStateReading(*js), 0.03, 100.02, 100.03)
     with pytest.raises(InputError, match='header.stamp: goes backwards by 0.020000 s'):
-        ctrl.update_joint_state(*js, now=0.05, stamp=100.0, clock=100.05)
+        ctrl.take('joint_states', JointStateReading(*js), 0.05, 100.0, 100.05)
     assert ctrl.inputs.q_time == 0.03  # the rejected states were not kept
-    ctrl.update_joint_state(*js, now=0.05, stamp=0.0, clock=100.05)  # unstamped: not compared
-    ctrl.update_joint_state(*js, now=0.2, stamp=50.0, clock=100.2)  # the mark is stale
-    ctrl.update_joint_state(*js, now=0.21, stamp=50.01, clock=100.21)
+    ctrl.take('joint_states', JointStateReading(*js), 0.05, 0.0, 100.05)  # unstamped: not compared
+    ctrl.take('joint_states', JointStateReading(*js), 0.2, 50.0, 100.2)  # the mark is stale
+    ctrl.take('joint_states', JointStateReading(*js), 0.21, 50.01, 100.21)
     with pytest.raises(InputError, match='is negative'):
-        ctrl.update_wrench('', [0.0] * 3, [0.0] * 3, 0.3, stamp=-1.0)
-    ctrl.update_wrench('', [0.0] * 3, [0.0] * 3, 0.3, stamp=5.0, clock=0.0)  # clock not running
+        ctrl.take('external_wrench', WrenchReading('', [0.0] * 3, [0.0] * 3), 0.3, -1.0)
+    ctrl.take('external_wrench', WrenchReading('', [0.0] * 3, [0.0] * 3), 0.3, 5.0,
+              0.0)  # clock not running
     assert ctrl.counters.rejected == {'joint_states': 2, 'contacts': 0, 'external_wrench': 1}
 
 
@@ -292,7 +298,7 @@ def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
         for source, stamp in (('driver', t - 0.001),) + ((('skewed', t + 0.4),) if k % 8 == 0
                                                          else ()):
             try:
-                ctrl.update_joint_state(*js, now=t, stamp=stamp, clock=t)
+                ctrl.take('joint_states', JointStateReading(*js), t, stamp, t)
                 accepted[source] += 1
             except InputError:
                 pass
@@ -302,7 +308,7 @@ def test_a_source_stamping_ahead_cannot_lock_out_one_on_the_clock(planar):
 
 def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar):
     ctrl = fresh(planar, cycle_budget=1e-4, hold_time=1.0)
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
     r = ctrl.cycle(0.0)
     # The solvers stop by the budget (a failed solve), or the cycle overruns it after a
     # certified one: either way nothing is published.
@@ -311,7 +317,7 @@ def test_overrun_drops_the_command_and_the_next_cycle_in_budget_recovers(planar)
     assert ctrl.counters.overruns == 1 and ctrl.counters.commands == 0
     assert ctrl.last_command is None and ctrl.counters.max_cycle_time == r.cycle_time
     ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=10.0)
-    ctrl.update_joint_state(*joint_state(planar), 0.01)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.01)
     r = ctrl.cycle(0.01)
     assert r.kind == 'solution' and ctrl.counters.recoveries == 1 and ctrl.fault == ''
 
@@ -331,7 +337,7 @@ def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
     ctrl = fresh(hard, cycle_budget=0.05, joint_state_timeout=1.0)
     settings = ProxSuiteSettings(max_iter=100000, max_iter_in=100)
     ctrl.solver = make_solver('proxsuite', settings)
-    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     t0 = time.perf_counter()
     r = ctrl.cycle(0.0)
     assert time.perf_counter() - t0 < 0.05 + 0.5
@@ -358,7 +364,7 @@ def test_the_adaptive_method_keeps_the_budget_too(allegro):
                                              method='tau-qp-adaptive'),
                             ProxSuiteSettings(eps_abs=1e-12, max_iter=10000, max_iter_in=200),
                             'proxsuite', True, 'daqp')
-    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     t0 = time.perf_counter()
     ctrl.cycle(0.0)
     assert time.perf_counter() - t0 < 0.05 + 0.5
@@ -373,13 +379,13 @@ def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar)
     """
     ctrl = fresh(planar, cycle_budget=10.0, joint_state_timeout=0.05, hold_time=1.0)
     ctrl.solver = Slow(0.08)
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
     r = ctrl.cycle(0.0)
     assert r.command is None and r.fault.startswith('inputs went stale during the cycle: '
                                                     'joint_states stale')
     assert ctrl.counters.commands == 0 and ctrl.last_command is None
     ctrl.solver = Slow(0.0)
-    ctrl.update_joint_state(*joint_state(planar), 1.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 1.0)
     assert ctrl.cycle(1.0).kind == 'solution'
 
 
@@ -399,9 +405,9 @@ def test_lowered_limits_act_on_the_command_in_force_at_once(allegro, policy):
     policy: nothing new was published and the controller kept 0.63 N m forever.
     """
     ctrl = fresh(allegro, fault_policy=policy, hold_time=1.0, joint_state_timeout=1.0)
-    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     w = allegro.external_wrench * 6.2
-    ctrl.update_wrench('', w[:3], w[3:], 0.0)
+    ctrl.take('external_wrench', WrenchReading('', w[:3], w[3:]), 0.0)
     first = ctrl.cycle(0.0)
     assert first.kind == 'solution' and 0.6 < np.abs(first.command).max() < 0.7
     # Still holdable within 0.65: the new certified command at once.
@@ -419,13 +425,13 @@ def test_lowered_limits_act_on_the_command_in_force_at_once(allegro, policy):
     assert ctrl.reconfigured(0.03) is None
     # Raised again: the next cycle recovers.
     with_limits(ctrl, 0.7)
-    ctrl.update_joint_state(*joint_state(allegro), 0.04)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.04)
     assert ctrl.cycle(0.04).kind == 'solution' and ctrl.fault == ''
 
 
 def test_lowered_limits_with_stale_inputs_zero_at_once(planar):
     ctrl = fresh(planar, fault_policy='hold', joint_state_timeout=0.05, hold_time=10.0)
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
     cmd = ctrl.cycle(0.0).command
     assert ctrl.reconfigured(1.0) is None  # stale, but the command in force is within limits
     with_limits(ctrl, 0.5 * float(np.abs(cmd).max()))
@@ -441,14 +447,14 @@ def test_lowered_limits_with_stale_inputs_zero_at_once(planar):
 def test_a_failing_solver_never_passes_through(planar, mode, policy):
     ctrl = fresh(planar, hold_time=0.05, fault_policy=policy)
     js = joint_state(planar)
-    ctrl.update_joint_state(*js, 0.0)
+    ctrl.take('joint_states', JointStateReading(*js), 0.0)
     good = ctrl.cycle(0.0)
     assert good.kind == 'solution'
     ctrl.solver = Injected(mode)
     kinds = []
     for k in range(1, 11):
         t = 0.01 * k
-        ctrl.update_joint_state(*js, t)
+        ctrl.take('joint_states', JointStateReading(*js), t)
         t0 = time.perf_counter()
         r = ctrl.cycle(t)
         assert time.perf_counter() - t0 < 1.0  # refused or capped, never a stall
@@ -463,7 +469,7 @@ def test_a_failing_solver_never_passes_through(planar, mode, policy):
     assert ctrl.counters.solver_failures == 10
     assert ctrl.last_command is good.command  # the last certified command is what is held
     ctrl.solver.healthy = True
-    ctrl.update_joint_state(*js, 0.2)
+    ctrl.take('joint_states', JointStateReading(*js), 0.2)
     assert ctrl.cycle(0.2).kind == 'solution' and ctrl.counters.recoveries == 1
 
 

@@ -11,6 +11,7 @@
 from conftest import ALLEGRO, CONFIG, scenario_doc, setup_from_doc
 from cycle_inputs import fresh, joint_state
 from g1_grasp import ARM_Q, g1_doc, HAND_Q
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
 import pinocchio as pin
@@ -36,7 +37,8 @@ def test_a_coupled_hand_is_commanded_by_actuator_from_either_joint_state(coupled
     ref = solve(coupled)
     assert ref.optimal and ref.tau.shape == (13,)
     actuators_only = fresh(coupled)
-    actuators_only.update_joint_state(*joint_state(coupled, names=coupled.hand.joints), 0.0)
+    actuators_only.take('joint_states',
+                        JointStateReading(*joint_state(coupled, names=coupled.hand.joints)), 0.0)
     a = actuators_only.cycle(0.0)
     assert a.kind == 'solution'
     np.testing.assert_allclose(a.command, ref.tau, atol=1e-9)
@@ -44,14 +46,15 @@ def test_a_coupled_hand_is_commanded_by_actuator_from_either_joint_state(coupled
     names, positions = joint_state(coupled)
     positions = [p + 0.05 if n in dict(PAIRS) else p for n, p in zip(names, positions)]
     every_joint = fresh(coupled)
-    every_joint.update_joint_state(names, positions, 0.0)
+    every_joint.take('joint_states', JointStateReading(names, positions), 0.0)
     np.testing.assert_allclose(every_joint.cycle(0.0).command, ref.tau, atol=1e-9)
 
 
 def test_gravity_compensation_of_a_coupled_hand_is_c_transpose_g(coupled):
     gravity = np.array([9.81, 0.0, 0.0])
     ctrl = fresh(coupled, gravity_compensation=True, gravity=tuple(gravity))
-    ctrl.update_joint_state(*joint_state(coupled, names=coupled.hand.joints), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(coupled, names=coupled.hand.joints)),
+              0.0)
     r = ctrl.cycle(0.0)
     assert r.kind == 'solution'
     model = coupled.hand.model
@@ -72,8 +75,9 @@ def test_a_hand_in_a_robot_follows_the_robots_joint_states_in_the_palm_frame():
     ctrl = fresh(setup, gravity_compensation=True, gravity=(0.0, 0.0, -9.81))
     names = list(ARM_Q) + list(HAND_Q)
     still = fresh(setup, gravity_compensation=True, gravity=(0.0, 0.0, -9.81))
-    still.update_joint_state(list(HAND_Q), list(HAND_Q.values()), 0.0)
-    ctrl.update_joint_state(names, list(ARM_Q.values()) + list(HAND_Q.values()), 0.0)
+    still.take('joint_states', JointStateReading(list(HAND_Q), list(HAND_Q.values())), 0.0)
+    ctrl.take('joint_states',
+              JointStateReading(names, list(ARM_Q.values()) + list(HAND_Q.values())), 0.0)
     a, b = still.cycle(0.0), ctrl.cycle(0.0)
     assert a.kind == b.kind == 'solution'
     # Gravity is given in the palm's axes: its torques do not move with the arm either.

@@ -14,7 +14,7 @@ import time
 from cycle_inputs import Injected
 from grasp_torque_opt.backends import DaqpSettings, make_solver, ProxSuiteSettings
 from grasp_torque_opt.control.cycle import Cycle, round_settings
-from grasp_torque_opt.control.inputs import Counters, Inputs
+from grasp_torque_opt.control.inputs.store import Counters, Inputs
 from grasp_torque_opt.control.parameters import CycleConfig
 import pytest
 

@@ -13,6 +13,8 @@ import dataclasses
 from cycle_inputs import fresh, joint_state
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.diagnostics import ERROR, OK, report, STALE, WARN
+from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import numpy as np
@@ -27,7 +29,7 @@ def test_levels_follow_the_cycle(planar):
     ctrl = fresh(planar, joint_state_timeout=0.05, hold_time=0.1, fault_policy='zero')
     rep = report(ctrl, 0.0)
     assert rep.level == STALE and rep.message == 'waiting for joint_states'
-    ctrl.update_joint_state(*joint_state(planar), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
     ctrl.cycle(0.0)
     rep = report(ctrl, 0.01)
     v = values(rep)
@@ -49,7 +51,7 @@ def test_levels_follow_the_cycle(planar):
 def test_rejections_are_reported(planar):
     ctrl = fresh(planar)
     with pytest.raises(InputError):
-        ctrl.update_joint_state(['joint1'], [0.0, 1.0], 0.0)
+        ctrl.take('joint_states', JointStateReading(['joint1'], [0.0, 1.0]), 0.0)
     v = values(report(ctrl, 0.0))
     assert v['rejected.joint_states'] == '1'
     assert v['last_rejection'] == 'joint_states: 1 names but 2 positions'
@@ -57,7 +59,7 @@ def test_rejections_are_reported(planar):
 
 def test_friction_usage_matches_the_wrenches(allegro):
     ctrl = fresh(allegro)
-    ctrl.update_joint_state(*joint_state(allegro), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     r = ctrl.cycle(0.0)
     v = values(report(ctrl, 0.0))
     mu1 = allegro.friction.mu1
@@ -71,13 +73,14 @@ def test_warm_starts_and_their_fallbacks_are_reported(allegro):
     ctrl = TorqueController(dataclasses.replace(allegro, hand=dataclasses.replace(allegro.hand)),
                             CycleConfig(cycle_budget=10.0), backend='daqp', warm_start=True)
     names, positions = joint_state(allegro)
-    ctrl.update_joint_state(names, positions, 0.0)
+    ctrl.take('joint_states', JointStateReading(names, positions), 0.0)
     assert ctrl.cycle(0.0).kind == 'solution'
-    ctrl.update_joint_state(names, positions, 0.01)
+    ctrl.take('joint_states', JointStateReading(names, positions), 0.01)
     assert ctrl.cycle(0.01).kind == 'solution'
     # A load no grasp holds: the warm answer is not optimal, so it is redone cold.
-    ctrl.update_wrench('', allegro.external_wrench[:3] * 100, np.zeros(3), 0.02)
-    ctrl.update_joint_state(names, positions, 0.02)
+    ctrl.take('external_wrench',
+              WrenchReading('', allegro.external_wrench[:3] * 100, np.zeros(3)), 0.02)
+    ctrl.take('joint_states', JointStateReading(names, positions), 0.02)
     assert ctrl.cycle(0.02).kind == 'none'
     v = values(report(ctrl, 0.02))
     assert v['solver.backend'] == 'daqp'
@@ -99,7 +102,7 @@ def test_fallback_solves_are_reported(allegro):
 
     ctrl.solver = Wrong()
     names, positions = joint_state(allegro)
-    ctrl.update_joint_state(names, positions, 0.0)
+    ctrl.take('joint_states', JointStateReading(names, positions), 0.0)
     result = ctrl.cycle(0.0)
     assert result.kind == 'solution' and result.solution.backend == 'daqp'
     assert values(report(ctrl, 0.0))['solver.fallback_solves'] == '1'

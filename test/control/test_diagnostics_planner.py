@@ -12,6 +12,7 @@ import dataclasses
 
 from cycle_inputs import fresh, joint_state
 from grasp_torque_opt.control.diagnostics import report
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 import numpy as np
 
 
@@ -19,7 +20,7 @@ def test_margined_usage_is_reported_on_the_unreduced_cone(allegro):
     setup = dataclasses.replace(allegro, friction=dataclasses.replace(allegro.friction,
                                                                       margin=0.5))
     ctrl = fresh(setup)
-    ctrl.update_joint_state(*joint_state(setup), 0.0)
+    ctrl.take('joint_states', JointStateReading(*joint_state(setup)), 0.0)
     r = ctrl.cycle(0.0)
     v = dict(report(ctrl, 0.0).values)
     fr = allegro.friction

@@ -11,7 +11,7 @@
 import dataclasses
 
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
-from grasp_torque_opt.control.inputs import Counters
+from grasp_torque_opt.control.inputs.store import Counters
 from grasp_torque_opt.control.parameters import CycleConfig
 import numpy as np
 import pytest

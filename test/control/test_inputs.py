@@ -9,7 +9,10 @@
 """The input store alone: a message is kept whole or not at all; stamps; staleness."""
 
 from cycle_inputs import joint_state
-from grasp_torque_opt.control.inputs import Counters, Inputs, InputStore
+from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
+from grasp_torque_opt.control.inputs.gravity import GravityReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
+from grasp_torque_opt.control.inputs.store import Counters, Inputs, InputStore
 from grasp_torque_opt.control.parameters import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import pytest
@@ -22,10 +25,10 @@ def store(setup, **config):
 def test_a_rejected_message_changes_nothing_but_its_counter(planar):
     s = store(planar)
     names, positions = joint_state(planar)
-    s.update_joint_state(names, positions, 1.0)
+    s.take('joint_states', JointStateReading(names, positions), 1.0)
     kept = s.inputs
     with pytest.raises(InputError, match='joint_states'):
-        s.update_joint_state(names, positions[:-1], 2.0)
+        s.take('joint_states', JointStateReading(names, positions[:-1]), 2.0)
     assert s.inputs is kept and s.counters.rejected['joint_states'] == 1
     assert s.last_rejection.startswith('joint_states: ')
 
@@ -34,17 +37,18 @@ def test_gravity_is_counted_from_its_first_rejection(planar):
     s = store(planar)
     assert 'gravity' not in s.counters.rejected
     with pytest.raises(InputError):
-        s.update_gravity('', [0.0, 0.0, float('nan')], 0.0)
+        s.take('gravity', GravityReading('', [0.0, 0.0, float('nan')]), 0.0)
     assert s.counters.rejected['gravity'] == 1 and s.inputs == Inputs()
 
 
 def test_stamps_out_of_order_are_refused_until_the_mark_is_stale(planar):
     s = store(planar, joint_state_timeout=0.1)
     names, positions = joint_state(planar)
-    s.update_joint_state(names, positions, 0.0, stamp=10.0)
+    s.take('joint_states', JointStateReading(names, positions), 0.0, 10.0)
     with pytest.raises(InputError, match='goes backwards by 1.000000 s'):
-        s.update_joint_state(names, positions, 0.05, stamp=9.0)
-    s.update_joint_state(names, positions, 0.2, stamp=9.0)  # the mark is stale: recovered
+        s.take('joint_states', JointStateReading(names, positions), 0.05, 9.0)
+    s.take('joint_states', JointStateReading(names, positions), 0.2,
+           9.0)  # the mark is stale: recovered
     assert s.inputs.q_time == 0.2
 
 
@@ -52,17 +56,17 @@ def test_a_stamp_ahead_of_the_clock_is_refused_and_never_marks_the_future(planar
     s = store(planar, stamp_future_tolerance=0.5)
     names, positions = joint_state(planar)
     with pytest.raises(InputError, match='ahead of the clock'):
-        s.update_joint_state(names, positions, 0.0, stamp=11.0, clock=10.0)
-    s.update_joint_state(names, positions, 0.0, stamp=10.4, clock=10.0)
-    s.update_joint_state(names, positions, 0.01, stamp=10.1, clock=10.01)  # mark was 10.0
+        s.take('joint_states', JointStateReading(names, positions), 0.0, 11.0, 10.0)
+    s.take('joint_states', JointStateReading(names, positions), 0.0, 10.4, 10.0)
+    s.take('joint_states', JointStateReading(names, positions), 0.01, 10.1, 10.01)  # mark was 10.0
 
 
 def test_staleness_names_the_oldest_input(planar):
     s = store(planar, joint_state_timeout=0.1, wrench_timeout=0.5)
     assert s.stale(0.0) == 'no joint state yet'
-    s.update_joint_state(*joint_state(planar), 0.0)
-    s.update_wrench('', [0.0, 0.0, 1.0], [0.0, 0.0, 0.0], 0.0)
+    s.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
+    s.take('external_wrench', WrenchReading('', [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]), 0.0)
     assert s.stale(0.05) == ''
     assert s.stale(0.2).startswith('joint_states stale')
-    s.update_joint_state(*joint_state(planar), 0.55)
+    s.take('joint_states', JointStateReading(*joint_state(planar)), 0.55)
     assert s.stale(0.6).startswith('external_wrench stale')

@@ -16,6 +16,8 @@ are that combination of theirs: inside the exact cone, never pulling.
 """
 
 from cycle_inputs import base_poses, fresh, joint_state, tilted
+from grasp_torque_opt.control.inputs.contacts import ContactsReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.rates import slewed, step_wrenches
 from grasp_torque_opt.core.friction import cone_margin
 import numpy as np
@@ -49,18 +51,18 @@ def test_slewed_commands_keep_their_wrenches_in_the_exact_cone(allegro):
     ends = []
     for q in (quat, tilted(quat, 0.1)):  # the two grasps, each from a controller of its own
         own = fresh(allegro)
-        own.update_joint_state(names, pos, 0.0)
-        own.update_contacts('', points, q, 0.0)
+        own.take('joint_states', JointStateReading(names, pos), 0.0)
+        own.take('contacts', ContactsReading('', points, q), 0.0)
         ends.append(own.cycle(0.0).command)
-    ctrl.update_joint_state(names, pos, 0.0)
-    ctrl.update_contacts('', points, quat, 0.0)
+    ctrl.take('joint_states', JointStateReading(names, pos), 0.0)
+    ctrl.take('contacts', ContactsReading('', points, quat), 0.0)
     prev = ctrl.cycle(0.0).command
     np.testing.assert_allclose(prev, ends[0], atol=1e-7)
-    ctrl.update_contacts('', points, tilted(quat, 0.1), 0.0)
+    ctrl.take('contacts', ContactsReading('', points, tilted(quat, 0.1)), 0.0)
     steps = 0
     for k in range(1, 400):
         now = 1e-3 * k
-        ctrl.update_joint_state(names, pos, now)
+        ctrl.take('joint_states', JointStateReading(names, pos), now)
         result = ctrl.cycle(now)
         cmd = result.command
         if result.wrenches is None:  # reached: the certified command whole

@@ -131,3 +131,14 @@ def test_a_driver_without_efforts_turns_the_estimation_off_once(allegro):
         assert h.diagnostics[-1]['effort_estimation'].startswith('effort_estimation off')
     finally:
         h.close()
+
+
+def test_the_subscriptions_are_made_from_the_inputs_table():
+    """Every input of the registry has its message class and conversion on the ROS side."""
+    from grasp_torque_opt.control.inputs.registry import REGISTRY
+    from grasp_torque_opt.ros.node.inputs import MESSAGES
+
+    assert list(MESSAGES) == list(REGISTRY)
+    for name, (msg_type, _) in MESSAGES.items():
+        package, _, kind = REGISTRY[name].message.partition('/msg/')
+        assert (msg_type.__module__.split('.')[0], msg_type.__name__) == (package, kind), name

@@ -16,6 +16,8 @@ between two values made every command a full step.
 
 from conftest import PLANAR
 from cycle_inputs import base_poses, flipped, fresh, joint_state, tilted
+from grasp_torque_opt.control.inputs.contacts import ContactsReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 import numpy as np
 from rclpy.parameter import Parameter
 from ros_harness import Harness
@@ -84,8 +86,8 @@ def test_flapping_contacts_do_not_chatter(planar):
     ends = []
     for q in (quat, other):
         ctrl = fresh(planar)
-        ctrl.update_joint_state(*joint_state(planar), 0.0)
-        ctrl.update_contacts('', points, q, 0.0)
+        ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
+        ctrl.take('contacts', ContactsReading('', points, q), 0.0)
         ends.append(ctrl.cycle(0.0).command)
     full = float(np.abs(ends[0] - ends[1]).max())
     assert full > 0.05  # a 0.05 rad turn of the normals: 0.09 N m

@@ -30,6 +30,7 @@ import rclpy
 from rclpy.parameter import Parameter
 from grasp_torque_opt.backends import single_threaded_math
 from grasp_torque_opt.ros.node import GraspTorqueNode
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from cycle_inputs import joint_state
 from grasp_torque_opt import GraspSetup
 with warnings.catch_warnings(record=True) as caught:
@@ -45,7 +46,7 @@ assert not refused.successful and "daqp is not installed" in refused.reason, ref
 setup = GraspSetup.from_file({str(ALLEGRO)!r})
 names, positions = joint_state(setup)
 now = time.monotonic()
-node.controller.update_joint_state(names, positions, now)
+node.controller.take("joint_states", JointStateReading(names, positions), now)
 result = node.controller.cycle(now)
 assert result.kind == "solution" and result.solution.optimal, result
 assert result.solution.backend == "proxsuite"

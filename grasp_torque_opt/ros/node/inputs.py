@@ -8,7 +8,7 @@
 
 
 """
-The node's inputs: subscriptions, the size gate, and messages to plain arrays.
+The node's inputs: subscriptions made from the inputs' table, the size gate, messages to readings.
 
 Every input is taken serialized, so that its length is checked before it is
 deserialized (``max_message_bytes``); with message info, it is aged from when the
@@ -16,6 +16,11 @@ middleware received it. The controller checks the rest (docs/node.md, "Input
 checks"); a rejection is logged (throttled) and counted, and never commanded.
 A joint state runs one cycle while the node commands: that path is kept short, as it
 runs up to a thousand times a second.
+
+:data:`MESSAGES` gives each input of
+:data:`~grasp_torque_opt.control.inputs.registry.REGISTRY` its message class and its
+conversion to the input's reading (plain arrays; a frame looked up with tf2 where the
+input takes one); a test holds the two tables to each other.
 """
 
 from __future__ import annotations
@@ -24,7 +29,15 @@ import time
 from typing import Any, TYPE_CHECKING
 
 from geometry_msgs.msg import PoseArray, PoseStamped, Vector3Stamped, WrenchStamped
-from grasp_torque_opt.control.inputs import stamp_seconds
+from grasp_torque_opt.control.inputs.base import stamp_seconds
+from grasp_torque_opt.control.inputs.contacts import ContactsReading
+from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
+from grasp_torque_opt.control.inputs.gravity import GravityReading
+from grasp_torque_opt.control.inputs.imu import ImuReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
+from grasp_torque_opt.control.inputs.object_pose import PoseReading
+from grasp_torque_opt.control.inputs.registry import REGISTRY
+from grasp_torque_opt.control.parameters import value_of
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
 from grasp_torque_opt.ros.peers import quiet_subscription
@@ -66,23 +79,21 @@ class Inputs:
         self.sim_time = bool(root.node.get_parameter('use_sim_time').value)
 
     def start(self) -> list[Any]:
-        """Make the subscriptions (imu with imu.enabled); give them (destroyed at stop)."""
+        """Make a subscription per input of the table (an input's ``enabled`` parameter on)."""
         made = []
-        topics = [(JointState, 'joint_states', self.on_joint_state),
-                  (PoseArray, 'contacts', self.on_contacts),
-                  (WrenchStamped, 'external_wrench', self.on_wrench),
-                  (Vector3Stamped, 'gravity', self.on_gravity),
-                  (PoseStamped, 'object_pose', self.on_object_pose)]
-        if self.root.params.imu.enabled:
-            topics.append((Imu, 'imu', self.on_imu))
-        for msg_type, topic, take in topics:
-            callback = self._callback(topic, msg_type, take)
-            qos = JOINT_STATE_QOS if topic == 'joint_states' else qos_profile_sensor_data
-            sub = self.node.create_subscription(msg_type, topic, callback, qos, raw=True,
+        for name, given in REGISTRY.items():
+            if given.enabled and not value_of(self.root.params, given.enabled):
+                continue
+            msg_type = MESSAGES[name][0]
+            take = self.on_joint_state if name == 'joint_states' else (
+                lambda msg, receipt, name=name: self.on_message(name, msg, receipt))
+            callback = self._callback(name, msg_type, take)
+            qos = JOINT_STATE_QOS if given.qos == 'joint_states' else qos_profile_sensor_data
+            sub = self.node.create_subscription(msg_type, name, callback, qos, raw=True,
                                                 event_callbacks=quiet_subscription())
             made.append(sub)
             self.root.peers.watch(sub, msg_type)
-            if topic == 'joint_states':
+            if name == 'joint_states':
                 self.joint_states_topic = sub.topic_name
         return made
 
@@ -143,9 +154,9 @@ class Inputs:
             if ctrl is None:
                 return
             try:
-                # The controller checks the sizes first (the bytes are bounded already).
-                ctrl.update_joint_state(msg.name, msg.position, receipt, stamp,
-                                        self.clock_now(), msg.effort)
+                # The store checks the sizes first (the bytes are bounded already).
+                ctrl.take('joint_states', JointStateReading(msg.name, msg.position, msg.effort),
+                          receipt, stamp, self.clock_now())
             except InputError as e:
                 self._rejected(e)
                 return
@@ -157,110 +168,87 @@ class Inputs:
                     load.said = True
                     self.node.get_logger().warn(load.off)
 
-    def on_contacts(self, msg: PoseArray, receipt: float | None = None) -> None:
+    def on_message(self, name: str, msg: Any, receipt: float | None = None) -> None:
         """
-        Take contact frames in a model frame: one per scenario contact, or per named link.
+        Take a message of the input ``name`` (any but the joint states): convert, check, keep.
 
-        ``header.frame_id`` is ``FRAME`` (one pose per scenario contact, by index) or
-        ``FRAME;LINK_1,...`` (one pose per named link:
-        :mod:`grasp_torque_opt.control.named_contacts`).
+        The conversion (:data:`MESSAGES`) may look a frame up with tf2, outside the lock;
+        a rejection is logged (throttled) and counted, never commanded.
         """
         now = time.monotonic() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self.root.lock:
             ctrl = self.root.controller
-            try:
-                ctrl.check_size('contacts', len(msg.poses), msg.header.frame_id)
-                positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
-                quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
-                         for p in msg.poses]
-                ctrl.update_contacts(msg.header.frame_id, np.array(positions), np.array(quats),
-                                     now, stamp, self.clock_now())
-            except InputError as e:
-                self._rejected(e)
+            if ctrl is None:
+                return
+            hand = ctrl.setup.hand
+        try:
+            reading = MESSAGES[name][1](self, msg, hand)
+            with self.root.lock:
+                ctrl = self.root.controller
+                if ctrl is None:
+                    return
+                ctrl.take(name, reading, now, stamp, self.clock_now())
+        except InputError as e:
+            self._rejected(e)
 
-    def on_wrench(self, msg: WrenchStamped, receipt: float | None = None) -> None:
-        """Take the load on the object, in a model frame."""
-        now = time.monotonic() if receipt is None else receipt
-        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        f, t = msg.wrench.force, msg.wrench.torque
-        with self.root.lock:
-            try:
-                self.root.controller.update_wrench(msg.header.frame_id, [f.x, f.y, f.z],
-                                                   [t.x, t.y, t.z], now, stamp,
-                                                   self.clock_now())
-            except InputError as e:
-                self._rejected(e)
-
-    def on_gravity(self, msg: Vector3Stamped, receipt: float | None = None) -> None:
+    def looked_up(self, hand: Any, frame: str) -> tuple:
         """
-        Take gravity [m/s^2] in the hand's base frame (another frame only through tf2).
+        Return ``frame``'s transform to the hand's base frame by tf2, and why not.
 
-        g(q) and the scenario's load (its object's weight) follow it; once one has
-        arrived, it goes stale after ``gravity_timeout``, as the other inputs do.
+        Gives (None, why) for the base frame itself, a model frame, or without tf2.
         """
-        now = time.monotonic() if receipt is None else receipt
-        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        frame, v = msg.header.frame_id, msg.vector
-        with self.root.lock:
-            base = self.root.controller.setup.hand.base_frame
-        tf = self.root.tf
-        rotation, why = (None, 'tf2_ros is not installed')
-        if frame not in ('', base) and tf.running:
-            rotation, why = tf.rotation(base, frame)
-        with self.root.lock:
-            try:
-                self.root.controller.update_gravity(frame, [v.x, v.y, v.z], now, stamp,
-                                                    self.clock_now(), rotation, why)
-            except InputError as e:
-                self._rejected(e)
+        if frame in ('', hand.base_frame) or hand.model.existFrame(frame) \
+                or not self.root.tf.running:
+            return None, 'tf2_ros is not installed'
+        return self.root.tf.transform(hand.base_frame, frame)
 
-    def on_object_pose(self, msg: PoseStamped, receipt: float | None = None) -> None:
-        """
-        Take the object's pose: in the base frame, a model frame, or any frame tf2 resolves.
 
-        The contacts from geometry and the load's point follow it; rejected (counted,
-        logged, not kept): the last accepted pose is used while fresh.
-        """
-        now = time.monotonic() if receipt is None else receipt
-        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        frame, p, o = msg.header.frame_id, msg.pose.position, msg.pose.orientation
-        with self.root.lock:
-            hand = self.root.controller.setup.hand
-            known = frame in ('', hand.base_frame) or hand.model.existFrame(frame)
-            base = hand.base_frame
-        transform, why = None, 'tf2_ros is not installed'
-        if not known and self.root.tf.running:
-            transform, why = self.root.tf.transform(base, frame)
-        with self.root.lock:
-            try:
-                self.root.controller.store.update_object_pose(
-                    frame, [p.x, p.y, p.z], [o.x, o.y, o.z, o.w], now, stamp,
-                    self.clock_now(), transform, why)
-            except InputError as e:
-                self._rejected(e)
+def _contacts(inputs: Inputs, msg: PoseArray, hand: Any) -> ContactsReading:
+    """Give the contacts' reading; its count is checked against the frame_id first."""
+    with inputs.root.lock:
+        inputs.root.controller.check_size('contacts', len(msg.poses), msg.header.frame_id)
+    positions = [[p.position.x, p.position.y, p.position.z] for p in msg.poses]
+    quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
+             for p in msg.poses]
+    return ContactsReading(msg.header.frame_id, np.array(positions), np.array(quats))
 
-    def on_imu(self, msg: Imu, receipt: float | None = None) -> None:
-        """
-        Take the base's IMU: specific force and angular velocity (imu.enabled).
 
-        In the hand's base frame, or another frame through tf2 (its rotation and origin);
-        its orientation is not used. Rejected (counted, logged, not kept): the cycle
-        uses the last accepted reading while it is fresh, then the scenario's gravity.
-        """
-        now = time.monotonic() if receipt is None else receipt
-        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        frame, a, w = msg.header.frame_id, msg.linear_acceleration, msg.angular_velocity
-        with self.root.lock:
-            base = self.root.controller.setup.hand.base_frame
-        tf = self.root.tf
-        transform, why = None, 'tf2_ros is not installed'
-        if frame not in ('', base) and tf.running:
-            transform, why = tf.transform(base, frame)
-        with self.root.lock:
-            try:
-                self.root.controller.store.update_imu(frame, [a.x, a.y, a.z], [w.x, w.y, w.z],
-                                                      now, stamp, self.clock_now(), transform,
-                                                      why)
-            except InputError as e:
-                self._rejected(e)
+def _wrench(inputs: Inputs, msg: WrenchStamped, hand: Any) -> WrenchReading:
+    f, t = msg.wrench.force, msg.wrench.torque
+    return WrenchReading(msg.header.frame_id, [f.x, f.y, f.z], [t.x, t.y, t.z])
+
+
+def _gravity(inputs: Inputs, msg: Vector3Stamped, hand: Any) -> GravityReading:
+    """Give gravity's reading, another frame than the base's only through tf2 (its rotation)."""
+    frame, v = msg.header.frame_id, msg.vector
+    rotation, why = (None, 'tf2_ros is not installed') if frame in ('', hand.base_frame) \
+        or not inputs.root.tf.running else inputs.root.tf.rotation(hand.base_frame, frame)
+    return GravityReading(frame, [v.x, v.y, v.z], rotation, why)
+
+
+def _imu(inputs: Inputs, msg: Imu, hand: Any) -> ImuReading:
+    """Give the IMU's reading, another frame than the base's through tf2; no orientation."""
+    frame, a, w = msg.header.frame_id, msg.linear_acceleration, msg.angular_velocity
+    transform, why = (None, 'tf2_ros is not installed') if frame in ('', hand.base_frame) \
+        or not inputs.root.tf.running else inputs.root.tf.transform(hand.base_frame, frame)
+    return ImuReading(frame, [a.x, a.y, a.z], [w.x, w.y, w.z], transform, why)
+
+
+def _object_pose(inputs: Inputs, msg: PoseStamped, hand: Any) -> PoseReading:
+    """Give the object pose's reading: base or model frame, or any frame tf2 resolves."""
+    frame, p, o = msg.header.frame_id, msg.pose.position, msg.pose.orientation
+    transform, why = inputs.looked_up(hand, frame)
+    return PoseReading(frame, [p.x, p.y, p.z], [o.x, o.y, o.z, o.w], transform, why)
+
+
+#: Input name -> (its message class, its conversion (inputs, message, hand) -> reading);
+#: the joint states are converted on their own short path (:meth:`Inputs.on_joint_state`).
+MESSAGES: dict[str, tuple[type, Any]] = {
+    'joint_states': (JointState, None),
+    'contacts': (PoseArray, _contacts),
+    'external_wrench': (WrenchStamped, _wrench),
+    'gravity': (Vector3Stamped, _gravity),
+    'imu': (Imu, _imu),
+    'object_pose': (PoseStamped, _object_pose),
+}
