@@ -167,43 +167,17 @@ def echo_main(args: argparse.Namespace) -> int:
 def load_main(args: argparse.Namespace) -> int:
     """Publish joint states at a fixed rate, receive the commands, write the figures as JSON."""
     from grasp_torque_opt.core.grasp_setup import GraspSetup
-    import numpy as np
     import rclpy
-    from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+    from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
-    from std_msgs.msg import Float64MultiArray
 
     setup = GraspSetup.from_file(CONFIG / HANDS[args.hand][0])
     names = list(setup.hand.joints)
-    q0 = setup.q[setup.hand.idx_q].astype(float)
-    phase = 0.4 * np.arange(len(names))
 
     rclpy.init(args=[sys.argv[0]])
     node = rclpy.create_node('grasp_load')
     pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
-    receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
-    command_times: list[float] = []  # perf_counter at receipt of each effort_commands
-    bad_length = 0
-    stamped: dict[int, int] = {}  # joint-state stamp -> receipt [ns, system clock]
-    duplicates = 0
-
-    def on_command(msg: Float64MultiArray) -> None:
-        nonlocal bad_length
-        command_times.append(time.perf_counter())
-        if len(msg.data) != len(names):
-            bad_length += 1
-
-    def on_stamped(msg: JointState) -> None:
-        nonlocal duplicates
-        now = time.time_ns()
-        s = stamp_ns(msg.header.stamp)
-        if s in stamped:
-            duplicates += 1
-        else:
-            stamped[s] = now
-
-    node.create_subscription(Float64MultiArray, 'effort_commands', on_command, receiver_qos)
-    node.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
+    received = _Received(node, len(names))
     executor = _executor(args.load_executor)
     executor.add_node(node)
     if args.load_priority:  # as ros2_control's controller_manager loop, which sends and takes
@@ -224,21 +198,83 @@ def load_main(args: argparse.Namespace) -> int:
         print('load: nobody answers on joint_states', file=sys.stderr)
         return 1
 
+    window = _Window(args.duration)
+    _publish(pacer, pub, setup, received, window)
+    pacer.spin_for(DRAIN_S)
+    foreign = {'joint_states_publishers': node.count_publishers('joint_states'),
+               'joint_states_subscribers': node.count_subscribers('joint_states')}
+    node.destroy_node()
+    rclpy.try_shutdown()
+    if 'start' not in window.times:
+        print('load: no command came back', file=sys.stderr)
+        return 1
+    Path(args.result).write_text(json.dumps(_figures(received, window, foreign)))
+    return 0
+
+
+class _Received:
+    """The commands the load process receives: their times, the stamped copies by stamp."""
+
+    def __init__(self, node, m: int) -> None:
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import Float64MultiArray
+
+        self.m = m
+        self.command_times: list[float] = []  # perf_counter at receipt of each effort_commands
+        self.bad_length = 0
+        self.stamped: dict[int, int] = {}  # joint-state stamp -> receipt [ns, system clock]
+        self.duplicates = 0
+        receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+        node.create_subscription(Float64MultiArray, 'effort_commands', self.on_command,
+                                 receiver_qos)
+        node.create_subscription(JointState, STAMPED_TOPIC, self.on_stamped, receiver_qos)
+
+    def on_command(self, msg) -> None:
+        self.command_times.append(time.perf_counter())
+        if len(msg.data) != self.m:
+            self.bad_length += 1
+
+    def on_stamped(self, msg) -> None:
+        now = time.time_ns()
+        s = stamp_ns(msg.header.stamp)
+        if s in self.stamped:
+            self.duplicates += 1
+        else:
+            self.stamped[s] = now
+
+
+class _Window:
+    """The measured window: warm-up from the first command, then ``duration`` [s]."""
+
+    def __init__(self, duration: float) -> None:
+        self.duration = duration
+        self.times: dict[str, float] = {}  # warm, start, end [perf_counter s]
+        self.sent: list[tuple[int, float]] = []  # (stamp [ns], perf_counter at publish)
+        self.lateness: list[float] = []  # of the measured ticks [s]
+        self.t_start = time.perf_counter()
+
+
+def _publish(pacer: Pacer, pub, setup, received: _Received, window: _Window) -> None:
+    """Publish the joint states on the pacer's deadlines until the window ends."""
+    import numpy as np
+    from sensor_msgs.msg import JointState
+
+    names = list(setup.hand.joints)
+    q0 = setup.q[setup.hand.idx_q].astype(float)
+    phase = 0.4 * np.arange(len(names))
     clock = UniqueClock()
-    sent: list[tuple[int, float]] = []  # (stamp [ns], perf_counter at publish), measured only
-    lateness: list[float] = []  # of the measured ticks [s]
-    window: dict[str, float] = {}
-    t_start = time.perf_counter()
+    times = window.times
 
     def tick(k: int, now: float) -> bool:
-        if 'warm' not in window:
-            if stamped:
-                window['warm'] = now
-                window['start'] = now + WARMUP_S
-                window['end'] = window['start'] + args.duration
-            elif now - t_start > READY_TIMEOUT_S:
+        if 'warm' not in times:
+            if received.stamped:
+                times['warm'] = now
+                times['start'] = now + WARMUP_S
+                times['end'] = times['start'] + window.duration
+            elif now - window.t_start > READY_TIMEOUT_S:
                 return False
-        if 'end' in window and now >= window['end']:
+        if 'end' in times and now >= times['end']:
             return False
         msg = JointState(name=names,
                          position=(q0 + AMPLITUDE * np.sin(np.pi * k * pacer.period + phase)
@@ -246,44 +282,38 @@ def load_main(args: argparse.Namespace) -> int:
         s = clock()
         set_stamp(msg.header, s)
         pub.publish(msg)
-        if 'start' in window and now >= window['start']:
-            sent.append((s, now))
-            lateness.append(pacer.lateness[-1])
+        if 'start' in times and now >= times['start']:
+            window.sent.append((s, now))
+            window.lateness.append(pacer.lateness[-1])
         return True
 
     pacer.run(tick)
-    pacer.spin_for(DRAIN_S)
-    foreign = {'joint_states_publishers': node.count_publishers('joint_states'),
-               'joint_states_subscribers': node.count_subscribers('joint_states')}
-    node.destroy_node()
-    rclpy.try_shutdown()
-    if 'start' not in window:
-        print('load: no command came back', file=sys.stderr)
-        return 1
 
+
+def _figures(received: _Received, window: _Window, foreign: dict) -> dict:
+    """Return the load process's figures: rates, drops, latency, the graph at the end."""
+    sent, stamped = window.sent, received.stamped
     n_pub = len(sent)
     span = sent[-1][1] - sent[0][1] if n_pub > 1 else float('nan')
     latencies = [1e-9 * (stamped[s] - s) for s, _ in sent if s in stamped]
     dropped = n_pub - len(latencies)
-    t0, t1 = window['start'], window['end']
-    n_cmd = sum(t0 <= t <= t1 for t in command_times)
-    result = {
+    t0, t1 = window.times['start'], window.times['end']
+    n_cmd = sum(t0 <= t <= t1 for t in received.command_times)
+    return {
         'published': n_pub,
         'publish_rate_hz': (n_pub - 1) / span if n_pub > 1 else None,
-        'publish_lateness': percentiles_ms(lateness),
+        'publish_lateness': percentiles_ms(window.lateness),
         'commands': n_cmd,
         'command_rate_hz': n_cmd / (t1 - t0),
         'answered': len(latencies),
         'dropped': dropped,
         'dropped_pct': 100.0 * dropped / n_pub if n_pub else None,
         'latency': percentiles_ms(latencies),
-        'duplicate_stamps': duplicates,
-        'wrong_length_commands': bad_length,
-        'time_to_first_command_s': window['warm'] - t_start,
+        'duplicate_stamps': received.duplicates,
+        'wrong_length_commands': received.bad_length,
+        'time_to_first_command_s': window.times['warm'] - window.t_start,
         'graph_at_end': foreign,
     }
-    Path(args.result).write_text(json.dumps(result))
-    return 0
 
 
 # -- the run ---------------------------------------------------------------------------------

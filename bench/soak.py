@@ -183,54 +183,113 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     """Publish the mix at the node, check every command, report."""
     from cycle import machine
     from diagnostic_msgs.msg import DiagnosticArray
-    from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
-    from grasp_torque_opt.core.grasp_setup import GraspSetup
-    import pinocchio as pin
-    from rcl_interfaces.srv import SetParameters
     import rclpy
     from rclpy.experimental import EventsExecutor
-    from rclpy.parameter import Parameter
-    from rclpy.qos import HistoryPolicy, qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
-    from std_srvs.srv import Trigger
 
-    p = _node_params()
-    setup = GraspSetup.from_file(CONFIG / p['scenario'])
-    hand = setup.hand
-    names = list(hand.joints)
-    m = len(names)
-    limits = np.array(p.get('torque_limits', hand.torque_limits), dtype=float)
-    q0 = setup.q[hand.idx_q].astype(float)
-    base = hand.base_frame
-    timeout = float(p.get('joint_state_timeout', 0.1))
-    hold = float(p.get('hold_time', 0.1))
-    policy = p.get('fault_policy', 'hold')
-    stop_bound_s = timeout + hold + DELIVERY_MARGIN_S
-    w0 = np.asarray(setup.external_wrench, dtype=float)
-    frames = setup.maps().contacts
-    contact_poses = [(np.asarray(f.position, dtype=float),
-                      np.asarray(pin.Quaternion(f.rotation).coeffs(), dtype=float))  # x y z w
-                     for f in frames]
-
+    hand = NodeSetup()
     rng = random.Random(args.seed)
     phases = schedule(rng, args.duration)
     # The warm-up lasts until the node answers: its draws come from a generator of their
     # own, so that the mix depends on the seed only.
     state = {'last_valid_stamp': 0, 'since_silence': 0, 'mixing': False, 'phase': None,
              'rng': random.Random(args.seed + 1)}
-    mix = {'joint_states_invalid_fraction': P_JS_INVALID, 'joint_states_invalid_kinds': JS_INVALID,
-           'contacts_and_load_rate_hz': SLOW_RATE_HZ, 'slow_invalid_fraction': P_SLOW_INVALID,
-           'contacts_invalid_kinds': CONTACT_INVALID, 'external_wrench_invalid_kinds':
-           WRENCH_INVALID, 'silences': sum(k == 'silence' for k, _, _ in phases),
-           'infeasible_load_phases': sum(k == 'infeasible_load' for k, _, _ in phases),
-           'phase_s': PHASE_S, 'infeasible_force_N': INFEASIBLE_FORCE_N,
-           'holdable_load': 'scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis',
-           **{f'{k}_phases': sum(kind == k for kind, _, _ in phases) for k in ISSUE13_PHASES},
-           'skew_s': SKEW_S, 'skewed_rate_hz': SKEWED_RATE_HZ,
-           'limits_fraction': LIMITS_FRACTION, 'flood_calls': FLOOD_CALLS,
-           'solver_bounds': BOUNDS}
+    mix = _mix_description(phases)
     mach = machine()
+    _print_intro(args, node, domain, logs, mach, mix, hand)
+
+    rclpy.init()
+    ros = rclpy.create_node('grasp_soak_driver')
+    checker = Checker(hand, state)
+    inputs = Inputs(ros, args, hand, state, checker)
+    receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+    ros.create_subscription(Float64MultiArray, 'effort_commands', checker.on_command,
+                            receiver_qos)
+    ros.create_subscription(JointState, STAMPED_TOPIC, checker.on_stamped, receiver_qos)
+    ros.create_subscription(DiagnosticArray, '/diagnostics', checker.on_diag, 10)
+    # Served by spin_once in the pacer (its spin() does not deliver here; see node_load.py).
+    executor = EventsExecutor()
+    executor.add_node(ros)
+    pacer = Pacer(executor, args.rate)
+    spans = Phases(ros, args, hand, checker, phases)
+
+    if not _warm_up(args, ros, pacer, node, logs, inputs, checker):
+        return None
+    pacer.spin_for(0.3)  # a fresh /diagnostics
+    run = {'diag_start': dict(checker.diag), 'commands_before': len(checker.commands),
+           'stamped_before': checker.stamped_ok, 'memory': [(0.0, vm_rss_kib(node.pid))]}
+    share = CpuShare(exclude=(node.pid,))
+    state['mixing'] = True
+    state['rng'] = rng
+    run.update(_mix(args, pacer, inputs, spans, state, node, run['memory']))
+    pacer.spin_for(DRAIN_S)
+    run['service'] = _drain(pacer, spans, checker)
+    pacer.spin_for(0.3)
+    run['diag_end'] = dict(checker.diag)
+    run['memory'].append((args.duration, vm_rss_kib(node.pid)))
+    run['others'], run['node_cores'] = share.others_cores(), share.cores_of(node.pid)
+    run['alive'] = node.alive()
+    ros.destroy_node()
+    rclpy.try_shutdown()
+
+    _check_phases(spans.spans, checker, hand, run['start_ns'], run['end_ns'])
+    result = _result(args, hand, mach, mix, inputs, checker, pacer, run)
+    print()
+    print(report(result))
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(json.dumps(result, indent=2))
+    print(f'\nwritten: {args.out}')
+    return result
+
+
+class NodeSetup:
+    """The node's hand and settings, from its params file: what the checks hold it to."""
+
+    def __init__(self) -> None:
+        from grasp_torque_opt.core.grasp_setup import GraspSetup
+        import pinocchio as pin
+
+        p = self.params = _node_params()
+        setup = self.setup = GraspSetup.from_file(CONFIG / p['scenario'])
+        hand = setup.hand
+        self.names = list(hand.joints)
+        self.m = len(self.names)
+        self.limits = np.array(p.get('torque_limits', hand.torque_limits), dtype=float)
+        self.q0 = setup.q[hand.idx_q].astype(float)
+        self.base = hand.base_frame
+        self.timeout = float(p.get('joint_state_timeout', 0.1))
+        self.hold = float(p.get('hold_time', 0.1))
+        self.policy = p.get('fault_policy', 'hold')
+        self.stop_bound_s = self.timeout + self.hold + DELIVERY_MARGIN_S
+        self.w0 = np.asarray(setup.external_wrench, dtype=float)
+        frames = setup.maps().contacts
+        self.contact_poses = [(np.asarray(f.position, dtype=float),
+                               np.asarray(pin.Quaternion(f.rotation).coeffs(),
+                                          dtype=float))  # x y z w
+                              for f in frames]
+
+
+def _mix_description(phases: list[tuple[str, float, float]]) -> dict:
+    """Return the mix as the result records it: shares, kinds, rates and phase counts."""
+    return {'joint_states_invalid_fraction': P_JS_INVALID, 'joint_states_invalid_kinds':
+            JS_INVALID, 'contacts_and_load_rate_hz': SLOW_RATE_HZ,
+            'slow_invalid_fraction': P_SLOW_INVALID,
+            'contacts_invalid_kinds': CONTACT_INVALID, 'external_wrench_invalid_kinds':
+            WRENCH_INVALID, 'silences': sum(k == 'silence' for k, _, _ in phases),
+            'infeasible_load_phases': sum(k == 'infeasible_load' for k, _, _ in phases),
+            'phase_s': PHASE_S, 'infeasible_force_N': INFEASIBLE_FORCE_N,
+            'holdable_load': 'scenario load x U(0.7, 1.3) plus U(-0.2, 0.2) N per axis',
+            **{f'{k}_phases': sum(kind == k for kind, _, _ in phases) for k in ISSUE13_PHASES},
+            'skew_s': SKEW_S, 'skewed_rate_hz': SKEWED_RATE_HZ,
+            'limits_fraction': LIMITS_FRACTION, 'flood_calls': FLOOD_CALLS,
+            'solver_bounds': BOUNDS}
+
+
+def _print_intro(args: argparse.Namespace, node: Child, domain: int, logs: Path, mach: dict,
+                 mix: dict, hand: NodeSetup) -> None:
+    """Print the machine, the run and its mix."""
     print(f"machine: {mach['cpu']}, {mach['cores']} cores, Python {mach['python']}; "
           f"{mach['date']}")
     print(f'soak: {args.duration:g} s at {args.rate:g} Hz, seed {args.seed}, node pid '
@@ -240,116 +299,124 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
           f'{SLOW_RATE_HZ:g} Hz, {100 * P_SLOW_INVALID:.0f}% invalid (contacts: '
           f"{', '.join(CONTACT_INVALID)}; load: {', '.join(WRENCH_INVALID)}); "
           f"{mix['silences']} silences and {mix['infeasible_load_phases']} infeasible loads "
-          f'({INFEASIBLE_FORCE_N:g} N) of {PHASE_S:g} s; fault_policy {policy}, stop bound '
-          f'{timeout:g} + {hold:g} + {DELIVERY_MARGIN_S:g} s', flush=True)
+          f'({INFEASIBLE_FORCE_N:g} N) of {PHASE_S:g} s; fault_policy {hand.policy}, stop bound '
+          f'{hand.timeout:g} + {hand.hold:g} + {DELIVERY_MARGIN_S:g} s', flush=True)
 
-    rclpy.init()
-    ros = rclpy.create_node('grasp_soak_driver')
-    js_pub = ros.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
-    contacts_pub = ros.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
-    wrench_pub = ros.create_publisher(WrenchStamped, 'external_wrench', qos_profile_sensor_data)
-    receiver_qos = QoSProfile(depth=RECEIVER_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
 
-    valid_stamps: set[int] = set()
-    invalid_stamps: set[int] = set()
-    skewed_stamps: set[int] = set()  # valid joint states of the second, skewed source
-    # The limits in force: (time from which a command must meet them [ns], limits).
-    limits_in_force: list[tuple[int, np.ndarray]] = [(0, limits)]
-    flood_futures: list = []
-    param_futures: list = []
-    commands: list[tuple[int, bool]] = []  # (receipt [ns], all zero)
-    violations: dict[str, int] = {}
-    examples: list[str] = []
-    stamped_ok = 0
-    late_receipts = {'n': 0}  # commands received later than joint_state_timeout + margin
-    zero_policy_commands = 0
-    stamped_times: list[tuple[int, int]] = []  # (stamp, receipt) of valid-stamp commands
-    diag: dict[str, str] = {}
+class Checker:
+    """The invariants, checked on every command the node sends back; what broke."""
 
-    def broken(kind: str, detail: str) -> None:
-        violations[kind] = violations.get(kind, 0) + 1
-        if len(examples) < 10:
-            examples.append(f'{kind}: {detail}')
+    def __init__(self, hand: NodeSetup, state: dict) -> None:
+        self.hand, self.state = hand, state
+        self.valid_stamps: set[int] = set()
+        self.invalid_stamps: set[int] = set()
+        self.skewed_stamps: set[int] = set()  # valid joint states of the second, skewed source
+        # The limits in force: (time from which a command must meet them [ns], limits).
+        self.limits_in_force: list[tuple[int, np.ndarray]] = [(0, hand.limits)]
+        self.commands: list[tuple[int, bool]] = []  # (receipt [ns], all zero)
+        self.violations: dict[str, int] = {}
+        self.examples: list[str] = []
+        self.stamped_ok = 0
+        self.late_receipts = 0  # commands received later than joint_state_timeout + margin
+        self.zero_policy_commands = 0
+        self.stamped_times: list[tuple[int, int]] = []  # (stamp, receipt) of valid-stamp ones
+        self.diag: dict[str, str] = {}
 
-    def check_values(values, where: str) -> None:
+    def broken(self, kind: str, detail: str) -> None:
+        self.violations[kind] = self.violations.get(kind, 0) + 1
+        if len(self.examples) < 10:
+            self.examples.append(f'{kind}: {detail}')
+
+    def check_values(self, values, where: str) -> None:
+        m, limits = self.hand.m, self.hand.limits
         v = np.asarray(values, dtype=float)
         if v.shape != (m,):
-            broken('wrong_length', f'{where} has {v.size} values for {m} joints')
+            self.broken('wrong_length', f'{where} has {v.size} values for {m} joints')
         elif not np.all(np.isfinite(v)):
-            broken('not_finite', f'{where} {v.tolist()}')
+            self.broken('not_finite', f'{where} {v.tolist()}')
         elif np.any(np.abs(v) > limits):
-            broken('over_limit', f'{where} max |value| {np.abs(v).max():.6g}')
+            self.broken('over_limit', f'{where} max |value| {np.abs(v).max():.6g}')
         else:
             now = time.time_ns()
-            in_force = next(lim for t, lim in reversed(limits_in_force) if t <= now)
+            in_force = next(lim for t, lim in reversed(self.limits_in_force) if t <= now)
             if np.any(np.abs(v) > in_force):
-                broken('over_lowered_limit', f'{where} max |value| {np.abs(v).max():.6g} '
-                       f'over the lowered limit {in_force.max():.6g}')
+                self.broken('over_lowered_limit', f'{where} max |value| {np.abs(v).max():.6g} '
+                            f'over the lowered limit {in_force.max():.6g}')
 
-    def on_command(msg: Float64MultiArray) -> None:
-        commands.append((time.time_ns(), not any(msg.data)))
-        check_values(msg.data, 'effort_commands')
+    def on_command(self, msg) -> None:
+        self.commands.append((time.time_ns(), not any(msg.data)))
+        self.check_values(msg.data, 'effort_commands')
 
-    def on_stamped(msg: JointState) -> None:
-        nonlocal stamped_ok, zero_policy_commands
+    def on_stamped(self, msg) -> None:
         now = time.time_ns()
         s = stamp_ns(msg.header.stamp)
-        check_values(msg.effort, 'effort_commands_stamped')
-        if list(msg.name) != names:
-            broken('wrong_names', f'stamped command names {list(msg.name)[:3]}...')
-        if s in valid_stamps:
-            stamped_ok += 1
-            stamped_times.append((s, now))
-            if now - s > int(1e9 * (timeout + DELIVERY_MARGIN_S)):
+        self.check_values(msg.effort, 'effort_commands_stamped')
+        if list(msg.name) != self.hand.names:
+            self.broken('wrong_names', f'stamped command names {list(msg.name)[:3]}...')
+        if s in self.valid_stamps:
+            self.stamped_ok += 1
+            self.stamped_times.append((s, now))
+            if now - s > int(1e9 * (self.hand.timeout + DELIVERY_MARGIN_S)):
                 # Reported, not an invariant: the receipt time includes the command's
                 # delivery and this process's own scheduling (1400 such on a machine
                 # whose other work took 1.38 of its 2 cores); the node's own bound, from
                 # receipt to publication, is checked by the test suite's campaign.
-                late_receipts['n'] += 1
-            phase = state['phase']
+                self.late_receipts += 1
+            phase = self.state['phase']
             if phase is not None and phase['kind'] == 'skewed_source' and \
-                    s not in skewed_stamps:
+                    s not in self.skewed_stamps:
                 phase['on_clock_commands'] = phase.get('on_clock_commands', 0) + 1
-        elif s in invalid_stamps:
-            broken('from_invalid_joint_state', f'command stamped {s} answers a rejected state')
-        elif policy == 'zero' and not any(msg.effort):
-            zero_policy_commands += 1
+        elif s in self.invalid_stamps:
+            self.broken('from_invalid_joint_state',
+                        f'command stamped {s} answers a rejected state')
+        elif self.hand.policy == 'zero' and not any(msg.effort):
+            self.zero_policy_commands += 1
         else:
-            broken('unknown_stamp', f'command stamped {s} answers no published joint state')
+            self.broken('unknown_stamp', f'command stamped {s} answers no published joint state')
 
-    def on_diag(msg: DiagnosticArray) -> None:
+    def on_diag(self, msg) -> None:
         for status in msg.status:
             if status.name.startswith('/grasp_torque_node: '):
-                diag.clear()
-                diag.update({kv.key: kv.value for kv in status.values})
-                diag['_level'] = str(status.level[0] if isinstance(status.level, bytes)
-                                     else status.level)
+                self.diag.clear()
+                self.diag.update({kv.key: kv.value for kv in status.values})
+                self.diag['_level'] = str(status.level[0] if isinstance(status.level, bytes)
+                                          else status.level)
 
-    ros.create_subscription(Float64MultiArray, 'effort_commands', on_command, receiver_qos)
-    ros.create_subscription(JointState, STAMPED_TOPIC, on_stamped, receiver_qos)
-    ros.create_subscription(DiagnosticArray, '/diagnostics', on_diag, 10)
-    # Served by spin_once in the pacer (its spin() does not deliver here; see node_load.py).
-    executor = EventsExecutor()
-    executor.add_node(ros)
-    pacer = Pacer(executor, args.rate)
-    clock = UniqueClock()
 
-    # -- messages ------------------------------------------------------------------------
-    sent = {'joint_states': {'valid': 0}, 'contacts': {'valid': 0},
-            'external_wrench': {'valid': 0, 'infeasible': 0}}
-    for kind in JS_INVALID:
-        sent['joint_states'][kind] = 0
-    for kind in CONTACT_INVALID:
-        sent['contacts'][kind] = 0
-    for kind in WRENCH_INVALID:
-        sent['external_wrench'][kind] = 0
-    huge = JointState(name=names, position=[0.0] * 100000)
+class Inputs:
+    """What this process publishes at the node, valid or not, and how many of each kind."""
 
-    def joint_state(k: int, invalid: str | None) -> None:
-        q = (q0 + 1e-3 * np.sin(np.pi * k / args.rate + 0.4 * np.arange(m))).tolist()
-        n = list(names)
+    def __init__(self, ros, args: argparse.Namespace, hand: NodeSetup, state: dict,
+                 checker: Checker) -> None:
+        from geometry_msgs.msg import PoseArray, WrenchStamped
+        from rclpy.qos import qos_profile_sensor_data
+        from sensor_msgs.msg import JointState
+
+        self.args, self.hand, self.state, self.checker = args, hand, state, checker
+        self.js_pub = ros.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+        self.contacts_pub = ros.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
+        self.wrench_pub = ros.create_publisher(WrenchStamped, 'external_wrench',
+                                               qos_profile_sensor_data)
+        self.clock = UniqueClock()
+        self.sent = {'joint_states': {'valid': 0}, 'contacts': {'valid': 0},
+                     'external_wrench': {'valid': 0, 'infeasible': 0}}
+        for kind in JS_INVALID:
+            self.sent['joint_states'][kind] = 0
+        for kind in CONTACT_INVALID:
+            self.sent['contacts'][kind] = 0
+        for kind in WRENCH_INVALID:
+            self.sent['external_wrench'][kind] = 0
+        self.huge = JointState(name=hand.names, position=[0.0] * 100000)
+
+    def joint_state(self, k: int, invalid: str | None) -> None:
+        from sensor_msgs.msg import JointState
+
+        m, state = self.hand.m, self.state
+        q = (self.hand.q0 + 1e-3 * np.sin(np.pi * k / self.args.rate + 0.4 * np.arange(m))
+             ).tolist()
+        n = list(self.hand.names)
         msg = JointState()
-        s = clock()
+        s = self.clock()
         if invalid is None:
             variant = k % 3
             if variant == 1:  # as joint_state_broadcaster: any order, NaN efforts
@@ -361,43 +428,52 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
                 n, q = n + ['wrist_camera_joint'], q + [0.0]
             msg.name, msg.position = n, q
         elif invalid == 'huge_arrays':
-            msg = huge
+            msg = self.huge
         else:
-            i = state['rng'].randrange(m)
-            if invalid == 'nan_position':
-                q[i] = math.nan
-            elif invalid == 'out_of_range_position':
-                q[i] = 1e4
-            elif invalid == 'length_mismatch':
-                q = q[:-1]
-            elif invalid == 'duplicate_name':
-                n[(i + 1) % m] = n[i]
-            elif invalid == 'empty_name':
-                n[i] = ''
-            elif invalid == 'missing_joint':
-                del n[i], q[i]
-            elif invalid == 'empty_message':
-                n, q = [], []
-            elif invalid == 'future_stamp':
-                s += 10_000_000_000
-            elif invalid == 'backwards_stamp':
-                s = state['last_valid_stamp'] - 200_000_000
-                while s in valid_stamps:
-                    s -= 1
+            n, q, s = self._spoiled(invalid, n, q, s)
             msg.name, msg.position = n, q
         set_stamp(msg.header, s)
         if invalid is None:
-            valid_stamps.add(s)
+            self.checker.valid_stamps.add(s)
             state['last_valid_stamp'] = s
         else:
-            invalid_stamps.add(s)
+            self.checker.invalid_stamps.add(s)
         if state['mixing']:
-            sent['joint_states']['valid' if invalid is None else invalid] += 1
-        js_pub.publish(msg)
+            self.sent['joint_states']['valid' if invalid is None else invalid] += 1
+        self.js_pub.publish(msg)
 
-    def contacts(invalid: str | None) -> None:
+    def _spoiled(self, invalid: str, n: list, q: list, s: int) -> tuple[list, list, int]:
+        """Return the names, positions and stamp of a joint state made ``invalid``."""
+        m = self.hand.m
+        i = self.state['rng'].randrange(m)
+        if invalid == 'nan_position':
+            q[i] = math.nan
+        elif invalid == 'out_of_range_position':
+            q[i] = 1e4
+        elif invalid == 'length_mismatch':
+            q = q[:-1]
+        elif invalid == 'duplicate_name':
+            n[(i + 1) % m] = n[i]
+        elif invalid == 'empty_name':
+            n[i] = ''
+        elif invalid == 'missing_joint':
+            del n[i], q[i]
+        elif invalid == 'empty_message':
+            n, q = [], []
+        elif invalid == 'future_stamp':
+            s += 10_000_000_000
+        elif invalid == 'backwards_stamp':
+            s = self.state['last_valid_stamp'] - 200_000_000
+            while s in self.checker.valid_stamps:
+                s -= 1
+        return n, q, s
+
+    def contacts(self, invalid: str | None) -> None:
+        from geometry_msgs.msg import Pose, PoseArray
+
+        contact_poses = self.hand.contact_poses
         msg = PoseArray()
-        msg.header.frame_id = base if state['rng'].random() < 0.5 else ''
+        msg.header.frame_id = self.hand.base if self.state['rng'].random() < 0.5 else ''
         for i, (pos, quat) in enumerate(contact_poses):
             pos, quat = pos.copy(), quat.copy()
             if invalid == 'non_unit_quaternion' and i == 0:
@@ -415,16 +491,19 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             msg.poses.append(pose)
         if invalid == 'unknown_frame':
             msg.header.frame_id = 'no_such_frame'
-        set_stamp(msg.header, clock())
-        if state['mixing']:
-            sent['contacts']['valid' if invalid is None else invalid] += 1
-        contacts_pub.publish(msg)
+        set_stamp(msg.header, self.clock())
+        if self.state['mixing']:
+            self.sent['contacts']['valid' if invalid is None else invalid] += 1
+        self.contacts_pub.publish(msg)
 
-    def wrench(kind: str) -> None:
+    def wrench(self, kind: str) -> None:
+        from geometry_msgs.msg import WrenchStamped
+
+        state = self.state
         r = state['rng']
         msg = WrenchStamped()
-        msg.header.frame_id = base if r.random() < 0.5 else ''
-        w = w0 * r.uniform(0.7, 1.3)
+        msg.header.frame_id = self.hand.base if r.random() < 0.5 else ''
+        w = self.hand.w0 * r.uniform(0.7, 1.3)
         w[:3] += [r.uniform(-0.2, 0.2) for _ in range(3)]
         if kind == 'infeasible':
             w = np.array([INFEASIBLE_FORCE_N, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -433,39 +512,79 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         elif kind == 'inf_torque':
             w[4] = math.inf
         elif kind == 'over_max_force':
-            w[0] = 10.0 * float(p.get('max_wrench_force', 1000.0))
+            w[0] = 10.0 * float(self.hand.params.get('max_wrench_force', 1000.0))
         elif kind == 'unknown_frame':
             msg.header.frame_id = 'no_such_frame'
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = map(float, w)
-        s = clock()
+        s = self.clock()
         set_stamp(msg.header, s)
         if state['mixing']:
-            sent['external_wrench'][kind] += 1
+            self.sent['external_wrench'][kind] += 1
         if kind == 'infeasible' and state['phase'] is not None:
             state['phase'].setdefault('first_infeasible_ns', s)
             state['infeasible_span'] = state['phase']
         elif kind == 'valid' and state.get('infeasible_span') is not None:
             state['infeasible_span']['holdable_again_ns'] = s
             state['infeasible_span'] = None
-        wrench_pub.publish(msg)
+        self.wrench_pub.publish(msg)
 
-    # -- issue 13's phases: a skewed second source, parameter changes, a service flood --
-    set_params = ros.create_client(SetParameters, '/grasp_torque_node/set_parameters')
-    flood_client = ros.create_client(Trigger, '/grasp_torque_node/solve', qos_profile=QoSProfile(
-        history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
-    skewed_every = max(1, round(args.rate / SKEWED_RATE_HZ))
-    defaults = {'torque_limits': [float(x) for x in limits],
-                'weights': [float(x) for x in p.get('weights', setup.weights)],
-                'solver.max_iter': 200, 'solver.max_iter_in': 50, 'solver.eps_abs': 1e-9}
+    def skewed_joint_state(self) -> None:
+        from sensor_msgs.msg import JointState
 
-    def set_parameters(values: dict, span: dict | None = None) -> None:
+        msg = JointState(name=list(self.hand.names), position=self.hand.q0.tolist())
+        s = self.clock() + int(1e9 * SKEW_S)
+        set_stamp(msg.header, s)
+        self.checker.valid_stamps.add(s)
+        self.checker.skewed_stamps.add(s)
+        self.js_pub.publish(msg)
+
+
+class Phases:
+    """
+    Issue 13's phases and the mix's others, by tick; their start and end events.
+
+    A skewed second source, parameter changes and a service flood start and end here;
+    silences and infeasible loads are what the ticks publish (:func:`_mix`).
+    """
+
+    def __init__(self, ros, args: argparse.Namespace, hand: NodeSetup, checker: Checker,
+                 phases: list[tuple[str, float, float]]) -> None:
+        from rcl_interfaces.srv import SetParameters
+        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+        from std_srvs.srv import Trigger
+
+        self.hand, self.checker = hand, checker
+        self.set_params = ros.create_client(SetParameters,
+                                            '/grasp_torque_node/set_parameters')
+        self.flood_client = ros.create_client(
+            Trigger, '/grasp_torque_node/solve', qos_profile=QoSProfile(
+                history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE))
+        limits = hand.limits
+        self.defaults = {'torque_limits': [float(x) for x in limits],
+                         'weights': [float(x) for x in hand.params.get('weights',
+                                                                       hand.setup.weights)],
+                         'solver.max_iter': 200, 'solver.max_iter_in': 50,
+                         'solver.eps_abs': 1e-9}
+        self.flood_futures: list = []
+        self.param_futures: list = []
+        # Phases by tick (deterministic), with the wall-clock times they really had.
+        self.spans = [{'kind': kind, 'k0': round(a * args.rate), 'k1': round(b * args.rate)}
+                      for kind, a, b in phases]
+        self.period_ns = int(1e9 / args.rate)
+        self.i = 0
+
+    def set_parameters(self, values: dict, span: dict | None = None) -> None:
+        from rcl_interfaces.srv import SetParameters
+        from rclpy.parameter import Parameter
+
         req = SetParameters.Request(parameters=[Parameter(k, value=v).to_parameter_msg()
                                                 for k, v in values.items()])
-        future = set_params.call_async(req)
-        param_futures.append(future)
+        future = self.set_params.call_async(req)
+        self.param_futures.append(future)
         if span is not None and 'torque_limits' in values:
             lowered = np.array(values['torque_limits'])
+            limits_in_force = self.checker.limits_in_force
 
             def acknowledged(_f, lowered=lowered, span=span):
                 # From the answer on (plus delivery), every command meets the new limits.
@@ -475,31 +594,58 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
                                             lowered))
             future.add_done_callback(acknowledged)
 
-    def phase_event(kind: str, starting: bool, span: dict) -> None:
+    def event(self, kind: str, starting: bool, span: dict) -> None:
+        from std_srvs.srv import Trigger
+
+        limits, defaults = self.hand.limits, self.defaults
         if kind == 'limits_below':
             if starting:
-                set_parameters({'torque_limits': [LIMITS_FRACTION * x for x in limits]}, span)
+                self.set_parameters({'torque_limits': [LIMITS_FRACTION * x for x in limits]},
+                                    span)
             else:
-                set_parameters({'torque_limits': defaults['torque_limits']})
-                limits_in_force.append((time.time_ns(), limits))
+                self.set_parameters({'torque_limits': defaults['torque_limits']})
+                self.checker.limits_in_force.append((time.time_ns(), limits))
         elif kind == 'solver_bounds':
             m_ = len(defaults['weights'])
             bounded = {**BOUNDS, 'weights': ([1e-3, 1e3] * m_)[:m_]}
-            set_parameters(bounded if starting else
-                           {k: defaults[k] for k in bounded})
+            self.set_parameters(bounded if starting else
+                                {k: defaults[k] for k in bounded})
         elif kind == 'service_flood' and starting:
-            flood_futures.extend(flood_client.call_async(Trigger.Request())
-                                 for _ in range(FLOOD_CALLS))
+            self.flood_futures.extend(self.flood_client.call_async(Trigger.Request())
+                                      for _ in range(FLOOD_CALLS))
 
-    def skewed_joint_state() -> None:
-        msg = JointState(name=list(names), position=q0.tolist())
-        s = clock() + int(1e9 * SKEW_S)
-        set_stamp(msg.header, s)
-        valid_stamps.add(s)
-        skewed_stamps.add(s)
-        js_pub.publish(msg)
+    def current(self, k: int, state: dict) -> str:
+        """Return the phase of tick k ('' between phases), starting and ending phases."""
+        spans = self.spans
+        while self.i < len(spans) and spans[self.i]['k1'] <= k:
+            span = spans[self.i]
+            if 'start_ns' in span and not span.get('ended'):
+                span['ended'] = True
+                self.event(span['kind'], False, span)
+            self.i += 1
+        if self.i < len(spans) and spans[self.i]['k0'] <= k:
+            span = spans[self.i]
+            t = time.time_ns()
+            if 'start_ns' not in span:
+                span['start_ns'] = t
+                self.event(span['kind'], True, span)
+            span['end_ns'] = t + self.period_ns
+            state['phase'] = span
+            return span['kind']
+        state['phase'] = None
+        return ''
 
-    # -- discovery and warm-up -------------------------------------------------------------
+    def end_all(self) -> None:
+        """End a phase that was still on when the mix ended."""
+        for span in self.spans:
+            if 'start_ns' in span and not span.get('ended'):
+                span['ended'] = True
+                self.event(span['kind'], False, span)
+
+
+def _warm_up(args: argparse.Namespace, ros, pacer: Pacer, node: Child, logs: Path,
+             inputs: Inputs, checker: Checker) -> bool:
+    """Wait for the node, then publish valid inputs until it has answered for WARMUP_S."""
     deadline = time.monotonic() + 60.0
     while time.monotonic() < deadline and not (
             ros.count_subscribers('joint_states') and ros.count_publishers(STAMPED_TOPIC)):
@@ -508,78 +654,56 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             break
     if not (ros.count_subscribers('joint_states') and ros.count_publishers(STAMPED_TOPIC)):
         print(f"soak: the node did not come up (log: {logs / 'node.log'})", file=sys.stderr)
-        return None
+        return False
     slow_every = max(1, round(args.rate / SLOW_RATE_HZ))
     warm: dict[str, float] = {}
 
     def warm_tick(k: int, now: float) -> bool:
         if k % slow_every == 0:
-            contacts(None)
-            wrench('valid')
-        joint_state(k, None)
-        if stamped_ok and 't' not in warm:
+            inputs.contacts(None)
+            inputs.wrench('valid')
+        inputs.joint_state(k, None)
+        if checker.stamped_ok and 't' not in warm:
             warm['t'] = now
         return not ('t' in warm and now - warm['t'] >= WARMUP_S) and k < 60 * args.rate
 
     pacer.run(warm_tick)
     if 't' not in warm:
         print(f"soak: no command came back (log: {logs / 'node.log'})", file=sys.stderr)
-        return None
-    pacer.spin_for(0.3)  # a fresh /diagnostics
-    diag_start = dict(diag)
-    commands_before, stamped_before = len(commands), stamped_ok
-    memory = [(0.0, vm_rss_kib(node.pid))]
-    share = CpuShare(exclude=(node.pid,))
+        return False
+    return True
 
-    # -- the mix -----------------------------------------------------------------------------
-    state['mixing'] = True
-    state['rng'] = rng
+
+def _mix(args: argparse.Namespace, pacer: Pacer, inputs: Inputs, spans: Phases, state: dict,
+         node: Child, memory: list) -> dict:
+    """Publish the mix for ``--duration``; return its start, end, ticks and achieved rate."""
+    rng = state['rng']
     start_ns = time.time_ns()
-    # Phases by tick (deterministic), with the wall-clock times they really had.
-    spans = [{'kind': kind, 'k0': round(a * args.rate), 'k1': round(b * args.rate)}
-             for kind, a, b in phases]
+    slow_every = max(1, round(args.rate / SLOW_RATE_HZ))
+    skewed_every = max(1, round(args.rate / SKEWED_RATE_HZ))
     memory_every = max(1, int(args.duration * args.rate / MEMORY_SAMPLES))
     n_ticks = int(args.duration * args.rate)
-    period_ns = int(1e9 / args.rate)
-    pi = {'i': 0}
-
-    def current_phase(k: int) -> str:
-        while pi['i'] < len(spans) and spans[pi['i']]['k1'] <= k:
-            span = spans[pi['i']]
-            if 'start_ns' in span and not span.get('ended'):
-                span['ended'] = True
-                phase_event(span['kind'], False, span)
-            pi['i'] += 1
-        if pi['i'] < len(spans) and spans[pi['i']]['k0'] <= k:
-            span = spans[pi['i']]
-            t = time.time_ns()
-            if 'start_ns' not in span:
-                span['start_ns'] = t
-                phase_event(span['kind'], True, span)
-            span['end_ns'] = t + period_ns
-            state['phase'] = span
-            return span['kind']
-        state['phase'] = None
-        return ''
 
     def mix_tick(k: int, now: float) -> bool:
         if k >= n_ticks:
             return False
-        phase = current_phase(k)
+        phase = spans.current(k, state)
         if k % slow_every == 0:
-            contacts(_pick(rng, CONTACT_INVALID) if rng.random() < P_SLOW_INVALID else None)
+            inputs.contacts(_pick(rng, CONTACT_INVALID) if rng.random() < P_SLOW_INVALID
+                            else None)
             if phase == 'infeasible_load':
-                wrench('infeasible')
+                inputs.wrench('infeasible')
             else:
-                wrench(_pick(rng, WRENCH_INVALID) if rng.random() < P_SLOW_INVALID else 'valid')
+                inputs.wrench(_pick(rng, WRENCH_INVALID) if rng.random() < P_SLOW_INVALID
+                              else 'valid')
         if phase == 'skewed_source' and k % skewed_every == 0:
-            skewed_joint_state()
+            inputs.skewed_joint_state()
         if phase != 'silence':
             invalid = _pick(rng, JS_INVALID) if rng.random() < P_JS_INVALID else None
             if invalid == 'backwards_stamp' and state['since_silence'] < 100:
                 invalid = None  # right after a silence the node's last stamp may be stale
             state['since_silence'] += 1
-            joint_state(k, invalid)
+            inputs.joint_state(k, invalid)
         else:
             state['since_silence'] = 0
         if k and k % memory_every == 0:
@@ -589,34 +713,32 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
     t_mix = time.perf_counter()
     pacer.run(mix_tick)
     mix_s = time.perf_counter() - t_mix
-    for span in spans:  # a phase that was still on when the mix ended
-        if 'start_ns' in span and not span.get('ended'):
-            span['ended'] = True
-            phase_event(span['kind'], False, span)
-    published_rate = n_ticks / mix_s
-    end_ns = time.time_ns()
-    pacer.spin_for(DRAIN_S)
+    spans.end_all()
+    return {'start_ns': start_ns, 'end_ns': time.time_ns(), 'n_ticks': n_ticks,
+            'published_rate': n_ticks / mix_s}
+
+
+def _drain(pacer: Pacer, spans: Phases, checker: Checker) -> dict:
+    """Wait for every service call and parameter change to be answered; count the answers."""
+    flood_futures = spans.flood_futures
     deadline = time.monotonic() + 30.0  # every service call answered, every change too
     while time.monotonic() < deadline and not all(f.done() for f in flood_futures +
-                                                  param_futures):
+                                                  spans.param_futures):
         pacer.spin_for(0.1)
     unanswered = sum(not f.done() for f in flood_futures)
     if unanswered:
-        broken('service_unanswered', f'{unanswered} of {len(flood_futures)} calls')
+        checker.broken('service_unanswered', f'{unanswered} of {len(flood_futures)} calls')
     answers = [f.result() for f in flood_futures if f.done()]
-    service = {'calls': len(flood_futures), 'unanswered': unanswered,
-               'solved': sum(a.success for a in answers),
-               'busy': sum(a.message.startswith('busy: ') for a in answers),
-               'cannot_solve': sum(a.message.startswith('cannot solve: ') for a in answers)}
-    pacer.spin_for(0.3)
-    diag_end = dict(diag)
-    memory.append((args.duration, vm_rss_kib(node.pid)))
-    others, node_cores = share.others_cores(), share.cores_of(node.pid)
-    alive = node.alive()
-    ros.destroy_node()
-    rclpy.try_shutdown()
+    return {'calls': len(flood_futures), 'unanswered': unanswered,
+            'solved': sum(a.success for a in answers),
+            'busy': sum(a.message.startswith('busy: ') for a in answers),
+            'cannot_solve': sum(a.message.startswith('cannot solve: ') for a in answers)}
 
-    # -- after the run: silences and infeasible phases -----------------------------------------
+
+def _check_phases(spans: list[dict], checker: Checker, hand: NodeSetup, start_ns: int,
+                  end_ns: int) -> None:
+    """After the run: the invariants of the silences, infeasible and issue 13's phases."""
+    broken, commands, policy = checker.broken, checker.commands, hand.policy
     for span in spans:
         if 'start_ns' not in span:
             continue
@@ -631,7 +753,7 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
         if kind in ('limits_below', 'solver_bounds', 'service_flood'):
             continue
         if kind == 'silence':
-            bound = a + int(1e9 * stop_bound_s)
+            bound = a + int(1e9 * hand.stop_bound_s)
             late = [t for t, zero in commands
                     if bound < t <= b and not (zero and policy == 'zero')]
             if late:
@@ -641,58 +763,62 @@ def drive(args: argparse.Namespace, node: Child, domain: int, logs: Path) -> dic
             # A state of the phase may be answered late, once a holdable load is back.
             bound = span.get('first_infeasible_ns', a) + int(1e9 * DELIVERY_MARGIN_S)
             back = span.get('holdable_again_ns', end_ns)
-            under = [s for s, r in stamped_times if bound < s <= b and r < back]
+            under = [s for s, r in checker.stamped_times if bound < s <= b and r < back]
             if under:
                 broken('command_under_infeasible_load',
                        f'{len(under)} command(s) stamped {1e-9 * (under[0] - a):.3f} s into '
                        'an infeasible load')
+
+
+def _counter(d: dict, key: str) -> int | None:
+    try:
+        return int(d[key])
+    except (KeyError, ValueError):
+        return None
+
+
+def _result(args: argparse.Namespace, hand: NodeSetup, mach: dict, mix: dict, inputs: Inputs,
+            checker: Checker, pacer: Pacer, run: dict) -> dict:
+    """Return the run's figures and invariants, as written to ``--out``."""
+    start_ns, end_ns, n_ticks = run['start_ns'], run['end_ns'], run['n_ticks']
+    diag_start, diag_end = run['diag_start'], run['diag_end']
+    commands, memory, alive = checker.commands, run['memory'], run['alive']
+    violations = checker.violations
     mixed_commands = [t for t, _ in commands if start_ns <= t <= end_ns + int(1e9 * DRAIN_S)]
-    latencies = [(s, r) for s, r in stamped_times if s >= start_ns]
-
-    def counter(d: dict, key: str) -> int | None:
-        try:
-            return int(d[key])
-        except (KeyError, ValueError):
-            return None
-
+    latencies = [(s, r) for s, r in checker.stamped_times if s >= start_ns]
     keys = sorted({k for k in diag_end if k in ('cycles', 'commands', 'zero_commands', 'faults',
                                                 'recoveries', 'overruns', 'solver_failures')
                    or k.startswith('rejected.')})
-    node_counters = {k: {'start': counter(diag_start, k), 'end': counter(diag_end, k)}
+    node_counters = {k: {'start': _counter(diag_start, k), 'end': _counter(diag_end, k)}
                      for k in keys}
     for v in node_counters.values():
         v['during'] = (v['end'] - v['start']) if None not in (v['start'], v['end']) else None
-    result = {
+    return {
         'machine': mach, 'date_utc': datetime.now(timezone.utc).isoformat(timespec='seconds'),
         'duration_s': args.duration, 'rate_hz': args.rate, 'seed': args.seed,
-        'params_file': PARAMS.name, 'fault_policy': policy, 'stop_bound_s': stop_bound_s,
-        'delivery_margin_s': DELIVERY_MARGIN_S, 'mix': mix, 'sent': sent,
-        'published_joint_state_rate_hz': published_rate,
+        'params_file': PARAMS.name, 'fault_policy': hand.policy,
+        'stop_bound_s': hand.stop_bound_s,
+        'delivery_margin_s': DELIVERY_MARGIN_S, 'mix': mix, 'sent': inputs.sent,
+        'published_joint_state_rate_hz': run['published_rate'],
         'publish_lateness': percentiles_ms(pacer.lateness[-n_ticks:]),
-        'commands_received': len(commands) - commands_before,
+        'commands_received': len(commands) - run['commands_before'],
         'commands_received_in_mix': len(mixed_commands),
-        'stamped_commands_matched': stamped_ok - stamped_before,
-        'zero_policy_commands': zero_policy_commands,
+        'stamped_commands_matched': checker.stamped_ok - run['stamped_before'],
+        'zero_policy_commands': checker.zero_policy_commands,
         'latency_ms': percentiles_ms([1e-9 * (r - s) for s, r in latencies]),
         'latency_ms_per_window': _windows(latencies, start_ns, args.duration),
-        'node_counters': node_counters, 'service_flood': service,
-        'late_receipts': late_receipts['n'],
+        'node_counters': node_counters, 'service_flood': run['service'],
+        'late_receipts': checker.late_receipts,
         'node_fault_at_end': diag_end.get('fault'),
         'memory_kib': [{'t_s': t, 'vm_rss_kib': r} for t, r in memory],
         'memory_growth_kib': (memory[-1][1] - memory[0][1])
         if memory[0][1] is not None and memory[-1][1] is not None else None,
-        'other_processes_cores': others, 'node_cores': node_cores,
+        'other_processes_cores': run['others'], 'node_cores': run['node_cores'],
         'node_alive_at_end': alive,
         'invariants_broken': sum(violations.values()) + (0 if alive else 1),
         'violations': violations if alive else {**violations, 'node_died': 1},
-        'examples': examples,
+        'examples': checker.examples,
     }
-    print()
-    print(report(result))
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(json.dumps(result, indent=2))
-    print(f'\nwritten: {args.out}')
-    return result
 
 
 def _windows(latencies: list[tuple[int, int]], start_ns: int, duration: float) -> list[dict]:

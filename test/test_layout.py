@@ -277,3 +277,21 @@ def test_the_public_api_holds_what_a_planner_and_a_driver_need():
 def test_the_readme_is_read_in_one_sitting():
     """README.md at most 200 lines: the two commands, a tour, the pages (figures live in docs/)."""
     assert (ROOT / 'README.md').read_text().count('\n') <= 200
+
+
+#: The function rule (issue 31, the house style): one job, at most about 80 lines.
+MAX_FUNCTION_LINES = 80
+
+
+def test_no_function_is_too_long_to_read():
+    """Every function of the package and of bench/, methods and nested ones each on its own."""
+    long = []
+    for folder in (PACKAGE, ROOT / 'bench'):
+        for path in sorted(folder.rglob('*.py')):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    n = node.end_lineno - node.lineno + 1
+                    if n > MAX_FUNCTION_LINES:
+                        long.append(f'{path.relative_to(ROOT)}:{node.lineno} {node.name}: '
+                                    f'{n} lines (at most {MAX_FUNCTION_LINES})')
+    assert not long, '\n'.join(long)

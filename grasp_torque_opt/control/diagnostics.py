@@ -42,50 +42,14 @@ def report(controller: TorqueController, now: float) -> Report:
     """
     c = controller
     cfg = c.config
+    level, message = _level(c, now)
     values: list[tuple[str, str]] = []
-    last = c.last
-    sol = last.solution if last is not None else None
-    if c.inputs.q is None:
-        level, message = STALE, 'waiting for joint_states'
-    elif not c.fault:
-        level, message = OK, 'certified torques published'
-    else:
-        held = (c.last_command_time is not None
-                and now - c.last_command_time <= cfg.hold_time)
-        if held:
-            level, message = WARN, f'holding last certified command: {c.fault}'
-        elif cfg.fault_policy == 'zero':
-            level, message = ERROR, f'zero torques published: {c.fault}'
-        else:
-            level, message = ERROR, f'hold policy, last certified command kept: {c.fault}'
     values.append(('fault', c.fault or 'none'))
     # The order of the command's values: a controller with a fixed joint list must match it.
     values.append(('command_joints', ','.join(c.setup.hand.joints)))
     values.append(('fault_policy', cfg.fault_policy))
-    if sol is not None:
-        values += [('status', sol.status), ('solver_message', sol.message),
-                   ('solve_time_s', f'{sol.solve_time_s:.6f}'),
-                   ('cycle_time_s', f'{last.cycle_time or sum(sol.timings.values()):.6f}'),
-                   ('iterations', str(sol.iterations))]
-        if sol.certificate is not None:
-            cert = sol.certificate.as_dict()
-            values += [(f'certificate.{k}', f'{cert[k]:.3e}')
-                       for k in ('equilibrium', 'torque', 'cone', 'normal_force',
-                                 'torque_limit')]
-            values.append(('certificate.ok', str(sol.certificate.ok).lower()))
-        if sol.optimal and last.maps is not None:
-            values.append(('torque_norm', f'{sol.torque_norm:.6f}'))
-            values += [('objective', sol.objective),
-                       ('friction_margin', f'{sol.friction_margin:g}'),
-                       ('max_torque_ratio', f'{sol.max_torque_ratio:.4f}'),
-                       ('friction_usage_max', f'{float(sol.friction_usage.max()):.4f}')]
-            usage = friction_usage(sol.wrenches, c.setup.friction.mu1, c.setup.friction.mu2)
-            for i, (frame, (ut, ur)) in enumerate(zip(last.maps.contacts, usage)):
-                key = f'contact{i}.{frame.link}'
-                values += [(f'{key}.normal_force_N', f'{sol.wrenches[i, 2]:.4f}'),
-                           (f'{key}.friction_usage', f'{sol.friction_usage[i]:.4f}'),
-                           (f'{key}.tangential_usage', f'{ut:.4f}'),
-                           (f'{key}.torsional_usage', f'{ur:.4f}')]
+    values += solution_values(c)
+    last = c.last
     if last is not None and last.gravity_torque is not None:
         values.append(('gravity_torque_norm',
                        f'{float((last.gravity_torque ** 2).sum() ** 0.5):.6f}'))
@@ -97,18 +61,7 @@ def report(controller: TorqueController, now: float) -> Report:
                ('slew_refused', str(n.slew_refused)),
                ('max_cycle_time_s', f'{n.max_cycle_time:.6f}'),
                ('cycle_budget_s', f'{cfg.cycle_budget:.6f}')]
-    solver = c.solver
-    values += [('solver.backend', getattr(solver, 'name', type(solver).__name__)),
-               ('solver.warm_solves', str(getattr(solver, 'warm_solves', 0))),
-               ('solver.warm_start_fallbacks', str(getattr(solver, 'fallbacks', 0))),
-               ('solver.fallback_solves', str(n.fallback_solves))]
-    fast = c.compiled_cycle
-    values += [('solver.compiled', 'true' if fast is not None and not fast.gave_up else
-                f'false: {c.compiled_reason}' if c.compiled_reason else 'no cycle yet'),
-               ('solver.compiled_module', fast.module.__name__.rsplit('.', 1)[-1]
-                if fast is not None else 'none'),
-               ('solver.compiled_solves', str(fast.solves if fast is not None else 0)),
-               ('solver.compiled_handed_back', str(fast.handed_back if fast is not None else 0))]
+    values += solver_values(c)
     values += motion_values(c, now)
     values += contact_values(c, now)
     if level == OK and c.solving.imu_state:
@@ -119,6 +72,72 @@ def report(controller: TorqueController, now: float) -> Report:
                ('age.contacts_s', _ago(now, c.inputs.contacts_time)),
                ('age.external_wrench_s', _ago(now, c.inputs.wrench_time))]
     return Report(level, message, values)
+
+
+def _level(c: TorqueController, now: float) -> tuple[int, str]:
+    """Give the level and message of :func:`report` before the IMU's say."""
+    cfg = c.config
+    if c.inputs.q is None:
+        return STALE, 'waiting for joint_states'
+    if not c.fault:
+        return OK, 'certified torques published'
+    held = (c.last_command_time is not None
+            and now - c.last_command_time <= cfg.hold_time)
+    if held:
+        return WARN, f'holding last certified command: {c.fault}'
+    if cfg.fault_policy == 'zero':
+        return ERROR, f'zero torques published: {c.fault}'
+    return ERROR, f'hold policy, last certified command kept: {c.fault}'
+
+
+def solution_values(c: TorqueController) -> list[tuple[str, str]]:
+    """Give the last solution's values: status, times, certificate, friction per contact."""
+    last = c.last
+    sol = last.solution if last is not None else None
+    if sol is None:
+        return []
+    values = [('status', sol.status), ('solver_message', sol.message),
+              ('solve_time_s', f'{sol.solve_time_s:.6f}'),
+              ('cycle_time_s', f'{last.cycle_time or sum(sol.timings.values()):.6f}'),
+              ('iterations', str(sol.iterations))]
+    if sol.certificate is not None:
+        cert = sol.certificate.as_dict()
+        values += [(f'certificate.{k}', f'{cert[k]:.3e}')
+                   for k in ('equilibrium', 'torque', 'cone', 'normal_force',
+                             'torque_limit')]
+        values.append(('certificate.ok', str(sol.certificate.ok).lower()))
+    if sol.optimal and last.maps is not None:
+        values.append(('torque_norm', f'{sol.torque_norm:.6f}'))
+        values += [('objective', sol.objective),
+                   ('friction_margin', f'{sol.friction_margin:g}'),
+                   ('max_torque_ratio', f'{sol.max_torque_ratio:.4f}'),
+                   ('friction_usage_max', f'{float(sol.friction_usage.max()):.4f}')]
+        usage = friction_usage(sol.wrenches, c.setup.friction.mu1, c.setup.friction.mu2)
+        for i, (frame, (ut, ur)) in enumerate(zip(last.maps.contacts, usage)):
+            key = f'contact{i}.{frame.link}'
+            values += [(f'{key}.normal_force_N', f'{sol.wrenches[i, 2]:.4f}'),
+                       (f'{key}.friction_usage', f'{sol.friction_usage[i]:.4f}'),
+                       (f'{key}.tangential_usage', f'{ut:.4f}'),
+                       (f'{key}.torsional_usage', f'{ur:.4f}')]
+    return values
+
+
+def solver_values(c: TorqueController) -> list[tuple[str, str]]:
+    """Give the backend's values and the compiled cycle's: in use or why not, its counts."""
+    n = c.counters
+    solver = c.solver
+    values = [('solver.backend', getattr(solver, 'name', type(solver).__name__)),
+              ('solver.warm_solves', str(getattr(solver, 'warm_solves', 0))),
+              ('solver.warm_start_fallbacks', str(getattr(solver, 'fallbacks', 0))),
+              ('solver.fallback_solves', str(n.fallback_solves))]
+    fast = c.compiled_cycle
+    values += [('solver.compiled', 'true' if fast is not None and not fast.gave_up else
+                f'false: {c.compiled_reason}' if c.compiled_reason else 'no cycle yet'),
+               ('solver.compiled_module', fast.module.__name__.rsplit('.', 1)[-1]
+                if fast is not None else 'none'),
+               ('solver.compiled_solves', str(fast.solves if fast is not None else 0)),
+               ('solver.compiled_handed_back', str(fast.handed_back if fast is not None else 0))]
+    return values
 
 
 def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:

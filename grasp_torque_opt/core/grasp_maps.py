@@ -139,31 +139,9 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
     p = len(contacts)
     fids = tuple(hand.frame_index(spec.link, f'grasp.contacts[{i}].link')
                  for i, spec in enumerate(contacts))
-    po = np.empty((2 * p, 3))  # contact points p_i, then link origins o_i
-    for i, (spec, fid) in enumerate(zip(contacts, fids)):
-        oMf = data.oMf[fid]
-        if spec.position is None:
-            raise InputError(f'grasp.contacts[{i}].position', 'not found yet: a contact given '
-                             'by its link only is found from geometry when the scenario is '
-                             'bound (GraspSetup.from_scenario)')
-        po[i] = oMf.act(spec.position)
-        po[p + i] = oMf.translation
-    Rb = None
-    if hand.base_link is not None:
-        # The grasp is written in hand.base_link: points, and below the Jacobians' rows, in
-        # its axes (the actuated joints move only links below it: Hand.from_model).
-        oMb = data.oMf[hand.frame_index(hand.base_link, 'hand.base_link')]
-        Rb = oMb.rotation
-        po = (po - oMb.translation) @ Rb
+    po, Rb = _points_in_base(hand, contacts, fids)
     points = po[:p]
-    normals = [spec.normal for spec in contacts]
-    for i, n in enumerate(normals):
-        if n is None:
-            towards = c - points[i]
-            if towards @ towards < 1e-18:
-                raise InputError(f'grasp.contacts[{i}].normal', 'cannot default: the '
-                                 'contact point coincides with grasp.object_origin')
-            normals[i] = towards
+    normals = _normals(contacts, points, c)
     R = contact_rotations(normals, [spec.tangent for spec in contacts],
                           [f'grasp.contacts[{i}]' for i in range(p)])
     # skew(v) rows for r_i = p_i - c (moments) and d_i = p_i - o_i (point velocity).
@@ -192,3 +170,45 @@ def compute_grasp_maps(hand: Hand, q: np.ndarray, contacts: list[ContactSpec],
     return GraspMaps(G=Gb.reshape(6, 4 * p), J=Jb.reshape(4 * p, hand.m),
                      links=tuple(spec.link for spec in contacts), frame_ids=fids,
                      positions=points, rotations=R, object_origin=c)
+
+
+def _points_in_base(hand: Hand, contacts: list[ContactSpec], fids: tuple[int, ...]
+                    ) -> tuple[np.ndarray, np.ndarray | None]:
+    """
+    Return the contact points p_i, then the link origins o_i, in the base frame [m].
+
+    Returns ``(po, Rb)``: po of shape (2p, 3); Rb the rotation of ``hand.base_link``
+    in the model's world, or None without one. The frame placements must be current.
+    """
+    p = len(contacts)
+    po = np.empty((2 * p, 3))  # contact points p_i, then link origins o_i
+    for i, (spec, fid) in enumerate(zip(contacts, fids)):
+        oMf = hand.data.oMf[fid]
+        if spec.position is None:
+            raise InputError(f'grasp.contacts[{i}].position', 'not found yet: a contact given '
+                             'by its link only is found from geometry when the scenario is '
+                             'bound (GraspSetup.from_scenario)')
+        po[i] = oMf.act(spec.position)
+        po[p + i] = oMf.translation
+    Rb = None
+    if hand.base_link is not None:
+        # The grasp is written in hand.base_link: points, and below the Jacobians' rows, in
+        # its axes (the actuated joints move only links below it: Hand.from_model).
+        oMb = hand.data.oMf[hand.frame_index(hand.base_link, 'hand.base_link')]
+        Rb = oMb.rotation
+        po = (po - oMb.translation) @ Rb
+    return po, Rb
+
+
+def _normals(contacts: list[ContactSpec], points: np.ndarray,
+             c: np.ndarray) -> list[np.ndarray]:
+    """Return the contact normals as given, a missing one towards the object origin c."""
+    normals = [spec.normal for spec in contacts]
+    for i, n in enumerate(normals):
+        if n is None:
+            towards = c - points[i]
+            if towards @ towards < 1e-18:
+                raise InputError(f'grasp.contacts[{i}].normal', 'cannot default: the '
+                                 'contact point coincides with grasp.object_origin')
+            normals[i] = towards
+    return normals

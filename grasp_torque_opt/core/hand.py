@@ -342,6 +342,21 @@ class Hand:
             raise InputError('hand.urdf', f'the model has {model.nv} degrees of freedom, more '
                              f'than {MAX_ROBOT_DOF}')
         coupling = Coupling.resolve(model, mimics or [])
+        joints = cls._actuated(model, joints, coupling, base_link)
+        ids = [model.getJointId(n) for n in joints]
+        idx_q = np.array([model.joints[j].idx_q for j in ids], dtype=int)
+        idx_v = np.array([model.joints[j].idx_v for j in ids], dtype=int)
+        limits = _torque_limits(model, joints, idx_v, torque_limits, above_urdf)
+        C = coupling.velocity_map(model, idx_v)
+        selection = np.count_nonzero(C) == len(joints)
+        return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
+                   torque_limits=np.array(limits, dtype=float), coupling=coupling,
+                   velocity_map=None if selection else C, base_link=base_link)
+
+    @classmethod
+    def _actuated(cls, model: pin.Model, joints: list[str] | None, coupling: Coupling,
+                  base_link: str | None) -> list[str]:
+        """Return the actuated joints, checked (``from_model``'s ``joints``, or the default)."""
         followers = coupling.followers
         available = cls.one_dof_joints(model)
         base_joint = None
@@ -373,35 +388,7 @@ class Hand:
                 if not cls._below(model, name, base_joint):
                     raise InputError(f'hand.joints[{i}]', f"joint '{name}' does not move "
                                      f"below hand.base_link '{base_link}'")
-        ids = [model.getJointId(n) for n in joints]
-        idx_q = np.array([model.joints[j].idx_q for j in ids], dtype=int)
-        idx_v = np.array([model.joints[j].idx_v for j in ids], dtype=int)
-        if torque_limits is None:
-            limits = np.asarray(model.effortLimit, dtype=float)[idx_v]
-            for name, lim in zip(joints, limits):
-                if not (np.isfinite(lim) and lim > 0.0):
-                    raise InputError('hand.torque_limits',
-                                     f"the URDF gives no effort limit for joint '{name}'; "
-                                     'set hand.torque_limits')
-        else:
-            limits = np.asarray(torque_limits, dtype=float)
-            if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):
-                raise InputError('hand.torque_limits',
-                                 f'must have {len(joints)} entries (one per joint), '
-                                 f'got {limits.size}')
-            limits = np.broadcast_to(limits, (len(joints),))
-            effort = np.asarray(model.effortLimit, dtype=float)[idx_v]
-            bounds = np.full(len(joints), MAX_TORQUE_LIMIT)
-            if not above_urdf:
-                known = np.isfinite(effort) & (effort > 0.0)
-                bounds[known] = np.minimum(effort[known], MAX_TORQUE_LIMIT)
-            cls.check_limits(limits, list(joints), bounds, 'hand.torque_limits',
-                             'hand.torque_limits_above_urdf')
-        C = coupling.velocity_map(model, idx_v)
-        selection = np.count_nonzero(C) == len(joints)
-        return cls(model=model, joints=list(joints), idx_q=idx_q, idx_v=idx_v,
-                   torque_limits=np.array(limits, dtype=float), coupling=coupling,
-                   velocity_map=None if selection else C, base_link=base_link)
+        return joints
 
     @staticmethod
     def _below(model: pin.Model, name: str, base_joint: int) -> bool:
@@ -476,3 +463,31 @@ class Hand:
                              f"'{m.joint}' = {m.multiplier:g} * '{m.target}' + {m.offset:g} "
                              f'= {value:.6g} (coupled in {m.source}); leave it out')
         return q
+
+
+def _torque_limits(model: pin.Model, joints: list[str], idx_v: np.ndarray,
+                   torque_limits: float | list[float] | np.ndarray | None,
+                   above_urdf: bool) -> np.ndarray:
+    """Return ``Hand.from_model``'s torque limits [N m], checked: given, or the URDF's efforts."""
+    if torque_limits is None:
+        limits = np.asarray(model.effortLimit, dtype=float)[idx_v]
+        for name, lim in zip(joints, limits):
+            if not (np.isfinite(lim) and lim > 0.0):
+                raise InputError('hand.torque_limits',
+                                 f"the URDF gives no effort limit for joint '{name}'; "
+                                 'set hand.torque_limits')
+        return limits
+    limits = np.asarray(torque_limits, dtype=float)
+    if limits.ndim > 1 or (limits.ndim == 1 and limits.size != len(joints)):
+        raise InputError('hand.torque_limits',
+                         f'must have {len(joints)} entries (one per joint), '
+                         f'got {limits.size}')
+    limits = np.broadcast_to(limits, (len(joints),))
+    effort = np.asarray(model.effortLimit, dtype=float)[idx_v]
+    bounds = np.full(len(joints), MAX_TORQUE_LIMIT)
+    if not above_urdf:
+        known = np.isfinite(effort) & (effort > 0.0)
+        bounds[known] = np.minimum(effort[known], MAX_TORQUE_LIMIT)
+    Hand.check_limits(limits, list(joints), bounds, 'hand.torque_limits',
+                      'hand.torque_limits_above_urdf')
+    return limits

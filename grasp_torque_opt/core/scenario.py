@@ -306,6 +306,33 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
                     _SECTIONS['load'])
     objective = _mapping(top.get('objective') or {}, 'objective', _SECTIONS['objective'])
 
+    h = _parse_hand(hand, name_map)
+    names, joints = h['name_map'], h['joints']
+    positions = _parse_joint_positions(grasp, names)
+    origin = _vector(_require(grasp, 'object_origin', 'grasp'), 'grasp.object_origin', 3)
+    contacts = parse_contacts(_require(grasp, 'contacts', 'grasp'), names,
+                              top.get('object') is not None, MAX_CONTACTS)
+    tolerance = _positive(grasp.get('contact_tolerance', DEFAULT_CONTACT_TOLERANCE),
+                          'grasp.contact_tolerance')
+    fric = _parse_friction(friction)
+
+    if weighed and load.get('external_wrench') is None:
+        extra = np.zeros(6)
+    else:
+        extra = _vector(_require(load, 'external_wrench', 'load'), 'load.external_wrench', 6)
+    obj = _object(top['object'], origin) if top.get('object') is not None else None
+    wrench = extra + weight_wrench(obj, gravity, origin)
+
+    weights, kind = _parse_objective(objective, joints, h['torque_limits'])
+    return Scenario(base_dir=base_dir, joint_positions=positions, object_origin=origin,
+                    contacts=[] if contacts == AUTO else contacts,
+                    friction=fric, external_wrench=wrench, weights=weights, source=source,
+                    contacts_auto=contacts == AUTO, contact_tolerance=tolerance,
+                    object=obj, gravity=gravity, extra_wrench=extra, objective=kind, **h)
+
+
+def _parse_hand(hand: dict, name_map: dict[str, str] | None) -> dict[str, Any]:
+    """Read the ``hand`` section: the Scenario's fields it gives, by name (``name_map`` merged)."""
     urdf = _require(hand, 'urdf', 'hand')
     if not isinstance(urdf, str) or not urdf:
         raise InputError('hand.urdf', f'must be a path, got {quote(urdf)}')
@@ -315,17 +342,7 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
     joints = _names(hand['joints'], 'hand.joints') if hand.get('joints') is not None else None
     if joints is not None:
         joints = _renamed(joints, names, 'hand.joints')
-
-    limits = hand.get('torque_limits')
-    if limits is not None:
-        if isinstance(limits, (list, tuple)):
-            limits = [_positive(v, f'hand.torque_limits[{i}]') for i, v in enumerate(limits)]
-            if joints is not None and len(limits) != len(joints):
-                raise InputError('hand.torque_limits',
-                                 f'must have {len(joints)} entries (one per joint), '
-                                 f'got {len(limits)}')
-        else:
-            limits = _positive(limits, 'hand.torque_limits')
+    limits = _parse_torque_limits(hand.get('torque_limits'), joints)
     coupling = parse_coupling(hand.get('coupling'), names)
     base_link = hand.get('base_link')
     if base_link is not None:
@@ -335,7 +352,27 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
     above_urdf = hand.get('torque_limits_above_urdf', False)
     if not isinstance(above_urdf, bool):
         raise InputError('hand.torque_limits_above_urdf', 'must be true or false')
+    return {'urdf': urdf, 'joints': joints, 'torque_limits': limits,
+            'torque_limits_above_urdf': above_urdf, 'name_map': names, 'coupling': coupling,
+            'base_link': base_link}
 
+
+def _parse_torque_limits(limits: Any, joints: list[str] | None) -> float | list[float] | None:
+    """Read ``hand.torque_limits``: None, one positive value, or one per joint."""
+    if limits is None:
+        return None
+    if isinstance(limits, (list, tuple)):
+        limits = [_positive(v, f'hand.torque_limits[{i}]') for i, v in enumerate(limits)]
+        if joints is not None and len(limits) != len(joints):
+            raise InputError('hand.torque_limits',
+                             f'must have {len(joints)} entries (one per joint), '
+                             f'got {len(limits)}')
+        return limits
+    return _positive(limits, 'hand.torque_limits')
+
+
+def _parse_joint_positions(grasp: dict, names: dict[str, str]) -> dict[str, float]:
+    """Read ``grasp.joint_positions``, renamed through the name map."""
     positions_raw = grasp.get('joint_positions') or {}
     if not isinstance(positions_raw, dict):
         raise InputError('grasp.joint_positions', 'must be a mapping joint name -> position')
@@ -345,15 +382,11 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
     positions = {str(k): _number(v, f'grasp.joint_positions.{cut(k)}')
                  for k, v in positions_raw.items()}
     renamed = _renamed(list(positions), names, 'grasp.joint_positions')
-    positions = dict(zip(renamed, positions.values()))
+    return dict(zip(renamed, positions.values()))
 
-    origin = _vector(_require(grasp, 'object_origin', 'grasp'), 'grasp.object_origin', 3)
 
-    contacts = parse_contacts(_require(grasp, 'contacts', 'grasp'), names,
-                              top.get('object') is not None, MAX_CONTACTS)
-    tolerance = _positive(grasp.get('contact_tolerance', DEFAULT_CONTACT_TOLERANCE),
-                          'grasp.contact_tolerance')
-
+def _parse_friction(friction: dict) -> Friction:
+    """Read the ``friction`` section."""
     sides = _require(friction, 'polygon_sides', 'friction')
     if isinstance(sides, bool) or not isinstance(sides, int):
         raise InputError('friction.polygon_sides', f'must be an integer, got {quote(sides)}')
@@ -365,7 +398,7 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
     fmin = _number(friction.get('min_normal_force', 0.0), 'friction.min_normal_force')
     if fmin < 0.0:
         raise InputError('friction.min_normal_force', f'must be >= 0, got {fmin}')
-    fric = Friction(
+    return Friction(
         mu1=_positive(_require(friction, 'mu_tangential', 'friction'), 'friction.mu_tangential'),
         mu2=_positive(_require(friction, 'mu_torsional', 'friction'), 'friction.mu_torsional'),
         sides=sides,
@@ -373,13 +406,10 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
         margin=_margin(friction.get('margin', 0.0)),
     )
 
-    if weighed and load.get('external_wrench') is None:
-        extra = np.zeros(6)
-    else:
-        extra = _vector(_require(load, 'external_wrench', 'load'), 'load.external_wrench', 6)
-    obj = _object(top['object'], origin) if top.get('object') is not None else None
-    wrench = extra + weight_wrench(obj, gravity, origin)
 
+def _parse_objective(objective: dict, joints: list[str] | None,
+                     limits: float | list[float] | None) -> tuple[list[float] | None, str]:
+    """Read the ``objective`` section: (weights, type); per-joint values need ``hand.joints``."""
     weights = None
     if objective.get('weights') is not None:
         weights = [_positive(v, f'objective.weights[{i}]')
@@ -398,14 +428,7 @@ def parse_scenario(data: Any, base_dir: Path, source: str = '<memory>',
         raise InputError('hand.joints', f'required when {per_joint} gives one value per joint '
                          "(without it the values would follow Pinocchio's joint order, which "
                          "is not the URDF file's: on the Allegro 0-3, 12-15, 4-7, 8-11)")
-    return Scenario(urdf=urdf, base_dir=base_dir, joints=joints, torque_limits=limits,
-                    joint_positions=positions, object_origin=origin,
-                    contacts=[] if contacts == AUTO else contacts,
-                    friction=fric, external_wrench=wrench, weights=weights, source=source,
-                    contacts_auto=contacts == AUTO, contact_tolerance=tolerance,
-                    object=obj, gravity=gravity, extra_wrench=extra, objective=kind,
-                    torque_limits_above_urdf=above_urdf, name_map=names, coupling=coupling,
-                    base_link=base_link)
+    return weights, kind
 
 
 def load_scenario(path: str | Path, name_map: dict[str, str] | None = None) -> Scenario:

@@ -356,17 +356,24 @@ class BatchScorer:
         ok = b['ok']
         m = self.scorer.base.hand.m
         A, bu, bl = b['A'], b['bupper'], b['blower']
-        rows = A.shape[1]
-        sense = np.zeros(m + rows, dtype=np.int32)
+        sense = np.zeros(m + A.shape[1], dtype=np.int32)
         sense[m:m + b['n_eq']] = 5  # equality
         stage_s = time.perf_counter() - t0
         model = self._model(A, bu, bl, sense, ok)
+        times, X, LAM, solved, t1 = self._warm_solves(model, b, n, m)
+        fin = self.cycle.finish_batch(b['G'], b['J'], W, b['M1w'], b['M2'], A, bu, bl, X, LAM,
+                                      solved, KKT_TOLERANCE)
+        self._cold_redo(model, b, W, sense, fin, times, X, LAM, solved)
+        share = parse_s + (stage_s + time.perf_counter() - t1) / n
+        self._records(members, records, b, Q, W, X, fin, times, share)
+
+    def _warm_solves(self, model, b: dict, n: int, m: int) -> tuple:
+        """Solve the group's built QPs warm, in turn: (times, X, LAM, solved, its end)."""
+        ok, A, bu, bl = b['ok'], b['A'], b['bupper'], b['blower']
         update, solve = model.update, model.solve
         clock = time.perf_counter
-        times = [0.0] * n
-        flags = [0] * n
-        zero_x, zero_lam = np.zeros(m), np.zeros(m + rows)
-        xs, lams = [zero_x] * n, [zero_lam] * n
+        times, flags = [0.0] * n, [0] * n
+        xs, lams = [np.zeros(m)] * n, [np.zeros(m + A.shape[1])] * n
         A_rows, bu_rows, bl_rows = list(A), list(bu), list(bl)
         for i in np.flatnonzero(ok).tolist():  # the solver's loop: nothing else in it
             ts = clock()
@@ -377,11 +384,12 @@ class BatchScorer:
             if flag == 1:
                 xs[i], lams[i], flags[i] = x, info['lam'], 1
         t1 = time.perf_counter()
-        X, LAM = np.array(xs), np.array(lams)
-        solved = np.array(flags) == 1
-        fin = self.cycle.finish_batch(b['G'], b['J'], W, b['M1w'], b['M2'], A, bu, bl, X, LAM,
-                                      solved, KKT_TOLERANCE)
-        redo = np.flatnonzero(ok & ~fin['passes'])
+        return times, np.array(xs), np.array(lams), np.array(flags) == 1, t1
+
+    def _cold_redo(self, model, b, W, sense, fin, times, X, LAM, solved) -> None:
+        """Solve cold the warm answers off the KKT check or the certificate; update ``fin``."""
+        A, bu, bl = b['A'], b['bupper'], b['blower']
+        redo = np.flatnonzero(b['ok'] & ~fin['passes'])
         if redo.size:  # warm answers off the KKT check or the certificate: cold
             for i in redo.tolist():
                 ts = time.perf_counter()
@@ -393,7 +401,10 @@ class BatchScorer:
                 bu[redo], bl[redo], X[redo], LAM[redo], solved[redo], KKT_TOLERANCE)
             for key in ('passes', 'f', 'usage', 'ratio'):
                 fin[key][redo] = again[key]
-        share = parse_s + (stage_s + time.perf_counter() - t1) / n
+
+    def _records(self, members, records, b, Q, W, X, fin, times, share) -> None:
+        """Write the certified candidates' records (the capacity metrics too when asked)."""
+        clock = time.perf_counter
         job = self.scorer.job
         passes = fin['passes'].tolist()
         usage, ratio = fin['usage'], fin['ratio'].tolist()
@@ -403,7 +414,7 @@ class BatchScorer:
         full = None
         if job.metrics == 'full':  # the capacity LPs of the certified candidates
             t2 = clock()
-            good = [i for i in range(n) if passes[i]]
+            good = [i for i in range(len(members)) if passes[i]]
             full = dict(zip(good, self.capacity.metrics(
                 b['G'][good], b['J'][good], W[good],
                 lambda j: self._bound(Q[good[j]], members[good[j]][2][2], W[good[j]], b,

@@ -139,10 +139,8 @@ def _commands_topic(node, name: str, until: float) -> str | None:
 
 def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
     from diagnostic_msgs.msg import DiagnosticArray
-    from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
-    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
+    from geometry_msgs.msg import PoseArray, WrenchStamped
     from grasp_torque_opt.ros.node import COMMAND_QOS
-    import pinocchio as pin
     import rclpy
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import JointState
@@ -151,37 +149,15 @@ def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
     hand = setup.hand
     names = hand.one_dof_joints(hand.model)
     idx_q = [hand.model.joints[hand.model.getJointId(n)].idx_q for n in names]
-    base = hand.base_frame
-    limits = hand.torque_limits
+    publishers = None
     if not args.watch:  # a watch publishes nothing
         js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
         contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
         wrench_pub = node.create_publisher(WrenchStamped, 'external_wrench',
                                            qos_profile_sensor_data)
-    received: list[tuple[float, np.ndarray]] = []
-    diag: dict[str, str] = {}
-    solve_times: list[float] = []
-    bad = 0
-
-    def on_command(msg: Float64MultiArray) -> None:
-        nonlocal bad
-        cmd = np.array(msg.data)
-        if cmd.shape != limits.shape or not np.all(np.isfinite(cmd)) or \
-                np.any(np.abs(cmd) > limits):
-            bad += 1
-        received.append((time.monotonic(), cmd))
-
+        publishers = (js_pub, contacts_pub, wrench_pub)
     watched = (args.node or 'grasp_torque_node').rstrip('/').rpartition('/')[2]
-
-    def on_diagnostics(msg: DiagnosticArray) -> None:
-        for status in msg.status:
-            # The node's fully qualified name, then ': grasp torques'.
-            if status.name.partition(': ')[0].rpartition('/')[2] == watched:
-                diag.clear()
-                diag.update({kv.key: kv.value for kv in status.values})
-                diag['message'] = status.message
-                if 'solve_time_s' in diag:
-                    solve_times.append(float(diag['solve_time_s']))
+    heard = _Heard(hand.torque_limits, watched)
 
     domain = os.environ.get('ROS_DOMAIN_ID', '0')
     topic = 'effort_commands'
@@ -192,8 +168,8 @@ def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
             print(f'grasp-torque-demo: no node {args.node} publishing effort commands on '
                   f'ROS_DOMAIN_ID {domain} within {args.duration:g} s', file=sys.stderr)
             return 1
-    sub = node.create_subscription(Float64MultiArray, topic, on_command, COMMAND_QOS)
-    node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, 10)
+    sub = node.create_subscription(Float64MultiArray, topic, heard.on_command, COMMAND_QOS)
+    node.create_subscription(DiagnosticArray, '/diagnostics', heard.on_diagnostics, 10)
 
     if args.watch:
         print(f'grasp-torque-demo: watching {sub.topic_name} and /diagnostics for '
@@ -215,13 +191,63 @@ def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
         # (startup_check_time): the grasp at rest until its first command, then the play.
         rest = JointState(name=list(names), position=[float(setup.q[i]) for i in idx_q],
                           effort=[float('nan')] * len(names))
-        while not received and time.monotonic() < deadline:
+        while not heard.received and time.monotonic() < deadline:
             rest.header.stamp = node.get_clock().now().to_msg()
             js_pub.publish(rest)
             rclpy.spin_once(node, timeout_sec=1.0 / args.rate)
-        received.clear()
+        heard.received.clear()
+    played = _play_for(args, node, setup, heard, publishers,
+                       start if args.watch else time.monotonic())
+    end = time.monotonic() + 0.2  # the last commands in flight
+    while time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.02)
+    _print_summary(args, heard, played)
+    return 0 if (heard.received or args.watch) and heard.bad == 0 else 1
+
+
+class _Heard:
+    """What the demo hears: the commands (checked against the limits), the node's diagnostics."""
+
+    def __init__(self, limits: np.ndarray, watched: str) -> None:
+        self.limits = limits
+        self.watched = watched  # the node's own name, without its namespace
+        self.received: list[tuple[float, np.ndarray]] = []
+        self.diag: dict[str, str] = {}
+        self.solve_times: list[float] = []
+        self.bad = 0
+
+    def on_command(self, msg) -> None:
+        cmd = np.array(msg.data)
+        if cmd.shape != self.limits.shape or not np.all(np.isfinite(cmd)) or \
+                np.any(np.abs(cmd) > self.limits):
+            self.bad += 1
+        self.received.append((time.monotonic(), cmd))
+
+    def on_diagnostics(self, msg) -> None:
+        for status in msg.status:
+            # The node's fully qualified name, then ': grasp torques'.
+            if status.name.partition(': ')[0].rpartition('/')[2] == self.watched:
+                self.diag.clear()
+                self.diag.update({kv.key: kv.value for kv in status.values})
+                self.diag['message'] = status.message
+                if 'solve_time_s' in self.diag:
+                    self.solve_times.append(float(self.diag['solve_time_s']))
+
+
+def _play_for(args: argparse.Namespace, node, setup, heard: _Heard, publishers,
+              t0: float) -> dict[str, str]:
+    """
+    Play (or watch) for ``--duration`` from ``t0``, printing the live line a second.
+
+    Joint states at ``--rate``, contacts and load at 50 Hz, unless a watch
+    (``publishers`` None). Returns the node's diagnostics while joint states flowed.
+    """
+    import rclpy
+
+    hand = setup.hand
+    names = hand.one_dof_joints(hand.model)
+    idx_q = [hand.model.joints[hand.model.getJointId(n)].idx_q for n in names]
     period = 1.0 / args.rate
-    t0 = start if args.watch else time.monotonic()
     next_tick, next_print, next_slow = t0, t0 + 1.0, t0
     last_count = 0
     q = setup.q.copy()
@@ -231,58 +257,76 @@ def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
             t = now - t0
             for k, iq in enumerate(idx_q):
                 q[iq] = setup.q[iq] + args.amplitude * np.sin(2 * np.pi * 0.5 * t + 0.4 * k)
-            js = JointState(name=list(names), position=[float(q[i]) for i in idx_q],
-                            effort=[float('nan')] * len(names))
-            js.header.stamp = node.get_clock().now().to_msg()
-            js_pub.publish(js)
+            stamp = _publish_joint_state(node, publishers[0], names, [float(q[i]) for i in idx_q])
             if now >= next_slow:  # contacts and load at 50 Hz
                 next_slow += 0.02
-                maps = compute_grasp_maps(hand, q, setup.contacts, setup.object_origin)
-                poses = PoseArray()
-                poses.header.frame_id, poses.header.stamp = base, js.header.stamp
-                for frame in maps.contacts:
-                    x, y, z, w = pin.Quaternion(frame.rotation).coeffs()
-                    pose = Pose()
-                    pose.position.x, pose.position.y, pose.position.z = map(float,
-                                                                            frame.position)
-                    pose.orientation.x, pose.orientation.y = float(x), float(y)
-                    pose.orientation.z, pose.orientation.w = float(z), float(w)
-                    poses.poses.append(pose)
-                contacts_pub.publish(poses)
-                ws = WrenchStamped()
-                ws.header.frame_id, ws.header.stamp = base, js.header.stamp
-                F, M = setup.external_wrench[:3], setup.external_wrench[3:]
-                ws.wrench.force.x, ws.wrench.force.y, ws.wrench.force.z = map(float, F)
-                ws.wrench.torque.x, ws.wrench.torque.y, ws.wrench.torque.z = map(float, M)
-                wrench_pub.publish(ws)
+                _publish_contacts_and_load(publishers[1:], setup, q, stamp)
         if now >= next_print:
             next_print += 1.0
-            n = len(received) - last_count
-            last_count = len(received)
-            norm = np.linalg.norm(received[-1][1]) if received else float('nan')
-            solve_ms = 1e3 * float(diag.get('solve_time_s', 'nan'))
+            n = len(heard.received) - last_count
+            last_count = len(heard.received)
+            norm = np.linalg.norm(heard.received[-1][1]) if heard.received else float('nan')
+            solve_ms = 1e3 * float(heard.diag.get('solve_time_s', 'nan'))
             if args.watch:
                 next_tick = next_print
             print(f't={now - t0:4.1f} s  commands {n:4d}/s  solve {solve_ms:6.3f} ms  '
-                  f"|command| {norm:.4f} N m  status {diag.get('status', '-')}  "
-                  f"fault {diag.get('fault', '-')}", flush=True)
+                  f"|command| {norm:.4f} N m  status {heard.diag.get('status', '-')}  "
+                  f"fault {heard.diag.get('fault', '-')}", flush=True)
         rclpy.spin_once(node, timeout_sec=max(0.0, min(next_tick, next_print) - time.monotonic()))
-    played = dict(diag)  # the node's state while joint states flowed
-    end = time.monotonic() + 0.2  # the last commands in flight
-    while time.monotonic() < end:
-        rclpy.spin_once(node, timeout_sec=0.02)
+    return dict(heard.diag)  # the node's state while joint states flowed
 
+
+def _publish_joint_state(node, js_pub, names: list[str], positions: list[float]):
+    """Publish the joint states, NaN efforts as joint_state_broadcaster sends them; its stamp."""
+    from sensor_msgs.msg import JointState
+
+    js = JointState(name=list(names), position=positions, effort=[float('nan')] * len(names))
+    js.header.stamp = node.get_clock().now().to_msg()
+    js_pub.publish(js)
+    return js.header.stamp
+
+
+def _publish_contacts_and_load(publishers, setup, q: np.ndarray, stamp) -> None:
+    """Publish the contact frames at configuration q and the scenario's load, base axes."""
+    from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
+    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
+    import pinocchio as pin
+
+    contacts_pub, wrench_pub = publishers
+    hand = setup.hand
+    base = hand.base_frame
+    maps = compute_grasp_maps(hand, q, setup.contacts, setup.object_origin)
+    poses = PoseArray()
+    poses.header.frame_id, poses.header.stamp = base, stamp
+    for frame in maps.contacts:
+        x, y, z, w = pin.Quaternion(frame.rotation).coeffs()
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = map(float, frame.position)
+        pose.orientation.x, pose.orientation.y = float(x), float(y)
+        pose.orientation.z, pose.orientation.w = float(z), float(w)
+        poses.poses.append(pose)
+    contacts_pub.publish(poses)
+    ws = WrenchStamped()
+    ws.header.frame_id, ws.header.stamp = base, stamp
+    F, M = setup.external_wrench[:3], setup.external_wrench[3:]
+    ws.wrench.force.x, ws.wrench.force.y, ws.wrench.force.z = map(float, F)
+    ws.wrench.torque.x, ws.wrench.torque.y, ws.wrench.torque.z = map(float, M)
+    wrench_pub.publish(ws)
+
+
+def _print_summary(args: argparse.Namespace, heard: _Heard, played: dict[str, str]) -> None:
+    """Print the summary line: commands, malformed ones, |command|, solve time, the node's."""
+    received, solve_times = heard.received, heard.solve_times
     sent = '' if args.watch else f' for about {int(args.duration * args.rate)} joint states'
     norms = [np.linalg.norm(c) for _, c in received]
     print(f'summary: {len(received)} commands{sent} '
-          f'({len(received) / args.duration:.1f}/s); malformed {bad}; '
+          f'({len(received) / args.duration:.1f}/s); malformed {heard.bad}; '
           + (f'|command| {min(norms):.4f} to {max(norms):.4f} N m; ' if norms else '')
           + (f'solve time median {1e3 * np.median(solve_times):.3f} ms (diagnostics); '
              if solve_times else '')
           + f"node cycles {played.get('cycles', '-')}, faults {played.get('faults', '-')}, "
           f"rejected joint states {played.get('rejected.joint_states', '-')}, "
           f"last status {played.get('status', '-')}")
-    return 0 if (received or args.watch) and bad == 0 else 1
 
 
 if __name__ == '__main__':

@@ -120,93 +120,148 @@ def _predicted(message: str) -> list[np.ndarray] | None:
 
 
 def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
-    from geometry_msgs.msg import Pose, PoseArray
-    from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
-    from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME, SERVICE_QOS
-    from grasp_torque_opt.ros.sim_topics import imu_message, publish_contacts
-    from grasp_torque_opt.sim.simulator import friction_usage
+    from grasp_torque_opt.ros.node import NODE_NAME
     import rclpy
-    from rclpy.qos import qos_profile_sensor_data
-    from sensor_msgs.msg import Imu, JointState
-    from std_msgs.msg import Float64MultiArray
-    from std_srvs.srv import Trigger
 
-    hand = setup.hand
-    names = list(hsim.sim.joints)
-    m = len(names)
-    mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
-
-    rclpy.init()
-    node = rclpy.create_node('grasp_sim_driver')
-    js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
-    contacts_pub = node.create_publisher(PoseArray, 'contacts', qos_profile_sensor_data)
-    imu_pub = node.create_publisher(Imu, 'imu', qos_profile_sensor_data)
-    solve = node.create_client(Trigger, f'{NODE_NAME}/solve', qos_profile=SERVICE_QOS)
-    state = {'command': None, 'commands': 0, 'malformed': 0, 'predicted': None,
-             'pending': None}
-
-    def on_command(msg: Float64MultiArray) -> None:
-        cmd = np.array(msg.data, dtype=float)
-        if cmd.shape != (m,) or not np.all(np.isfinite(cmd)):
-            state['malformed'] += 1
-            return
-        state['command'] = cmd
-        state['commands'] += 1
-
-    node.create_subscription(Float64MultiArray, 'effort_commands', on_command, COMMAND_QOS)
-
-    def close(code: int) -> int:
-        node.destroy_node()
-        rclpy.try_shutdown()
-        return code
-
-    def ask_prediction() -> None:
-        if state['pending'] is None and solve.service_is_ready():
-            state['pending'] = solve.call_async(Trigger.Request())
-
-    def take_prediction() -> None:
-        future = state['pending']
-        if future is not None and future.done():
-            state['pending'] = None
-            result = future.result()
-            if result is not None and result.success:
-                state['predicted'] = _predicted(result.message) or state['predicted']
-
+    link = _Link(args, setup, hsim, baseline)
+    m = len(link.names)
     disturbed = describe(args)
     print(f'{PROG}: {Path(scenario.source).name} in MuJoCo {_mujoco_version()}, {m} joints, '
           f'1 kHz physics, joint states at {args.rate:g} Hz, impedance Kp {args.kp:g} N m/rad '
           f'Kd {args.kd:g} N m s/rad, controller {args.controller}'
           + (f'; {disturbed}' if disturbed else ''), flush=True)
     deadline = time.monotonic() + args.wait
-    while baseline is None and js_pub.get_subscription_count() == 0 and \
+    while baseline is None and link.js_pub.get_subscription_count() == 0 and \
             time.monotonic() < deadline:
-        rclpy.spin_once(node, timeout_sec=0.1)
-    if baseline is None and js_pub.get_subscription_count() == 0:
+        rclpy.spin_once(link.node, timeout_sec=0.1)
+    if baseline is None and link.js_pub.get_subscription_count() == 0:
         print(f'{PROG}: no {NODE_NAME} is listening on joint_states (start one, or '
               'use --with-node)', file=sys.stderr)
-        return close(1)
+        return link.close(1)
 
-    dt = hsim.model.opt.timestep
-    period = 1.0 / args.rate
-    base = hand.base_frame
+    # 1. Fingers held at the grasp configuration (as a driver's position mode would),
+    #    object pinned, until the node commands.
+    hsim.hold_joints = baseline is None
+    reference = getattr(baseline, 'reference', None)
+    if reference is not None:  # position control: the driver's reference is the target
+        hsim.q_ref = reference(hsim.q_ref)
+    if not link.run_for(args.wait, until=lambda: link.state['commands'] > 0):
+        print(f'{PROG}: no effort command from {NODE_NAME} within {args.wait:g} s',
+              file=sys.stderr)
+        return link.close(1)
+    # 2. The commands press the fingers on the pinned object, then it is let go.
+    link.ask_prediction()
+    link.run_for(args.settle)
+    hsim.release()
+    if reference is not None:
+        hsim.q_ref = reference(hsim.q_ref)
+    t_release_wall = time.monotonic()
+    counted_at_release = link.state['commands']
+    # 3. The object held (or not) for --duration, a line a second.
+    track = _Track(args, scenario, setup, link, disturbed)
+    link.run_for(args.duration, until=track.watch, each_second=track.every_second)
+    track.every_second()
+    wall = time.monotonic() - t_release_wall
+    commands = link.state['commands'] - counted_at_release
+    held, summary = _summary(args, track, commands, wall, link.state['malformed'])
+    print(summary)
+    if not args.no_picture:
+        print(_picture(hsim, args.picture, link.state['predicted']))
+        print(_plot(args, scenario, track.trace, baseline is None))
+    return link.close(0 if held and commands > 0 else 1)
 
-    def publish() -> None:
-        stamp = node.get_clock().now().to_msg()
-        js = JointState(name=names, position=[float(x) for x in hsim.reading],
+
+class _Link:
+    """
+    The driver's ROS side and its real-time loop.
+
+    Its node publishes the simulated hand's joint states, IMU and (``--contacts``) the
+    contacts; it takes the effort commands (or the baseline's) and the node's ~/solve
+    predictions, and steps the simulation in real time.
+    """
+
+    def __init__(self, args: argparse.Namespace, setup, hsim, baseline) -> None:
+        from geometry_msgs.msg import PoseArray
+        from grasp_torque_opt.ros.node import COMMAND_QOS, NODE_NAME, SERVICE_QOS
+        import rclpy
+        from rclpy.qos import qos_profile_sensor_data
+        from sensor_msgs.msg import Imu, JointState
+        from std_msgs.msg import Float64MultiArray
+        from std_srvs.srv import Trigger
+
+        self.args, self.setup, self.hsim, self.baseline = args, setup, hsim, baseline
+        self.names = list(hsim.sim.joints)
+        rclpy.init()
+        node = self.node = rclpy.create_node('grasp_sim_driver')
+        self.js_pub = node.create_publisher(JointState, 'joint_states', qos_profile_sensor_data)
+        self.contacts_pub = node.create_publisher(PoseArray, 'contacts',
+                                                  qos_profile_sensor_data)
+        self.imu_pub = node.create_publisher(Imu, 'imu', qos_profile_sensor_data)
+        self.solve = node.create_client(Trigger, f'{NODE_NAME}/solve', qos_profile=SERVICE_QOS)
+        self.state = {'command': None, 'commands': 0, 'malformed': 0, 'predicted': None,
+                      'pending': None}
+        node.create_subscription(Float64MultiArray, 'effort_commands', self.on_command,
+                                 COMMAND_QOS)
+
+    def on_command(self, msg) -> None:
+        cmd = np.array(msg.data, dtype=float)
+        if cmd.shape != (len(self.names),) or not np.all(np.isfinite(cmd)):
+            self.state['malformed'] += 1
+            return
+        self.state['command'] = cmd
+        self.state['commands'] += 1
+
+    def close(self, code: int) -> int:
+        import rclpy
+
+        self.node.destroy_node()
+        rclpy.try_shutdown()
+        return code
+
+    def ask_prediction(self) -> None:
+        from std_srvs.srv import Trigger
+
+        if self.state['pending'] is None and self.solve.service_is_ready():
+            self.state['pending'] = self.solve.call_async(Trigger.Request())
+
+    def take_prediction(self) -> None:
+        future = self.state['pending']
+        if future is not None and future.done():
+            self.state['pending'] = None
+            result = future.result()
+            if result is not None and result.success:
+                self.state['predicted'] = _predicted(result.message) or self.state['predicted']
+
+    def publish(self) -> None:
+        from geometry_msgs.msg import Pose, PoseArray
+        from grasp_torque_opt.core.grasp_maps import compute_grasp_maps
+        from grasp_torque_opt.ros.sim_topics import imu_message, publish_contacts
+        from sensor_msgs.msg import Imu, JointState
+        from std_msgs.msg import Float64MultiArray
+
+        hsim, hand = self.hsim, self.setup.hand
+        stamp = self.node.get_clock().now().to_msg()
+        js = JointState(name=self.names, position=[float(x) for x in hsim.reading],
                         velocity=[float(x) for x in hsim.qdot],
                         effort=[float(x) for x in hsim.effort()])
         js.header.stamp = stamp
-        js_pub.publish(js)
-        imu_pub.publish(imu_message(Imu, *hsim.imu(), base, stamp))
-        if baseline is not None:  # the driver's own controller, on what it publishes
-            on_command(Float64MultiArray(data=[float(x) for x in baseline(hsim.reading)]))
-        if args.contacts:
+        self.js_pub.publish(js)
+        self.imu_pub.publish(imu_message(Imu, *hsim.imu(), hand.base_frame, stamp))
+        if self.baseline is not None:  # the driver's own controller, on what it publishes
+            self.on_command(Float64MultiArray(data=[float(x)
+                                                    for x in self.baseline(hsim.reading)]))
+        if self.args.contacts:
             # In the root frame (MuJoCo's world), where the simulated contacts are read.
-            publish_contacts(hsim, setup, contacts_pub, hand.root_frame, stamp,
+            publish_contacts(hsim, self.setup, self.contacts_pub, hand.root_frame, stamp,
                              compute_grasp_maps, Pose, PoseArray)
 
-    def run_for(seconds: float, until=None, each_second=None) -> bool:
+    def run_for(self, seconds: float, until=None, each_second=None) -> bool:
         """Step in real time; publish joint states, apply commands; stop early on until()."""
+        import rclpy
+
+        hsim, state = self.hsim, self.state
+        dt = hsim.model.opt.timestep
+        period = 1.0 / self.args.rate
         t0_wall, t0_sim = time.monotonic(), hsim.time
         next_pub, next_second = t0_wall, t0_wall + 1.0
         while (now := time.monotonic()) < t0_wall + seconds:
@@ -218,52 +273,55 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
                 hsim.step(min(behind, 20))  # at most 20 ms per pass, then catch up
             if now >= next_pub:
                 next_pub += period
-                publish()
+                self.publish()
             if until is not None and until():
                 return True
             if each_second is not None and now >= next_second:
                 next_second += 1.0
                 each_second()
             wait = min(next_pub, t0_wall + seconds) - time.monotonic()
-            rclpy.spin_once(node, timeout_sec=max(0.0, wait))
-            take_prediction()
+            rclpy.spin_once(self.node, timeout_sec=max(0.0, wait))
+            self.take_prediction()
         return False
 
-    # 1. Fingers held at the grasp configuration (as a driver's position mode would),
-    #    object pinned, until the node commands.
-    hsim.hold_joints = baseline is None
-    reference = getattr(baseline, 'reference', None)
-    if reference is not None:  # position control: the driver's reference is the target
-        hsim.q_ref = reference(hsim.q_ref)
-    if not run_for(args.wait, until=lambda: state['commands'] > 0):
-        print(f'{PROG}: no effort command from {NODE_NAME} within {args.wait:g} s',
-              file=sys.stderr)
-        return close(1)
-    # 2. The commands press the fingers on the pinned object, then it is let go.
-    ask_prediction()
-    run_for(args.settle)
-    hsim.release()
-    if reference is not None:
-        hsim.q_ref = reference(hsim.q_ref)
-    t_release_wall, sim_release = time.monotonic(), hsim.time
-    counted_at_release = state['commands']
-    limit = args.drift_limit * 1e-3
-    # ~/solve predicts for the scenario's mass and pose, asked once a second: against a
-    # disturbed run its forces are a reference, not a prediction to score.
-    track = {'passed': None, 'max_drift': 0.0, 'lost': {}, 'errors': [], 'usage': [],
-             'trace': []}
 
-    def every_second() -> None:
-        t = hsim.time - sim_release
+class _Track:
+    """
+    The object after release: its drift, lost contacts, force errors, friction usage.
+
+    ~/solve predicts for the scenario's mass and pose, asked once a second: against a
+    disturbed run its forces are a reference, not a prediction to score.
+    """
+
+    def __init__(self, args: argparse.Namespace, scenario, setup, link: _Link,
+                 disturbed: str) -> None:
+        self.args, self.setup, self.link, self.hsim = args, setup, link, link.hsim
+        self.mu = scenario.friction.mu1, scenario.friction.mu2
+        self.disturbed = disturbed
+        self.sim_release = self.hsim.time
+        self.limit = args.drift_limit * 1e-3
+        self.passed: float | None = None
+        self.max_drift = 0.0
+        self.lost: dict[str, float] = {}
+        self.errors: list[float] = []
+        self.usage: list[float] = []
+        self.trace: list[tuple[float, float, float]] = []
+
+    def every_second(self) -> None:
+        """Print the line of the second: drift, rotation, forces against the prediction."""
+        from grasp_torque_opt.sim.simulator import friction_usage
+
+        hsim = self.hsim
+        t = hsim.time - self.sim_release
         drift, rotation = hsim.motion()
         readings, unplanned = hsim.readings()
-        pred = state['predicted']
+        pred = self.link.state['predicted']
         parts = [f't={t:4.1f} s  drift {drift * 1e3:7.3f} mm  rotation '
                  f'{np.degrees(rotation):6.3f} deg']
         forces, usage = [], []
         for i, r in enumerate(readings):
             if not r.touching:
-                track['lost'].setdefault(setup.contacts[i].link, t)
+                self.lost.setdefault(self.setup.contacts[i].link, t)
                 forces.append('-/' + (f'{np.linalg.norm(pred[i]):.2f}' if pred else '?'))
                 continue
             forces.append(f'{np.linalg.norm(r.force):.2f}/'
@@ -272,71 +330,70 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
             fn = float(r.force @ normal)
             ft = float(np.linalg.norm(r.force - fn * normal))
             usage.append(friction_usage(np.array([ft, 0.0, fn, float(r.torque @ normal)]),
-                                        mu1, mu2))
+                                        *self.mu))
         parts.append('forces sim/pred [N] ' + ' '.join(forces))
-        if pred and all(r.touching for r in readings) and not disturbed:
+        if pred and all(r.touching for r in readings) and not self.disturbed:
             err = max(np.linalg.norm(r.force - p) / np.linalg.norm(p)
                       for r, p in zip(readings, pred))
-            track['errors'].append(err)
+            self.errors.append(err)
             parts.append(f'(max error {100 * err:.1f}%)')
         if usage:
-            track['usage'].append(max(usage))
+            self.usage.append(max(usage))
             parts.append('friction (planned cone) ' + ' '.join(f'{100 * u:.0f}' for u in usage)
                          + ' %')
         if unplanned > 1e-3:
             parts.append(f'other contacts {unplanned:.2f} N')
         print('  '.join(parts), flush=True)
-        ask_prediction()
+        self.link.ask_prediction()
 
-    def watch() -> bool:
+    def watch(self) -> bool:
+        """Record the drift and the trace; tell whether the object fell."""
+        hsim = self.hsim
         drift, _ = hsim.motion()
-        track['max_drift'] = max(track['max_drift'], drift)
-        t = hsim.time - sim_release
-        if not track['trace'] or t - track['trace'][-1][0] >= 1.0 / args.rate:
+        self.max_drift = max(self.max_drift, drift)
+        t = hsim.time - self.sim_release
+        if not self.trace or t - self.trace[-1][0] >= 1.0 / self.args.rate:
             applied = hsim.effort()
-            track['trace'].append((t, drift, float(np.sqrt(np.mean(applied ** 2)))))
-        if drift > limit and track['passed'] is None:
-            track['passed'] = hsim.time - sim_release
-        return drift > max(20e-3, 10 * limit)  # fallen: no point in going on
+            self.trace.append((t, drift, float(np.sqrt(np.mean(applied ** 2)))))
+        if drift > self.limit and self.passed is None:
+            self.passed = hsim.time - self.sim_release
+        return drift > max(20e-3, 10 * self.limit)  # fallen: no point in going on
 
-    run_for(args.duration, until=watch, each_second=every_second)
-    every_second()
-    wall = time.monotonic() - t_release_wall
-    simulated = hsim.time - sim_release
-    commands = state['commands'] - counted_at_release
+
+def _summary(args: argparse.Namespace, track: _Track, commands: int, wall: float,
+             malformed: int) -> tuple[bool, str]:
+    """Return whether the object was held, and the summary line that says why."""
+    hsim = track.hsim
+    simulated = hsim.time - track.sim_release
     drift, rotation = hsim.motion()
-    held = track['passed'] is None
+    held = track.passed is None
     if held:
         why = (f'held: drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg '
                f'after {simulated:.1f} s (limit {args.drift_limit:g} mm)')
     else:
-        why = (f"NOT held: drift passed {args.drift_limit:g} mm at t = {track['passed']:.2f} s"
-               f", {track['max_drift'] * 1e3:.1f} mm at most")
-        if track['lost']:
-            first = min(track['lost'], key=track['lost'].get)
+        why = (f'NOT held: drift passed {args.drift_limit:g} mm at t = {track.passed:.2f} s'
+               f', {track.max_drift * 1e3:.1f} mm at most')
+        if track.lost:
+            first = min(track.lost, key=track.lost.get)
             why += f'; contact lost first at {first}'
         why += ('; the torques did not hold the object with this impedance and friction'
                 if commands else '; no command arrived after release')
     extra = []
-    if track['errors']:
-        extra.append(f"contact forces within {100 * max(track['errors']):.1f}% of the node's "
+    if track.errors:
+        extra.append(f"contact forces within {100 * max(track.errors):.1f}% of the node's "
                      'predicted wrenches')
-    elif disturbed:
+    elif track.disturbed:
         extra.append("contact forces not scored against the node's ~/solve (it plans for "
                      "the scenario's mass and pose, asked once a second): the run was "
                      'disturbed')
-    if track['usage']:
-        extra.append(f"friction usage up to {100 * max(track['usage']):.0f}% of the planned "
+    if track.usage:
+        extra.append(f'friction usage up to {100 * max(track.usage):.0f}% of the planned '
                      "cone (MuJoCo's elliptic cone is wider)")
     extra.append(f'{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed '
-                 f"{state['malformed']})")
+                 f'{malformed})')
     extra.append(f'real-time factor {simulated / max(wall, 1e-9):.2f}')
     why += f'; mean effort {hsim.mean_effort():.4f} N m (RMS joint torque)'
-    print('summary: ' + why + '; ' + '; '.join(extra))
-    if not args.no_picture:
-        print(_picture(hsim, args.picture, state['predicted']))
-        print(_plot(args, scenario, track['trace'], baseline is None))
-    return close(0 if held and commands > 0 else 1)
+    return held, 'summary: ' + why + '; ' + '; '.join(extra)
 
 
 def _mujoco_version() -> str:

@@ -173,35 +173,9 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
         hsim.step()
     hsim.release()
 
-    samples, lost = [], {}
-    per_sample = max(1, round(settings.sample_period / dt))
-    fallen = max(20e-3, 10 * settings.drift_limit)
-    readings, unplanned = hsim.readings()
-    max_drift = max_effort = 0.0
-    passed_at = None
-    n = round(settings.duration / dt)
-    for k in range(1, n + 1):
-        hsim.command = command()
-        max_effort = max(max_effort, float(np.abs(hsim.effort()).max()))
-        hsim.step()
-        drift, rotation = hsim.motion()
-        max_drift = max(max_drift, drift)
-        t = hsim.time - hsim.release_time
-        if drift > settings.drift_limit and passed_at is None:
-            passed_at = t
-        if k % per_sample == 0 or k == n or drift > fallen:
-            samples.append((t, drift, rotation))
-            now, now_unplanned = hsim.readings()
-            for link, r in zip(maps.links, now):
-                if not r.touching:
-                    lost.setdefault(link, t)
-            if passed_at is None:
-                readings, unplanned = now, now_unplanned
-        if drift > fallen:
-            break
-
+    w = _watch(hsim, command, settings, maps.links, dt)
     contacts = []
-    for i, (link, r) in enumerate(zip(maps.links, readings)):
+    for i, (link, r) in enumerate(zip(maps.links, w.readings)):
         w_sim = wrench_in_frame(r, sim_model.base_rotation @ maps.rotations[i])
         w_pred = sol.wrenches[i]
         mu1, mu2 = scenario.friction.mu1, scenario.friction.mu2
@@ -210,18 +184,80 @@ def hold(scenario: Scenario, settings: HoldSettings = HoldSettings(),
                                       maps.rotations[i]))
     drift, rotation = hsim.motion()
     t_end = hsim.time - hsim.release_time
-    limit_mm = settings.drift_limit * 1e3
-    if passed_at is None:
-        reason = (f'drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg '
-                  f'after {t_end:.2f} s (limit {limit_mm:g} mm)')
-    else:
-        reason = f'drift passed {limit_mm:g} mm at t = {passed_at:.2f} s'
-        reason += (f' and reached {max_drift * 1e3:.1f} mm (the object fell)'
-                   if max_drift > fallen else f', {drift * 1e3:.2f} mm at the end')
-        if lost:
-            first = min(lost, key=lost.get)
-            reason += f'; contact lost first at {first} (t = {lost[first]:.2f} s)'
-    return HoldReport(held=passed_at is None, reason=reason, time=t_end, drift=drift,
-                      max_drift=max_drift, rotation=rotation, contacts=contacts,
-                      unplanned_force=unplanned, max_effort=max_effort, samples=samples,
+    reason = _reason(w, settings, drift, rotation, t_end)
+    return HoldReport(held=w.passed_at is None, reason=reason, time=t_end, drift=drift,
+                      max_drift=w.max_drift, rotation=rotation, contacts=contacts,
+                      unplanned_force=w.unplanned, max_effort=w.max_effort, samples=w.samples,
                       wall_time=time.perf_counter() - t_wall, solution=sol)
+
+
+@dataclass
+class _Watched:
+    """
+    What :func:`_watch` saw after the release.
+
+    Attributes:
+        samples: (time [s], drift [m], rotation [rad]) every sample period.
+        lost: link -> when it first stopped touching the object [s].
+        readings: the contact readings at the end, or at the last sample before the
+            drift limit was passed.
+        unplanned: force of other hand bodies on the object then [N].
+        max_drift: largest displacement [m].
+        max_effort: largest joint torque applied [N m].
+        passed_at: when the drift passed its limit [s], or None.
+        fallen: the drift at which the object counts as fallen [m].
+    """
+
+    samples: list[tuple[float, float, float]]
+    lost: dict[str, float]
+    readings: list
+    unplanned: float
+    max_drift: float = 0.0
+    max_effort: float = 0.0
+    passed_at: float | None = None
+    fallen: float = 0.0
+
+
+def _watch(hsim: HandSim, command, settings: HoldSettings, links: tuple[str, ...],
+           dt: float) -> _Watched:
+    """Step the released hand for the episode's duration (or until the object fell)."""
+    readings, unplanned = hsim.readings()
+    w = _Watched([], {}, readings, unplanned, fallen=max(20e-3, 10 * settings.drift_limit))
+    per_sample = max(1, round(settings.sample_period / dt))
+    n = round(settings.duration / dt)
+    for k in range(1, n + 1):
+        hsim.command = command()
+        w.max_effort = max(w.max_effort, float(np.abs(hsim.effort()).max()))
+        hsim.step()
+        drift, rotation = hsim.motion()
+        w.max_drift = max(w.max_drift, drift)
+        t = hsim.time - hsim.release_time
+        if drift > settings.drift_limit and w.passed_at is None:
+            w.passed_at = t
+        if k % per_sample == 0 or k == n or drift > w.fallen:
+            w.samples.append((t, drift, rotation))
+            now, now_unplanned = hsim.readings()
+            for link, r in zip(links, now):
+                if not r.touching:
+                    w.lost.setdefault(link, t)
+            if w.passed_at is None:
+                w.readings, w.unplanned = now, now_unplanned
+        if drift > w.fallen:
+            break
+    return w
+
+
+def _reason(w: _Watched, settings: HoldSettings, drift: float, rotation: float,
+            t_end: float) -> str:
+    """Say why the object was held or not, in words."""
+    limit_mm = settings.drift_limit * 1e3
+    if w.passed_at is None:
+        return (f'drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg '
+                f'after {t_end:.2f} s (limit {limit_mm:g} mm)')
+    reason = f'drift passed {limit_mm:g} mm at t = {w.passed_at:.2f} s'
+    reason += (f' and reached {w.max_drift * 1e3:.1f} mm (the object fell)'
+               if w.max_drift > w.fallen else f', {drift * 1e3:.2f} mm at the end')
+    if w.lost:
+        first = min(w.lost, key=w.lost.get)
+        reason += f'; contact lost first at {first} (t = {w.lost[first]:.2f} s)'
+    return reason

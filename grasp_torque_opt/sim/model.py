@@ -215,15 +215,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
                          '(shape, size, mass)')
     if scenario.gravity is None:
         raise InputError('gravity', "the simulation needs the scenario's gravity")
-    urdf_dir = None
-    if urdf_xml is None:
-        path = resolve_urdf(scenario.urdf, scenario.base_dir)
-        urdf_xml, urdf_dir = path.read_text(), path.parent
-    try:
-        spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml, urdf_dir))
-    except (ValueError, RuntimeError) as e:
-        raise InputError('hand.urdf', f'MuJoCo cannot load it: '
-                         f'{str(e).strip().splitlines()[0]}') from e
+    spec, urdf_xml = _hand_spec(scenario, urdf_xml)
     if setup is None:
         # The simulated object may sit where the scenario's contacts are not (an offset
         # on purpose, --object-offset): the model is built from the hand and the object,
@@ -237,16 +229,7 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
     mu2 = scenario.friction.mu2 if settings.mu_torsional is None else settings.mu_torsional
     mass = scenario.object.mass if settings.mass is None else settings.mass
     friction = [mu1, mu2, 0.0]
-    spec.option.timestep = settings.timestep
-    spec.option.gravity = [float(x) for x in base[0] @ scenario.gravity]
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = settings.impratio
-    spec.option.noslip_iterations = settings.noslip_iterations
-    for geom in spec.geoms:
-        geom.friction = friction
-        geom.condim = 4
-        geom.solref = [settings.contact_timeconst, 1.0]
-        geom.contype, geom.conaffinity = _HAND_BITS
+    _set_physics(spec, settings, base[0] @ scenario.gravity, friction)
     _add_object(spec, scenario.object, mass, friction, settings.contact_timeconst, base)
     try:
         model = spec.compile()
@@ -254,25 +237,8 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         raise InputError('hand.urdf', f'MuJoCo cannot compile it: '
                          f'{str(e).strip().splitlines()[0]}') from e
 
-    names = [model.joint(j).name for j in range(model.njnt)
-             if int(model.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_HINGE),
-                                           int(mujoco.mjtJoint.mjJNT_SLIDE))]
+    names, bodies = _checked_bodies(model, setup)
     joints = setup.hand.joints
-    for i, name in enumerate(joints):
-        if name not in names:
-            raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
-                             'MuJoCo model')
-    bodies = []
-    for i, contact in enumerate(setup.contacts):  # found from geometry where not written
-        field = f'grasp.contacts[{i}].link'
-        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
-        if body < 0:
-            raise InputError(field, f"'{contact.link}' is not a link of the MuJoCo model "
-                             '(the simulation needs contacts on URDF links)')
-        if model.body_geomnum[body] == 0:
-            raise InputError(field, f"link '{contact.link}' has no collision geometry to "
-                             'touch the object with')
-        bodies.append(body)
     free = model.joint(f'{OBJECT_BODY}_free')
     hand_dofs = [model.jnt_dofadr[j] for j in range(model.njnt) if model.joint(j).name in names]
     model.dof_damping[hand_dofs] = settings.joint_damping
@@ -287,6 +253,58 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         followers=tuple((int(model.joint(m.joint).qposadr[0]),
                          int(model.joint(m.target).qposadr[0]), m.multiplier, m.offset)
                         for m in coupled))
+
+
+def _hand_spec(scenario: Scenario, urdf_xml: str | None) -> tuple[mujoco.MjSpec, str]:
+    """Return the hand's MuJoCo spec from its adapted URDF, and the URDF read."""
+    urdf_dir = None
+    if urdf_xml is None:
+        path = resolve_urdf(scenario.urdf, scenario.base_dir)
+        urdf_xml, urdf_dir = path.read_text(), path.parent
+    try:
+        spec = mujoco.MjSpec.from_string(adapt_urdf(urdf_xml, urdf_dir))
+    except (ValueError, RuntimeError) as e:
+        raise InputError('hand.urdf', f'MuJoCo cannot load it: '
+                         f'{str(e).strip().splitlines()[0]}') from e
+    return spec, urdf_xml
+
+
+def _set_physics(spec: mujoco.MjSpec, settings: SimSettings, gravity: np.ndarray,
+                 friction: list[float]) -> None:
+    """Set the options (gravity in MuJoCo's world [m/s^2]) and the hand's contact geoms."""
+    spec.option.timestep = settings.timestep
+    spec.option.gravity = [float(x) for x in gravity]
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = settings.impratio
+    spec.option.noslip_iterations = settings.noslip_iterations
+    for geom in spec.geoms:
+        geom.friction = friction
+        geom.condim = 4
+        geom.solref = [settings.contact_timeconst, 1.0]
+        geom.contype, geom.conaffinity = _HAND_BITS
+
+
+def _checked_bodies(model: mujoco.MjModel, setup: GraspSetup) -> tuple[list[str], list[int]]:
+    """Return the model's 1-DoF joints and the contacts' bodies, each actuator and link checked."""
+    names = [model.joint(j).name for j in range(model.njnt)
+             if int(model.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_HINGE),
+                                           int(mujoco.mjtJoint.mjJNT_SLIDE))]
+    for i, name in enumerate(setup.hand.joints):
+        if name not in names:
+            raise InputError(f'hand.joints[{i}]', f"'{name}' is not a 1-DoF joint of the "
+                             'MuJoCo model')
+    bodies = []
+    for i, contact in enumerate(setup.contacts):  # found from geometry where not written
+        field = f'grasp.contacts[{i}].link'
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, contact.link)
+        if body < 0:
+            raise InputError(field, f"'{contact.link}' is not a link of the MuJoCo model "
+                             '(the simulation needs contacts on URDF links)')
+        if model.body_geomnum[body] == 0:
+            raise InputError(field, f"link '{contact.link}' has no collision geometry to "
+                             'touch the object with')
+        bodies.append(body)
+    return names, bodies
 
 
 def base_placement(setup: GraspSetup) -> tuple[np.ndarray, np.ndarray]:

@@ -96,7 +96,21 @@ def sweep_grasp(doc: dict[str, Any], base_dir: Path,
         mujoco.mj_forward(sim.model, data)
         return _touching(sim, data)
 
-    s_of = dict.fromkeys(fingers, 0.0)
+    points = _touch_points(pose, fingers, _first_touches(pose, fingers))
+    model = setup.hand.model
+    full = setup.q.copy()
+    full[setup.hand.idx_q] = q
+    pin.framesForwardKinematics(model, setup.hand.data, setup.hand.complete(full))
+    positions = {n: round(float(v), 4) for n, v in zip(joints, q)}
+    doc['grasp']['joint_positions'] = {**doc['grasp'].get('joint_positions', {}), **positions}
+    for contact in doc['grasp']['contacts']:
+        oMl = setup.hand.data.oMf[model.getFrameId(contact['link'])]
+        contact['position'] = [round(float(x), 5) for x in oMl.actInv(points[contact['link']])]
+    return doc
+
+
+def _first_touches(pose, fingers: dict) -> dict[str, float]:
+    """Sweep every finger from s = 0 to 1: the s at which each contact link first touches."""
     hit: dict[str, float] = {}
     for s in np.linspace(0.0, 1.0, STEPS + 1):
         touches = pose({link: s for link in fingers if link not in hit})
@@ -110,6 +124,12 @@ def sweep_grasp(doc: dict[str, Any], base_dir: Path,
     missing = sorted(set(fingers) - set(hit))
     if missing:
         raise InputError('grasp.contacts', f"{', '.join(missing)}: closed without touching")
+    return hit
+
+
+def _touch_points(pose, fingers: dict, hit: dict[str, float]) -> dict[str, np.ndarray]:
+    """Bisect each finger's s to a touch within TOUCH; its point in MuJoCo's world [m]."""
+    s_of = dict.fromkeys(fingers, 0.0)
     points = {}
     for link, s_hit in hit.items():
         lo, hi = s_hit - 1.0 / STEPS, s_hit
@@ -127,13 +147,4 @@ def sweep_grasp(doc: dict[str, Any], base_dir: Path,
             s_of[link] = hi
             points[link] = min((t for t in pose(s_of) if t[0] == link), key=lambda t: t[2])[1]
         pose({link: s_of[link]})
-    model = setup.hand.model
-    full = setup.q.copy()
-    full[setup.hand.idx_q] = q
-    pin.framesForwardKinematics(model, setup.hand.data, setup.hand.complete(full))
-    positions = {n: round(float(v), 4) for n, v in zip(joints, q)}
-    doc['grasp']['joint_positions'] = {**doc['grasp'].get('joint_positions', {}), **positions}
-    for contact in doc['grasp']['contacts']:
-        oMl = setup.hand.data.oMf[model.getFrameId(contact['link'])]
-        contact['position'] = [round(float(x), 5) for x in oMl.actInv(points[contact['link']])]
-    return doc
+    return points

@@ -13,9 +13,9 @@ import dataclasses
 from cycle_inputs import fresh, joint_state
 from grasp_torque_opt.control.inputs.base import NodeInput, QOS
 from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.object_pose import PoseReading
 from grasp_torque_opt.control.inputs.registry import REGISTRY, SOURCES
-from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.store import Inputs
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.object_geometry import object_pose
