@@ -292,8 +292,13 @@ class Scorer:
         """Return the full metrics of a bound candidate solved with ``status`` (plain data)."""
         lp = CapacityLP(setup, maps)
         cap = lp.solve(setup.external_wrench, binding=False)
+        reason = None if cap.status == 'optimal' else cap.message
+        fraction = cap.value if status == 'infeasible' else None
+        if fraction is not None and fraction >= 1.0:  # the solve and the LP disagree
+            fraction, reason = None, (f'the capacity LP holds {cap.value:.6g} times the '
+                                      'load, which the solve found infeasible')
         return {'capacity': cap.value, 'capacity_status': cap.status,
-                'holdable_fraction': cap.value if status == 'infeasible' else None,
+                'capacity_reason': reason, 'holdable_fraction': fraction,
                 'capacities': {k: c.value for k, c in
                                direction_capacities(setup, maps, lp, binding=False).items()}}
 

@@ -73,7 +73,8 @@ def assert_same(fast: list, slow: list, tol: float = 1e-7) -> None:
     assert len(fast) == len(slow)
     for a, b in zip(fast, slow):
         assert a.keys() == b.keys(), (a['line'], a.keys() ^ b.keys())
-        for key in ('line', 'id', 'status', 'error', 'backend', 'capacity_status'):
+        for key in ('line', 'id', 'status', 'error', 'backend', 'capacity_status',
+                    'capacity_reason'):
             assert a.get(key) == b.get(key), (a['line'], key, a.get(key), b.get(key))
         for key in ('torque_norm', 'max_torque_ratio', 'friction_usage_max', 'capacity',
                     'holdable_fraction'):
