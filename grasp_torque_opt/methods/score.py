@@ -28,9 +28,10 @@ Each candidate is solved (tau-QP, the batch's backend and objective) and, with
 ``status`` (``optimal``, ``infeasible``, ``failed``, or ``error`` for a bad
 line), ``error``, ``torque_norm`` [N m], ``max_torque_ratio`` [-],
 ``friction_usage_max`` [-], ``friction_usage`` (per contact), ``capacity``
-[-] and ``capacity_status``, ``capacities`` (direction -> N or N m, null where
-not certified), ``holdable_fraction`` (infeasible candidates: their capacity)
-and ``time_s`` (the candidate's scoring time [s]); with ``solutions=True``
+[-] (every load from zero to it held, :mod:`.capacity`), ``capacity_status`` and
+``capacity_reason``, ``capacities`` (direction -> N or N m, null where not
+certified), ``holdable_fraction`` (infeasible candidates: their capacity),
+``time_s`` (the candidate's scoring time [s]) and ``rank`` (:func:`score_batch`); with ``solutions=True``
 also ``tau`` (joint torques [N m], the base hand's joint order) and ``wrenches``
 (per contact [f_x, f_y, f_z, m_z] in its contact frame [N, N m]), null unless
 optimal, so the winner need not be solved again.
@@ -74,6 +75,7 @@ from grasp_torque_opt.methods.ranking import (  # noqa: F401 -- re-exported, as 
     rank,
     rank_key,
     RANK_KEYS,
+    ranked_records,
     record_json,
     summary,
 )
@@ -395,9 +397,9 @@ def thread_env(value: str | None) -> Iterator[None]:
 def score_batch(job: ScoreJob, lines: Iterable[Any], *, workers: int | None = None,
                 engine: str = 'processes', scheduler: str | None = None,
                 progress: Callable[[int, int], None] | None = None,
-                chunk: int = CHUNK) -> list[dict[str, Any]]:
+                chunk: int = CHUNK, rank_by: str = 'capacity') -> list[dict[str, Any]]:
     """
-    Score every candidate line, in parallel; records in input order.
+    Score every candidate line, in parallel; records in input order, each with its rank.
 
     Args:
         job: the base scenario and options.
@@ -411,15 +413,19 @@ def score_batch(job: ScoreJob, lines: Iterable[Any], *, workers: int | None = No
             local cluster (``dask`` only).
         progress: called with (candidates done, total) as chunks finish.
         chunk: candidates per task.
+        rank_by: the key of the ``rank`` each record gets (:func:`.ranking.rank`:
+            feasible candidates by it, then infeasible ones by holdable fraction, then
+            the rest).
 
     Raises:
         InputError: the base scenario is bad (the batch cannot start).
-        ValueError: an unknown engine.
+        ValueError: an unknown engine or rank key.
         BrokenProcessPool: a worker process died (``processes``); the message says
             why it may have (a script without ``if __name__ == "__main__":``).
     """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    rank_key([], rank_by)  # an unknown key fails before the work
     Scorer(job)  # a bad base scenario fails here, once, in this process
     workers = max(1, workers or os.cpu_count() or 1)
     lines = numbered(lines)
@@ -442,7 +448,9 @@ def score_batch(job: ScoreJob, lines: Iterable[Any], *, workers: int | None = No
         _pool_map(job, tasks, workers, finished)
     else:
         _dask_map(job, tasks, workers, scheduler, finished)
-    return [r for records in results for r in records]
+    records = [r for records in results for r in records]
+    ranked_records(records, rank_by)
+    return records
 
 
 def _pool_map(job: ScoreJob, tasks: list, workers: int, finished) -> None:
