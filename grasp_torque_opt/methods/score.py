@@ -28,10 +28,9 @@ Each candidate is solved (tau-QP, the batch's backend and objective) and, with
 ``status`` (``optimal``, ``infeasible``, ``failed``, or ``error`` for a bad
 line), ``error``, ``torque_norm`` [N m], ``max_torque_ratio`` [-],
 ``friction_usage_max`` [-], ``friction_usage`` (per contact), ``capacity``
-[-] (every load from zero to it held, :mod:`.capacity`), ``capacity_status`` and
-``capacity_reason``, ``capacities`` (direction -> N or N m, null where not
-certified), ``holdable_fraction`` (infeasible candidates: their capacity),
-``time_s`` (the candidate's scoring time [s]) and ``rank`` (:func:`score_batch`); with ``solutions=True``
+[-] (every load from zero to it held), ``capacity_status``, ``capacity_reason``,
+``capacities`` (direction -> N or N m, null where not certified), ``holdable_fraction``
+(infeasible candidates: their capacity), ``time_s`` [s] and ``rank``; with ``solutions=True``
 also ``tau`` (joint torques [N m], the base hand's joint order) and ``wrenches``
 (per contact [f_x, f_y, f_z, m_z] in its contact frame [N, N m]), null unless
 optimal, so the winner need not be solved again.
@@ -65,11 +64,12 @@ from typing import Any
 
 from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
-from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.grasp_setup import bind_for_candidates, GraspSetup, issue_once
 from grasp_torque_opt.core.scenario import OBJECTIVES, parse_scenario
 from grasp_torque_opt.core.scenario_contacts import resolve_contacts
 from grasp_torque_opt.methods.capacity import CapacityLP, direction_capacities
 from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.methods.explain import holdable
 from grasp_torque_opt.methods.ranking import (  # noqa: F401 -- re-exported, as before
     format_table,
     rank,
@@ -176,7 +176,8 @@ class Scorer:
                              .splitlines()[0]) from e
         self.base_dir = Path(job.base_dir)
         self.doc = doc
-        self.base = GraspSetup.from_scenario(parse_scenario(doc, self.base_dir, job.source))
+        self.base, self.base_warnings = bind_for_candidates(  # warned when a line keeps
+            parse_scenario(doc, self.base_dir, job.source))     # the contacts (_bind)
         self.solver = make_solver(job.backend)
         self.fallback = (make_solver(job.fallback) if job.fallback not in (None, job.backend)
                          else None)
@@ -227,6 +228,8 @@ class Scorer:
                                  f"{', '.join(CANDIDATE_KEYS)}; the hand is the base "
                                  "scenario's)")
         ident = data.pop('id', lineno)
+        if 'contacts' not in (data.get('grasp') if isinstance(data.get('grasp'), dict) else {}):
+            issue_once(self.base_warnings)  # the line keeps the base's contacts
         try:
             scenario = parse_scenario(merge(self.doc, data), self.base_dir, f'line {lineno}')
             base = self.base
@@ -294,11 +297,7 @@ class Scorer:
         """Return the full metrics of a bound candidate solved with ``status`` (plain data)."""
         lp = CapacityLP(setup, maps)
         cap = lp.solve(setup.external_wrench, binding=False)
-        reason = None if cap.status == 'optimal' else cap.message
-        fraction = cap.value if status == 'infeasible' else None
-        if fraction is not None and fraction >= 1.0:  # the solve and the LP disagree
-            fraction, reason = None, (f'the capacity LP holds {cap.value:.6g} times the '
-                                      'load, which the solve found infeasible')
+        fraction, reason = holdable(cap, status)
         return {'capacity': cap.value, 'capacity_status': cap.status,
                 'capacity_reason': reason, 'holdable_fraction': fraction,
                 'capacities': {k: c.value for k, c in
@@ -413,9 +412,7 @@ def score_batch(job: ScoreJob, lines: Iterable[Any], *, workers: int | None = No
             local cluster (``dask`` only).
         progress: called with (candidates done, total) as chunks finish.
         chunk: candidates per task.
-        rank_by: the key of the ``rank`` each record gets (:func:`.ranking.rank`:
-            feasible candidates by it, then infeasible ones by holdable fraction, then
-            the rest).
+        rank_by: the key of each record's ``rank`` (:func:`.ranking.rank`).
 
     Raises:
         InputError: the base scenario is bad (the batch cannot start).
