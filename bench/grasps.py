@@ -48,7 +48,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, report, ROOT  # noqa: E402, I100
 from grasp_torque_opt.core.exceptions import GraspTorqueError  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
-from grasp_torque_opt.methods.score import THREAD_VARS  # noqa: E402
+from grasp_torque_opt.methods.engines import THREAD_VARS  # noqa: E402
 from grasp_torque_opt.reference.feasibility import linearized_feasible  # noqa: E402
 
 SCENARIO = ROOT / 'config' / 'allegro_right.yaml'

@@ -45,9 +45,10 @@ from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import parse_scenario
+from grasp_torque_opt.methods.engines import score_batch
 from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
 from grasp_torque_opt.methods.ranking import rank
-from grasp_torque_opt.methods.score import score_batch, ScoreJob
+from grasp_torque_opt.methods.score import ScoreJob
 from grasp_torque_opt.ros.sim_compare import node_controller
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 import numpy as np

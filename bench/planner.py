@@ -55,7 +55,7 @@ from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.backends import make_solver  # noqa: E402
 from grasp_torque_opt.core.grasp_setup import GraspSetup  # noqa: E402
 from grasp_torque_opt.methods.dispatch import solve  # noqa: E402
-from grasp_torque_opt.methods.score import thread_env  # noqa: E402
+from grasp_torque_opt.methods.engines import thread_env  # noqa: E402
 from grasps import allegro_grasps, blas_threads, SCENARIO  # noqa: E402
 
 CHUNK = 25

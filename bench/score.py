@@ -57,7 +57,8 @@ from candidates import candidate_lines  # noqa: E402
 from cycle import machine, report  # noqa: E402
 from grasp_torque_opt.backends import single_threaded_math  # noqa: E402
 from grasp_torque_opt.methods.batch import BatchScorer  # noqa: E402
-from grasp_torque_opt.methods.score import score_batch, ScoreJob, Scorer  # noqa: E402
+from grasp_torque_opt.methods.engines import score_batch  # noqa: E402
+from grasp_torque_opt.methods.score import ScoreJob, Scorer  # noqa: E402
 from grasps import blas_threads, SCENARIO  # noqa: E402
 import numpy as np  # noqa: E402
 

@@ -100,6 +100,34 @@ def lp_capacity(setup, maps, load):
     return float(res.x[-1]), res.x[:nf]
 
 
+def lp_alpha_range(setup, maps, load, cap=1e6):
+    """
+    Return the interval (lo, hi) of alpha in [0, cap] with alpha load holdable, by HiGHS.
+
+    Two LPs in contact-force space (min and max alpha, the planned polygons and the
+    limits, as :func:`lp_capacity`); None when no alpha in [0, cap] is holdable. The
+    holdable multiples of a load form an interval: the constraints are convex.
+    """
+    S, b, lim, off = _f_space(setup, maps)
+    nf = 4 * maps.p
+    pad = np.zeros((S.shape[0], 1))
+    A_ub = np.vstack((np.hstack((S, pad)), np.hstack((maps.J.T, np.zeros((setup.hand.m, 1)))),
+                      np.hstack((-maps.J.T, np.zeros((setup.hand.m, 1))))))
+    b_ub = np.concatenate((b, lim - off, lim + off))
+    A_eq = np.hstack((maps.G, np.asarray(load, float)[:, None]))
+    ends = []
+    for sign in (1.0, -1.0):
+        c = np.zeros(nf + 1)
+        c[-1] = sign
+        res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=np.zeros(6),
+                      bounds=[(None, None)] * nf + [(0, cap)], method='highs')
+        assert res.status in (0, 2), res.message
+        if res.status == 2:
+            return None
+        ends.append(float(res.x[-1]))
+    return tuple(ends)
+
+
 def lp_minmax(setup, maps, weights=None):
     """
     Minimize t in contact-force space with HiGHS.

@@ -17,14 +17,25 @@ import time
 
 from grasp_torque_opt.backends import BACKENDS
 from grasp_torque_opt.cli.args import count, PROG
-from grasp_torque_opt.core.command_line import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, \
-    HelpFormatter, one_line
+from grasp_torque_opt.core.command_line import (
+    EXIT_BAD_INPUT,
+    EXIT_FAILED,
+    EXIT_OK,
+    HelpFormatter,
+    one_line,
+)
 from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import OBJECTIVES
-from grasp_torque_opt.methods.ranking import format_table, rank, rank_key, RANK_KEYS, \
-    record_json, summary
-from grasp_torque_opt.methods.score import ENGINES, METRICS, read_candidates, score_batch, \
-    ScoreJob
+from grasp_torque_opt.methods.engines import ENGINES, read_candidates, score_batch
+from grasp_torque_opt.methods.ranking import (
+    format_table,
+    rank,
+    rank_key,
+    RANK_KEYS,
+    record_json,
+    summary,
+)
+from grasp_torque_opt.methods.score import METRICS, ScoreJob
 
 
 def add_parser(sub) -> None:

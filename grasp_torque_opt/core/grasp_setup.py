@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+import warnings
 
 from grasp_torque_opt.core.contact_links import check_contact_links
-from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.core.exceptions import GeometryWarning, InputError
 from grasp_torque_opt.core.grasp_maps import compute_grasp_maps, GraspMaps
 from grasp_torque_opt.core.hand import Hand, resolve_urdf
 from grasp_torque_opt.core.inward import check_inward_normals
@@ -116,3 +117,27 @@ class GraspSetup:
     def maps(self) -> GraspMaps:
         """Contact frames, G and J at this configuration."""
         return compute_grasp_maps(self.hand, self.q, self.contacts, self.object_origin)
+
+
+def bind_for_candidates(scenario: Scenario) -> tuple[GraspSetup, list[Warning]]:
+    """
+    Bind a base scenario whose contacts candidates may replace (planning, scoring).
+
+    Its contacts' :class:`GeometryWarning` s (points written for another object, the
+    bundled sphere's with a box ``object``) are returned, not issued: the caller issues
+    them when a candidate keeps those contacts.
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always', GeometryWarning)
+        setup = GraspSetup.from_scenario(scenario)
+    for w in caught:  # anything else is issued as it would have been
+        if not issubclass(w.category, GeometryWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return setup, [w.message for w in caught if issubclass(w.category, GeometryWarning)]
+
+
+def issue_once(caught: list[Warning]) -> None:
+    """Issue the warnings :func:`bind_for_candidates` returned, then forget them."""
+    for message in caught:
+        warnings.warn(message, stacklevel=3)
+    caught.clear()

@@ -47,7 +47,7 @@ from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
 from grasp_torque_opt.core.friction import contact_block
 from grasp_torque_opt.core.grasp_maps import GraspMaps
-from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.grasp_setup import GraspSetup, issue_once
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.scenario import MAX_CONTACTS, parse_scenario, weight_wrench
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
@@ -275,6 +275,8 @@ class BatchScorer:
             joints = (index, _numbers(list(positions.values())))
         if 'contacts' in grasp:
             contacts = parse_contacts(grasp['contacts'], self.scorer.base.hand)
+        else:
+            issue_once(self.scorer.base_warnings)  # the line keeps the base's contacts
         extra = None if self.base_has_extra else _NO_LOAD
         if 'load' in data:
             load = data['load']

@@ -15,9 +15,12 @@ as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the rows and bounds
 :class:`~grasp_torque_opt.methods.capacity.CapacityLP`). What the single path does
 after each DAQP call in Python (the KKT check, alpha, the certificate of the answer
 at alpha times the load) runs for all the LPs of a few candidates in one compiled
-call (``lp_finish_batch``). An LP whose answer does not pass, or that DAQP does not
-call optimal, is solved again by the single path's :meth:`CapacityLP.solve` (HiGHS
-behind DAQP, the unbounded and infeasible verdicts), whose answer is then the value.
+call (``lp_finish_batch``), and so do each candidate's zero-load LP's (a capacity is
+that of the load range from zero, :mod:`.capacity`). An LP whose answer does not pass,
+or that DAQP does not call optimal, is solved again by the single path's
+:meth:`CapacityLP.solve` (HiGHS behind DAQP, the unbounded and infeasible verdicts),
+whose answer is then the value; so are all of a candidate's LPs when its zero-load LP
+does not pass.
 """
 
 from __future__ import annotations
@@ -120,14 +123,15 @@ class CapacityBatch:
         fin = self.cycle.lp_finish_batch(G, J, cand, loads, scale, A, bl, bu, c, x, lam, ok,
                                          KKT_TOLERANCE, ALPHA_MAX)
         passes, alpha = fin['passes'].tolist(), fin['alpha'].tolist()
+        zero = self._zero_holds(G, J, np.ascontiguousarray(A[::len(LOADS)]), t, start, stop)
         out = []
         for i in range(stop - start):
             lp = None
-            values, statuses = {}, {}
+            values, statuses, reasons = {}, {}, {}
             for j, (name, axis, unit) in enumerate(LOADS):
                 k = i * len(LOADS) + j
-                if passes[k] and usable[k]:
-                    values[name], statuses[name] = alpha[k], 'optimal'
+                if passes[k] and usable[k] and zero[i]:
+                    values[name], statuses[name], reasons[name] = alpha[k], 'optimal', None
                     continue
                 if lp is None:  # the single path's LP of this candidate, and its verdict
                     lp = CapacityLP(*bound(start + i))
@@ -138,7 +142,35 @@ class CapacityBatch:
                     load[axis[0]] = axis[1]
                 cap = lp.solve(load, unit, binding=False)
                 values[name], statuses[name] = cap.value, cap.status
+                reasons[name] = None if cap.status == 'optimal' else cap.message
             out.append({'capacity': values['load'], 'capacity_status': statuses['load'],
-                        'holdable_fraction': None,
+                        'capacity_reason': reasons['load'], 'holdable_fraction': None,
                         'capacities': {name: values[name] for name in DIRECTIONS}})
         return out
+
+    def _zero_holds(self, G, J, A, t: CapacityLP, start: int, stop: int) -> list[bool]:
+        """
+        Say, per candidate, whether its zero-load LP passes (DAQP, the KKT check, certified).
+
+        The capacity LP's rows with alpha fixed at 0 (:meth:`CapacityLP.zero_load`); a
+        candidate that does not pass takes the single path for all its LPs.
+        """
+        form, c = t.zero_form, t.c
+        count, cols = A.shape[0], A.shape[2]
+        x = np.zeros((count, cols))
+        lam = np.zeros((count, cols + A.shape[1]))
+        ok = np.zeros(count, dtype=bool)
+        for k in range(count):
+            try:
+                xk, _, flag, info = self._solve(form.H, c, A[k], form.bu, form.bl, form.sense,
+                                                primal_tol=PRIMAL_TOL, iter_limit=MAX_ITER,
+                                                eps_prox=EPS_PROX)
+            except (RuntimeError, ValueError):
+                continue
+            if flag in (1, 2) and xk is not None:
+                x[k], lam[k] = xk, info['lam']
+                ok[k] = bool(np.isfinite(x[k]).all())
+        fin = self.cycle.lp_finish_batch(G, J, np.arange(start, stop, dtype=np.int64),
+                                         np.zeros((count, 6)), np.ones(count), A, form.bl,
+                                         form.bu, c, x, lam, ok, KKT_TOLERANCE, ALPHA_MAX)
+        return fin['passes'].tolist()

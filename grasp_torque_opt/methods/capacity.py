@@ -10,8 +10,15 @@
 Load capacity: how many times over a grasp holds its load, and how much along each axis.
 
 The capacity of a grasp for a load w_ext is the largest factor alpha such that
-alpha w_ext is holdable within the torque limits and the (margined) linearized
-cones, an LP over the contact wrenches f and alpha (docs/planner.md):
+every load s w_ext with s in [0, alpha] is holdable within the torque limits and the
+(margined) linearized cones (docs/planner.md). The loads a grasp holds along w_ext
+form an interval (the constraints are convex), which need not contain zero: a grasp
+whose contacts only balance a weight cannot squeeze at the minimum normal force
+without it. So zero load is checked first (:meth:`CapacityLP.zero_load`, once per
+grasp, a feasibility LP whose wrenches are certified at zero load); a grasp that
+cannot hold it has capacity 0 (``infeasible``, with the infeasibility certificate of
+:mod:`.infeasibility` saying why). Then the top of the interval is an LP over the
+contact wrenches f and alpha:
 
     maximize    alpha
     subject to  G f + alpha w_ext = 0
@@ -23,9 +30,11 @@ on the unit direction w_ext / max|w_ext| (alpha rescaled after, so that the LP's
 numbers do not depend on the load's size). Solved by
 :func:`grasp_torque_opt.methods.lp.solve_lp` (DAQP, KKT-checked, HiGHS behind it)
 and certified like every other result: the f it returns is checked against the
-exact problem at the load alpha w_ext (:func:`certify`), so the grasp provably
-holds alpha times the load. alpha < 1: the load itself cannot be held,
-and alpha is the largest holdable fraction of it (:mod:`.explain` says what binds).
+exact problem at the load alpha w_ext (:func:`certify`). With the certified zero-load
+wrenches f0, (1 - s/alpha) f0 + (s/alpha) f holds s w_ext for every s in [0, alpha]
+(the exact cone is convex), so the grasp provably holds every load up to alpha times
+its own. alpha < 1: the load itself cannot be held, and alpha is the largest
+holdable fraction of it (:mod:`.explain` says what binds).
 
 The 12 axis capacities are the same LP for the unit loads +-e_i, about the object
 origin in base axes: +Fx is the largest force [N] along +x that the environment
@@ -35,6 +44,7 @@ may apply on the object (a weight with gravity along +x), +Mx the largest moment
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 from grasp_torque_opt.core.certificate import Certificate, certify, DEFAULT_TOLERANCE
@@ -97,13 +107,14 @@ class Capacity:
     One capacity.
 
     Attributes:
-        status: ``optimal`` (certified), ``infeasible`` (not even alpha = 0 holds;
+        status: ``optimal`` (certified), ``infeasible`` (not even zero load holds;
             confirmed by the independent feasibility LP, and ``binding`` and
             ``conflict`` from its infeasibility certificate, :mod:`.infeasibility`),
             ``unbounded`` (alpha reached :data:`ALPHA_MAX` on the unit direction, or the
             load is zero) or ``failed``.
         value: alpha: a factor on the load [-], or for an axis direction the largest
-            load along it [N or N m]; None unless ``optimal``.
+            load along it [N or N m], every smaller multiple held as well; 0 when
+            ``infeasible``; None when ``unbounded`` or ``failed``.
         unit: ``-``, ``N`` or ``N m``.
         tau: joint torques holding value times the load [N m], or None.
         wrenches: the contact wrenches then, shape (p, 4) [N, N m], or None.
@@ -172,6 +183,52 @@ class CapacityLP:
         self.c = np.zeros(n)
         self.c[-1] = -1.0
         self.form = DaqpForm(n, self.lower, self.upper)
+        # The zero-load LP: the same rows with alpha fixed at 0.
+        self.zero_upper = self.upper.copy()
+        self.zero_upper[nf] = 0.0
+        self.zero_form = DaqpForm(n, self.lower, self.zero_upper)
+        self.zero_form.sense[nf] = 5
+        self._zero: dict[bool, Capacity | None] = {}
+
+    def zero_load(self, highs_only: bool = False) -> Capacity | None:
+        """
+        Check that the grasp holds zero load (once per grasp; every direction shares it).
+
+        The capacity LP's rows with alpha fixed at 0 (DAQP, KKT-checked, HiGHS behind
+        it), the wrenches found certified at zero load.
+
+        Returns:
+            None when zero load is holdable (certified); else the capacity every load
+            direction then has: ``infeasible`` (value 0, confirmed by the independent
+            feasibility LP, the conflict from the infeasibility certificate) or
+            ``failed`` (no certified answer either way).
+        """
+        if highs_only not in self._zero:
+            self._zero[highs_only] = self._zero_load(highs_only)
+        return self._zero[highs_only]
+
+    def _zero_load(self, highs_only: bool) -> Capacity | None:
+        res = solve_lp(self.c, self.A, self.lower, self.zero_upper, highs_only=highs_only,
+                       form=self.zero_form)
+        if res.status == 'optimal' and self._holds_zero(res.x[:self.nf]):
+            return None
+        if res.solver == 'daqp' and not highs_only:
+            res = solve_lp(self.c, self.A, self.lower, self.zero_upper, highs_only=True)
+            if res.status == 'optimal' and self._holds_zero(res.x[:self.nf]):
+                return None
+        # Said only when the independent feasibility LP agrees that zero load cannot
+        # be held (else the verdict is numerics, not the grasp).
+        if linearized_feasible(self.maps, self.friction, np.zeros(6), self.tau_min,
+                               self.tau_max) is False:
+            return self._conflict(res)
+        return Capacity('failed', None, '-', solver=res.solver, message=(
+            f'zero load: {res.message}, and no certified answer (the feasibility LP does '
+            'not confirm that zero load cannot be held)'))
+
+    def _holds_zero(self, f: np.ndarray) -> bool:
+        """Certify the wrenches f at zero load (the exact planned cone, f_min, limits)."""
+        return certify(self.maps.G, self.maps.J, np.zeros(6), self.friction, self.tau_min,
+                       self.tau_max, self.maps.J.T @ f, f, self.tolerance).ok
 
     def solve(self, load: np.ndarray, unit: str = '-', highs_only: bool = False,
               binding: bool = True) -> Capacity:
@@ -190,6 +247,9 @@ class CapacityLP:
         scale = float(np.abs(load).max())  # the max norm: no overflow at 1e300
         if not np.isfinite(scale):
             return Capacity('failed', None, unit, message='load not finite')
+        zero = self.zero_load(highs_only)
+        if zero is not None:  # no load range from zero: capacity 0, or no answer
+            return dataclasses.replace(zero, unit=unit)
         if scale == 0.0:
             return Capacity('unbounded', None, unit, message=(
                 'zero load: any multiple of it is the same load'))
@@ -206,15 +266,9 @@ class CapacityLP:
 
     def _capacity(self, res: LPResult, load: np.ndarray, scale: float, unit: str,
                   binding: bool = True) -> Capacity:
-        if res.status == 'infeasible':
-            # Said only when the independent feasibility LP agrees that zero load cannot
-            # be held either (else the capacity LP's verdict is numerics, not the grasp).
-            if linearized_feasible(self.maps, self.friction, np.zeros(6), self.tau_min,
-                                   self.tau_max) is False:
-                return self._conflict(res, unit)
+        if res.status == 'infeasible':  # alpha = 0 is feasible (zero_load): numerics
             return Capacity('failed', None, unit, solver=res.solver, message=(
-                f'{res.message}, but the feasibility LP does not confirm that zero load '
-                'cannot be held'))
+                f'{res.message}, although zero load is holdable (certified)'))
         if res.status != 'optimal':
             return Capacity('failed', None, unit, solver=res.solver, message=res.message)
         f, alpha = res.x[:self.nf], float(res.x[-1])
@@ -235,15 +289,15 @@ class CapacityLP:
                         solver=res.solver,
                         message=f'certified ({res.message})')
 
-    def _conflict(self, res: LPResult, unit: str) -> Capacity:
-        """Zero load is not holdable: name the conflict from its certificate."""
+    def _conflict(self, res: LPResult) -> Capacity:
+        """Zero load is not holdable: capacity 0, the conflict named from its certificate."""
         conflict = zero_load_conflict(self.maps, self.friction, list(self.setup.hand.joints),
                                       self.tau_min, self.tau_max)
         if conflict is None:
-            return Capacity('infeasible', None, unit, solver=res.solver, message=(
+            return Capacity('infeasible', 0.0, '-', solver=res.solver, message=(
                 'not even zero load can be held; no infeasibility certificate found '
                 f'({res.message})'))
-        return Capacity('infeasible', None, unit, solver=res.solver,
+        return Capacity('infeasible', 0.0, '-', solver=res.solver,
                         binding=Binding(conflict.joints, conflict.contacts),
                         conflict=conflict,
                         message=conflict.text(self.friction.min_normal_force))

@@ -79,3 +79,24 @@ class Explanation:
 def explain(setup: GraspSetup, maps: GraspMaps | None = None) -> Explanation:
     """Find the largest holdable fraction of the setup's load and what binds there."""
     return Explanation(load_capacity(setup, maps))
+
+
+def holdable(cap: Capacity, status: str) -> tuple[float | None, str | None]:
+    """
+    Return a scored candidate's holdable fraction and why its capacity is not ``optimal``.
+
+    Args:
+        cap: the capacity LP's answer for its load.
+        status: the solve's status of that load.
+
+    Returns:
+        (the fraction: the capacity of an ``infeasible`` candidate, else None; the
+        capacity's message unless ``optimal``, else None). A capacity of 1 or more for
+        a load the solve found infeasible gives no fraction, and says so.
+    """
+    reason = None if cap.status == 'optimal' else cap.message
+    fraction = cap.value if status == 'infeasible' else None
+    if fraction is not None and fraction >= 1.0:  # the solve and the LP disagree
+        return None, (f'the capacity LP holds {cap.value:.6g} times the load, which the '
+                      'solve found infeasible')
+    return fraction, reason

@@ -34,7 +34,7 @@ from typing import Any
 
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
-from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.grasp_setup import bind_for_candidates
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import load_scenario, Scenario
@@ -161,7 +161,9 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     """
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
-    setup = GraspSetup.from_scenario(scenario)
+    # Only the hand is used: the candidates replace the base's contacts, whose distance
+    # to this object (a box's, not the sphere they were written for) says nothing.
+    setup, _ = bind_for_candidates(scenario)
     hand = setup.hand
     shape = _object_shape(scenario, shape)
     if mass is None:

@@ -38,22 +38,62 @@ def rank_key(records: Sequence[dict[str, Any]], by: str = 'capacity') -> str:
     return by
 
 
+#: The ranking's groups, in order: held (by the rank key), infeasible (by holdable
+#: fraction), the rest (infeasible without a fraction, failed, bad lines).
+GROUPS = ('feasible', 'infeasible', 'rest')
+
+
+def rank_group(record: dict[str, Any]) -> str:
+    """
+    Return the group of :data:`GROUPS` a record is ranked in.
+
+    ``feasible``: status ``optimal``; ``infeasible``: status ``infeasible`` with a
+    holdable fraction (``metrics="full"``); ``rest``: everything else.
+    """
+    status = record.get('status')
+    if status == 'optimal':
+        return 'feasible'
+    v = record.get('holdable_fraction')
+    if status == 'infeasible' and v is not None and math.isfinite(v):
+        return 'infeasible'
+    return 'rest'
+
+
 def rank(records: Sequence[dict[str, Any]], by: str = 'capacity') -> list[dict[str, Any]]:
     """
-    Optimal candidates best first by ``by`` (:data:`RANK_KEYS`), then the others.
+    Rank records: feasible ones by ``by``, then infeasible by holdable fraction, then the rest.
 
-    Without capacities (``metrics="basic"``) ``capacity`` falls back to ``torque_norm``.
+    Feasible (optimal) candidates come first, best first by ``by`` (:data:`RANK_KEYS`;
+    without capacities, ``metrics="basic"``, ``capacity`` falls back to
+    ``torque_norm``; one without a value after those with one); then infeasible
+    candidates by their holdable fraction, largest first; then the rest
+    (:func:`rank_group`), infeasible before failed before bad lines. Ties keep line
+    order.
     """
     by = rank_key(records, by)
     larger = RANK_KEYS[by]
 
     def key(r: dict) -> tuple:
-        v = r.get(by)
-        ok = r.get('status') == 'optimal' and v is not None and math.isfinite(v)
-        order = {'optimal': 0, 'infeasible': 1, 'failed': 2}.get(r.get('status'), 3)
-        return (not ok, order, (-v if larger else v) if ok else 0.0, r['line'])
+        group = GROUPS.index(rank_group(r))
+        if group == 0:
+            v = r.get(by)
+            ok = v is not None and math.isfinite(v)
+            return (0, not ok, (-v if larger else v) if ok else 0.0, r['line'])
+        if group == 1:
+            return (1, False, -r['holdable_fraction'], r['line'])
+        order = {'infeasible': 0, 'failed': 1}.get(r.get('status'), 2)
+        return (2, False, order, r['line'])
 
     return sorted(records, key=key)
+
+
+def ranked_records(records: Sequence[dict[str, Any]], by: str = 'capacity'
+                   ) -> list[dict[str, Any]]:
+    """Set each record's ``rank`` (1 the best, :func:`rank`) in place; return them ranked."""
+    ranked = rank(records, by)
+    for i, r in enumerate(ranked, 1):
+        r['rank'] = i
+    return ranked
 
 
 def summary(records: Sequence[dict[str, Any]], seconds: float) -> str:
@@ -73,13 +113,14 @@ def format_table(ranked: Sequence[dict[str, Any]], top: int = 10) -> str:
         return format(v, fmt) if v is not None else '-'.rjust(int(fmt.split('.')[0]))
 
     full = any('capacity' in r for r in ranked)
-    head = f"{'rank':>4}  {'line':>6}  {'id':<12} {'status':<10} {'|tau| N m':>9} " \
-           f"{'max tau/lim':>11} {'friction':>8}"
+    head = f"{'rank':>4}  {'group':<10} {'line':>6}  {'id':<12} {'status':<10} " \
+           f"{'|tau| N m':>9} {'max tau/lim':>11} {'friction':>8}"
     if full:
         head += f" {'capacity':>8} {'worst axis':>18}"
     lines = [head]
     for i, r in enumerate(ranked[:top], 1):
-        row = (f"{i:>4}  {r['line']:>6}  {str(r.get('id'))[:12]:<12} {r['status']:<10} "
+        row = (f"{i:>4}  {rank_group(r):<10} {r['line']:>6}  {str(r.get('id'))[:12]:<12} "
+               f"{r['status']:<10} "
                f"{num(r.get('torque_norm'), '9.4f')} {num(r.get('max_torque_ratio'), '11.3f')} "
                f"{num(r.get('friction_usage_max'), '8.3f')}")
         if full:

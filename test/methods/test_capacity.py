@@ -6,15 +6,18 @@
 #
 # SPDX-License-Identifier: BSD-3-Clause
 
-"""Load capacity: feasible at alpha, infeasible just above, by independent solvers."""
+"""Load capacity: every load from zero to alpha held, none just above, by independent solvers."""
 
 import copy
 import dataclasses
 
+import box_grasp
 from conftest import setup_from_doc
+from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.capacity import direction_capacities, DIRECTIONS, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
-from independent import assert_holds, lp_capacity, lp_feasible
+from grasp_torque_opt.methods.explain import explain
+from independent import assert_holds, lp_alpha_range, lp_capacity, lp_feasible
 import numpy as np
 import pytest
 
@@ -47,7 +50,8 @@ def test_allegro_capacity_holds_at_alpha_and_not_just_above(allegro_doc, margin)
     cap = load_capacity(setup, maps)
     assert cap.status == 'optimal' and cap.certificate.ok and cap.value > 1
     w = setup.external_wrench
-    assert holds(setup, maps, (1 - 1e-6) * cap.value * w)
+    for s in (0.0, 0.5, 1 - 1e-6):  # the whole range from zero
+        assert holds(setup, maps, s * cap.value * w), s
     assert above_is_infeasible(setup, maps, (1 + 1e-4) * cap.value * w)
     # The LP's own holding wrenches, checked independently at alpha w_ext.
     assert_holds(dataclasses.replace(reduced(setup), external_wrench=cap.value * w), maps,
@@ -74,7 +78,8 @@ def test_axis_capacities_hold_at_their_value_and_not_above(allegro):
         d[i] = sign
         assert cap.status == 'optimal', (name, cap.message)
         assert cap.unit == ('N' if name[1] == 'F' else 'N m')
-        assert holds(allegro, maps, (1 - 1e-6) * cap.value * d), name
+        for s in (0.0, 0.5, 1 - 1e-6):
+            assert holds(allegro, maps, s * cap.value * d), (name, s)
         assert above_is_infeasible(allegro, maps, (1 + 1e-4) * cap.value * d), name
 
 
@@ -88,13 +93,19 @@ def test_planar_capacity_with_internal_forces(planar):
     assert above_is_infeasible(planar, maps, (1 + 1e-4) * cap.value * w)
 
 
-def test_no_capacity_when_not_even_zero_load_holds(allegro_doc):
+def test_capacity_zero_when_not_even_zero_load_holds(allegro_doc):
     doc = copy.deepcopy(allegro_doc)
     doc['friction']['min_normal_force'] = 50.0  # no joint can squeeze this hard
     setup = setup_from_doc(doc)
-    cap = load_capacity(setup)
-    assert cap.status == 'infeasible' and cap.value is None
+    maps = setup.maps()
+    assert not lp_feasible(dataclasses.replace(setup, external_wrench=np.zeros(6)), maps)
+    cap = load_capacity(setup, maps)
+    assert cap.status == 'infeasible' and cap.value == 0.0
+    assert cap.conflict is not None and cap.conflict.certified
     assert 'minimum normal force' in cap.message
+    for name, c in direction_capacities(setup, maps).items():
+        assert (c.status, c.value) == ('infeasible', 0.0), name
+        assert c.unit == ('N' if name[1] == 'F' else 'N m')
 
 
 @pytest.mark.parametrize('scale', [1e-200, 1e-6, 1e6, 1e200])
@@ -130,3 +141,35 @@ def test_capacity_equals_an_independent_lp_on_random_grasps(allegro):
         alpha, _ = lp_capacity(setup, maps, setup.external_wrench)
         assert cap.status == 'optimal' and cap.certificate.ok
         assert cap.value == pytest.approx(alpha, rel=1e-6)
+
+
+def box_setup(tmp_path, mz: float) -> GraspSetup:
+    """
+    Return the box held by two fingers and an offset thumb, mu 0.3, under a moment Mz.
+
+    Its squeeze makes a moment about +z that friction cannot balance (test/box_grasp.py):
+    zero load is not holdable, a load of -Mz large enough is.
+    """
+    doc = box_grasp.scenario()
+    doc['load']['external_wrench'] = [0.0, 0.0, 0.0, 0.0, 0.0, mz]
+    return GraspSetup.from_file(box_grasp.write(tmp_path, doc))
+
+
+@pytest.mark.parametrize('mz', [-0.01, -0.04])
+def test_a_load_range_that_misses_zero_gives_capacity_zero(tmp_path, mz):
+    setup = box_setup(tmp_path, mz)
+    maps = setup.maps()
+    w = setup.external_wrench
+    lo, hi = lp_alpha_range(setup, maps, w)
+    assert 0 < lo < hi  # HiGHS: multiples from lo to hi are held, none below lo
+    assert not lp_feasible(dataclasses.replace(setup, external_wrench=np.zeros(6)), maps)
+    assert holds(setup, maps, 2 * lo * w)  # the tau-QP agrees that some are
+    assert solve(setup, maps=maps).status == ('optimal' if lo <= 1 else 'infeasible')
+    cap = load_capacity(setup, maps)
+    assert (cap.status, cap.value) == ('infeasible', 0.0)
+    assert cap.conflict.certified and 'not even zero load' in cap.message
+    axis = direction_capacities(setup, maps)['-Mz']  # held from 0.016 N m, not from 0
+    assert lp_alpha_range(setup, maps, np.array([0, 0, 0, 0, 0, -1.0]))[0] > 0
+    assert (axis.status, axis.value, axis.unit) == ('infeasible', 0.0, 'N m')
+    why = explain(setup, maps)
+    assert why.holdable_fraction == 0.0 and why.text == cap.message

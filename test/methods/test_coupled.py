@@ -16,8 +16,9 @@ from conftest import CONFIG, setup_from_doc
 from coupled_reference import coupled_lp, coupled_qp, mechanism
 from grasp_torque_opt.methods.capacity import load_capacity
 from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.methods.engines import score_batch
 from grasp_torque_opt.methods.explain import explain
-from grasp_torque_opt.methods.score import score_batch, ScoreJob
+from grasp_torque_opt.methods.score import ScoreJob
 from independent import assert_holds
 import numpy as np
 import pytest

@@ -28,7 +28,7 @@ def test_the_thumb_off_the_fingers_line_is_a_friction_conflict(tmp_path):
     assert solve(setup).status == 'infeasible'
     why = explain(setup)
     c = why.capacity
-    assert c.status == 'infeasible' and why.holdable_fraction is None
+    assert c.status == 'infeasible' and why.holdable_fraction == 0.0
     assert c.conflict.certified
     assert c.binding.joints == []  # 1000 N limits never bind
     kinds = {k for _, k in c.binding.contacts}

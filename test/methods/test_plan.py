@@ -18,17 +18,20 @@ coal directly; the joints against the URDF's limits. Then ``score`` solves them.
 
 import copy
 import json
+import warnings
 
 import coal
 from conftest import ALLEGRO, ROOT
 from grasp_torque_opt.cli import main
+from grasp_torque_opt.core.exceptions import GeometryWarning
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import parse_scenario
+from grasp_torque_opt.methods.engines import score_batch
 from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
 from grasp_torque_opt.methods.plan_ik import SurfaceIK
-from grasp_torque_opt.methods.score import score_batch, ScoreJob
+from grasp_torque_opt.methods.score import ScoreJob
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -221,3 +224,21 @@ def test_too_few_found_exits_3(capsys):
                  'sphere', '--size', '0.2', '--no-rotate'])
     out, err = capsys.readouterr()
     assert code == 5 and out == '' and 'planned 0 of 1 candidates in 2 IKs' in err
+
+
+def test_a_cylinder_base_plans_and_scores_without_its_contacts_warnings(tmp_path, allegro_doc):
+    """The base's sphere contacts sit off a cylinder: warned only for a line that keeps them."""
+    doc = copy.deepcopy(allegro_doc)
+    doc['object'] = {'shape': 'cylinder', 'size': [0.025, 0.08], 'mass': 0.12}
+    base = tmp_path / 'cylinder.yaml'
+    base.write_text(yaml.safe_dump(doc))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        plan = plan_grasps(base, PlanSettings(count=2, seed=7))
+        score_batch(ScoreJob.from_file(base), plan.candidates, engine='serial')
+    assert not [w for w in caught if issubclass(w.category, GeometryWarning)]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter('always')
+        score_batch(ScoreJob.from_file(base), [{'id': 'keeps the contacts'}], engine='serial')
+    kept = [str(w.message) for w in caught if issubclass(w.category, GeometryWarning)]
+    assert len(kept) == 4 and all("inside the object's cylinder" in m for m in kept), kept

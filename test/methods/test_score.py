@@ -14,17 +14,20 @@ serial answers.
 """
 
 import copy
+import dataclasses
 import json
 import subprocess
 import sys
 
+import box_grasp
 from conftest import ALLEGRO
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.capacity import direction_capacities, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.methods.engines import score_batch
 from grasp_torque_opt.methods.ranking import rank
-from grasp_torque_opt.methods.score import merge, score_batch, ScoreJob
-from independent import assert_holds
+from grasp_torque_opt.methods.score import merge, ScoreJob
+from independent import assert_holds, lp_alpha_range, lp_feasible
 import numpy as np
 import pytest
 import yaml
@@ -108,10 +111,30 @@ def test_batch_scores_equal_single_solves(job, lines, tmp_path, allegro_doc):
             assert rec['holdable_fraction'] is None
         else:
             assert rec['torque_norm'] is None and rec['holdable_fraction'] == rec['capacity'] < 1
+        assert (rec['capacity_reason'] is None) == (cap.status == 'optimal'), cand['id']
     by_id = {r['id']: r for r in records}
     assert by_id['heavy']['status'] == 'infeasible'
     assert by_id['margin']['friction_usage_max'] <= 1 / 1.2 + 1e-7
     assert by_id['three']['status'] == 'optimal' and len(by_id['three']['friction_usage']) == 3
+
+
+def test_a_grasp_that_holds_no_zero_load_scores_capacity_zero(tmp_path):
+    """The offset-thumb box (test/box_grasp.py): -Mz loads held from some size on only."""
+    job = ScoreJob.from_file(box_grasp.write(tmp_path, box_grasp.scenario()))
+    loads = {'small': -0.01, 'large': -0.04}  # N m about z: infeasible, then optimal
+    records = score_batch(job, [{'id': k, 'load': {'external_wrench': [0, 0, 0, 0, 0, v]}}
+                                for k, v in loads.items()], engine='serial')
+    setup = GraspSetup.from_file(tmp_path / 'box.yaml')
+    maps = setup.maps()
+    assert not lp_feasible(dataclasses.replace(setup, external_wrench=np.zeros(6)), maps)
+    for rec in records:
+        w = np.array([0, 0, 0, 0, 0, loads[rec['id']]])
+        lo, _ = lp_alpha_range(setup, maps, w)  # HiGHS: held from lo times w, not below
+        assert rec['status'] == ('optimal' if lo <= 1 else 'infeasible'), rec['id']
+        assert (rec['capacity'], rec['capacity_status']) == (0.0, 'infeasible')
+        assert 'not even zero load' in rec['capacity_reason']
+        assert set(rec['capacities'].values()) == {0.0}
+        assert rec['holdable_fraction'] == (0.0 if rec['status'] == 'infeasible' else None)
 
 
 def test_bad_lines_name_line_and_field_and_the_batch_goes_on(job):
