@@ -36,7 +36,7 @@ from grasp_torque_opt.backends import make_solver, single_threaded_math
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import MAX_CONTACTS
 from grasp_torque_opt.core.scenario_fields import ContactSpec

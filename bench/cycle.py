@@ -55,7 +55,7 @@ from grasp_torque_opt.backends import BACKENDS, make_solver, single_threaded_mat
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.geometry import ContactTracker
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import resolve_urdf

@@ -19,7 +19,7 @@ import time
 
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import SolverError
 from grasp_torque_opt.core.solution import RawResult
 import numpy as np

@@ -19,12 +19,10 @@ from __future__ import annotations
 from collections import Counter
 import math
 
+from grasp_torque_opt.control.parameters.limits import MAX_GRAVITY
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError
 import numpy as np
 import pinocchio as pin
-
-#: Largest accepted norm of a gravity input [m/s^2] (about 10 g), parameter or message.
-MAX_GRAVITY = 100.0
 
 #: A quaternion is accepted when | ||q|| - 1 | is at most this, then normalized.
 QUATERNION_TOLERANCE = 1e-3

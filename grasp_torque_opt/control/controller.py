@@ -52,7 +52,7 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control.cycle import Cycle
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, InputStore
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.control.rates import slewed, step_wrenches
 from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.grasp_maps import GraspMaps

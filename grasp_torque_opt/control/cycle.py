@@ -31,7 +31,7 @@ from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.named_contacts import topic_contacts
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup

@@ -21,7 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from grasp_torque_opt.control.inputs.store import Counters
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.solution import Solution

@@ -23,7 +23,7 @@ import dataclasses
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.scenario import Scenario
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated

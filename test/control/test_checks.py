@@ -13,12 +13,12 @@ from grasp_torque_opt.control.checks import (
     checked_gravity,
     checked_wrench,
     contact_rotations,
-    MAX_GRAVITY,
     quaternion_matrix,
     show,
     SHOWN_NAME_LENGTH,
 )
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
+from grasp_torque_opt.control.parameters.limits import MAX_GRAVITY
 from grasp_torque_opt.core.exceptions import InputError
 import numpy as np
 import pytest

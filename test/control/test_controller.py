@@ -18,7 +18,7 @@ from cycle_inputs import base_poses, FAULT_MODES, fresh, Injected, joint_state, 
 from grasp_torque_opt.control.inputs.contacts import ContactsReading
 from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.methods.dispatch import solve

@@ -15,7 +15,7 @@ from cycle_inputs import Injected
 from grasp_torque_opt.backends import DaqpSettings, make_solver, ProxSuiteSettings
 from grasp_torque_opt.control.cycle import Cycle, round_settings
 from grasp_torque_opt.control.inputs.store import Counters, Inputs
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 import pytest
 
 

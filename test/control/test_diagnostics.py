@@ -15,7 +15,7 @@ from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.diagnostics import ERROR, OK, report, STALE, WARN
 from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import numpy as np
 import pytest

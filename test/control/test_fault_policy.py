@@ -12,7 +12,7 @@ import dataclasses
 
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
 from grasp_torque_opt.control.inputs.store import Counters
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 import numpy as np
 import pytest
 

@@ -13,7 +13,7 @@ from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
 from grasp_torque_opt.control.inputs.gravity import GravityReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, InputStore
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 import pytest
 

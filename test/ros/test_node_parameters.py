@@ -9,7 +9,7 @@
 
 """The node's parameters over ROS, from the schema: descriptors and every validator known."""
 
-from grasp_torque_opt.control.param_validators import BUILT_IN
+from grasp_torque_opt.control.parameters.validators import BUILT_IN
 from grasp_torque_opt.ros.node.parameters import (
     descriptor,
     FIXED_WHILE_CONFIGURED,

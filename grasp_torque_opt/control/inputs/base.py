@@ -23,7 +23,7 @@ import numpy as np
 
 if TYPE_CHECKING:  # the store is the composition root of the inputs
     from grasp_torque_opt.control.inputs.store import Inputs, InputStore
-    from grasp_torque_opt.control.parameters import CycleConfig
+    from grasp_torque_opt.control.parameters.generated import CycleConfig
 
 #: The QoS an input is subscribed with: the joint states' own (reliable, a short
 #: queue: docs/design.md section 4.3), or rclpy's sensor-data profile.

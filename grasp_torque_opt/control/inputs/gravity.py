@@ -65,7 +65,7 @@ class Gravity:
 
         Raises:
             InputError: another frame without ``rotation``, not finite, a norm above
-                :data:`~grasp_torque_opt.control.checks.MAX_GRAVITY` or outside
+                :data:`~grasp_torque_opt.control.parameters.limits.MAX_GRAVITY` or outside
                 ``gravity_norm_bounds``.
         """
         return checked_gravity(store.setup.hand.base_frame, reading.frame, reading.vector,

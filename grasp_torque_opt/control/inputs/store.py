@@ -25,7 +25,7 @@ from grasp_torque_opt.control.geometry import ObjectPose
 from grasp_torque_opt.control.inputs.contacts import ContactPoses
 from grasp_torque_opt.control.inputs.registry import REGISTRY, SOURCES
 from grasp_torque_opt.control.motion import ImuTracker, Motion
-from grasp_torque_opt.control.parameters import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import ObjectSpec

@@ -22,11 +22,11 @@ from typing import Any
 
 from grasp_torque_opt.backends import available, make_solver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
-from grasp_torque_opt.backends.registry import is_backend, settings_for
+from grasp_torque_opt.backends.registry import entry, is_backend, settings_for
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.control.param_validators import stated_margin
-from grasp_torque_opt.control.parameters import cycle_config
+from grasp_torque_opt.control.parameters.generated import cycle_config
+from grasp_torque_opt.control.parameters.validators import stated_margin
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 import numpy as np
 
@@ -50,7 +50,7 @@ def setup_of(setup: GraspSetup, p: Any, obj: Any = None) -> GraspSetup:
     Give the grasp with the parameters' friction, weights, limits, objective, origin.
 
     The friction margin is the larger of ``friction_margin`` and the one the stated
-    uncertainty asks (:func:`~grasp_torque_opt.control.param_validators.stated_margin`;
+    uncertainty asks (:func:`~grasp_torque_opt.control.parameters.validators.stated_margin`;
     ``obj``: the scenario's object, whose radius the pose uncertainty needs).
     """
     margin = p.friction_margin
@@ -90,7 +90,8 @@ def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
     Args:
         ctrl: the controller to change, or None to make one.
         setup: the grasp as loaded (the parameters' values go over it).
-        p: the parameters (a frozen snapshot, :meth:`Schema.params`).
+        p: the parameters (a frozen snapshot,
+            :class:`~grasp_torque_opt.control.parameters.generated.Params`).
         service: the service's controller (cold, in slices) instead of the loop's.
         obj: the scenario's object (the stated pose uncertainty's radius).
 
@@ -98,7 +99,8 @@ def configure(ctrl: TorqueController | None, setup: GraspSetup, p: Any,
         The controller.
     """
     backend = p.solver.backend
-    warm = not service and p.solver.warm_start and backend != 'quadprog'
+    # A backend without warm starts of its own (quadprog) is made without one.
+    warm = not service and p.solver.warm_start and entry(backend).warm_start
     slice_s = SERVICE_SLICE_S if service else None
     settings = solver_settings(p)
     fallback = fallback_backend(backend, p.solver.fallback)

@@ -23,7 +23,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from grasp_torque_opt.control.param_validators import check_pairs, Context
+from grasp_torque_opt.control.parameters.generated import params_from
+from grasp_torque_opt.control.parameters.validators import check_pairs, Context
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.parameters import (
     descriptor,
@@ -72,7 +73,7 @@ class DeclaredParameters:
 
     def snapshot(self) -> Any:
         """Take a frozen, typed snapshot of every value (``p.solver.backend``)."""
-        return PARAMETERS.params(self.values())
+        return params_from(self.values())
 
     def declare(self, name: str, value: Any = None) -> Any:
         """

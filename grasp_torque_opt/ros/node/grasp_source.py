@@ -27,7 +27,7 @@ from typing import Any
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.geometry import ContactTracker
 from grasp_torque_opt.control.motion import Motion, motion_wrench
-from grasp_torque_opt.control.param_validators import name_map_of
+from grasp_torque_opt.control.parameters.validators import name_map_of
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNotFound
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup

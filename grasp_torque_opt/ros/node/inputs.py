@@ -37,7 +37,7 @@ from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.object_pose import PoseReading
 from grasp_torque_opt.control.inputs.registry import REGISTRY
-from grasp_torque_opt.control.parameters import value_of
+from grasp_torque_opt.control.parameters.generated import value_of
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
 from grasp_torque_opt.ros.peers import quiet_subscription

@@ -11,7 +11,7 @@
 The node's parameters over ROS: declared, described and checked from the one schema.
 
 The schema is ``grasp_torque_opt/control/grasp_torque_node_parameters.yaml``
-(:mod:`grasp_torque_opt.control.parameters`); here it gets what needs ROS: the
+(:mod:`grasp_torque_opt.control.parameters.schema`); here it gets what needs ROS: the
 ``ParameterDescriptor`` of each entry, the topic-name check, the types rclpy declares
 a parameter with while it has no value, and the snapshot of the values the node runs
 with.
@@ -22,8 +22,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from grasp_torque_opt.control.param_validators import Context
-from grasp_torque_opt.control.parameters import ParamSpec, SCHEMA
+from grasp_torque_opt.control.parameters.schema import ParamSpec, SCHEMA
+from grasp_torque_opt.control.parameters.validators import Context
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import Hand, MAX_TORQUE_LIMIT
 from grasp_torque_opt.core.scenario import Scenario
@@ -54,7 +54,7 @@ def validate_topic(name: str, value: Any, ctx: Context) -> str:
 
 
 #: The node's parameters: the schema with its ROS validators. ``PARAMETERS[name]`` is
-#: the entry (:class:`~grasp_torque_opt.control.parameters.ParamSpec`).
+#: the entry (:class:`~grasp_torque_opt.control.parameters.schema.ParamSpec`).
 PARAMETERS = SCHEMA.with_validators(topic_name=validate_topic)
 #: The parameters whose defaults come from the scenario (and its hand): the managed node
 #: declares them by type until configure fills them in.
@@ -96,25 +96,13 @@ def descriptor(name: str, managed: bool = False) -> ParameterDescriptor:
 
 
 def scenario_defaults(scenario: Scenario, setup: GraspSetup) -> dict[str, Any]:
-    """Give the defaults of :data:`SCENARIO_PARAMETERS` from a scenario bound to its hand."""
-    out = {
-        'joints': list(setup.hand.joints),
-        'torque_limits_above_urdf': scenario.torque_limits_above_urdf,
-        'object_origin': [float(x) for x in setup.object_origin],
-        'mu_tangential': setup.friction.mu1,
-        'mu_torsional': setup.friction.mu2,
-        'polygon_sides': setup.friction.sides,
-        'min_normal_force': setup.friction.min_normal_force,
-        'torque_limits': [float(x) for x in setup.hand.torque_limits],
-        'weights': [float(x) for x in setup.weights],
-        'friction_margin': setup.friction.margin,
-        'objective': setup.objective,
-        # One place for gravity: the scenario's, which also gives its load.
-        'gravity': ([float(x) for x in scenario.gravity] if scenario.gravity is not None
-                    else list(PARAMETERS['gravity'].default)),
-    }
-    assert out.keys() == SCENARIO_PARAMETERS.keys()  # the schema and this table agree
-    return out
+    """
+    Give the defaults of :data:`SCENARIO_PARAMETERS` from a scenario bound to its hand.
+
+    Each is read where its entry's ``from_scenario`` field says
+    (:meth:`~grasp_torque_opt.control.parameters.schema.Schema.scenario_defaults`).
+    """
+    return PARAMETERS.scenario_defaults({'scenario': scenario, 'setup': setup})
 
 
 def limit_bounds(hand: Hand, above_urdf: bool) -> np.ndarray:

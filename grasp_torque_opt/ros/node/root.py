@@ -26,7 +26,7 @@ import time
 from typing import Any
 
 from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.control.param_validators import check_pairs
+from grasp_torque_opt.control.parameters.validators import check_pairs
 from grasp_torque_opt.ros.node import controllers
 from grasp_torque_opt.ros.node.declared import DeclaredParameters
 from grasp_torque_opt.ros.node.grasp_source import (

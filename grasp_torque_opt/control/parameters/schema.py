@@ -7,22 +7,22 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-The node's parameters from one schema file, without ROS.
+The node's parameter schema read, without ROS: the loader.
 
-``grasp_torque_node_parameters.yaml`` beside this module is written in
+``grasp_torque_opt/control/grasp_torque_node_parameters.yaml`` is written in
 generate_parameter_library's format (ros2_controllers' ``*_parameters.yaml``): one
 entry per parameter with its type, default, description, read-only flag and
 validation. generate_parameter_library is a C++/Python code generator of the ROS
 build that is not on the package registry, so this module reads the same format
-itself; a colcon build could switch to the generated module later. From the file
-come:
+itself. From the file come:
 
 - :data:`SCHEMA`, the parameters in order (:class:`ParamSpec`), with
-  :meth:`Schema.check` (the validation that names the parameter) and the docs table
+  :meth:`Schema.check` (the validation that names the parameter), the scenario's
+  defaults (:meth:`Schema.scenario_defaults`) and the docs table
   (:meth:`Schema.markdown_table`, docs/design.md section 4.4);
-- :class:`CycleConfig`, the frozen settings of the cycle, whose fields are the
-  entries with a ``cycle`` key, with their types and defaults;
-- :meth:`Schema.params`, a frozen snapshot of every value (``p.solver.backend``).
+- the typed module :mod:`~grasp_torque_opt.control.parameters.generated`
+  (``CycleConfig``, the ``Params`` snapshot), written from :data:`SCHEMA` by
+  :mod:`~grasp_torque_opt.control.parameters.generate`.
 
 The ROS side (declarations, descriptors, topic-name checks) is
 :mod:`grasp_torque_opt.ros.node.parameters`.
@@ -31,23 +31,30 @@ The ROS side (declarations, descriptors, topic-name checks) is
 from __future__ import annotations
 
 from collections.abc import Mapping
-import dataclasses
 from dataclasses import dataclass
 import math
 from pathlib import Path
 from typing import Any
 
-from grasp_torque_opt.control.param_validators import BUILT_IN, Context, Validator, VALIDATORS
+from grasp_torque_opt.control.parameters.validators import (
+    BUILT_IN,
+    Context,
+    REGISTRY_CHOICES,
+    Validator,
+    VALIDATORS,
+)
 from grasp_torque_opt.core.exceptions import InputError
 import yaml
 
 #: The schema file.
-SCHEMA_FILE = Path(__file__).with_name('grasp_torque_node_parameters.yaml')
+SCHEMA_FILE = Path(__file__).parent.parent / 'grasp_torque_node_parameters.yaml'
 #: Python types of the schema's types.
 PYTHON_TYPES = {'string': str, 'double': float, 'int': int, 'bool': bool,
                 'string_array': tuple, 'double_array': tuple}
 #: Validators that fix an array's length: run first, as the others index it.
 SIZE_VALIDATORS = ('fixed_size<>', 'size_of_joints')
+#: What a ``from_scenario`` field is read from: the scenario, or the grasp bound to its hand.
+SCENARIO_SOURCES = ('scenario', 'setup')
 
 
 @dataclass(frozen=True)
@@ -64,8 +71,11 @@ class ParamSpec:
         default: the default value (None: none: from the scenario, or unset).
         read_only: fixed after start (the managed node: while configured).
         from_scenario: where the scenario gives the default, in words (None: not).
+        scenario_field: the attribute that gives it, from one of
+            :data:`SCENARIO_SOURCES` (``setup.friction.mu1``; None: not from the
+            scenario).
         unset: the words for a parameter without a default that may stay unset.
-        cycle: the :class:`CycleConfig` field that takes it (None: none).
+        cycle: the ``CycleConfig`` field that takes it (None: none).
         validation: (validator, arguments) in the file's order.
     """
 
@@ -76,6 +86,7 @@ class ParamSpec:
     default: Any = None
     read_only: bool = False
     from_scenario: str | None = None
+    scenario_field: str | None = None
     unset: str | None = None
     cycle: str | None = None
     validation: tuple[tuple[str, tuple], ...] = ()
@@ -97,6 +108,36 @@ class ParamSpec:
         return tuple(args[0]) if args else None
 
 
+def _from_scenario(name: str, entry: Mapping[str, Any]) -> tuple[str | None, str | None]:
+    """Read an entry's ``from_scenario: {field: SOURCE.ATTRIBUTE..., docs: WORDS}``."""
+    given = entry.get('from_scenario')
+    if given is None:
+        return None, None
+    field = given.get('field', '') if isinstance(given, Mapping) else ''
+    if field.partition('.')[0] not in SCENARIO_SOURCES or 'docs' not in given:
+        raise ValueError(f'{SCHEMA_FILE.name}: {name}: from_scenario must be '
+                         f"{{field: {'|'.join(SCENARIO_SOURCES)}.ATTRIBUTE, docs: WORDS}}, "
+                         f'got {given!r}')
+    return str(given['docs']), field
+
+
+def _validation(entry: Mapping[str, Any]) -> tuple[tuple[str, tuple], ...]:
+    """
+    Read an entry's validators, in order, with a registry's choices filled in.
+
+    ``one_of_backends: [[none]]`` becomes ``one_of<>: [[proxsuite, daqp, quadprog, none]]``
+    (:data:`~grasp_torque_opt.control.parameters.validators.REGISTRY_CHOICES`).
+    """
+    out = []
+    for validator, args in (entry.get('validation') or {}).items():
+        args = tuple(args or ())
+        if validator in REGISTRY_CHOICES:
+            extra = tuple(args[0]) if args else ()
+            validator, args = 'one_of<>', ((*REGISTRY_CHOICES[validator], *extra),)
+        out.append((validator, args))
+    return tuple(out)
+
+
 def _entries(tree: Mapping[str, Any], prefix: str = '') -> list[ParamSpec]:
     """Flatten the file's nested maps into specs, in the file's order."""
     out = []
@@ -109,15 +150,14 @@ def _entries(tree: Mapping[str, Any], prefix: str = '') -> list[ParamSpec]:
             raise ValueError(f'{SCHEMA_FILE.name}: {name}: unknown type {entry["type"]!r}')
         cycle = entry.get('cycle')
         default = entry.get('default_value')
+        words, field = _from_scenario(name, entry)
         out.append(ParamSpec(
             name=name, type=entry['type'], description=' '.join(entry['description'].split()),
             unit=str(entry.get('unit', '-')),
             default=tuple(default) if isinstance(default, list) else default,
             read_only=bool(entry.get('read_only', False)),
-            from_scenario=entry.get('from_scenario'), unset=entry.get('unset'),
-            cycle=(key if cycle is True else cycle) or None,
-            validation=tuple((v, tuple(args or ())) for v, args in
-                             (entry.get('validation') or {}).items())))
+            from_scenario=words, scenario_field=field, unset=entry.get('unset'),
+            cycle=(key if cycle is True else cycle) or None, validation=_validation(entry)))
     return out
 
 
@@ -157,6 +197,30 @@ class Schema:
         return {s.name: list(s.default) if isinstance(s.default, tuple) else s.default
                 for s in self.specs.values()
                 if s.default is not None and s.from_scenario is None}
+
+    def scenario_defaults(self, sources: Mapping[str, Any]) -> dict[str, Any]:
+        """
+        Give the defaults that come from the scenario, each read where its entry says.
+
+        Args:
+            sources: :data:`SCENARIO_SOURCES` -> the object (``scenario``: the
+                :class:`~grasp_torque_opt.core.scenario.Scenario`; ``setup``: the
+                :class:`~grasp_torque_opt.core.grasp_setup.GraspSetup` bound to its hand).
+
+        Returns:
+            name -> value in the parameter's own type (lists for arrays), in declaration
+            order; where the scenario gives none (None), the entry's ``default_value``.
+        """
+        out = {}
+        for s in self.specs.values():
+            if s.scenario_field is None:
+                continue
+            source, *path = s.scenario_field.split('.')
+            value = sources[source]
+            for part in path:
+                value = getattr(value, part)
+            out[s.name] = _plain(s, s.default if value is None else value)
+        return out
 
     def reason(self, name: str, value: Any, ctx: Context = Context()) -> str:
         """Say why a value is refused, 'NAME: PROBLEM' ('' if it is accepted)."""
@@ -198,10 +262,6 @@ class Schema:
         if problem:
             raise InputError(spec.name, problem)
 
-    def params(self, values: Mapping[str, Any]) -> Any:
-        """Make a frozen snapshot of every value (``p.solver.backend``, ...)."""
-        return _snapshot(PARAMS_CLASSES, values)
-
     def markdown_table(self) -> str:
         """Write the parameter table of docs/design.md section 4.4."""
         rows = ['| parameter | type | unit | default | range, meaning |',
@@ -210,6 +270,14 @@ class Schema:
             rows.append(f'| `{s.name}` | {_type_words(s)} | {s.unit} | {_default_words(s)} '
                         f'| {_meaning(s)} |')
         return '\n'.join(rows) + '\n'
+
+
+def _plain(s: ParamSpec, value: Any) -> Any:
+    """Give a value in the parameter's type, as rclpy takes it (arrays as lists)."""
+    if value is None or not s.type.endswith('_array'):
+        return None if value is None else PYTHON_TYPES[s.type](value)
+    item = str if s.type == 'string_array' else float
+    return [item(x) for x in value]
 
 
 def _type_words(s: ParamSpec) -> str:
@@ -252,79 +320,7 @@ def _meaning(s: ParamSpec) -> str:
     return '; '.join(parts)
 
 
-def _tree(specs: list[ParamSpec]) -> dict[str, Any]:
-    tree: dict[str, Any] = {}
-    for s in specs:
-        *path, leaf = s.name.split('.')
-        node = tree
-        for part in path:
-            node = node.setdefault(part, {})
-        node[leaf] = s
-    return tree
-
-
-def _classes(name: str, tree: dict[str, Any]) -> tuple[type, dict[str, Any]]:
-    """Make a frozen dataclass per namespace of the schema."""
-    fields, subs = [], {}
-    for key, sub in tree.items():
-        if isinstance(sub, ParamSpec):
-            fields.append((key, PYTHON_TYPES[sub.type] | None))
-        else:
-            subs[key] = _classes(name + key.title(), sub)
-            fields.append((key, subs[key][0]))
-    cls = dataclasses.make_dataclass(name, fields, frozen=True)
-    cls.__module__ = __name__
-    return cls, subs
-
-
-def _snapshot(classes: tuple[type, dict[str, Any]], values: Mapping[str, Any],
-              prefix: str = '') -> Any:
-    cls, subs = classes
-    kwargs = {}
-    for f in dataclasses.fields(cls):
-        if f.name in subs:
-            kwargs[f.name] = _snapshot(subs[f.name], values, f'{prefix}{f.name}.')
-        else:
-            v = values.get(f'{prefix}{f.name}')
-            kwargs[f.name] = tuple(v) if isinstance(v, list) else v
-    return cls(**kwargs)
-
-
-def _cycle_config(specs: list[ParamSpec]) -> type:
-    """Make :class:`CycleConfig` from the entries with a ``cycle`` key."""
-    fields = [(s.cycle, PYTHON_TYPES[s.type], dataclasses.field(default=s.default))
-              for s in specs if s.cycle]
-    cls = dataclasses.make_dataclass('CycleConfig', fields, frozen=True)
-    cls.__module__ = __name__
-    cls.__doc__ = (
-        'Timing and safety settings of the cycle: the schema entries with a ``cycle`` key '
-        '(grasp_torque_node_parameters.yaml), with their types, defaults and units there. '
-        + ' '.join(f'{s.cycle}: {s.description} [{s.unit}].' for s in specs if s.cycle))
-    return cls
-
-
 #: The node's parameters.
 SCHEMA = Schema.load()
 #: The fault policies: keep the last certified command, or publish zero torques.
 POLICIES = SCHEMA['fault_policy'].choices
-#: The frozen classes of :meth:`Schema.params` (``Params``, ``ParamsSolver``).
-PARAMS_CLASSES = _classes('Params', _tree(list(SCHEMA.specs.values())))
-#: The cycle's settings: one field per schema entry with a ``cycle`` key.
-CycleConfig = _cycle_config(list(SCHEMA.specs.values()))
-
-
-def value_of(params: Any, name: str) -> Any:
-    """Give one value of a :meth:`Schema.params` snapshot by its dotted name."""
-    for part in name.split('.'):
-        params = getattr(params, part)
-    return params
-
-
-def cycle_config(params: Any) -> Any:
-    """Make the :class:`CycleConfig` of a :meth:`Schema.params` snapshot."""
-    return CycleConfig(**{s.cycle: value_of(params, n) for n, s in SCHEMA.specs.items()
-                          if s.cycle})
-
-
-if __name__ == '__main__':  # the table of docs/design.md section 4.4
-    print(SCHEMA.markdown_table(), end='')

@@ -12,8 +12,10 @@ The checks of the node's parameters: small pure functions, named in the schema.
 Built-in validators are generate_parameter_library's (``bounds<>``, ``one_of<>``,
 ``fixed_size<>``, ``element_bounds<>``); custom ones take (parameter, value,
 :class:`Context`) and give the problem in words ('' if none), or raise
-:class:`~grasp_torque_opt.core.exceptions.InputError` naming an entry. The ROS side
-adds its own (topic names) in :mod:`grasp_torque_opt.ros.node.parameters`.
+:class:`~grasp_torque_opt.core.exceptions.InputError` naming an entry. Choices that a
+registry holds are named, not written out (:data:`REGISTRY_CHOICES`: ``one_of_backends``
+is ``one_of<>`` over the backends' registry). The ROS side adds its own (topic names) in
+:mod:`grasp_torque_opt.ros.node.parameters`.
 """
 
 from __future__ import annotations
@@ -23,18 +25,17 @@ from dataclasses import dataclass
 import math
 from typing import Any
 
-from grasp_torque_opt.backends import available
-from grasp_torque_opt.control.checks import MAX_GRAVITY
+from grasp_torque_opt.backends.registry import available, BACKENDS
 from grasp_torque_opt.control.motion import tilt_radius, uncertainty_margin
+from grasp_torque_opt.control.parameters.limits import (
+    MAX_GRAVITY,
+    MAX_WEIGHT_RATIO,
+    WEIGHT_RANGE,
+)
 from grasp_torque_opt.core.exceptions import cut, InputError, quote
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.scenario import MAX_NAME_MAP, parse_name_map
 import numpy as np
-
-#: Each weight's range, and the largest ratio of two weights: W's condition number
-#: bounds how hard the QP is (ratios of 1e12 and more kept ProxSuite at its caps).
-WEIGHT_RANGE = (1e-6, 1e6)
-MAX_WEIGHT_RATIO = 1e6
 
 
 @dataclass(frozen=True)
@@ -84,6 +85,11 @@ def _element_bounds(name: str, value: Any, args: tuple, ctx: Context) -> str:
     return '' if all(low <= v <= high for v in value) else \
         f'every entry must be in [{low:g}, {high:g}]'
 
+
+#: Choices that belong to a registry: validator -> the registry's names. The loader
+#: makes an entry's ``one_of_backends: [[EXTRA, ...]]`` a ``one_of<>`` over the
+#: registry's names and then the extra ones (``solver.fallback``'s ``none``).
+REGISTRY_CHOICES: dict[str, tuple[str, ...]] = {'one_of_backends': BACKENDS}
 
 #: generate_parameter_library's validators that this schema uses.
 BUILT_IN: dict[str, Callable[[str, Any, tuple, Context], str]] = {

@@ -1,0 +1,567 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+# Generated from grasp_torque_opt/control/grasp_torque_node_parameters.yaml by
+# python -m grasp_torque_opt.control.parameters.generate: do not edit, regenerate.
+
+"""
+The node's parameters as typed, frozen dataclasses, generated from the schema.
+
+As generate_parameter_library writes a node's parameters module, every field is written
+out with its type (and, for :class:`CycleConfig`, its default) from
+``grasp_torque_node_parameters.yaml``; test/control/test_parameters.py fails when this
+file is not the one the schema gives.
+
+- :class:`CycleConfig`: the cycle's settings, one field per entry with a ``cycle`` key.
+- :class:`Params`: the frozen snapshot of every value (``p.solver.backend``), one class
+  per namespace, a value None while the parameter has none; :func:`params_from` makes it
+  from the values by dotted name, :func:`value_of` reads one by its dotted name,
+  :func:`cycle_config` gives its :class:`CycleConfig`.
+"""
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields, is_dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class CycleConfig:
+    """
+    Timing and safety settings of the cycle: the entries with a ``cycle`` key.
+
+    Attributes:
+        gravity_compensation: Add the fingers' own gravity torques g(q); the torque limits then
+            bound tau + g(q).
+        gravity: Gravity in the base frame for g(q) and, where the scenario's load is its object's
+            weight, for the load (the Allegro scenario: [9.81, 0, 0], palm down); once a message
+            arrives on the gravity topic, the topic's gravity is used instead. [m/s^2]
+        joint_state_timeout: Joint states older than this stop commands. [s]
+        contacts_timeout: Once contacts arrived, older than this stop commands; 0, never stale. [s]
+        wrench_timeout: Once a load arrived on external_wrench, older than this stops commands; 0,
+            never stale. [s]
+        gravity_timeout: Once gravity arrived on the gravity topic, older than this stops commands
+            (a fault, as any stale input); 0, never stale. [s]
+        hold_time: How long a fault may hold the last certified command before the fault policy
+            applies. [s]
+        fault_policy: After hold_time in a fault: hold (publish nothing, the effort controller
+            keeps the last certified command) or zero (publish zero torques); docs/node.md, Faults.
+        max_message_bytes: A message on joint_states, contacts, external_wrench or gravity whose
+            serialized form is longer than this is rejected before it is deserialized. [bytes]
+        max_joint_state_entries: A joint state with more names or positions than this is rejected
+            unread.
+        max_wrench_force: A load whose force norm exceeds this is rejected. [N]
+        max_wrench_torque: A load whose moment norm exceeds this is rejected. [N m]
+        max_contact_distance: A contact point farther than this from the base origin stops commands
+            (a fault). [m]
+        max_contact_link_distance: A contact point on the contacts topic farther than this from its
+            own link's frame is rejected (another finger's contact, a wrong frame); in the cycle,
+            at the configuration of the moment, a fault. [m]
+        max_torque_rate: A certified command farther from the command in force than this rate
+            allows since that command is published as a step of at most this rate towards it (the
+            rate rule, docs/node.md: flapping contacts or gravity cannot chatter the motors).
+            [N m/s]
+        gravity_norm_bounds: [low, high]: gravity on the topic, and the gravity parameter, must
+            have a norm in this range (a hand on Earth: 9.81); [0.0, 15.0] allows zero gravity
+            (space, a test). [m/s^2]
+        max_gravity_rate: The gravity in use moves towards each accepted gravity message at most
+            this fast (a wrist turning at 10 rad/s: 98 m/s^3; the rate rule, docs/node.md). [m/s^3]
+        imu_timeout_periods: (``imu.timeout_periods``) An IMU reading is fresh for this many of the
+            IMU's measured periods, within imu.timeout_bounds (before a period is measured: the
+            upper bound).
+        imu_timeout_bounds: (``imu.timeout_bounds``) [low, high]: the IMU's freshness stays in this
+            range (at 1 kHz, 5 periods are 5 ms; at 200 Hz, 25 ms). [s]
+        imu_max_specific_force: (``imu.max_specific_force``) An IMU reading whose specific force's
+            norm exceeds this is rejected (about 6 g: a hand that accelerates more is not holding
+            anything). [m/s^2]
+        imu_max_angular_velocity: (``imu.max_angular_velocity``) An IMU reading whose angular
+            velocity's norm exceeds this is rejected. [rad/s]
+        imu_angular_filter: (``imu.angular_filter``) Time constant of the low-pass on the
+            derivative of the IMU's angular velocity (the base's angular acceleration). [s]
+        contact_geometry: (``contact_geometry.enabled``) Find the contacts from geometry every
+            cycle (the scenario needs an object): the candidate links within
+            contact_geometry.tolerance of the object at the joint state and the object's pose
+            (object_pose, else the scenario's) touch it, their points and inward normals computed
+            (rolling tips); the set may change between cycles (docs/node.md, "Contacts from
+            geometry"). Off: the scenario's contacts fixed in their links. Contacts received on the
+            contacts topic are used instead.
+        contact_release: (``contact_geometry.release``) A link in the set leaves it when its
+            distance exceeds this many tolerances (hysteresis: a tip at the tolerance does not
+            flicker at 1 kHz).
+        object_pose_timeout: (``object_pose.timeout``) Once an object pose arrived, older than this
+            stops commands (a fault); 0, never stale. [s]
+        object_pose_max_offset: (``object_pose.max_offset``) An object pose whose position is
+            farther than this from the scenario's (base frame, at the joint state of the moment) is
+            rejected, at receipt and in the cycle. [m]
+        effort_estimation: (``effort_estimation.enabled``) Estimate the load the hand holds from
+            joint_states' effort (least squares through J^T and G, g(q) taken out) and add to the
+            planned load a bounded integral correction towards it (docs/node.md, "Load from
+            efforts"). Needs the scenario's object and gravity; a driver that reports no effort
+            (empty or NaN): off, said once.
+        effort_time_constant: (``effort_estimation.time_constant``) Time constant T of the integral
+            action on the estimated load. [s]
+        effort_filter: (``effort_estimation.filter``) Time constant of the low-pass on the
+            estimated load. [s]
+        effort_mass_only: (``effort_estimation.mass_only``) Correct only the force along the
+            apparent gravity (a mass error: one number, far less noisy); false, the whole wrench
+            (an unmodelled push or moment too).
+        effort_max_load_ratio: (``effort_estimation.max_load_ratio``) The correction's force is at
+            most this times the scenario's weight, its moment that force times the farthest
+            contact's distance from the object origin.
+        joint_limit_tolerance: A joint state with a used position beyond its joint's URDF limits by
+            more than this is rejected. [rad or m]
+        stamp_future_tolerance: A header stamp more than this ahead of the node's clock is
+            rejected. [s]
+        cycle_budget: A cycle that takes longer publishes nothing (overrun, a fault); its solvers
+            stop by it (or by joint_state_timeout if smaller). [s]
+        method: (``solver.method``) tau-qp (the paper's N-gon) or tau-qp-adaptive (the exact-cone
+            optimum from QPs with a certified gap to it, docs/adaptive.md; needs DAQP; warm across
+            cycles when solver.warm_start; solver.backend is then its fallback polygon's solver;
+            about 3 times tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
+        compiled: (``solver.compiled``) Run the cycle compiled (maps, build, ProxSuite solve and
+            certificate in C++, src/fast_cycle.hpp, section 2.6) where it applies: tau-qp,
+            sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on any
+            answer it cannot certify, the Python cycle answers (diagnostics solver.compiled says
+            which and why); false, the Python cycle always.
+        certificate_tolerance: Tolerance of the certificate on every residual. [SI]
+    """
+
+    gravity_compensation: bool = False
+    gravity: tuple = (0.0, 0.0, -9.81)
+    joint_state_timeout: float = 0.1
+    contacts_timeout: float = 0.5
+    wrench_timeout: float = 0.5
+    gravity_timeout: float = 0.5
+    hold_time: float = 0.1
+    fault_policy: str = 'hold'
+    max_message_bytes: int = 65536
+    max_joint_state_entries: int = 256
+    max_wrench_force: float = 1000.0
+    max_wrench_torque: float = 100.0
+    max_contact_distance: float = 1.0
+    max_contact_link_distance: float = 0.05
+    max_torque_rate: float = 20.0
+    gravity_norm_bounds: tuple = (5.0, 15.0)
+    max_gravity_rate: float = 100.0
+    imu_timeout_periods: float = 5.0
+    imu_timeout_bounds: tuple = (0.005, 0.05)
+    imu_max_specific_force: float = 60.0
+    imu_max_angular_velocity: float = 30.0
+    imu_angular_filter: float = 0.02
+    contact_geometry: bool = False
+    contact_release: float = 2.0
+    object_pose_timeout: float = 0.5
+    object_pose_max_offset: float = 0.03
+    effort_estimation: bool = False
+    effort_time_constant: float = 0.05
+    effort_filter: float = 0.01
+    effort_mass_only: bool = True
+    effort_max_load_ratio: float = 0.5
+    joint_limit_tolerance: float = 0.1
+    stamp_future_tolerance: float = 0.5
+    cycle_budget: float = 0.05
+    method: str = 'tau-qp'
+    compiled: bool = True
+    certificate_tolerance: float = 1e-06
+
+
+@dataclass(frozen=True)
+class ParamsImu:
+    """
+    The ``imu.*`` parameters.
+
+    Attributes:
+        enabled: Subscribe to the imu topic (sensor_msgs/Imu of the hand's base: specific force and
+            angular velocity, in the base frame or any frame tf2 resolves): while a reading is
+            fresh, g(q) and the scenario's load take the apparent gravity -R f, and the load the
+            object's inertial wrench from the base's angular velocity and its filtered derivative
+            (docs/node.md, "Moving base"). A stale or rejected IMU: the scenario's (or the gravity
+            topic's) gravity again, said in diagnostics.
+        timeout_periods: An IMU reading is fresh for this many of the IMU's measured periods,
+            within imu.timeout_bounds (before a period is measured: the upper bound).
+        timeout_bounds: [low, high]: the IMU's freshness stays in this range (at 1 kHz, 5 periods
+            are 5 ms; at 200 Hz, 25 ms). [s]
+        max_specific_force: An IMU reading whose specific force's norm exceeds this is rejected
+            (about 6 g: a hand that accelerates more is not holding anything). [m/s^2]
+        max_angular_velocity: An IMU reading whose angular velocity's norm exceeds this is
+            rejected. [rad/s]
+        angular_filter: Time constant of the low-pass on the derivative of the IMU's angular
+            velocity (the base's angular acceleration). [s]
+    """
+
+    enabled: bool | None
+    timeout_periods: float | None
+    timeout_bounds: tuple | None
+    max_specific_force: float | None
+    max_angular_velocity: float | None
+    angular_filter: float | None
+
+
+@dataclass(frozen=True)
+class ParamsContactGeometry:
+    """
+    The ``contact_geometry.*`` parameters.
+
+    Attributes:
+        enabled: Find the contacts from geometry every cycle (the scenario needs an object): the
+            candidate links within contact_geometry.tolerance of the object at the joint state and
+            the object's pose (object_pose, else the scenario's) touch it, their points and inward
+            normals computed (rolling tips); the set may change between cycles (docs/node.md,
+            "Contacts from geometry"). Off: the scenario's contacts fixed in their links. Contacts
+            received on the contacts topic are used instead.
+        links: The candidate links; empty: the scenario's contact links; [auto]: every link with
+            collision geometry that a joint moves.
+        tolerance: A candidate link enters the contact set when its signed distance to the object
+            is at most this. [m]
+        release: A link in the set leaves it when its distance exceeds this many tolerances
+            (hysteresis: a tip at the tolerance does not flicker at 1 kHz).
+    """
+
+    enabled: bool | None
+    links: tuple | None
+    tolerance: float | None
+    release: float | None
+
+
+@dataclass(frozen=True)
+class ParamsObjectPose:
+    """
+    The ``object_pose.*`` parameters.
+
+    Attributes:
+        timeout: Once an object pose arrived, older than this stops commands (a fault); 0, never
+            stale. [s]
+        max_offset: An object pose whose position is farther than this from the scenario's (base
+            frame, at the joint state of the moment) is rejected, at receipt and in the cycle. [m]
+    """
+
+    timeout: float | None
+    max_offset: float | None
+
+
+@dataclass(frozen=True)
+class ParamsEffortEstimation:
+    """
+    The ``effort_estimation.*`` parameters.
+
+    Attributes:
+        enabled: Estimate the load the hand holds from joint_states' effort (least squares through
+            J^T and G, g(q) taken out) and add to the planned load a bounded integral correction
+            towards it (docs/node.md, "Load from efforts"). Needs the scenario's object and
+            gravity; a driver that reports no effort (empty or NaN): off, said once.
+        time_constant: Time constant T of the integral action on the estimated load. [s]
+        filter: Time constant of the low-pass on the estimated load. [s]
+        mass_only: Correct only the force along the apparent gravity (a mass error: one number, far
+            less noisy); false, the whole wrench (an unmodelled push or moment too).
+        max_load_ratio: The correction's force is at most this times the scenario's weight, its
+            moment that force times the farthest contact's distance from the object origin.
+    """
+
+    enabled: bool | None
+    time_constant: float | None
+    filter: float | None  # noqa: A003 -- the parameter's name
+    mass_only: bool | None
+    max_load_ratio: float | None
+
+
+@dataclass(frozen=True)
+class ParamsUncertainty:
+    """
+    The ``uncertainty.*`` parameters.
+
+    Attributes:
+        friction: Friction uncertainty, a fraction (0.2: mu may be 20% lower). With
+            uncertainty.pose, sets the friction margin k = mu/mu_eff - 1, mu_eff = tan(atan(mu (1 -
+            friction)) - pose/(R + r)); the larger of it and friction_margin is planned
+            (docs/node.md, "Margin from stated uncertainty").
+        pose: Contact position / object pose uncertainty (0.002: 2 mm): tilts a normal by pose/(R +
+            r), R the scenario's object's radius (a box's flat face: no tilt), r
+            uncertainty.tip_radius. [m]
+        tip_radius: The fingertips' radius r in the tilt pose/(R + r) (Allegro's, 12 mm). [m]
+    """
+
+    friction: float | None
+    pose: float | None
+    tip_radius: float | None
+
+
+@dataclass(frozen=True)
+class ParamsSolver:
+    """
+    The ``solver.*`` parameters.
+
+    Attributes:
+        method: tau-qp (the paper's N-gon) or tau-qp-adaptive (the exact-cone optimum from QPs with
+            a certified gap to it, docs/adaptive.md; needs DAQP; warm across cycles when
+            solver.warm_start; solver.backend is then its fallback polygon's solver; about 3 times
+            tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
+        backend: QP backend: proxsuite, daqp or quadprog (grasps without internal-force variables
+            only); every result is certified whichever solves it.
+        fallback: Backend asked in the same cycle when solver.backend gives nothing certifiable
+            (none: no second try); its answer is certified the same way and counted (diagnostics
+            solver.fallback_solves).
+        warm_start: Start each solve from the previous cycle's (ProxSuite: its result,
+            preconditioner kept; DAQP: its active set); an answer that is not solved, fails the KKT
+            check or is not certified is redone cold in the same cycle and counted (diagnostics
+            solver.warm_start_fallbacks); no effect on quadprog; the ~/solve service always solves
+            cold.
+        compiled: Run the cycle compiled (maps, build, ProxSuite solve and certificate in C++,
+            src/fast_cycle.hpp, section 2.6) where it applies: tau-qp, sum-of-squares, ProxSuite, A
+            = [G; J^T] of full column rank. Elsewhere, and on any answer it cannot certify, the
+            Python cycle answers (diagnostics solver.compiled says which and why); false, the
+            Python cycle always.
+        eps_abs: Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol).
+        max_iter: Solver iteration cap (ProxSuite outer, DAQP).
+        max_iter_in: ProxSuite inner iteration cap; one outer iteration, up to this many inner
+            ones, is how far a solve can run past its budget.
+    """
+
+    method: str | None
+    backend: str | None
+    fallback: str | None
+    warm_start: bool | None
+    compiled: bool | None
+    eps_abs: float | None
+    max_iter: int | None
+    max_iter_in: int | None
+
+
+@dataclass(frozen=True)
+class Params:
+    """
+    The frozen snapshot of every parameter, one class per namespace.
+
+    Attributes:
+        scenario: Scenario file (docs/design.md section 4): hand, default contacts and load. A
+            path, or the name of a bundled file in the package's config/ (allegro_right.yaml).
+            Required.
+        robot_description: URDF document of the hand (the ROS convention), or a path to a URDF
+            file; empty: the URDF published on robot_description_topic if that is set, else the
+            scenario's hand.urdf.
+        robot_description_topic: A topic to take the URDF from when robot_description is empty
+            (std_msgs/String, reliable, transient local, e.g. robot_description, as
+            robot_state_publisher publishes it; relative names resolve in the node's namespace);
+            '': none. Waited for at start (the managed node: in configure) up to
+            robot_description_timeout.
+        robot_description_timeout: How long the node waits for the URDF on robot_description_topic
+            before it gives up, naming the topic. [s]
+        name_map: The scenario's joint and frame names to the URDF's, as SCENARIO_NAME=URDF_NAME
+            entries (one '=' each, at most 1024, one to one), over the scenario's hand.name_map:
+            applied before any name is checked against the URDF (section 4.1).
+        joints: Actuated joints in command order, the URDF's names (the scenario's after the name
+            map).
+        object_origin: Object origin c in the base frame. [m]
+        mu_tangential: Tangential friction coefficient mu1.
+        mu_torsional: Torsional friction coefficient mu2. [m]
+        polygon_sides: Sides N of the inscribed friction polygon.
+        min_normal_force: Minimum normal force f_min per contact. [N]
+        torque_limits: |command_i| <= torque_limits[i], per joint, each > 0 and at most the joint's
+            URDF effort limit (the scenario's limit where the URDF gives none) unless
+            torque_limits_above_urdf; a change acts on the command in force at once (docs/node.md,
+            Faults). [N m]
+        torque_limits_above_urdf: Allow torque_limits above the URDF's effort limits, up to 1e4 N
+            m.
+        weights: Objective weights W (diagonal), per joint, each in [1e-6, 1e6], the largest at
+            most 1e6 times the smallest (W's condition number bounds how hard the QP is).
+        friction_margin: Friction margin k: plan inside the cone of mu/(1+k), so that the commanded
+            wrenches hold with up to (1+k) times less friction (docs/planner.md).
+        objective: sum-of-squares (the paper's) or min-max (max |tau_i + g_i| / limit_i, an LP,
+            then the sum of squares among its optima: slower; docs/planner.md); min-max needs
+            solver.method tau-qp.
+        gravity_compensation: Add the fingers' own gravity torques g(q); the torque limits then
+            bound tau + g(q).
+        gravity: Gravity in the base frame for g(q) and, where the scenario's load is its object's
+            weight, for the load (the Allegro scenario: [9.81, 0, 0], palm down); once a message
+            arrives on the gravity topic, the topic's gravity is used instead. [m/s^2]
+        joint_state_timeout: Joint states older than this stop commands. [s]
+        contacts_timeout: Once contacts arrived, older than this stop commands; 0, never stale. [s]
+        wrench_timeout: Once a load arrived on external_wrench, older than this stops commands; 0,
+            never stale. [s]
+        gravity_timeout: Once gravity arrived on the gravity topic, older than this stops commands
+            (a fault, as any stale input); 0, never stale. [s]
+        hold_time: How long a fault may hold the last certified command before the fault policy
+            applies. [s]
+        fault_policy: After hold_time in a fault: hold (publish nothing, the effort controller
+            keeps the last certified command) or zero (publish zero torques); docs/node.md, Faults.
+        max_message_bytes: A message on joint_states, contacts, external_wrench or gravity whose
+            serialized form is longer than this is rejected before it is deserialized. [bytes]
+        max_joint_state_entries: A joint state with more names or positions than this is rejected
+            unread.
+        max_wrench_force: A load whose force norm exceeds this is rejected. [N]
+        max_wrench_torque: A load whose moment norm exceeds this is rejected. [N m]
+        max_contact_distance: A contact point farther than this from the base origin stops commands
+            (a fault). [m]
+        max_contact_link_distance: A contact point on the contacts topic farther than this from its
+            own link's frame is rejected (another finger's contact, a wrong frame); in the cycle,
+            at the configuration of the moment, a fault. [m]
+        max_torque_rate: A certified command farther from the command in force than this rate
+            allows since that command is published as a step of at most this rate towards it (the
+            rate rule, docs/node.md: flapping contacts or gravity cannot chatter the motors).
+            [N m/s]
+        gravity_norm_bounds: [low, high]: gravity on the topic, and the gravity parameter, must
+            have a norm in this range (a hand on Earth: 9.81); [0.0, 15.0] allows zero gravity
+            (space, a test). [m/s^2]
+        max_gravity_rate: The gravity in use moves towards each accepted gravity message at most
+            this fast (a wrist turning at 10 rad/s: 98 m/s^3; the rate rule, docs/node.md). [m/s^3]
+        imu: the ``imu.*`` parameters.
+        contact_geometry: the ``contact_geometry.*`` parameters.
+        object_pose: the ``object_pose.*`` parameters.
+        effort_estimation: the ``effort_estimation.*`` parameters.
+        uncertainty: the ``uncertainty.*`` parameters.
+        joint_limit_tolerance: A joint state with a used position beyond its joint's URDF limits by
+            more than this is rejected. [rad or m]
+        stamp_future_tolerance: A header stamp more than this ahead of the node's clock is
+            rejected. [s]
+        cycle_budget: A cycle that takes longer publishes nothing (overrun, a fault); its solvers
+            stop by it (or by joint_state_timeout if smaller). [s]
+        solver: the ``solver.*`` parameters.
+        certificate_tolerance: Tolerance of the certificate on every residual. [SI]
+        diagnostics_period: Period of /diagnostics (1 Hz, as diagnostic_updater; hardware_id is the
+            hand's URDF name, e.g. allegro_hand_right). [s]
+        marker_period: Period of ~/contact_wrenches; each arrow lives three periods, so the arrows
+            vanish when the node stops. [s]
+        watchdog_period: Period of the staleness check between joint states. [s]
+        startup_check_time: At start, how long the node looks for another node of its name on the
+            domain before it takes any input (discovery took 0.2 to 2.8 s here); one found, exit
+            code 2 and one line naming it; one seen later is reported (diagnostics ERROR, a log
+            line). [s]
+        thread_priority: At start, the SCHED_FIFO priority the executables ask for the thread that
+            spins the node, and for it alone (ros2_control's controller_manager asks 50 for its
+            loop), with Python's thread switch interval at 0.5 ms; refused (no rtprio limit or
+            CAP_SYS_NICE), a warning and normal scheduling; 0 (the default), the scheduling is left
+            as it is. Off by default: it helps the 1 kHz answer rate and hurts the tails on a busy
+            2-core machine (docs/node.md, The executor thread's priority).
+        marker_scale: Arrow length per newton in ~/contact_wrenches. [m/N]
+        publish_stamped_command: Also publish each command on ~/effort_commands_stamped
+            (sensor_msgs/JointState: joints, effort, and the stamp of the joint state it was
+            computed from).
+    """
+
+    scenario: str | None
+    robot_description: str | None
+    robot_description_topic: str | None
+    robot_description_timeout: float | None
+    name_map: tuple | None
+    joints: tuple | None
+    object_origin: tuple | None
+    mu_tangential: float | None
+    mu_torsional: float | None
+    polygon_sides: int | None
+    min_normal_force: float | None
+    torque_limits: tuple | None
+    torque_limits_above_urdf: bool | None
+    weights: tuple | None
+    friction_margin: float | None
+    objective: str | None
+    gravity_compensation: bool | None
+    gravity: tuple | None
+    joint_state_timeout: float | None
+    contacts_timeout: float | None
+    wrench_timeout: float | None
+    gravity_timeout: float | None
+    hold_time: float | None
+    fault_policy: str | None
+    max_message_bytes: int | None
+    max_joint_state_entries: int | None
+    max_wrench_force: float | None
+    max_wrench_torque: float | None
+    max_contact_distance: float | None
+    max_contact_link_distance: float | None
+    max_torque_rate: float | None
+    gravity_norm_bounds: tuple | None
+    max_gravity_rate: float | None
+    imu: ParamsImu
+    contact_geometry: ParamsContactGeometry
+    object_pose: ParamsObjectPose
+    effort_estimation: ParamsEffortEstimation
+    uncertainty: ParamsUncertainty
+    joint_limit_tolerance: float | None
+    stamp_future_tolerance: float | None
+    cycle_budget: float | None
+    solver: ParamsSolver
+    certificate_tolerance: float | None
+    diagnostics_period: float | None
+    marker_period: float | None
+    watchdog_period: float | None
+    startup_check_time: float | None
+    thread_priority: int | None
+    marker_scale: float | None
+    publish_stamped_command: bool | None
+
+
+#: CycleConfig field -> the parameter that gives it.
+CYCLE_FIELDS = {
+    'gravity_compensation': 'gravity_compensation',
+    'gravity': 'gravity',
+    'joint_state_timeout': 'joint_state_timeout',
+    'contacts_timeout': 'contacts_timeout',
+    'wrench_timeout': 'wrench_timeout',
+    'gravity_timeout': 'gravity_timeout',
+    'hold_time': 'hold_time',
+    'fault_policy': 'fault_policy',
+    'max_message_bytes': 'max_message_bytes',
+    'max_joint_state_entries': 'max_joint_state_entries',
+    'max_wrench_force': 'max_wrench_force',
+    'max_wrench_torque': 'max_wrench_torque',
+    'max_contact_distance': 'max_contact_distance',
+    'max_contact_link_distance': 'max_contact_link_distance',
+    'max_torque_rate': 'max_torque_rate',
+    'gravity_norm_bounds': 'gravity_norm_bounds',
+    'max_gravity_rate': 'max_gravity_rate',
+    'imu_timeout_periods': 'imu.timeout_periods',
+    'imu_timeout_bounds': 'imu.timeout_bounds',
+    'imu_max_specific_force': 'imu.max_specific_force',
+    'imu_max_angular_velocity': 'imu.max_angular_velocity',
+    'imu_angular_filter': 'imu.angular_filter',
+    'contact_geometry': 'contact_geometry.enabled',
+    'contact_release': 'contact_geometry.release',
+    'object_pose_timeout': 'object_pose.timeout',
+    'object_pose_max_offset': 'object_pose.max_offset',
+    'effort_estimation': 'effort_estimation.enabled',
+    'effort_time_constant': 'effort_estimation.time_constant',
+    'effort_filter': 'effort_estimation.filter',
+    'effort_mass_only': 'effort_estimation.mass_only',
+    'effort_max_load_ratio': 'effort_estimation.max_load_ratio',
+    'joint_limit_tolerance': 'joint_limit_tolerance',
+    'stamp_future_tolerance': 'stamp_future_tolerance',
+    'cycle_budget': 'cycle_budget',
+    'method': 'solver.method',
+    'compiled': 'solver.compiled',
+    'certificate_tolerance': 'certificate_tolerance',
+}
+
+
+def params_from(values: Mapping[str, Any], cls: type = Params, prefix: str = '') -> Any:
+    """
+    Make the frozen snapshot of every value (a list becomes a tuple).
+
+    Args:
+        values: dotted name -> value (a missing or None value: None).
+        cls: the class to make (a namespace's, for its ``prefix``).
+        prefix: the namespace's dotted prefix (``solver.``).
+    """
+    kwargs = {}
+    for f in fields(cls):
+        if is_dataclass(f.type):
+            kwargs[f.name] = params_from(values, f.type, f'{prefix}{f.name}.')
+        else:
+            value = values.get(f'{prefix}{f.name}')
+            kwargs[f.name] = tuple(value) if isinstance(value, list) else value
+    return cls(**kwargs)
+
+
+def value_of(p: Params, name: str) -> Any:
+    """Give one value of a :class:`Params` snapshot by its dotted name (``imu.enabled``)."""
+    value = p
+    for part in name.split('.'):
+        value = getattr(value, part)
+    return value
+
+
+def cycle_config(p: Params) -> CycleConfig:
+    """Make the :class:`CycleConfig` of a :class:`Params` snapshot."""
+    return CycleConfig(**{field: value_of(p, name) for field, name in CYCLE_FIELDS.items()})
