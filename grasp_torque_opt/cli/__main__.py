@@ -12,4 +12,5 @@ import sys
 
 from grasp_torque_opt.cli import main
 
-sys.exit(main())
+if __name__ == '__main__':
+    sys.exit(main())

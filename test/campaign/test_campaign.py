@@ -171,9 +171,9 @@ def run(rig: Rig, ops) -> None:
         if kind == 'joint_states':
             node.root.inputs.on_joint_state(arg)
         elif kind == 'contacts':
-            node.root.inputs.on_contacts(arg)
+            node.root.inputs.on_message('contacts', arg)
         elif kind == 'external_wrench':
-            node.root.inputs.on_wrench(arg)
+            node.root.inputs.on_message('external_wrench', arg)
         elif kind == 'sleep':
             time.sleep(arg)
         elif kind == 'watchdog':

@@ -10,4 +10,5 @@
 
 from grasp_torque_opt.control.parameters.schema import SCHEMA
 
-print(SCHEMA.markdown_table(), end='')
+if __name__ == '__main__':
+    print(SCHEMA.markdown_table(), end='')

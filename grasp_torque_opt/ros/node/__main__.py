@@ -13,4 +13,5 @@ import sys
 
 from grasp_torque_opt.ros.node.runner import main
 
-sys.exit(main())
+if __name__ == '__main__':
+    sys.exit(main())
