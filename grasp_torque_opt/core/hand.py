@@ -60,7 +60,6 @@ MAX_IMPLICIT_JOINTS = 30
 _ELEMENT = {tag: re.compile(rf'<{tag}[\s/>]') for tag in ('joint', 'link')}
 
 
-
 @contextlib.contextmanager
 def quiet_fd2():
     """
@@ -83,6 +82,7 @@ def parse_urdf(xml: str) -> pin.Model:
     """Build the Pinocchio model of a URDF document, urdfdom's own lines kept quiet."""
     with quiet_fd2():
         return pin.buildModelFromXML(xml)
+
 
 def example_robot_data_dir() -> Path:
     """
