@@ -51,6 +51,16 @@ def _source(relative: str) -> str:
     return relative if Path.cwd().resolve() == here else str(here / relative)
 
 
+def _note(message: str) -> None:
+    """
+    Say why the compiled cycle is not built, on stderr.
+
+    Never on stdout: colcon runs setup.py and reads its stdout as the package's
+    metadata (a Python literal), so one printed line there breaks every colcon verb.
+    """
+    print(f'setup.py: {message}', file=sys.stderr)
+
+
 def fast_cycle_extensions() -> list[Extension]:
     """
     Return the compiled cycle (src/fast_cycle.hpp) as extensions, if they can be built.
@@ -60,18 +70,18 @@ def fast_cycle_extensions() -> list[Extension]:
     node runs the Python cycle (docs/design.md section 2.6).
     """
     if os.environ.get('GRASP_TORQUE_OPT_NO_COMPILED'):
-        print('setup.py: GRASP_TORQUE_OPT_NO_COMPILED set: not building the compiled cycle')
+        _note('GRASP_TORQUE_OPT_NO_COMPILED set: not building the compiled cycle')
         return []
     try:
         import pybind11
     except ImportError:
-        print('setup.py: pybind11 not found: not building the compiled cycle')
+        _note('pybind11 not found: not building the compiled cycle (pip install pybind11)')
         return []
     eigen = _header_dir('Eigen/Core')
     proxsuite = _header_dir('proxsuite/proxqp/dense/dense.hpp')
     if eigen is None or proxsuite is None:
-        print("setup.py: Eigen's or ProxSuite's headers not found: not building the "
-              'compiled cycle')
+        _note("Eigen's or ProxSuite's headers not found: not building the compiled cycle "
+              '(pip install cmeel-eigen proxsuite)')
         return []
     # No debug information (Python's own flags ask for -g: 58 MB instead of 1 MB); the
     # libraries' headers as system headers (their own warnings are theirs).
@@ -164,6 +174,15 @@ setup(
             'flake8-import-order==0.19.2',
             'flake8-quotes==3.4.0',
             'pydocstyle==6.3.0',
+            # test/test_colcon_workspace.py: colcon builds and tests the package in a
+            # scratch workspace, running setup.py itself (no build isolation), so the
+            # compiled cycle's build requirements (pyproject.toml) must be here too.
+            'colcon-core',
+            'colcon-ros',
+            'colcon-python-setup-py',
+            'colcon-package-selection',
+            'pybind11>=2.12',
+            'cmeel-eigen>=3.4',
         ],
         # bench/: the other solvers compared, and process memory.
         'bench': ['osqp', 'psutil'],

@@ -32,6 +32,10 @@ from __future__ import annotations
 
 import importlib
 
+from grasp_torque_opt.core.interrupt import quiet_interrupt_in_console_scripts
+
+quiet_interrupt_in_console_scripts()
+
 #: Public name -> module that defines it.
 _EXPORTS = {
     'GraspSetup': 'grasp_torque_opt.core.grasp_setup',

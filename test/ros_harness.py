@@ -27,18 +27,20 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
+from ros_domains import domain
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import MarkerArray
 
-# Each run on its own domain, heard only on this machine.
+# Each run on its own domains above ROS_DOMAIN_ID (ros_domains.py), heard only on this
+# machine.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-DOMAIN = 1 + os.getpid() % 100
+DOMAIN = domain('in_process')
 #: The domain of the node processes this run starts (NodeProcess, the simulated hand):
 #: not this process's own, where its in-process nodes named grasp_torque_node live, so
 #: that a child's start-up check never takes one of those for a namesake.
-PROCESS_DOMAIN = 1 + (DOMAIN + 49) % 100
+PROCESS_DOMAIN = domain('process')
 
 
 class Harness:

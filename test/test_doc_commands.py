@@ -22,10 +22,12 @@ it is ``python``. Each needs a marker on the line before it:
 command line at a time, each to exit 0; ``exit=N`` for the last one), within
 ``timeout`` seconds (default 60), and looks for each ``expect`` in its output (stdout
 and stderr). ``stop_after=S`` stops a command that runs until stopped (a node) with
-SIGINT after S seconds, which it must end on with exit 0. ``background`` starts the
-block, waits ``wait`` seconds (default 5), keeps it running while the next ``run``
-block of the page runs, then stops it as ``stop_after`` does. A ``python`` block runs
-as a script with ``.venv/bin/python``.
+SIGINT S seconds after it is ready, which it must end on with exit 0: ready when its
+output shows every ``expect`` (its start-up line; waited for up to ``timeout``, so a
+slow start on a loaded machine is not stopped half-way). ``background`` starts the
+block, waits until it is ready and ``wait`` seconds more (default 1), keeps it running
+while the next ``run`` block of the page runs, then stops it as ``stop_after`` does. A
+``python`` block runs as a script with ``.venv/bin/python``.
 ``skip`` needs a ``reason``. An unmarked command block fails.
 
 The commands run in a scratch folder that links every entry of the repository (so the
@@ -44,6 +46,7 @@ import subprocess
 import time
 
 import pytest
+from ros_domains import domain
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [*sorted(ROOT.glob('*.md')), *sorted((ROOT / 'docs').glob('*.md'))]
@@ -51,8 +54,8 @@ SHELL_LANGUAGES = {'bash', 'sh', 'shell', 'console'}
 MARKER = re.compile(r'^\s*<!--\s*doc-test:\s*(?P<body>.*?)\s*-->\s*$')
 FENCE = re.compile(r'^(?P<indent>\s*)(?P<fence>```|~~~)(?P<lang>[\w+-]*)\s*$')
 DEFAULT_TIMEOUT = 60.0
-#: A ROS domain of this run (the ROS tests use 1 to 100).
-DOMAIN = 101 + os.getpid() % 100
+#: This run's domain for the documented commands (ros_domains.py).
+DOMAIN = domain('doc_commands')
 
 
 @dataclass
@@ -217,10 +220,32 @@ def stop(process: subprocess.Popen, grace: float = 20.0) -> int:
     return process.returncode
 
 
+def wait_ready(process: subprocess.Popen, log: Path, expect: list[str],
+               timeout: float) -> None:
+    """Wait until the output shows every ``expect`` line, or the command has ended."""
+    deadline = time.monotonic() + timeout
+    while process.poll() is None:
+        output = log.read_text(errors='replace')
+        if all(e in output for e in expect):
+            return
+        if time.monotonic() > deadline:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+            pytest.fail(f'{process.args[-1]!r} not ready (showing {expect}) within '
+                        f'{timeout} s:\n{output[-3000:]}')
+        time.sleep(0.1)
+
+
 def run_command(command: list[str], cwd: Path, log: Path, timeout: float,
-                stop_after: float | None) -> tuple[int, str]:
-    """Run one command (SIGINT after ``stop_after``, if given); return its exit and output."""
+                stop_after: float | None, expect: list[str]) -> tuple[int, str]:
+    """
+    Run one command; return its exit and output.
+
+    With ``stop_after``, SIGINT ``stop_after`` seconds after it is ready (``expect``).
+    """
     process = start(command, cwd, log)
+    if stop_after is not None:
+        wait_ready(process, log, expect, timeout)
     try:
         process.wait(stop_after if stop_after is not None else timeout)
     except subprocess.TimeoutExpired:
@@ -253,7 +278,7 @@ def run_block(block: Block, cwd: Path) -> None:
     output_all = ''
     for n, command in enumerate(commands, 1):
         code, output = run_command(command, cwd, log, marker.get('timeout', DEFAULT_TIMEOUT),
-                                   marker.get('stop_after'))
+                                   marker.get('stop_after'), marker['expect'])
         output_all += output
         want = marker.get('exit', 0) if n == len(commands) else 0
         assert code == want, (
@@ -284,7 +309,9 @@ def test_documented_command(block: Block, scratch: Path):
         assert len(command) == 1, f'{block.background.name}: one command in the background'
         log = scratch / f'.doc_test_{block.background.line}.log'
         background = start(['bash', '-c', command[0]], scratch, log)
-        time.sleep(block.background.marker.get('wait', 5.0))
+        marker = block.background.marker
+        wait_ready(background, log, marker['expect'], marker.get('timeout', DEFAULT_TIMEOUT))
+        time.sleep(marker.get('wait', 1.0))
     try:
         run_block(block, scratch)
     finally:

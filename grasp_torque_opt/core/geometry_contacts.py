@@ -44,7 +44,8 @@ import coal
 from grasp_torque_opt.core.contact_frame import contact_rotations
 from grasp_torque_opt.core.contact_links import check_contact_links
 from grasp_torque_opt.core.exceptions import cut, FrameNotFound, GeometryError, InputError
-from grasp_torque_opt.core.hand import bounded_urdf, frame_names, Hand, MAX_URDF_BYTES
+from grasp_torque_opt.core.hand import (
+    bounded_urdf, frame_names, Hand, MAX_URDF_BYTES, quiet_fd2)
 from grasp_torque_opt.core.meshes import resolve_meshes
 from grasp_torque_opt.core.object_geometry import coal_shape, nearest, ObjectShape
 from grasp_torque_opt.core.resources import decode_utf8, read_bounded
@@ -156,8 +157,9 @@ def collision_model(hand: Hand, urdf: str | Path, urdf_dir: Path | None = None
         raise InputError('hand.urdf', f'cannot parse the URDF: {e}') from e
     resolve_meshes(root, folder)
     try:
-        return pin.buildGeomFromUrdfString(hand.model, ET.tostring(root, encoding='unicode'),
-                                           pin.COLLISION)
+        with quiet_fd2():  # urdfdom's own lines; the InputError below says it
+            return pin.buildGeomFromUrdfString(
+                hand.model, ET.tostring(root, encoding='unicode'), pin.COLLISION)
     except (RuntimeError, ValueError) as e:
         raise InputError('hand.urdf', f'cannot build the collision model: {cut(e, 400)}') from e
 

@@ -18,12 +18,14 @@ Pinocchio's workspace grows as nv^3 on a chain (23 MB at 64, 142 MB at 128, 1.1 
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 from functools import cached_property
 from importlib import metadata
 import os
 from pathlib import Path
 import re
+import tempfile
 from xml.etree import ElementTree
 
 from grasp_torque_opt.core.coupling import Coupling, COUPLING_TOLERANCE, Mimic, urdf_mimics
@@ -56,6 +58,30 @@ MAX_ROBOT_DOF = 128
 #: more is a robot around a hand, whose legs and arms must not become actuators.
 MAX_IMPLICIT_JOINTS = 30
 _ELEMENT = {tag: re.compile(rf'<{tag}[\s/>]') for tag in ('joint', 'link')}
+
+
+@contextlib.contextmanager
+def quiet_fd2():
+    """
+    Keep what C++ writes on file descriptor 2 off the terminal while the block runs.
+
+    urdfdom prints its own "Error: ... at line N in joint.cpp" lines there before
+    Pinocchio raises; the caller's one-line error (naming the field) says it instead.
+    """
+    sys_err = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(sys_err, 2)
+            os.close(sys_err)
+
+
+def parse_urdf(xml: str) -> pin.Model:
+    """Build the Pinocchio model of a URDF document, urdfdom's own lines kept quiet."""
+    with quiet_fd2():
+        return pin.buildModelFromXML(xml)
 
 
 def example_robot_data_dir() -> Path:
@@ -411,7 +437,7 @@ class Hand:
         xml = decode_utf8(read_bounded(path, 'hand.urdf', MAX_URDF_BYTES), path, 'hand.urdf')
         check_inertials(bounded_urdf(xml, 'hand.urdf'), 'hand.urdf')
         try:
-            model = pin.buildModelFromXML(xml)
+            model = parse_urdf(xml)
         except (RuntimeError, ValueError) as e:
             raise InputError('hand.urdf',
                              f'cannot parse {cut(path, PATH_LENGTH)}: {cut(e, 400)}') from e
@@ -430,7 +456,7 @@ class Hand:
         """
         check_inertials(bounded_urdf(xml, 'robot_description'), 'robot_description')
         try:
-            model = pin.buildModelFromXML(xml)
+            model = parse_urdf(xml)
         except (RuntimeError, ValueError) as e:
             raise InputError('robot_description', f'cannot parse the URDF: {cut(e, 400)}') from e
         return cls.from_model(model, joints, torque_limits, above_urdf,

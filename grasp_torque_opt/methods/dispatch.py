@@ -336,8 +336,12 @@ def _fallback(grasp: _Grasp, answer: _Answer, deadline: float | None) -> None:
         cert = grasp.certify(tau, f)
         if cert.ok:
             answer.used = answer.fallback.name
-            answer.raw = dataclasses.replace(raw, message=f'{raw.message}; fallback after '
-                                             f'{answer.raw.message}')
+            # One line a user can act on: what went wrong first, what answered instead,
+            # and that the answer is as trustworthy as any (it passed the certificate).
+            answer.raw = dataclasses.replace(raw, message=(
+                f'fallback after {answer.raw.message}: {answer.fallback.name} solved the same '
+                f'tau-QP instead ({raw.message}); its answer is certified against the exact '
+                'cone like any other'))
             answer.tau, answer.f, answer.cert = tau, f, cert
 
 

@@ -8,6 +8,8 @@
 
 """Loading hands: paths, example-robot-data, joints and limits."""
 
+import re
+
 from conftest import ALLEGRO_URDF, ROOT
 from grasp_torque_opt.core.exceptions import InputError, JointNotFound
 from grasp_torque_opt.core.hand import example_robot_data_dir, Hand, resolve_urdf
@@ -73,3 +75,12 @@ def test_pinocchio_orders_joints_unlike_the_urdf_file():
     hand = Hand.from_urdf(resolve_urdf(ALLEGRO_URDF, ROOT))
     assert [int(float(n.split('_')[1])) for n in hand.joints] == \
         [0, 1, 2, 3, 12, 13, 14, 15, 4, 5, 6, 7, 8, 9, 10, 11]
+
+
+def test_urdfdoms_own_lines_stay_off_the_terminal(capfd):
+    # A limit without effort: urdfdom prints "Error: ... joint.cpp" on fd 2 before
+    # Pinocchio raises; the InputError alone tells the user.
+    xml = re.sub(r'effort="[^"]*"', '', (ROOT / 'urdf' / 'planar_two_finger.urdf').read_text())
+    with pytest.raises(InputError, match='robot_description'):
+        Hand.from_urdf_string(xml)
+    assert capfd.readouterr().err == ''

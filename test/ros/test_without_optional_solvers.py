@@ -17,6 +17,7 @@ import subprocess
 import sys
 
 from conftest import ALLEGRO, ROOT
+from ros_domains import domain
 
 TEST_DIR = ROOT / 'test'  # for cycle_inputs
 
@@ -37,7 +38,7 @@ with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
     single_threaded_math()
 assert any("threadpoolctl is not installed" in str(w.message) for w in caught), caught
-rclpy.init(domain_id=77)
+rclpy.init(domain_id={domain('without_optional')})
 node = GraspTorqueNode(parameter_overrides=[Parameter("scenario", value={str(ALLEGRO)!r}),
                                             Parameter("cycle_budget", value=1.0)])
 assert node.controller.fallback is None, "DAQP absent: no fallback, not a crash"

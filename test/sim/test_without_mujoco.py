@@ -12,6 +12,7 @@ import subprocess
 import sys
 
 from conftest import ALLEGRO
+from ros_domains import domain
 
 BLOCK = "import sys\nsys.modules['mujoco'] = None\n"
 
@@ -31,7 +32,7 @@ from grasp_torque_opt.ros.node import GraspTorqueNode
 from grasp_torque_opt.cli import main
 from rclpy.parameter import Parameter
 assert solve(GraspSetup.from_file({str(ALLEGRO)!r})).optimal
-rclpy.init(domain_id=99)
+rclpy.init(domain_id={domain('without_mujoco')})
 node = GraspTorqueNode(parameter_overrides=[Parameter("scenario", value={str(ALLEGRO)!r})])
 assert list(node.get_parameter("gravity").value) == [9.81, 0.0, 0.0]
 node.destroy_node()

@@ -1,0 +1,80 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""A suite run under a chosen ROS_DOMAIN_ID puts its nodes on that base's domains only."""
+
+import os
+import subprocess
+import sys
+import time
+
+from conftest import ROOT
+import pytest
+import rclpy
+from ros_domains import BASE, MAX_DOMAIN, ROLES, SPAN
+
+#: Two tests of the suite, one with the harness's in-process node, one with a script's.
+INNER = ['test/ros/test_node.py::'
+         'test_the_compiled_cycle_answers_over_ros_and_the_parameter_turns_it_off',
+         'test/ros/test_without_optional_solvers.py']
+
+
+def test_roles_have_distinct_domains_within_the_span():
+    offsets = list(ROLES.values()) + [ROLES['sim_listen'] + 1, ROLES['sim_listen'] + 2]
+    assert len(set(offsets)) == len(offsets) and min(offsets) >= 1 and max(offsets) <= SPAN
+    assert BASE + SPAN <= MAX_DOMAIN
+
+
+def test_a_run_under_a_chosen_domain_uses_that_bases_domains():
+    chosen = BASE + SPAN if BASE + 2 * SPAN <= MAX_DOMAIN else BASE - SPAN
+    watched = {chosen: 'base', chosen + ROLES['in_process']: 'in_process',
+               chosen + ROLES['without_optional']: 'without_optional'}
+    # Heard as the suite's processes are: discovery on localhost only.
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    contexts, nodes = {}, {}
+    for d in watched:
+        contexts[d] = rclpy.Context()
+        rclpy.init(context=contexts[d], domain_id=d)
+        nodes[d] = rclpy.create_node(f'domain_watcher_{d}', context=contexts[d])
+    time.sleep(1.0)  # the watchers' discovery settled before the run starts
+    env = dict(os.environ, ROS_DOMAIN_ID=str(chosen), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    env.pop('PYTEST_ADDOPTS', None)
+    seen = {d: set() for d in watched}
+    try:
+        # The inner nodes live a second or two: a watcher may miss one in discovery, so
+        # up to three runs until both roles were seen; the base must stay empty in all.
+        for _ in range(3):
+            inner = subprocess.Popen([sys.executable, '-m', 'pytest', '-q', '-p',
+                                      'no:cacheprovider', *INNER], cwd=ROOT, env=env,
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     text=True)
+            while inner.poll() is None:
+                for d, node in nodes.items():
+                    seen[d].update(n for n in node.get_node_names()
+                                   if not n.startswith('domain_'))
+                time.sleep(0.05)
+            out = inner.communicate(timeout=300)[0]
+            assert inner.returncode == 0, out[-3000:]
+            by_role = {watched[d]: sorted(names) for d, names in seen.items()}
+            if by_role['in_process'] and by_role['without_optional']:
+                break
+    finally:
+        for d in watched:
+            nodes[d].destroy_node()
+            rclpy.shutdown(context=contexts[d])
+    assert 'grasp_torque_node' in by_role['in_process'], by_role
+    assert 'grasp_torque_node' in by_role['without_optional'], by_role
+    assert not by_role['base'], f'a node on ROS_DOMAIN_ID itself: {by_role}'
+
+
+@pytest.mark.parametrize('bad', ['-1', str(MAX_DOMAIN - SPAN + 1)])
+def test_a_domain_id_without_room_for_the_span_is_refused(bad):
+    done = subprocess.run([sys.executable, '-c', 'import ros_domains'], cwd=ROOT / 'test',
+                          env=dict(os.environ, ROS_DOMAIN_ID=bad), capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode != 0 and f'ROS_DOMAIN_ID {bad}:' in done.stderr, done.stderr
