@@ -33,7 +33,7 @@ from pathlib import Path
 import sys
 import time
 
-from grasp_torque_opt.core.command_line import add_version, HelpFormatter
+from grasp_torque_opt.core.command_line import add_version, EXIT_INTERRUPTED, HelpFormatter
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 import numpy as np
 
@@ -95,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
         with node_process(params, args.with_node):
             return _play(args, scenario)
     except KeyboardInterrupt:  # Ctrl-C: a watch, or a demo, stopped by hand
-        return 130
+        return EXIT_INTERRUPTED
 
 
 def _play(args: argparse.Namespace, scenario: Path) -> int:
@@ -113,7 +113,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
         return _spin(args, scenario, node, setup)
     except (KeyboardInterrupt, ExternalShutdownException):
         print('grasp-torque-demo: interrupted', file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     finally:
         node.destroy_node()
         rclpy.try_shutdown()

@@ -35,6 +35,7 @@ from pathlib import Path
 import sys
 import time
 
+from grasp_torque_opt.core.command_line import EXIT_INTERRUPTED
 from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
 from grasp_torque_opt.ros.sim_options import check, describe, parser, PROG, rig_settings
 import numpy as np
@@ -82,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
             return _run(args, scenario, setup, rig, baseline)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 def _baseline(args: argparse.Namespace, scenario, setup):
