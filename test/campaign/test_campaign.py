@@ -30,9 +30,8 @@ from cycle_inputs import base_poses, FAULT_MODES, Injected, joint_state
 from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
 from grasp_torque_opt.cli import main as cli_main
 from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.control.parameters.generated import cycle_config
-from grasp_torque_opt.core import scenario as schema
-from grasp_torque_opt.core import scenario_fields as fields
+from grasp_torque_opt.control.parameters.snapshot import cycle_config
+from grasp_torque_opt.core import scenario as schema, scenario_fields as fields
 from grasp_torque_opt.ros.node import controllers, GraspTorqueNode, PARAMETERS
 from hypothesis import given, settings
 from hypothesis import strategies as st

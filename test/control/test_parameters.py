@@ -22,12 +22,7 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.backends.registry import REGISTRY
 from grasp_torque_opt.control.parameters import generated
 from grasp_torque_opt.control.parameters.generate import render
-from grasp_torque_opt.control.parameters.generated import (
-    cycle_config,
-    CycleConfig,
-    Params,
-    params_from,
-)
+from grasp_torque_opt.control.parameters.generated import CycleConfig, Params
 from grasp_torque_opt.control.parameters.schema import (
     POLICIES,
     PYTHON_TYPES,
@@ -35,11 +30,8 @@ from grasp_torque_opt.control.parameters.schema import (
     Schema,
     SCHEMA_FILE,
 )
-from grasp_torque_opt.control.parameters.validators import (
-    check_pairs,
-    Context,
-    REGISTRY_CHOICES,
-)
+from grasp_torque_opt.control.parameters.snapshot import cycle_config, params_from
+from grasp_torque_opt.control.parameters.validators import check_pairs, Context, REGISTRY_CHOICES
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup

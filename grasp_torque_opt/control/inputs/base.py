@@ -25,6 +25,8 @@ if TYPE_CHECKING:  # the store is the composition root of the inputs
     from grasp_torque_opt.control.inputs.store import Inputs, InputStore
     from grasp_torque_opt.control.parameters.generated import CycleConfig
 
+#: Why a frame other than the base's could not be looked up, when nothing says more.
+NO_TF = 'tf2_ros is not installed'
 #: The QoS an input is subscribed with: the joint states' own (reliable, a short
 #: queue: docs/design.md section 4.3), or rclpy's sensor-data profile.
 QOS = ('joint_states', 'sensor_data')

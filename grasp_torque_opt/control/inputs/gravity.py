@@ -21,12 +21,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from grasp_torque_opt.control.checks import checked_gravity
-from grasp_torque_opt.control.inputs.base import aged
+from grasp_torque_opt.control.inputs.base import aged, NO_TF
 from grasp_torque_opt.control.rates import turned_towards
 import numpy as np
-
-#: Why a frame other than the base's could not be looked up, when nothing says more.
-NO_TF = 'tf2_ros is not installed'
 
 
 @dataclass(frozen=True)

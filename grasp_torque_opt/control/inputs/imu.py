@@ -21,11 +21,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from grasp_torque_opt.control.inputs.base import NO_TF
 from grasp_torque_opt.control.motion import checked_imu, Motion
 import numpy as np
-
-#: Why a frame other than the base's could not be looked up, when nothing says more.
-NO_TF = 'tf2_ros is not installed'
 
 
 @dataclass(frozen=True)

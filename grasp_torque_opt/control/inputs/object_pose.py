@@ -22,12 +22,9 @@ from typing import Any
 
 from grasp_torque_opt.control.geometry import checked_pose, ObjectPose, placements_at, \
     pose_in_base
-from grasp_torque_opt.control.inputs.base import latest_q
+from grasp_torque_opt.control.inputs.base import latest_q, NO_TF
 from grasp_torque_opt.core.exceptions import InputError
 import numpy as np
-
-#: Why a frame other than the base's could not be looked up, when nothing says more.
-NO_TF = 'tf2_ros is not installed'
 
 
 @dataclass(frozen=True)

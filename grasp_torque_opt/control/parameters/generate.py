@@ -57,48 +57,12 @@ file is not the one the schema gives.
 
 - :class:`CycleConfig`: the cycle's settings, one field per entry with a ``cycle`` key.
 - :class:`Params`: the frozen snapshot of every value (``p.solver.backend``), one class
-  per namespace, a value None while the parameter has none; :func:`params_from` makes it
-  from the values by dotted name, :func:`value_of` reads one by its dotted name,
-  :func:`cycle_config` gives its :class:`CycleConfig`.
+  per namespace, a value None while the parameter has none
+  (:mod:`~grasp_torque_opt.control.parameters.snapshot` makes and reads it).
+- :data:`CYCLE_FIELDS`: each :class:`CycleConfig` field's parameter.
 """
 
-from collections.abc import Mapping
-from dataclasses import dataclass, fields, is_dataclass
-from typing import Any
-'''
-
-_FUNCTIONS = '''
-
-def params_from(values: Mapping[str, Any], cls: type = Params, prefix: str = '') -> Any:
-    """
-    Make the frozen snapshot of every value (a list becomes a tuple).
-
-    Args:
-        values: dotted name -> value (a missing or None value: None).
-        cls: the class to make (a namespace's, for its ``prefix``).
-        prefix: the namespace's dotted prefix (``solver.``).
-    """
-    kwargs = {}
-    for f in fields(cls):
-        if is_dataclass(f.type):
-            kwargs[f.name] = params_from(values, f.type, f'{prefix}{f.name}.')
-        else:
-            value = values.get(f'{prefix}{f.name}')
-            kwargs[f.name] = tuple(value) if isinstance(value, list) else value
-    return cls(**kwargs)
-
-
-def value_of(p: Params, name: str) -> Any:
-    """Give one value of a :class:`Params` snapshot by its dotted name (``imu.enabled``)."""
-    value = p
-    for part in name.split('.'):
-        value = getattr(value, part)
-    return value
-
-
-def cycle_config(p: Params) -> CycleConfig:
-    """Make the :class:`CycleConfig` of a :class:`Params` snapshot."""
-    return CycleConfig(**{field: value_of(p, name) for field, name in CYCLE_FIELDS.items()})
+from dataclasses import dataclass
 '''
 
 
@@ -189,7 +153,7 @@ def render(schema: Schema = SCHEMA) -> str:
     lines += _cycle_class(schema)
     lines += _params_classes(_tree(schema))
     lines += _cycle_fields(schema)
-    return '\n'.join(lines) + '\n' + _FUNCTIONS
+    return '\n'.join(lines) + '\n'
 
 
 def main(argv: list[str] | None = None) -> int:

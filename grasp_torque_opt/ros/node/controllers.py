@@ -25,7 +25,7 @@ from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.backends.registry import entry, is_backend, settings_for
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.control.parameters.generated import cycle_config
+from grasp_torque_opt.control.parameters.snapshot import cycle_config
 from grasp_torque_opt.control.parameters.validators import stated_margin
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 import numpy as np

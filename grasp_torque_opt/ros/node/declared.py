@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from grasp_torque_opt.control.parameters.generated import params_from
+from grasp_torque_opt.control.parameters.snapshot import params_from
 from grasp_torque_opt.control.parameters.validators import check_pairs, Context
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.parameters import (

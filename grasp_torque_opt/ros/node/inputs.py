@@ -29,7 +29,7 @@ import time
 from typing import Any, TYPE_CHECKING
 
 from geometry_msgs.msg import PoseArray, PoseStamped, Vector3Stamped, WrenchStamped
-from grasp_torque_opt.control.inputs.base import stamp_seconds
+from grasp_torque_opt.control.inputs.base import NO_TF, stamp_seconds
 from grasp_torque_opt.control.inputs.contacts import ContactsReading
 from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
 from grasp_torque_opt.control.inputs.gravity import GravityReading
@@ -37,7 +37,7 @@ from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.object_pose import PoseReading
 from grasp_torque_opt.control.inputs.registry import REGISTRY
-from grasp_torque_opt.control.parameters.generated import value_of
+from grasp_torque_opt.control.parameters.snapshot import value_of
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
 from grasp_torque_opt.ros.peers import quiet_subscription
@@ -200,7 +200,7 @@ class Inputs:
         """
         if frame in ('', hand.base_frame) or hand.model.existFrame(frame) \
                 or not self.root.tf.running:
-            return None, 'tf2_ros is not installed'
+            return None, NO_TF
         return self.root.tf.transform(hand.base_frame, frame)
 
 
@@ -222,7 +222,7 @@ def _wrench(inputs: Inputs, msg: WrenchStamped, hand: Any) -> WrenchReading:
 def _gravity(inputs: Inputs, msg: Vector3Stamped, hand: Any) -> GravityReading:
     """Give gravity's reading, another frame than the base's only through tf2 (its rotation)."""
     frame, v = msg.header.frame_id, msg.vector
-    rotation, why = (None, 'tf2_ros is not installed') if frame in ('', hand.base_frame) \
+    rotation, why = (None, NO_TF) if frame in ('', hand.base_frame) \
         or not inputs.root.tf.running else inputs.root.tf.rotation(hand.base_frame, frame)
     return GravityReading(frame, [v.x, v.y, v.z], rotation, why)
 
@@ -230,7 +230,7 @@ def _gravity(inputs: Inputs, msg: Vector3Stamped, hand: Any) -> GravityReading:
 def _imu(inputs: Inputs, msg: Imu, hand: Any) -> ImuReading:
     """Give the IMU's reading, another frame than the base's through tf2; no orientation."""
     frame, a, w = msg.header.frame_id, msg.linear_acceleration, msg.angular_velocity
-    transform, why = (None, 'tf2_ros is not installed') if frame in ('', hand.base_frame) \
+    transform, why = (None, NO_TF) if frame in ('', hand.base_frame) \
         or not inputs.root.tf.running else inputs.root.tf.transform(hand.base_frame, frame)
     return ImuReading(frame, [a.x, a.y, a.z], [w.x, w.y, w.z], transform, why)
 
