@@ -121,10 +121,10 @@ class CycleConfig:
             cycles when solver.warm_start; solver.backend is then its fallback polygon's solver;
             about 3 times tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
         compiled: (``solver.compiled``) Run the cycle compiled (maps, build, ProxSuite solve and
-            certificate in C++, src/fast_cycle.hpp, section 2.6) where it applies: tau-qp,
-            sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on any
-            answer it cannot certify, the Python cycle answers (diagnostics solver.compiled says
-            which and why); false, the Python cycle always.
+            certificate in C++, src/fast_cycle.hpp, docs/design.md section 2.6) where it applies:
+            tau-qp, sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on
+            any answer it cannot certify, the Python cycle answers (diagnostics solver.compiled
+            says which and why); false, the Python cycle always.
         certificate_tolerance: Tolerance of the certificate on every residual. [SI]
     """
 
@@ -308,10 +308,10 @@ class ParamsSolver:
             solver.warm_start_fallbacks); no effect on quadprog; the ~/solve service always solves
             cold.
         compiled: Run the cycle compiled (maps, build, ProxSuite solve and certificate in C++,
-            src/fast_cycle.hpp, section 2.6) where it applies: tau-qp, sum-of-squares, ProxSuite, A
-            = [G; J^T] of full column rank. Elsewhere, and on any answer it cannot certify, the
-            Python cycle answers (diagnostics solver.compiled says which and why); false, the
-            Python cycle always.
+            src/fast_cycle.hpp, docs/design.md section 2.6) where it applies: tau-qp,
+            sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on any
+            answer it cannot certify, the Python cycle answers (diagnostics solver.compiled says
+            which and why); false, the Python cycle always.
         eps_abs: Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol).
         max_iter: Solver iteration cap (ProxSuite outer, DAQP).
         max_iter_in: ProxSuite inner iteration cap; one outer iteration, up to this many inner
@@ -349,7 +349,7 @@ class Params:
             before it gives up, naming the topic. [s]
         name_map: The scenario's joint and frame names to the URDF's, as SCENARIO_NAME=URDF_NAME
             entries (one '=' each, at most 1024, one to one), over the scenario's hand.name_map:
-            applied before any name is checked against the URDF (section 4.1).
+            applied before any name is checked against the URDF (docs/design.md section 4.1).
         joints: Actuated joints in command order, the URDF's names (the scenario's after the name
             map).
         object_origin: Object origin c in the base frame. [m]
