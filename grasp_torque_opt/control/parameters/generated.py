@@ -119,7 +119,7 @@ class CycleConfig:
         method: (``solver.method``) tau-qp (the paper's N-gon) or tau-qp-adaptive (the exact-cone
             optimum from QPs with a certified gap to it, docs/adaptive.md; needs DAQP; warm across
             cycles when solver.warm_start; solver.backend is then its fallback polygon's solver;
-            about 3 times tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
+            slower than tau-qp, docs/adaptive.md); the ~/solve JSON carries its bounds.
         compiled: (``solver.compiled``) Run the cycle compiled (maps, build, ProxSuite solve and
             certificate in C++, src/fast_cycle.hpp, docs/design.md section 2.6) where it applies:
             tau-qp, sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on
@@ -295,8 +295,8 @@ class ParamsSolver:
     Attributes:
         method: tau-qp (the paper's N-gon) or tau-qp-adaptive (the exact-cone optimum from QPs with
             a certified gap to it, docs/adaptive.md; needs DAQP; warm across cycles when
-            solver.warm_start; solver.backend is then its fallback polygon's solver; about 3 times
-            tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
+            solver.warm_start; solver.backend is then its fallback polygon's solver; slower than
+            tau-qp, docs/adaptive.md); the ~/solve JSON carries its bounds.
         backend: QP backend: proxsuite, daqp or quadprog (grasps without internal-force variables
             only); every result is certified whichever solves it.
         fallback: Backend asked in the same cycle when solver.backend gives nothing certifiable
@@ -424,9 +424,8 @@ class Params:
             vanish when the node stops. [s]
         watchdog_period: Period of the staleness check between joint states. [s]
         startup_check_time: At start, how long the node looks for another node of its name on the
-            domain before it takes any input (discovery took 0.2 to 2.8 s here); one found, exit
-            code 2 and one line naming it; one seen later is reported (diagnostics ERROR, a log
-            line). [s]
+            domain before it takes any input (discovery can take seconds); one found, exit code 2
+            and one line naming it; one seen later is reported (diagnostics ERROR, a log line). [s]
         thread_priority: At start, the SCHED_FIFO priority the executables ask for the thread that
             spins the node, and for it alone (ros2_control's controller_manager asks 50 for its
             loop), with Python's thread switch interval at 0.5 ms; refused (no rtprio limit or
