@@ -12,7 +12,7 @@ The nodes' ``-h``: what they do, the ``--ros-args`` they take, their topics.
 A node's own options are few (``--executor``); what a user needs is in the ROS
 arguments: the required ``scenario`` parameter, a params file, remaps. This module
 holds that text and the parser that shows it, without importing rclpy, so that the
-node's ``run()`` builds its parser here (docs/design.md sections 4.3 and 4.4).
+node's ``run()`` builds its parser here (docs/node.md).
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def epilog(prog: str) -> str:
         '                             name: allegro_right.yaml, planar_two_finger.yaml)\n'
         '  --params-file FILE         parameters from a YAML file, e.g.\n'
         '                             config/allegro_right_node.yaml (sets scenario)\n'
-        '  -p NAME:=VALUE             any parameter (docs/design.md section 4.4)\n'
+        '  -p NAME:=VALUE             any parameter (docs/node.md, Parameters)\n'
         '  -r effort_commands:=TOPIC  remap a topic, e.g. to /effort_controller/commands\n'
         '  -r __node:=NAME, -r __ns:=NS  another node name or namespace\n'
         f'topics and services (relative names, remappable):\n{topics}\n'

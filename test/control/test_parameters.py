@@ -40,15 +40,15 @@ import numpy as np
 import pytest
 import yaml
 
-DESIGN = ROOT / 'docs' / 'design.md'
+NODE_PAGE = ROOT / 'docs' / 'node.md'
 
 
 def test_the_docs_table_is_the_schemas():
-    """docs/design.md section 4.4 holds the table the schema gives, and nothing else."""
-    text = DESIGN.read_text()
+    """docs/node.md ("Parameters") holds the table the schema gives, and nothing else."""
+    text = NODE_PAGE.read_text()
     found = re.search(r'<!-- parameters: generated[^\n]*-->\n(.*?)<!-- parameters: end -->',
                       text, re.S)
-    assert found, 'the generated table markers are missing from docs/design.md'
+    assert found, 'the generated table markers are missing from docs/node.md'
     assert found.group(1) == SCHEMA.markdown_table(), \
         'regenerate: python -m grasp_torque_opt.control.parameters'
 

@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # the store is the composition root of the inputs
 #: Why a frame other than the base's could not be looked up, when nothing says more.
 NO_TF = 'tf2_ros is not installed'
 #: The QoS an input is subscribed with: the joint states' own (reliable, a short
-#: queue: docs/design.md section 4.3), or rclpy's sensor-data profile.
+#: queue: docs/node.md, "Topics, message types and QoS"), or rclpy's sensor-data profile.
 QOS = ('joint_states', 'sensor_data')
 
 

@@ -21,6 +21,6 @@ The node's parameters, from one schema file, without ROS (the package holds no n
   :mod:`~grasp_torque_opt.control.parameters.generate` (committed; a test fails when
   it is stale).
 
-``python -m grasp_torque_opt.control.parameters`` prints the table of docs/design.md
-section 4.4.
+``python -m grasp_torque_opt.control.parameters`` prints the table of docs/node.md,
+"Parameters".
 """

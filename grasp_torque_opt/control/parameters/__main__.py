@@ -6,7 +6,7 @@
 #
 # SPDX-License-Identifier: BSD-3-Clause
 
-"""Print the parameter table of docs/design.md section 4.4, from the schema."""
+"""Print the parameter table of docs/node.md ("Parameters"), from the schema."""
 
 from grasp_torque_opt.control.parameters.schema import SCHEMA
 

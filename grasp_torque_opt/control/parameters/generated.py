@@ -119,12 +119,12 @@ class CycleConfig:
         method: (``solver.method``) tau-qp (the paper's N-gon) or tau-qp-adaptive (the exact-cone
             optimum from QPs with a certified gap to it, docs/adaptive.md; needs DAQP; warm across
             cycles when solver.warm_start; solver.backend is then its fallback polygon's solver;
-            about 3 times tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
+            slower than tau-qp, docs/adaptive.md); the ~/solve JSON carries its bounds.
         compiled: (``solver.compiled``) Run the cycle compiled (maps, build, ProxSuite solve and
-            certificate in C++, src/fast_cycle.hpp, section 2.6) where it applies: tau-qp,
-            sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on any
-            answer it cannot certify, the Python cycle answers (diagnostics solver.compiled says
-            which and why); false, the Python cycle always.
+            certificate in C++, src/fast_cycle.hpp, docs/design.md section 2.6) where it applies:
+            tau-qp, sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on
+            any answer it cannot certify, the Python cycle answers (diagnostics solver.compiled
+            says which and why); false, the Python cycle always.
         certificate_tolerance: Tolerance of the certificate on every residual. [SI]
     """
 
@@ -295,8 +295,8 @@ class ParamsSolver:
     Attributes:
         method: tau-qp (the paper's N-gon) or tau-qp-adaptive (the exact-cone optimum from QPs with
             a certified gap to it, docs/adaptive.md; needs DAQP; warm across cycles when
-            solver.warm_start; solver.backend is then its fallback polygon's solver; about 3 times
-            tau-qp's cycle with DAQP); the ~/solve JSON carries its bounds.
+            solver.warm_start; solver.backend is then its fallback polygon's solver; slower than
+            tau-qp, docs/adaptive.md); the ~/solve JSON carries its bounds.
         backend: QP backend: proxsuite, daqp or quadprog (grasps without internal-force variables
             only); every result is certified whichever solves it.
         fallback: Backend asked in the same cycle when solver.backend gives nothing certifiable
@@ -308,10 +308,10 @@ class ParamsSolver:
             solver.warm_start_fallbacks); no effect on quadprog; the ~/solve service always solves
             cold.
         compiled: Run the cycle compiled (maps, build, ProxSuite solve and certificate in C++,
-            src/fast_cycle.hpp, section 2.6) where it applies: tau-qp, sum-of-squares, ProxSuite, A
-            = [G; J^T] of full column rank. Elsewhere, and on any answer it cannot certify, the
-            Python cycle answers (diagnostics solver.compiled says which and why); false, the
-            Python cycle always.
+            src/fast_cycle.hpp, docs/design.md section 2.6) where it applies: tau-qp,
+            sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on any
+            answer it cannot certify, the Python cycle answers (diagnostics solver.compiled says
+            which and why); false, the Python cycle always.
         eps_abs: Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol).
         max_iter: Solver iteration cap (ProxSuite outer, DAQP).
         max_iter_in: ProxSuite inner iteration cap; one outer iteration, up to this many inner
@@ -349,7 +349,7 @@ class Params:
             before it gives up, naming the topic. [s]
         name_map: The scenario's joint and frame names to the URDF's, as SCENARIO_NAME=URDF_NAME
             entries (one '=' each, at most 1024, one to one), over the scenario's hand.name_map:
-            applied before any name is checked against the URDF (section 4.1).
+            applied before any name is checked against the URDF (docs/design.md section 4.1).
         joints: Actuated joints in command order, the URDF's names (the scenario's after the name
             map).
         object_origin: Object origin c in the base frame. [m]
@@ -424,9 +424,8 @@ class Params:
             vanish when the node stops. [s]
         watchdog_period: Period of the staleness check between joint states. [s]
         startup_check_time: At start, how long the node looks for another node of its name on the
-            domain before it takes any input (discovery took 0.2 to 2.8 s here); one found, exit
-            code 2 and one line naming it; one seen later is reported (diagnostics ERROR, a log
-            line). [s]
+            domain before it takes any input (discovery can take seconds); one found, exit code 2
+            and one line naming it; one seen later is reported (diagnostics ERROR, a log line). [s]
         thread_priority: At start, the SCHED_FIFO priority the executables ask for the thread that
             spins the node, and for it alone (ros2_control's controller_manager asks 50 for its
             loop), with Python's thread switch interval at 0.5 ms; refused (no rtprio limit or

@@ -19,7 +19,7 @@ itself. From the file come:
 - :data:`SCHEMA`, the parameters in order (:class:`ParamSpec`), with
   :meth:`Schema.check` (the validation that names the parameter), the scenario's
   defaults (:meth:`Schema.scenario_defaults`) and the docs table
-  (:meth:`Schema.markdown_table`, docs/design.md section 4.4);
+  (:meth:`Schema.markdown_table`, docs/node.md, "Parameters");
 - the typed module :mod:`~grasp_torque_opt.control.parameters.generated`
   (``CycleConfig``, the ``Params`` snapshot), written from :data:`SCHEMA` by
   :mod:`~grasp_torque_opt.control.parameters.generate`.
@@ -263,7 +263,7 @@ class Schema:
             raise InputError(spec.name, problem)
 
     def markdown_table(self) -> str:
-        """Write the parameter table of docs/design.md section 4.4."""
+        """Write the parameter table of docs/node.md, "Parameters"."""
         rows = ['| parameter | type | unit | default | range, meaning |',
                 '|---|---|---|---|---|']
         for s in self.specs.values():

@@ -23,7 +23,7 @@ made of small parts (docs/architecture.md, "The node's parts"):
 - :mod:`.root`: the composition root that owns the parts (plain or managed);
 - :mod:`.plain`: the plain node; :mod:`.runner` and :mod:`.signals`: running it.
 
-Interface pinned in docs/design.md section 4.
+Interface pinned in docs/node.md (what of it is stable: docs/design.md section 5).
 """
 
 from grasp_torque_opt.ros.node.grasp_source import wait_for_urdf

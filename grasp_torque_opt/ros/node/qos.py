@@ -7,7 +7,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 
-"""The node's name and the QoS of its topics and service, named (docs/design.md section 4.3)."""
+"""The node's name and the QoS of its topics and service, named (docs/node.md, "Topics")."""
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
