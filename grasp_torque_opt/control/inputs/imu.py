@@ -12,8 +12,8 @@ The base's IMU (sensor_msgs/Imu, with ``imu.enabled``): specific force, angular 
 In the hand's base frame, or another through its transform (tf2's rotation and origin);
 its orientation is not used. ``specific_force`` [m/s^2] reads -g at rest. A reading
 :func:`grasp_torque_opt.control.motion.checked_imu` or the cross-checks
-(:meth:`~grasp_torque_opt.control.motion.ImuTracker.cross_checked`) refuse is not kept: the last one
-ages out by its own timeout (:class:`~grasp_torque_opt.control.motion.ImuTracker`),
+(:meth:`~grasp_torque_opt.control.motion.ImuTracker.cross_checked`) refuse is not kept:
+the last one ages out by its own timeout (:class:`~grasp_torque_opt.control.motion.ImuTracker`),
 then the scenario's gravity is used again; it never makes the inputs stale.
 """
 
