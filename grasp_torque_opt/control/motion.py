@@ -173,7 +173,7 @@ class ImuTracker:
             if arm > config.imu_max_arm_acceleration:
                 raise InputError('imu.linear_acceleration', (
                     f'says the arm accelerates {arm:.6g} m/s^2 ({arm / 9.80665:.3g} g) from '
-                    'gravity as the IMU\'s own rotation lets it have turned, more than '
+                    "gravity as the IMU's own rotation lets it have turned, more than "
                     f'imu.max_arm_acceleration ({config.imu_max_arm_acceleration:g} m/s^2)'))
         except InputError as e:
             self.refused = str(e)

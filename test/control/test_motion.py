@@ -26,7 +26,7 @@ from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import load_scenario
-from grasp_torque_opt.ros.sim_compare import load_of_gravity
+from grasp_torque_opt.ros.node.grasp_source import load_of_gravity
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -46,7 +46,7 @@ def controller(**config):
 
 
 def true_wrenches(setup, command):
-    """The contact wrenches a command exerts on the still hand under the true gravity."""
+    """Give the contact wrenches a command exerts on the still hand under the true gravity."""
     model = setup.hand.model.copy()
     model.gravity.linear = G
     g = pin.computeGeneralizedGravity(model, model.createData(), setup.q)[setup.hand.idx_v]

@@ -103,7 +103,7 @@ LIFT = 1  # the middle finger lifts off: three contacts left
 
 
 def lifted(setup):
-    """The grasp's joint positions with the lifted finger's proximal flexion opened."""
+    """Give the grasp's joint positions with the lifted finger's proximal flexion opened."""
     model, q = setup.hand.model, setup.q.copy()
     q[model.joints[model.getJointId('joint_5.0')].idx_q] -= 0.1
     return q
