@@ -117,6 +117,8 @@ class ImuTracker:
         #: omega): the cross-checks' state (:meth:`cross_checked`).
         self.reference: np.ndarray | None = None
         self._seen: tuple[float, np.ndarray] | None = None
+        #: The receipt of the last reading the rate rule refused (None: none yet).
+        self._chatter: float | None = None
         #: Why the last reading was refused by a cross-check ('' when it was accepted).
         self.refused = ''
 
@@ -129,11 +131,16 @@ class ImuTracker:
 
         - the angular velocity changes no faster than ``imu.max_angular_acceleration``
           since the reading before (refused or not, within ``imu.timeout_bounds``' upper
-          bound): a chattering rate is refused whole;
+          bound), and after a reading that does not, the readings are refused until
+          they have kept that rule for that upper bound: a chattering rate is refused
+          whole, even when lost readings make two in a row agree;
         - the arm's acceleration |g_app - g_ref| is at most ``imu.max_arm_acceleration``,
           g_ref gravity's norm along the reference direction turned towards g_app's by at
           most (|omega| + ``imu.turn_tolerance``) times the time since the reading before:
           gravity turns in the base only as fast as the base turns.
+
+        The time between two readings is their receipts', as for the derivative it
+        guards (:meth:`update`): two readings received at once may differ by nothing.
 
         Args:
             now: the reading's receipt [s].
@@ -150,17 +157,25 @@ class ImuTracker:
                 with it).
         """
         seen, self._seen = self._seen, (now, omega.copy())
-        dt = now - seen[0] if seen is not None else 0.0
-        if not 0.0 < dt <= config.imu_timeout_bounds[1]:
-            dt = 0.0
+        dt = None if seen is None else max(now - seen[0], 0.0)
+        if dt is not None and dt > config.imu_timeout_bounds[1]:
+            dt = None  # after a pause: nothing to compare with
         try:
-            if dt > 0.0:
-                change = float(np.linalg.norm(omega - seen[1])) / dt
-                if change > config.imu_max_angular_acceleration:
-                    raise InputError('imu.angular_velocity', (
-                        f'changed at {change:.6g} rad/s^2 since the reading before, more than '
-                        f'imu.max_angular_acceleration ({config.imu_max_angular_acceleration:g}'
-                        ' rad/s^2)'))
+            change = 0.0 if dt is None else float(np.linalg.norm(omega - seen[1]))
+            settle = config.imu_timeout_bounds[1]
+            if dt is not None and change > config.imu_max_angular_acceleration * dt:
+                self._chatter = now
+                rate = f'{change / dt:.6g} rad/s^2' if dt > 0.0 else f'{change:.6g} rad/s at once'
+                raise InputError('imu.angular_velocity', (
+                    f'changed at {rate} since the reading before, more than '
+                    f'imu.max_angular_acceleration ({config.imu_max_angular_acceleration:g}'
+                    ' rad/s^2)'))
+            if self._chatter is not None and now - self._chatter < settle:
+                raise InputError('imu.angular_velocity', (
+                    f'{1e3 * (now - self._chatter):.4g} ms after a reading over '
+                    'imu.max_angular_acceleration: refused until the rate has kept it for '
+                    f"imu.timeout_bounds' upper bound ({1e3 * settle:g} ms)"))
+            dt = dt or 0.0
             norm = float(np.linalg.norm(gravity))
             u = self.reference if self.reference is not None else (
                 gravity / norm if norm > 1e-9 else np.array([0.0, 0.0, -1.0]))
