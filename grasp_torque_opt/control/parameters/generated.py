@@ -94,8 +94,9 @@ class CycleConfig:
             acceleration held for long). [rad/s]
         imu_max_angular_acceleration: (``imu.max_angular_acceleration``) An IMU reading whose
             angular velocity changed faster than this since the reading before it (refused or not)
-            is refused: angular-rate chatter never reaches the filtered derivative and the inertial
-            wrench. [rad/s^2]
+            is refused, and so are the readings after it until the rate has kept this for
+            imu.timeout_bounds' upper bound: angular-rate chatter never reaches the filtered
+            derivative and the inertial wrench. [rad/s^2]
         imu_angular_filter: (``imu.angular_filter``) Time constant of the low-pass on the
             derivative of the IMU's angular velocity (the base's angular acceleration). [s]
         contact_geometry: (``contact_geometry.enabled``) Find the contacts from geometry every
@@ -218,8 +219,9 @@ class ParamsImu:
             turning at most |omega| plus this (a gyro's bias, an acceleration held for long).
             [rad/s]
         max_angular_acceleration: An IMU reading whose angular velocity changed faster than this
-            since the reading before it (refused or not) is refused: angular-rate chatter never
-            reaches the filtered derivative and the inertial wrench. [rad/s^2]
+            since the reading before it (refused or not) is refused, and so are the readings after
+            it until the rate has kept this for imu.timeout_bounds' upper bound: angular-rate
+            chatter never reaches the filtered derivative and the inertial wrench. [rad/s^2]
         angular_filter: Time constant of the low-pass on the derivative of the IMU's angular
             velocity (the base's angular acceleration). [s]
     """
