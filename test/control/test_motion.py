@@ -130,3 +130,24 @@ def test_angular_rate_chatter_is_refused_and_every_joint_state_gets_its_command(
     assert [r.kind for r in still + results] == ['solution'] * 220
     assert refused == 1000 and 'imu.max_angular_acceleration' in ctrl.last_rejection
     assert not np.any(ctrl.store.imu.alpha)  # the filtered derivative never saw it
+
+
+def test_after_chatter_the_imu_is_refused_until_its_rate_has_settled():
+    # A lost reading makes two chatter readings in a row agree: still refused, until the
+    # rate has kept imu.max_angular_acceleration for imu.timeout_bounds' upper bound.
+    ctrl = controller()
+    settle = ctrl.config.imu_timeout_bounds[1]
+    spin = np.array([0.0, 29.0, 0.0])
+    verdicts, t = [], 0.0
+    for w in [np.zeros(3)] * 3 + [spin] * 80:  # +-29 rad/s with every -29 lost
+        t += 1e-3
+        try:
+            ctrl.take('imu', ImuReading('', STILL, w), t)
+            verdicts.append(True)
+        except InputError as e:
+            verdicts.append(False)
+            why = str(e)
+    n = round(settle / 1e-3)
+    assert verdicts[:3] == [True] * 3 and not any(verdicts[3:3 + n])
+    assert 'refused until the rate has kept it' in why
+    assert all(verdicts[4 + n:])  # a steady rate, consistent again: a real spin
