@@ -119,6 +119,9 @@ class ImuTracker:
         self._seen: tuple[float, np.ndarray] | None = None
         #: The receipt of the last reading the rate rule refused (None: none yet).
         self._chatter: float | None = None
+        #: The mean time between the readings seen, refused or not [s] (a running mean
+        #: of weight 0.1; None: not measured).
+        self.spacing: float | None = None
         #: Why the last reading was refused by a cross-check ('' when it was accepted).
         self.refused = ''
 
@@ -139,8 +142,11 @@ class ImuTracker:
           most (|omega| + ``imu.turn_tolerance``) times the time since the reading before:
           gravity turns in the base only as fast as the base turns.
 
-        The time between two readings is their receipts', as for the derivative it
-        guards (:meth:`update`): two readings received at once may differ by nothing.
+        The time between two readings is their receipts' (as for the derivative the rule
+        guards, :meth:`update`), but at least the mean time between the readings seen
+        (:attr:`spacing`), up to ``imu.timeout_bounds``' lower bound: readings a
+        middleware delivers in a burst are not taken for a jump (the filtered derivative
+        weighs such a reading by its short time, too).
 
         Args:
             now: the reading's receipt [s].
@@ -160,6 +166,10 @@ class ImuTracker:
         dt = None if seen is None else max(now - seen[0], 0.0)
         if dt is not None and dt > config.imu_timeout_bounds[1]:
             dt = None  # after a pause: nothing to compare with
+        elif dt is not None:
+            self.spacing = dt if self.spacing is None else self.spacing + 0.1 * (
+                dt - self.spacing)
+            dt = max(dt, min(self.spacing, config.imu_timeout_bounds[0]))
         try:
             change = 0.0 if dt is None else float(np.linalg.norm(omega - seen[1]))
             settle = config.imu_timeout_bounds[1]

@@ -14,6 +14,7 @@ scenario's gravity +x): the contact wrenches J^-T (tau - g_true(q)), g_true from
 Pinocchio under the true gravity, must lie in the exact soft-finger cone.
 """
 
+import contextlib
 import dataclasses
 
 from conftest import ALLEGRO
@@ -151,3 +152,21 @@ def test_after_chatter_the_imu_is_refused_until_its_rate_has_settled():
     assert verdicts[:3] == [True] * 3 and not any(verdicts[3:3 + n])
     assert 'refused until the rate has kept it' in why
     assert all(verdicts[4 + n:])  # a steady rate, consistent again: a real spin
+
+
+def test_a_noisy_gyro_delivered_in_bursts_is_not_taken_for_chatter():
+    # Five readings 1 ms apart at the IMU, received within 50 us (a middleware's burst):
+    # a gyro's noise of 0.01 rad/s between them is 200 rad/s^2 over 50 us, not over 1 ms.
+    ctrl = controller()
+    rng = np.random.default_rng(3)
+    t = 0.0
+    for burst in range(60):
+        t += 5e-3
+        if burst == 20:  # the readings' spacing learned (the first may be refused)
+            ctrl.counters.rejected['imu'] = 0
+        for j in range(5):
+            noise = rng.normal(0.0, 0.01, 3)
+            with contextlib.suppress(InputError):
+                ctrl.take('imu', ImuReading('', STILL, noise), t + 1e-5 * j)
+    assert ctrl.counters.rejected.get('imu', 0) == 0
+    assert ctrl.inputs.motion_time == t + 4e-5  # the last reading is the one in use
