@@ -247,36 +247,40 @@ class TorqueController:
         Cut a certified command's step from the command in force to ``max_torque_rate``.
 
         The rate rule (docs/node.md): the command moves along the straight line from the
-        command in force towards the certified command, no joint faster than
-        ``max_torque_rate`` times the time since the command in force. The step's
-        contact wrenches (the same combination of both ends') must lie in the exact
-        cone, finite, with the step within the torque limits: else, or when they are
-        not known (or the command in force had another contact set: a contact that is gone
-        is in none of a step's wrenches), the certified command is published whole
-        (``slew_refused``).
+        command in force towards the certified command, no joint by more than
+        ``max_torque_rate`` times the time since the command in force, and never more than
+        that rate times ``command_period`` (a long gap gives no bigger step). From zero
+        torques with gravity compensation the step starts at g(q), added whole: its
+        contact wrenches are ``s`` times the certified ones. Across a change of the
+        contact set, a contact that left fades out and a new one fades in
+        (:func:`~.rates.step_wrenches`). The step's contact wrenches must lie in the exact
+        cone, finite, with the step within the torque limits: else, or when they are not
+        known, the certified command is published whole (``slew_refused``).
         """
-        policy, rate = self.policy, self.config.max_torque_rate
+        policy, config = self.policy, self.config
         if policy.in_force is None or policy.in_force_time is None:
             return
-        step = slewed(policy.in_force, result.command,
-                      rate * max(now - policy.in_force_time, 0.0),
-                      self.setup.hand.torque_limits)
+        gap = min(max(now - policy.in_force_time, 0.0), config.command_period)
+        known, start = policy.in_force_wrenches, policy.in_force
+        if known is not None and known.size == 0 and result.gravity_torque is not None:
+            start = result.gravity_torque  # zero torques: g(q) whole, the wrenches stepped
+        limits = self.setup.hand.torque_limits
+        step = slewed(start, result.command, config.max_torque_rate * gap, limits)
         if step is None:
             return
         cmd, s = step
-        known = policy.in_force_wrenches
-        if known is not None and known.size and (
-                result.maps is None or policy.in_force_links != tuple(result.maps.links)):
-            known = None  # another contact set (geometry's may change): no step between them
-        wrenches = step_wrenches(known, getattr(result.solution, 'wrenches', None), s)
+        links = None if result.maps is None else tuple(result.maps.links)
+        blend = step_wrenches(known, policy.in_force_links,
+                              getattr(result.solution, 'wrenches', None), links, s)
         friction = self.setup.friction
-        if (wrenches is None or not np.all(np.isfinite(cmd))
-                or not np.all(np.abs(cmd) <= self.setup.hand.torque_limits)
-                or float(cone_margin(wrenches, friction.mu1, friction.mu2).min())
-                < -STEP_CONE_TOLERANCE):
+        if (blend is None or not np.all(np.isfinite(cmd))
+                or not np.all(np.abs(cmd) <= limits)
+                or float(cone_margin(np.vstack((blend[0], blend[2])), friction.mu1,
+                                     friction.mu2).min()) < -STEP_CONE_TOLERANCE):
             self.counters.slew_refused += 1
             return
-        result.command, result.wrenches = cmd, wrenches
+        result.command, result.wrenches = cmd, blend[0]
+        result.faded = blend[1], blend[2]
         self.counters.slew_limited += 1
 
     def _attempt(self, now: float, deadline: float) -> CycleResult:

@@ -145,7 +145,8 @@ def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
     solving, inputs = c.solving, c.inputs
     values = [('imu', 'none received' if inputs.motion is None else
                solving.imu_state or 'in use'),
-              ('age.imu_s', _ago(now, inputs.motion_time))]
+              ('age.imu_s', _ago(now, inputs.motion_time)),
+              ('imu.refused', c.store.imu.refused or 'none')]
     if inputs.motion is not None:
         values += [('imu.apparent_gravity', _vector(inputs.motion.gravity)),
                    ('imu.timeout_s', f'{inputs.motion.timeout:.4f}')]

@@ -50,6 +50,9 @@ class CycleResult:
             (the same combination of its ends' wrenches), else None (the solution's).
         q: the joint positions a certified command was solved at (its contact links'
             placements, for ~/contact_wrench).
+        faded: for a step across a change of the contact set, the links of the command
+            in force that are not in ``maps`` and their fading wrenches, shape (k, 4)
+            (None: none).
     """
 
     command: np.ndarray | None
@@ -61,6 +64,7 @@ class CycleResult:
     cycle_time: float = 0.0
     wrenches: np.ndarray | None = None
     q: np.ndarray | None = None
+    faded: tuple[tuple[str, ...], np.ndarray] | None = None
 
 
 class FaultPolicy:
@@ -88,8 +92,8 @@ class FaultPolicy:
         #: The contact wrenches of the command in force, shape (p, 4) (``NO_WRENCH`` for
         #: zero torques; None: not known).
         self.in_force_wrenches: np.ndarray | None = None
-        #: The links of those wrenches' contacts (None: not known): a step is taken only
-        #: between two commands of the same contact set (rates.step_wrenches).
+        #: The links of those wrenches' contacts (None: not known): a step combines the
+        #: wrenches link by link (rates.step_wrenches).
         self.in_force_links: tuple[str, ...] | None = None
         #: The last result, certified or not.
         self.last: CycleResult | None = None
@@ -104,6 +108,11 @@ class FaultPolicy:
         self.in_force_wrenches = (result.wrenches if result.wrenches is not None
                                   else getattr(result.solution, 'wrenches', None))
         self.in_force_links = None if result.maps is None else tuple(result.maps.links)
+        if result.faded is not None and self.in_force_wrenches is not None \
+                and self.in_force_links is not None:
+            # A step across a set change: the contacts fading out are in force too.
+            self.in_force_links += result.faded[0]
+            self.in_force_wrenches = np.vstack((self.in_force_wrenches, result.faded[1]))
         self.counters.commands += 1
         if from_fallback:
             self.counters.fallback_solves += 1

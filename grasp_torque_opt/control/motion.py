@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import math
 
 from grasp_torque_opt.control.checks import finite, show
+from grasp_torque_opt.control.rates import turned_towards
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
@@ -111,6 +112,99 @@ class ImuTracker:
         self.period: float | None = None
         self._last: tuple[float, np.ndarray] | None = None  # (receipt, omega)
         self.alpha = np.zeros(3)
+        #: The reference gravity's direction, base axes (None: gravity's own, until the
+        #: first accepted reading), and the last reading seen, refused or not (receipt,
+        #: omega): the cross-checks' state (:meth:`cross_checked`).
+        self.reference: np.ndarray | None = None
+        self._seen: tuple[float, np.ndarray] | None = None
+        #: The receipt of the last reading the rate rule refused (None: none yet).
+        self._chatter: float | None = None
+        #: The mean time between the readings seen, refused or not [s] (a running mean
+        #: of weight 0.1; None: not measured).
+        self.spacing: float | None = None
+        #: Why the last reading was refused by a cross-check ('' when it was accepted).
+        self.refused = ''
+
+    def cross_checked(self, now: float, apparent: np.ndarray, omega: np.ndarray,
+                      gravity: np.ndarray, config) -> np.ndarray:
+        """
+        Cross-check a reading with the last one and with gravity; give the new reference.
+
+        Two rules (docs/node.md, "Cross-checks and the one rate rule"):
+
+        - the angular velocity changes no faster than ``imu.max_angular_acceleration``
+          since the reading before (refused or not, within ``imu.timeout_bounds``' upper
+          bound), and after a reading that does not, the readings are refused until
+          they have kept that rule for that upper bound: a chattering rate is refused
+          whole, even when lost readings make two in a row agree;
+        - the arm's acceleration |g_app - g_ref| is at most ``imu.max_arm_acceleration``,
+          g_ref gravity's norm along the reference direction turned towards g_app's by at
+          most (|omega| + ``imu.turn_tolerance``) times the time since the reading before:
+          gravity turns in the base only as fast as the base turns.
+
+        The time between two readings is their receipts' (as for the derivative the rule
+        guards, :meth:`update`), but at least the mean time between the readings seen
+        (:attr:`spacing`), up to ``imu.timeout_bounds``' lower bound: readings a
+        middleware delivers in a burst are not taken for a jump (the filtered derivative
+        weighs such a reading by its short time, too).
+
+        Args:
+            now: the reading's receipt [s].
+            apparent: its apparent gravity -R f, base axes [m/s^2], shape (3,).
+            omega: its angular velocity, base axes [rad/s], shape (3,).
+            gravity: the gravity in use without an IMU, base axes [m/s^2], shape (3,).
+            config: the ``imu.*`` settings.
+
+        Returns:
+            The reference direction to keep when the reading is accepted, shape (3,).
+
+        Raises:
+            InputError: either rule fails (the reading is seen: the next is compared
+                with it).
+        """
+        seen, self._seen = self._seen, (now, omega.copy())
+        dt = None if seen is None else max(now - seen[0], 0.0)
+        if dt is not None and dt > config.imu_timeout_bounds[1]:
+            dt = None  # after a pause: nothing to compare with
+        elif dt is not None:
+            self.spacing = dt if self.spacing is None else self.spacing + 0.1 * (
+                dt - self.spacing)
+            dt = max(dt, min(self.spacing, config.imu_timeout_bounds[0]))
+        try:
+            change = 0.0 if dt is None else float(np.linalg.norm(omega - seen[1]))
+            settle = config.imu_timeout_bounds[1]
+            if dt is not None and change > config.imu_max_angular_acceleration * dt:
+                self._chatter = now
+                rate = f'{change / dt:.6g} rad/s^2' if dt > 0.0 else f'{change:.6g} rad/s at once'
+                raise InputError('imu.angular_velocity', (
+                    f'changed at {rate} since the reading before, more than '
+                    f'imu.max_angular_acceleration ({config.imu_max_angular_acceleration:g}'
+                    ' rad/s^2)'))
+            if self._chatter is not None and now - self._chatter < settle:
+                raise InputError('imu.angular_velocity', (
+                    f'{1e3 * (now - self._chatter):.4g} ms after a reading over '
+                    'imu.max_angular_acceleration: refused until the rate has kept it for '
+                    f"imu.timeout_bounds' upper bound ({1e3 * settle:g} ms)"))
+            dt = dt or 0.0
+            norm = float(np.linalg.norm(gravity))
+            u = self.reference if self.reference is not None else (
+                gravity / norm if norm > 1e-9 else np.array([0.0, 0.0, -1.0]))
+            seen_turn = (float(np.linalg.norm(omega)) + config.imu_turn_tolerance) * dt
+            a_norm = float(np.linalg.norm(apparent))
+            if a_norm > 1e-9:
+                u = turned_towards(u, apparent / a_norm, seen_turn)
+                u = u / np.linalg.norm(u)
+            arm = float(np.linalg.norm(apparent - norm * u))
+            if arm > config.imu_max_arm_acceleration:
+                raise InputError('imu.linear_acceleration', (
+                    f'says the arm accelerates {arm:.6g} m/s^2 ({arm / 9.80665:.3g} g) from '
+                    "gravity as the IMU's own rotation lets it have turned, more than "
+                    f'imu.max_arm_acceleration ({config.imu_max_arm_acceleration:g} m/s^2)'))
+        except InputError as e:
+            self.refused = str(e)
+            raise
+        self.refused = ''
+        return u
 
     def update(self, now: float, omega: np.ndarray, tau: float, reset_after: float
                ) -> np.ndarray:

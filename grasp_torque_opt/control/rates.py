@@ -21,7 +21,9 @@ N m) made every command a step. Two bounds:
   the straight line, the same fraction of every joint's change, so that it is the
   convex combination of two commands whose contact wrenches are known: the same
   combination of those wrenches is the step's, inside the exact cone when both ends
-  are (:func:`step_wrenches`);
+  are (:func:`step_wrenches`), across a change of the contact set too (a contact that
+  leaves fades out, one that comes fades in); a step is at most the rate times
+  ``command_period`` whatever the gap, and one from zero torques adds g(q) whole;
 - gravity: the gravity in use moves towards each accepted message at most
   ``max_gravity_rate`` times the time since the one in use was taken, turning
   (:func:`turned_towards`: its norm stays within the bounds both ends meet);
@@ -96,26 +98,46 @@ def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
     return in_force + s * delta, s
 
 
-def step_wrenches(in_force: np.ndarray | None, target: np.ndarray | None,
-                  s: float) -> np.ndarray | None:
+def step_wrenches(in_force: np.ndarray | None, in_links: tuple[str, ...] | None,
+                  target: np.ndarray | None, links: tuple[str, ...] | None, s: float
+                  ) -> tuple[np.ndarray, tuple[str, ...], np.ndarray] | None:
     """
-    Give the contact wrenches of a step: ``(1 - s) in_force + s target``.
+    Give the contact wrenches of a step: ``(1 - s) in_force + s target``, contact by contact.
+
+    A contact of both commands (the same link) takes the combination of its two wrenches;
+    one only in the certified command's set fades in (``s`` times its wrench), one only in
+    the command in force's fades out (``1 - s`` times its): every step of a contact-set
+    change is a combination of two commands whose wrenches are known, each contact's
+    inside the exact cone when both ends' are (zero is in it).
 
     Args:
-        in_force: the contact wrenches of the command in force, shape (p, 4) [N, N m],
-            shape (0, 4) for zero torques (a step from them is ``s`` times the
-            certified command's wrenches), or None (not known).
+        in_force: the contact wrenches of the command in force, shape (k, 4) [N, N m],
+            shape (0, 4) for zero torques (a step from them is ``s`` times the certified
+            command's wrenches), or None (not known).
+        in_links: their links (None: not known).
         target: the certified command's, shape (p, 4).
+        links: their links.
         s: the step's fraction.
 
     Returns:
-        The step's wrenches, or None when they are not known or the contacts differ in
-        number (the certified command is then published whole).
+        (the wrenches of ``links``' contacts, shape (p, 4); the links fading out; their
+        wrenches, shape (k', 4)), or None when they are not known or a set names a link
+        twice (the certified command is then published whole).
     """
+    none = np.zeros((0, 4))
     if in_force is None or target is None:
         return None
     if in_force.size == 0:
-        return s * target
-    if in_force.shape != target.shape:
+        return s * target, (), none
+    if in_links is None or links is None or len(set(in_links)) != len(in_links) \
+            or len(set(links)) != len(links) or in_force.shape != (len(in_links), 4) \
+            or target.shape != (len(links), 4):
         return None
-    return (1.0 - s) * in_force + s * target
+    index = {link: i for i, link in enumerate(in_links)}
+    wrenches = s * target
+    for i, link in enumerate(links):
+        if link in index:
+            wrenches[i] += (1.0 - s) * in_force[index[link]]
+    gone = tuple(link for link in in_links if link not in set(links))
+    faded = (1.0 - s) * in_force[[index[link] for link in gone]] if gone else none
+    return wrenches, gone, faded

@@ -195,6 +195,9 @@ def test_the_snapshot_is_frozen_and_typed():
 
 @pytest.mark.parametrize('name, value, ctx, message', [
     ('polygon_sides', 2, Context(), 'polygon_sides: must be in [3, 64], got 2'),
+    # Issue 33: 0.001 N m/s kept outdated torques for 31 s; a change of d N m now takes
+    # at most d seconds.
+    ('max_torque_rate', 1e-3, Context(), 'max_torque_rate: must be in [1.0, '),
     ('fault_policy', 'drop', Context(), 'fault_policy: must be one of hold, zero'),
     ('torque_limits', [1.0], Context(m=4), 'torque_limits: must have 4 entries, got 1'),
     ('torque_limits', [1.0, float('nan')], Context(m=2), 'torque_limits: must be finite'),

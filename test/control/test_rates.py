@@ -15,12 +15,15 @@ is the same combination of two commands whose wrenches are certified, so its wre
 are that combination of theirs: inside the exact cone, never pulling.
 """
 
+import dataclasses
+
 from cycle_inputs import base_poses, fresh, joint_state, tilted
 from grasp_torque_opt.control.inputs.contacts import ContactsReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.rates import slewed, step_wrenches
 from grasp_torque_opt.core.friction import cone_margin
 import numpy as np
+import pinocchio as pin
 
 
 def test_a_step_is_on_the_segment_and_no_joint_moves_faster():
@@ -35,15 +38,28 @@ def test_a_step_is_on_the_segment_and_no_joint_moves_faster():
 
 
 def test_step_wrenches_combine_both_ends_and_zero_torques_have_none():
-    a, b = np.ones((2, 4)), 3.0 * np.ones((2, 4))
-    np.testing.assert_allclose(step_wrenches(a, b, 0.25), 1.5 * np.ones((2, 4)))
-    np.testing.assert_allclose(step_wrenches(np.zeros((0, 4)), b, 0.25), 0.75 * np.ones((2, 4)))
-    assert step_wrenches(None, b, 0.5) is None
-    assert step_wrenches(np.ones((3, 4)), b, 0.5) is None  # another contact set
+    a, b = np.ones((2, 4)), 2 * np.ones((2, 4))
+    ab = ('a', 'b')
+    w, gone, faded = step_wrenches(a, ab, b, ab, 0.25)
+    np.testing.assert_allclose(w, 1.25 * np.ones((2, 4)))
+    assert gone == () and faded.shape == (0, 4)
+    np.testing.assert_allclose(step_wrenches(np.zeros((0, 4)), (), b, ab, 0.25)[0],
+                               0.5 * np.ones((2, 4)))
+    assert step_wrenches(None, None, b, ab, 0.5) is None
+    assert step_wrenches(a, ('a', 'a'), b, ab, 0.5) is None  # a link named twice
+
+
+def test_across_a_set_change_a_contact_fades_out_and_another_in():
+    old = np.array([[1.0, 0, 2, 0], [0, 1.0, 3, 0]])
+    new = np.array([[0, 0, 4.0, 0], [0, 0, 5.0, 0]])
+    w, gone, faded = step_wrenches(old, ('a', 'b'), new, ('b', 'c'), 0.25)
+    np.testing.assert_allclose(w, [0.75 * old[1] + 0.25 * new[0], 0.25 * new[1]])
+    assert gone == ('a',)
+    np.testing.assert_allclose(faded, [0.75 * old[0]])
 
 
 def test_slewed_commands_keep_their_wrenches_in_the_exact_cone(allegro):
-    rate = 0.2  # N m/s: a 1 ms cycle moves a joint 0.2 mN m
+    rate = 1.0  # N m/s: a 0.1 ms cycle moves a joint 0.1 mN m
     ctrl = fresh(allegro, max_torque_rate=rate)
     names, pos = joint_state(allegro)
     points, quat = base_poses(allegro)
@@ -61,7 +77,7 @@ def test_slewed_commands_keep_their_wrenches_in_the_exact_cone(allegro):
     ctrl.take('contacts', ContactsReading('', points, tilted(quat, 0.1)), 0.0)
     steps = 0
     for k in range(1, 400):
-        now = 1e-3 * k
+        now = 1e-4 * k
         ctrl.take('joint_states', JointStateReading(names, pos), now)
         result = ctrl.cycle(now)
         cmd = result.command
@@ -70,7 +86,7 @@ def test_slewed_commands_keep_their_wrenches_in_the_exact_cone(allegro):
             break
         steps += 1
         delta, want = cmd - prev, ends[1] - prev
-        assert np.abs(delta).max() <= rate * 1e-3 + 1e-12
+        assert np.abs(delta).max() <= rate * 1e-4 + 1e-12
         # On the segment towards the certified command: parallel to what is left.
         s = float(delta @ want / (want @ want))
         np.testing.assert_allclose(delta, s * want, atol=1e-7)  # the solver's tolerance
@@ -79,5 +95,113 @@ def test_slewed_commands_keep_their_wrenches_in_the_exact_cone(allegro):
     else:
         raise AssertionError('the certified command was never reached')
     full = float(np.abs(ends[1] - ends[0]).max())
-    assert steps >= int(full / (rate * 1e-3)) - 1 and steps > 5
+    assert steps >= int(full / (rate * 1e-4)) - 1 and steps > 5
     assert ctrl.counters.slew_limited == steps and ctrl.counters.slew_refused == 0
+
+
+LIFT = 1  # the middle finger lifts off: three contacts left
+
+
+def lifted(setup):
+    """Give the grasp's joint positions with the lifted finger's proximal flexion opened."""
+    model, q = setup.hand.model, setup.q.copy()
+    q[model.joints[model.getJointId('joint_5.0')].idx_q] -= 0.1
+    return q
+
+
+def union_torque(setup, q, links, wrenches):
+    """J^T w summed over contacts given by link (each from the grasp's own contact there)."""
+    by_link = {c.link: c for c in setup.contacts}
+    maps = dataclasses.replace(setup, q=q, contacts=[by_link[k] for k in links]).maps()
+    return maps.J.T @ np.asarray(wrenches).reshape(-1)
+
+
+def test_a_contact_set_change_and_flapping_go_through_the_rate_rule(allegro):
+    # Issue 33, item 4a: a change of the contact set was published whole (a jump), and a
+    # set flapping at 1 kHz made every command a step of the whole difference.
+    rate, dt = 1.0, 1e-3
+    ctrl = fresh(allegro, max_torque_rate=rate)
+    q = lifted(allegro)
+    links = [c.link for c in allegro.contacts]
+    three = links[:LIFT] + links[LIFT + 1:]
+    names, pos = joint_state(allegro, q)
+    points, quat = base_poses(allegro, q)
+    keep = [i for i in range(4) if i != LIFT]
+    sets = {4: (';' + ','.join(links), points, quat),
+            3: (';' + ','.join(three), points[keep], quat[keep])}
+    ctrl.take('contacts', ContactsReading(*sets[4]), 0.0)
+    ctrl.take('joint_states', JointStateReading(names, pos), 0.0)
+    prev = ctrl.cycle(0.0).command
+    friction, steps = allegro.friction, 0
+    for k in range(1, 300):
+        now = dt * k
+        # Three contacts from now on, then the set flapping every cycle from k = 200.
+        ctrl.take('contacts', ContactsReading(*sets[3 if k < 200 or k % 2 else 4]), now)
+        ctrl.take('joint_states', JointStateReading(names, pos), now)
+        result = ctrl.cycle(now)
+        assert result.kind == 'solution'
+        cmd = result.command
+        assert np.abs(cmd - prev).max() <= rate * dt + 1e-12  # never a jump
+        if result.wrenches is not None:  # a step: its wrenches, fading ones too, hold
+            steps += 1
+            gone, faded = result.faded
+            every = np.vstack((result.wrenches, faded))
+            assert cone_margin(every, friction.mu1, friction.mu2).min() >= -1e-6
+            # They are the step's: J^T w over both sets' contacts gives its torque.
+            np.testing.assert_allclose(
+                union_torque(allegro, q, list(result.maps.links) + list(gone), every), cmd,
+                atol=1e-6)
+        prev = cmd
+    assert steps > 10 and ctrl.counters.slew_refused == 0
+
+
+def test_a_step_is_at_most_the_rate_times_the_nominal_period_whatever_the_gap(allegro):
+    # Issue 33, item 4b: the rule allowed rate x gap (a loop slowed to 76 Hz took steps
+    # of 0.55-0.69 N m).
+    rate, period = 1.0, 1e-3
+    ctrl = fresh(allegro, max_torque_rate=rate, command_period=period)
+    names, pos = joint_state(allegro)
+    points, quat = base_poses(allegro)
+    ctrl.take('joint_states', JointStateReading(names, pos), 0.0)
+    ctrl.take('contacts', ContactsReading('', points, quat), 0.0)
+    first = ctrl.cycle(0.0).command
+    gap = 0.04  # within joint_state_timeout
+    ctrl.take('contacts', ContactsReading('', points, tilted(quat, 0.1)), gap)
+    ctrl.take('joint_states', JointStateReading(names, pos), gap)
+    result = ctrl.cycle(gap)
+    assert result.wrenches is not None  # a step, not the certified command whole
+    assert np.abs(result.command - first).max() <= rate * period + 1e-12
+
+
+def test_a_recovery_from_zeros_steps_the_contact_wrenches_with_gravity_whole(allegro):
+    # Issue 33, item 4c: with gravity compensation a recovery step was s (tau + g): the
+    # fingers' wrenches s W - (1 - s) J^-T g, 15 of 15 outside the cone.
+    gravity = np.array([9.81, 0.0, 0.0])
+    ctrl = fresh(allegro, max_torque_rate=1.0, gravity_compensation=True,
+                 gravity=tuple(gravity), fault_policy='zero', hold_time=0.01,
+                 joint_state_timeout=0.05)
+    names, pos = joint_state(allegro)
+    model = allegro.hand.model.copy()
+    model.gravity.linear = gravity
+    g = pin.computeGeneralizedGravity(model, model.createData(), allegro.q)[allegro.hand.idx_v]
+    maps = allegro.maps()
+    ctrl.take('joint_states', JointStateReading(names, pos), 0.0)
+    assert ctrl.cycle(0.0).kind == 'solution'
+    assert ctrl.watchdog(0.2).kind == 'zero'  # stale: zero torques in force
+    friction, steps, now = allegro.friction, 0, 0.2
+    while True:
+        now += 1e-3
+        ctrl.take('joint_states', JointStateReading(names, pos), now)
+        result = ctrl.cycle(now)
+        assert result.kind == 'solution'
+        # What the fingers exert on the ball under the true gravity, from Pinocchio.
+        exerted = np.linalg.solve(maps.J.T, result.command - g).reshape(-1, 4)
+        certified = result.solution.wrenches
+        s = float(exerted[:, 2].sum() / certified[:, 2].sum())
+        np.testing.assert_allclose(exerted, s * certified, atol=1e-6)
+        assert cone_margin(exerted, friction.mu1, friction.mu2).min() >= -1e-6
+        if result.wrenches is None:
+            break
+        steps += 1
+        assert 0.0 < s < 1.0
+    assert steps >= 3

@@ -26,6 +26,7 @@ from grasp_torque_opt.core.scenario import load_scenario
 from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
 import pinocchio as pin
+import pytest
 from rclpy.qos import qos_profile_sensor_data
 from ros_harness import Harness
 from sensor_msgs.msg import Imu
@@ -113,6 +114,38 @@ def test_a_bad_imu_is_rejected_and_the_scenarios_gravity_used(allegro):
         h.spin_until(lambda: 'stale' in h.diagnostics[-1].get('imu', ''), 2.0)
         assert 'imu stale' in h.diagnostics[-1]['imu']
         assert h.diagnostics[-1]['_level'] == 1  # WARN
+    finally:
+        h.close()
+
+
+@pytest.mark.parametrize('lie', ['1.9 g sideways', 'rate chatter'])
+def test_an_imu_lie_is_refused_and_every_joint_state_gets_the_nominal_command(allegro, lie):
+    # Issue 33: a still hand told 1.9 g sideways (every command pulled at the true grasp),
+    # or +-29 rad/s alternating (every other grasp infeasible: commands lost).
+    h = ImuHarness()
+    try:
+        nominal = reference(G, allegro.q)
+        # Each reading taken before the next is sent, as a node spinning at 1 kHz takes
+        # them (sensor-data QoS keeps the last 5 of a burst).
+        for _ in range(5):  # a still IMU first: the reading before the lie is a true one
+            h.send_imu(-G)
+            h.spin_for(0.001)
+        for k in range(20):
+            for j in range(5):
+                if lie == 'rate chatter':
+                    h.send_imu(-G, omega=(0.0, 29.0 if (5 * k + j) % 2 else -29.0, 0.0))
+                else:
+                    h.send_imu([0.0, 0.0, -18.64])
+                h.spin_for(0.001)
+            h.send_joint_state(*joint_state(allegro))
+            cmd = h.next_command()
+            assert cmd is not None, k
+            np.testing.assert_allclose(cmd, nominal, atol=1e-7)
+        why = 'imu.max_arm_acceleration' if lie == '1.9 g sideways' else \
+            'imu.max_angular_acceleration'
+        assert why in h.node.controller.last_rejection
+        d = last_diag(h, 'imu.refused')
+        assert why in h.diagnostics[-1]['imu.refused'], d
     finally:
         h.close()
 

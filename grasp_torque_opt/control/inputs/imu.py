@@ -11,8 +11,9 @@ The base's IMU (sensor_msgs/Imu, with ``imu.enabled``): specific force, angular 
 
 In the hand's base frame, or another through its transform (tf2's rotation and origin);
 its orientation is not used. ``specific_force`` [m/s^2] reads -g at rest. A reading
-:func:`grasp_torque_opt.control.motion.checked_imu` refuses is not kept: the last one
-ages out by its own timeout (:class:`~grasp_torque_opt.control.motion.ImuTracker`),
+:func:`grasp_torque_opt.control.motion.checked_imu` or the cross-checks
+(:meth:`~grasp_torque_opt.control.motion.ImuTracker.cross_checked`) refuse is not kept:
+the last one ages out by its own timeout (:class:`~grasp_torque_opt.control.motion.ImuTracker`),
 then the scenario's gravity is used again; it never makes the inputs stale.
 """
 
@@ -57,14 +58,25 @@ class Imu:
     timeout = 'imu.timeout_periods, imu.timeout_bounds'
 
     def check(self, store, reading: ImuReading) -> tuple:
-        """Check a reading (:func:`.motion.checked_imu`); give (gravity, omega, point)."""
-        return checked_imu(store.setup.hand.base_frame, reading.frame, reading.specific_force,
-                           reading.omega, reading.transform, reading.unresolved, store.config)
+        """
+        Check a reading; give (gravity, omega, point, reference direction).
+
+        Its own bounds (:func:`.motion.checked_imu`), then the cross-checks with the
+        reading before and with gravity (:meth:`.motion.ImuTracker.cross_checked`).
+        """
+        c = store.config
+        g, w, point = checked_imu(store.setup.hand.base_frame, reading.frame,
+                                  reading.specific_force, reading.omega, reading.transform,
+                                  reading.unresolved, c)
+        gravity = np.asarray(c.gravity if store.inputs.gravity is None
+                             else store.inputs.gravity, dtype=float)
+        return g, w, point, store.imu.cross_checked(store.now, g, w, gravity, c)
 
     def keep(self, store, value: tuple, now: float) -> dict[str, Any]:
         """Keep the base's motion: the rate filtered into an angular acceleration."""
-        g, w, point = value
+        g, w, point, reference = value
         c = store.config
+        store.imu.reference = reference
         alpha = store.imu.update(now, w, c.imu_angular_filter, c.imu_timeout_bounds[1])
         timeout = store.imu.timeout(c.imu_timeout_periods, c.imu_timeout_bounds)
         return {'motion': Motion(g, w, alpha, point, timeout), 'motion_time': now}

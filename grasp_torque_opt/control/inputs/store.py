@@ -137,6 +137,9 @@ class InputStore:
         #: with the same names skips the name checks).
         self.joint_names: tuple | None = None
         self.imu = ImuTracker()
+        #: The receipt time of the message being taken [s] (a check comparing it with the
+        #: input's earlier messages reads it).
+        self.now = 0.0
         #: Why the last joint state's efforts were not used ('' when they were).
         self.effort_missing = ''
         self.effort_index: tuple | None = None  # (names, indices of the actuators)
@@ -190,6 +193,7 @@ class InputStore:
                 reason kept); nothing is kept.
         """
         given = REGISTRY[source]
+        self.now = now
         try:
             value = given.check(self, reading)
             self._check_stamp(source, stamp, clock, now)

@@ -60,9 +60,14 @@ class CycleConfig:
             own link's frame is rejected (another finger's contact, a wrong frame); in the cycle,
             at the configuration of the moment, a fault. [m]
         max_torque_rate: A certified command farther from the command in force than this rate
-            allows since that command is published as a step of at most this rate towards it (the
-            rate rule, docs/node.md: flapping contacts or gravity cannot chatter the motors).
+            allows since that command (at most command_period) is published as a step of at most
+            this rate towards it (the rate rule, docs/node.md: flapping contacts or gravity cannot
+            chatter the motors). At least 1 N m/s: a change of d N m is reached within d seconds.
             [N m/s]
+        command_period: The joint states' nominal period: a step of the rate rule is at most
+            max_torque_rate times the time since the command in force, and never more than
+            max_torque_rate times this, however long the gap (a loop slowed by a flood cannot take
+            bigger steps). [s]
         gravity_norm_bounds: [low, high]: gravity on the topic, and the gravity parameter, must
             have a norm in this range (a hand on Earth: 9.81); [0.0, 15.0] allows zero gravity
             (space, a test). [m/s^2]
@@ -78,6 +83,20 @@ class CycleConfig:
             anything). [m/s^2]
         imu_max_angular_velocity: (``imu.max_angular_velocity``) An IMU reading whose angular
             velocity's norm exceeds this is rejected. [rad/s]
+        imu_max_arm_acceleration: (``imu.max_arm_acceleration``) An IMU reading whose specific
+            force implies an arm acceleration |g_app - g_ref| above this is refused: g_ref is
+            gravity (the scenario's, the gravity topic's) with its direction turned as the IMU's
+            own angular velocity allows (about 2 g: the 2 g the simulation's robustness grid shakes
+            the hand with pass, a still hand told 1.9 g sideways does not; docs/node.md,
+            "Cross-checks and the one rate rule"). [m/s^2]
+        imu_turn_tolerance: (``imu.turn_tolerance``) The reference gravity's direction follows the
+            IMU's apparent gravity turning at most |omega| plus this (a gyro's bias, an
+            acceleration held for long). [rad/s]
+        imu_max_angular_acceleration: (``imu.max_angular_acceleration``) An IMU reading whose
+            angular velocity changed faster than this since the reading before it (refused or not)
+            is refused, and so are the readings after it until the rate has kept this for
+            imu.timeout_bounds' upper bound: angular-rate chatter never reaches the filtered
+            derivative and the inertial wrench. [rad/s^2]
         imu_angular_filter: (``imu.angular_filter``) Time constant of the low-pass on the
             derivative of the IMU's angular velocity (the base's angular acceleration). [s]
         contact_geometry: (``contact_geometry.enabled``) Find the contacts from geometry every
@@ -143,12 +162,16 @@ class CycleConfig:
     max_contact_distance: float = 1.0
     max_contact_link_distance: float = 0.05
     max_torque_rate: float = 20.0
+    command_period: float = 0.005
     gravity_norm_bounds: tuple = (5.0, 15.0)
     max_gravity_rate: float = 100.0
     imu_timeout_periods: float = 5.0
     imu_timeout_bounds: tuple = (0.005, 0.05)
     imu_max_specific_force: float = 60.0
     imu_max_angular_velocity: float = 30.0
+    imu_max_arm_acceleration: float = 20.0
+    imu_turn_tolerance: float = 0.1
+    imu_max_angular_acceleration: float = 200.0
     imu_angular_filter: float = 0.02
     contact_geometry: bool = False
     contact_release: float = 2.0
@@ -187,6 +210,18 @@ class ParamsImu:
             (about 6 g: a hand that accelerates more is not holding anything). [m/s^2]
         max_angular_velocity: An IMU reading whose angular velocity's norm exceeds this is
             rejected. [rad/s]
+        max_arm_acceleration: An IMU reading whose specific force implies an arm acceleration
+            |g_app - g_ref| above this is refused: g_ref is gravity (the scenario's, the gravity
+            topic's) with its direction turned as the IMU's own angular velocity allows (about 2 g:
+            the 2 g the simulation's robustness grid shakes the hand with pass, a still hand told
+            1.9 g sideways does not; docs/node.md, "Cross-checks and the one rate rule"). [m/s^2]
+        turn_tolerance: The reference gravity's direction follows the IMU's apparent gravity
+            turning at most |omega| plus this (a gyro's bias, an acceleration held for long).
+            [rad/s]
+        max_angular_acceleration: An IMU reading whose angular velocity changed faster than this
+            since the reading before it (refused or not) is refused, and so are the readings after
+            it until the rate has kept this for imu.timeout_bounds' upper bound: angular-rate
+            chatter never reaches the filtered derivative and the inertial wrench. [rad/s^2]
         angular_filter: Time constant of the low-pass on the derivative of the IMU's angular
             velocity (the base's angular acceleration). [s]
     """
@@ -196,6 +231,9 @@ class ParamsImu:
     timeout_bounds: tuple | None
     max_specific_force: float | None
     max_angular_velocity: float | None
+    max_arm_acceleration: float | None
+    turn_tolerance: float | None
+    max_angular_acceleration: float | None
     angular_filter: float | None
 
 
@@ -397,9 +435,14 @@ class Params:
             own link's frame is rejected (another finger's contact, a wrong frame); in the cycle,
             at the configuration of the moment, a fault. [m]
         max_torque_rate: A certified command farther from the command in force than this rate
-            allows since that command is published as a step of at most this rate towards it (the
-            rate rule, docs/node.md: flapping contacts or gravity cannot chatter the motors).
+            allows since that command (at most command_period) is published as a step of at most
+            this rate towards it (the rate rule, docs/node.md: flapping contacts or gravity cannot
+            chatter the motors). At least 1 N m/s: a change of d N m is reached within d seconds.
             [N m/s]
+        command_period: The joint states' nominal period: a step of the rate rule is at most
+            max_torque_rate times the time since the command in force, and never more than
+            max_torque_rate times this, however long the gap (a loop slowed by a flood cannot take
+            bigger steps). [s]
         gravity_norm_bounds: [low, high]: gravity on the topic, and the gravity parameter, must
             have a norm in this range (a hand on Earth: 9.81); [0.0, 15.0] allows zero gravity
             (space, a test). [m/s^2]
@@ -469,6 +512,7 @@ class Params:
     max_contact_distance: float | None
     max_contact_link_distance: float | None
     max_torque_rate: float | None
+    command_period: float | None
     gravity_norm_bounds: tuple | None
     max_gravity_rate: float | None
     imu: ParamsImu
@@ -507,12 +551,16 @@ CYCLE_FIELDS = {
     'max_contact_distance': 'max_contact_distance',
     'max_contact_link_distance': 'max_contact_link_distance',
     'max_torque_rate': 'max_torque_rate',
+    'command_period': 'command_period',
     'gravity_norm_bounds': 'gravity_norm_bounds',
     'max_gravity_rate': 'max_gravity_rate',
     'imu_timeout_periods': 'imu.timeout_periods',
     'imu_timeout_bounds': 'imu.timeout_bounds',
     'imu_max_specific_force': 'imu.max_specific_force',
     'imu_max_angular_velocity': 'imu.max_angular_velocity',
+    'imu_max_arm_acceleration': 'imu.max_arm_acceleration',
+    'imu_turn_tolerance': 'imu.turn_tolerance',
+    'imu_max_angular_acceleration': 'imu.max_angular_acceleration',
     'imu_angular_filter': 'imu.angular_filter',
     'contact_geometry': 'contact_geometry.enabled',
     'contact_release': 'contact_geometry.release',
