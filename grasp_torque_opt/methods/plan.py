@@ -124,7 +124,7 @@ class PlanSettings:
                              f'{self.orientation!r}')
         if self.hold_margin is not None and not (
                 math.isfinite(self.hold_margin) and 0.0 <= self.hold_margin <= 100.0):
-            raise InputError('hold_margin', f'must be in [0, 100] or None, got '
+            raise InputError('hold_margin', f'must be in [0, 100], got '
                              f'{self.hold_margin!r}')
         if self.contacts not in CONTACT_MODES:
             raise InputError('contacts', f"must be one of {', '.join(CONTACT_MODES)}, got "

@@ -209,6 +209,7 @@ def test_the_command_writes_the_functions_candidates(tmp_path, capsys):
     (['--links', 'palm_link'], "links[0].link: 'palm_link'"),
     (['--region', '0'], 'region: must be in (0, 1] m, got 0.0'),
     (['--mass', '-1'], '--mass: must be finite and > 0 [kg]'),
+    (['--hold-margin', '-1'], 'hold_margin: must be in [0, 100], got -1.0'),
     (['--mesh', str(ROOT / 'no.stl')], 'mesh file not found'),
 ])
 def test_bad_options_are_named(argv, message, capsys):
