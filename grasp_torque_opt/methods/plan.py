@@ -10,18 +10,22 @@
 Candidate grasps from geometry: the object placed near the palm, the fingers on it.
 
 :func:`plan_grasps` draws, from one seed, an object pose in a reach region about the
-base scenario's object origin (its orientation uniform at random for a box, cylinder
-or mesh) and joint positions about the base scenario's grasp, then solves the IK of
-:mod:`~grasp_torque_opt.methods.plan_ik` (the contact links' collision shapes on the
-object's surface, every other shape at least ``clearance`` from it, joints within
-their limits). A solution is kept only if an independent check passes: the contacts
-found by :class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed
-forms where they apply) are every contact link's, each within ``tolerance`` of the
+base scenario's object origin (a box's or cylinder's orientation opposed to the base
+grasp's thumb and fingers, :func:`opposition_frame`, slightly tilted; or uniform at
+random, always for a mesh) and joint positions about the base scenario's grasp, then
+solves the IK of :mod:`~grasp_torque_opt.methods.plan_ik` (the contact links'
+collision shapes on the object's surface, every other shape at least ``clearance``
+from it, joints within their limits). A solution is kept only if an independent
+check passes: the contacts found by
+:class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed forms
+where they apply) are every contact link's, each within ``tolerance`` of the
 surface with its inward normal, none within :data:`EDGE` of an edge; every other
 link of the hand (the palm included) is at least ``clearance`` away; every joint is
-within its URDF limits. Each candidate
-is a line that ``grasp-torque-opt score`` reads (docs/planner.md, "Planning
-candidates").
+within its URDF limits. Then, by default, it must hold its own load: its load
+capacity (:mod:`.capacity`, certified, every load from zero up to it held) with
+friction margin ``hold_margin`` is at least 1. Each refusal is counted by its reason.
+Each candidate is a line that ``grasp-torque-opt score`` reads (docs/planner.md,
+"Planning candidates").
 """
 
 from __future__ import annotations
