@@ -10,7 +10,7 @@
 Planned grasps in physics: does the ranking, and each prediction, hold in MuJoCo.
 
 Usage: .venv/bin/python bench/plan_physics.py [--count 9] [--per-band 2] [--seed 0]
-       [--out bench/results/plan_physics.json]
+       [--margin K] [--unfiltered] [--out bench/results/plan_physics.json]
        .venv/bin/python bench/plan_physics.py --simulate-best PLAN SCORES [--picture F]
 
 Per object (a sphere, a box, a cylinder of 0.15 kg on the bundled Allegro): plan
@@ -22,6 +22,10 @@ centre along +x, -x, +y, -y, +z, -z in turn (one episode of 2 s each after 0.3 s
 of settling), the node told that load. Success: the object moves < 5 cm and turns
 < 15 deg; strict: < 2 mm and < 2 deg. The prediction of an episode: the candidate
 has an axis capacity along the force (certified) of at least the force.
+
+``--unfiltered`` plans as before issue 38 (uniform orientations, every candidate that
+touches kept, held or not): the population whose capacities of grasps that cannot
+hold their own load the prediction must get right.
 
 ``--simulate-best`` is the loop's last step (README): the best-ranked line of SCORES
 (``score --out``) from PLAN, simulated on the base scenario's own load (its weight,
@@ -104,9 +108,12 @@ def bands(ranked: list[dict], k: int) -> dict[str, list[dict]]:
     return {'top': ranked[:k], 'median': ranked[mid:mid + k], 'bottom': ranked[max(0, n - k):]}
 
 
-def run_object(kind: str, count: int, per_band: int, seed: int) -> dict:
+def run_object(kind: str, count: int, per_band: int, seed: int, unfiltered: bool = False
+               ) -> dict:
     shape = ObjectShape(kind, np.array(OBJECTS[kind]))
-    plan = plan_grasps(SCENARIO, PlanSettings(count=count, seed=seed), shape=shape, mass=MASS)
+    extra = {'orientation': 'random', 'hold_margin': None} if unfiltered else {}
+    plan = plan_grasps(SCENARIO, PlanSettings(count=count, seed=seed, **extra), shape=shape,
+                       mass=MASS)
     by_id = {c['id']: c for c in plan.candidates}
     records = score_batch(ScoreJob.from_file(SCENARIO), plan.candidates, engine='serial')
     for r, c in zip(records, plan.candidates):
@@ -186,6 +193,9 @@ def main() -> int:
     p.add_argument('--out')
     p.add_argument('--simulate-best', nargs=2, metavar=('PLAN', 'SCORES'))
     p.add_argument('--picture', default='best.png')
+    p.add_argument('--unfiltered', action='store_true',
+                   help='plan uniform orientations and keep every candidate that touches '
+                   '(the planner before issue 38)')
     p.add_argument('--margin', type=float, default=0.0,
                    help="the friction margin k of the scenario: the plan's scores, the "
                         "capacities predicted and the node's torques all use it")
@@ -200,7 +210,7 @@ def main() -> int:
     if args.simulate_best:
         return simulate_best(*args.simulate_best, args.picture)
     t0 = time.time()
-    results = [run_object(k, args.count, args.per_band, args.seed)
+    results = [run_object(k, args.count, args.per_band, args.seed, args.unfiltered)
                for k in args.objects.split(',')]
     commit = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True,
                             text=True, cwd=ROOT).stdout.strip()

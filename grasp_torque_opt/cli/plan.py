@@ -27,7 +27,8 @@ from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import load_scenario
-from grasp_torque_opt.methods.plan import CONTACT_MODES, plan_grasps, PlanResult, PlanSettings
+from grasp_torque_opt.methods.plan import (CONTACT_MODES, ORIENTATIONS, plan_grasps, PlanResult,
+                                           PlanSettings)
 import numpy as np
 
 #: Sizes of each primitive's ``--size``.
@@ -68,6 +69,16 @@ def add_parser(sub) -> None:
                    help="the region's centre [m] (default: the scenario's object origin)")
     p.add_argument('--no-rotate', action='store_true',
                    help="keep the object's axes the base's (else drawn at random)")
+    p.add_argument('--orientation', choices=ORIENTATIONS, default=d.orientation,
+                   help="a box's or cylinder's orientation: opposed (faces or the curved "
+                   "side across the base grasp's thumb and fingers, tilted a little) or "
+                   'random (uniform)')
+    p.add_argument('--hold-margin', type=float, default=d.hold_margin, metavar='K',
+                   help='keep only candidates whose load capacity, with friction margin K '
+                   "(or the scenario's, if larger), is at least 1: every load from zero to "
+                   'their own held')
+    p.add_argument('--keep-unheld', action='store_true',
+                   help='keep every candidate that touches, held or not (no --hold-margin)')
     p.add_argument('--clearance', type=float, default=d.clearance,
                    help='every other link at least this far from the object [m]')
     p.add_argument('--tolerance', type=float, default=d.tolerance,
@@ -105,7 +116,9 @@ def plan(args: argparse.Namespace) -> PlanResult:
     settings = PlanSettings(
         count=args.count, seed=args.seed, region=args.region,
         links=tuple(args.links.split(',')) if args.links else None, centre=args.centre,
-        rotate=not args.no_rotate, clearance=args.clearance, tolerance=args.tolerance,
+        rotate=not args.no_rotate, orientation=args.orientation,
+        hold_margin=None if args.keep_unheld else args.hold_margin,
+        clearance=args.clearance, tolerance=args.tolerance,
         attempts=args.attempts, contacts=args.contacts, extra_load=args.load)
     return plan_grasps(scenario, settings, shape, args.mass)
 

@@ -10,22 +10,27 @@
 Candidate grasps from geometry: the object placed near the palm, the fingers on it.
 
 :func:`plan_grasps` draws, from one seed, an object pose in a reach region about the
-base scenario's object origin (its orientation uniform at random for a box, cylinder
-or mesh) and joint positions about the base scenario's grasp, then solves the IK of
-:mod:`~grasp_torque_opt.methods.plan_ik` (the contact links' collision shapes on the
-object's surface, every other shape at least ``clearance`` from it, joints within
-their limits). A solution is kept only if an independent check passes: the contacts
-found by :class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed
-forms where they apply) are every contact link's, each within ``tolerance`` of the
+base scenario's object origin (a box's or cylinder's orientation opposed to the base
+grasp's thumb and fingers, :func:`opposition_frame`, slightly tilted; or uniform at
+random, always for a mesh) and joint positions about the base scenario's grasp, then
+solves the IK of :mod:`~grasp_torque_opt.methods.plan_ik` (the contact links'
+collision shapes on the object's surface, every other shape at least ``clearance``
+from it, joints within their limits). A solution is kept only if an independent
+check passes: the contacts found by
+:class:`~grasp_torque_opt.core.geometry_contacts.GeometryContacts` (closed forms
+where they apply) are every contact link's, each within ``tolerance`` of the
 surface with its inward normal, none within :data:`EDGE` of an edge; every other
 link of the hand (the palm included) is at least ``clearance`` away; every joint is
-within its URDF limits. Each candidate
-is a line that ``grasp-torque-opt score`` reads (docs/planner.md, "Planning
-candidates").
+within its URDF limits. Then, by default, it must hold its own load: its load
+capacity (:mod:`.capacity`, certified, every load from zero up to it held) with
+friction margin ``hold_margin`` is at least 1. Each refusal is counted by its reason.
+Each candidate is a line that ``grasp-torque-opt score`` reads (docs/planner.md,
+"Planning candidates").
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 import json
 import math
@@ -38,6 +43,7 @@ from grasp_torque_opt.core.grasp_setup import bind_for_candidates
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import load_scenario, Scenario
+from grasp_torque_opt.methods.capacity import load_capacity
 from grasp_torque_opt.methods.plan_ik import SurfaceIK
 import numpy as np
 import pinocchio as pin
@@ -49,6 +55,12 @@ MAX_COUNT = 100_000
 EDGE = 3e-3
 #: Contact modes of the output: points and normals written, or the links only.
 CONTACT_MODES = ('points', 'links')
+#: How a box's or cylinder's orientation is drawn (docs/planner.md, "Planning candidates").
+ORIENTATIONS = ('opposed', 'random')
+#: Standard deviation of the tilt about the opposed orientation [rad].
+TILT = 0.1
+#: The friction margin a kept candidate's own load is held at, by default [-].
+HOLD_MARGIN = 0.3
 
 
 @dataclass(frozen=True)
@@ -64,6 +76,11 @@ class PlanSettings:
             about ``centre`` [m].
         centre: the region's centre, base frame [m]; None: the base's object origin.
         rotate: draw the object's orientation (a sphere's is never drawn).
+        orientation: ``opposed`` (a box's faces, a cylinder's side, facing the base
+            grasp's fingers and thumb, tilted at random) or ``random`` (uniform).
+        hold_margin: keep only candidates that hold their own load from zero with this
+            friction margin (or the scenario's, if larger) [-]; None keeps every
+            candidate that touches.
         joint_spread: standard deviation of the start joints about the base grasp [rad].
         clearance: every other link keeps at least this from the object [m].
         tolerance: a contact link within this of the surface (either side) [m].
@@ -80,6 +97,8 @@ class PlanSettings:
     region: float = 0.02
     centre: tuple[float, float, float] | None = None
     rotate: bool = True
+    orientation: str = 'opposed'
+    hold_margin: float | None = HOLD_MARGIN
     joint_spread: float = 0.2
     clearance: float = 2e-3
     tolerance: float = 5e-4
@@ -104,6 +123,13 @@ class PlanSettings:
         if not (isinstance(self.attempts, int) and 1 <= self.attempts <= 1000):
             raise InputError('attempts', f'must be an integer in [1, 1000], got '
                              f'{self.attempts!r}')
+        if self.orientation not in ORIENTATIONS:
+            raise InputError('orientation', f"must be one of {', '.join(ORIENTATIONS)}, got "
+                             f'{self.orientation!r}')
+        if self.hold_margin is not None and not (
+                math.isfinite(self.hold_margin) and 0.0 <= self.hold_margin <= 100.0):
+            raise InputError('hold_margin', f'must be in [0, 100], got '
+                             f'{self.hold_margin!r}')
         if self.contacts not in CONTACT_MODES:
             raise InputError('contacts', f"must be one of {', '.join(CONTACT_MODES)}, got "
                              f'{self.contacts!r}')
@@ -190,27 +216,125 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     region = (centre - settings.region, centre + settings.region)
     rng = np.random.default_rng(settings.seed)
     theta_base = setup.q[hand.idx_q]
+    frame = opposition_frame(setup)
+    load = _load(mass, scenario.gravity, settings.extra_load)
+    margin = (None if settings.hold_margin is None
+              else max(settings.hold_margin, scenario.friction.margin))
     out: list[dict[str, Any]] = []
     rejected: dict[str, int] = {}
     tries = 0
     while len(out) < settings.count and tries < settings.count * settings.attempts:
         tries += 1
         p0 = rng.uniform(region[0], region[1])
-        R = (Rotation.random(random_state=rng).as_matrix()
-             if settings.rotate and shape.kind != 'sphere' else np.eye(3))
+        R = _draw_orientation(shape.kind, shape.size, settings, frame, rng)
         theta0 = np.clip(theta_base + rng.normal(0.0, settings.joint_spread, hand.m),
                          lower, upper)
         sol = ik.solve(theta0, p0, R, setup.q, (lower, upper), region, settings.clearance)
         q = ik.full_q(sol.theta, setup.q)
-        why = _reject(check, ik, q, pin.SE3(R, sol.position), links, settings)
+        pose = pin.SE3(R, sol.position)
+        why = _reject(check, ik, q, pose, links, settings)
+        found = check.contacts(q, pose) if why is None else None
+        if why is None and margin is not None:
+            why = _not_held(setup, q, found, sol.position, load, margin)
         if why is not None:
             rejected[why] = rejected.get(why, 0) + 1
             continue
-        found = check.contacts(q, pin.SE3(R, sol.position))
         out.append(_candidate(f'plan-{settings.seed}-{len(out)}', hand, sol.theta,
                               sol.position, R, shape, mass, found, settings,
                               scenario.gravity))
     return PlanResult(out, tries, rejected)
+
+
+def _load(mass: float, gravity, extra) -> np.ndarray:
+    """Return the candidate's own load: the weight at the object's centre plus ``extra``."""
+    load = np.asarray(extra if extra is not None else [0.0] * 6, dtype=float).copy()
+    if gravity is not None:
+        load[:3] += mass * np.asarray(gravity, dtype=float)
+    return load
+
+
+def opposition_frame(setup) -> tuple[np.ndarray, float] | None:
+    """
+    Return the base grasp's opposition frame, columns (d, e, d x e), and its row's span.
+
+    d is the axis the contact normals share most (the principal axis of sum n n^T: the
+    fingers' against the thumb's), e the direction the contact points spread most
+    across d (the fingers' row); the span is their extent along e [m]. None with fewer
+    than two contacts.
+    """
+    if len(setup.contacts) < 2:
+        return None
+    maps = setup.maps()
+    normals = maps.rotations[:, :, 2]
+    d = np.linalg.eigh(normals.T @ normals)[1][:, -1]
+    spread = maps.positions - maps.positions.mean(axis=0)
+    spread = spread - np.outer(spread @ d, d)
+    e = np.linalg.eigh(spread.T @ spread)[1][:, -1]
+    e = e - (e @ d) * d
+    e /= np.linalg.norm(e)
+    span = float(np.ptp(maps.positions @ e))
+    return np.column_stack([d, e, np.cross(d, e)]), span
+
+
+def _draw_orientation(kind: str, box_size, settings: PlanSettings, frame, rng
+                      ) -> np.ndarray:
+    """
+    Draw the object's orientation in the base frame.
+
+    ``opposed`` (``frame``: :func:`opposition_frame`'s): a box with one of its axes
+    along the opposition axis d (its faces across it, the thumb against the fingers)
+    and another along the fingers' row e, one whose face is wide enough for the row; a
+    cylinder with its axis along e (the fingers and the thumb on its curved side,
+    normals towards the axis), turned about it at random; then tilted by a rotation
+    vector of standard deviation :data:`TILT` per axis. A sphere's is never drawn.
+    """
+    if not settings.rotate or kind == 'sphere':
+        return np.eye(3)
+    if settings.orientation == 'random' or frame is None or kind not in ('box', 'cylinder'):
+        return Rotation.random(random_state=rng).as_matrix()
+    frame, span = frame
+    d, e = frame[:, 0], frame[:, 1]
+    if kind == 'box':
+        # Along the fingers' row an axis whose face takes it (off the edges), else the
+        # longest; across the grasp one of the other two at random.
+        size = np.asarray(box_size, dtype=float)
+        fits = [a for a in range(3) if size[a] >= span + 4.0 * EDGE] or [int(np.argmax(size))]
+        row = int(rng.choice(fits))
+        across = int(rng.choice([a for a in range(3) if a != row]))
+        perm = np.array([across, row, 3 - across - row])
+        signs = rng.choice([-1.0, 1.0], 3)
+        P = np.zeros((3, 3))
+        P[perm, np.arange(3)] = signs
+        R = frame @ P.T  # object axis perm[i] (signed) along frame column i
+        if np.linalg.det(R) < 0.0:
+            R[:, perm[2]] *= -1.0
+    else:
+        turn = Rotation.from_rotvec(e * rng.uniform(0.0, 2.0 * math.pi)).as_matrix()
+        R = turn @ np.column_stack([d, np.cross(e, d), e])
+    tilt = Rotation.from_rotvec(rng.normal(0.0, TILT, 3)).as_matrix()
+    return tilt @ R
+
+
+def _not_held(setup, q: np.ndarray, found, position: np.ndarray, load: np.ndarray,
+              margin: float) -> str | None:
+    """
+    Return why a touching candidate is not kept for its load, or None (it is held).
+
+    Held: its load capacity (the certified LP of :mod:`.capacity`, every load from zero
+    up to it held with friction margin ``margin``) is at least 1.
+    """
+    candidate = dataclasses.replace(
+        setup, q=q, contacts=found.specs(), object_origin=np.asarray(position, float),
+        external_wrench=load, friction=dataclasses.replace(setup.friction, margin=margin))
+    try:
+        cap = load_capacity(candidate)
+    except (InputError, GeometryError):
+        return 'no grasp maps'
+    if cap.status == 'unbounded' or (cap.status == 'optimal' and cap.value >= 1.0):
+        return None
+    if cap.status == 'failed':
+        return 'capacity failed'
+    return 'infeasible for its load'
 
 
 def _reject(check: GeometryContacts, ik: SurfaceIK, q: np.ndarray, pose: pin.SE3,

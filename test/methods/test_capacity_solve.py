@@ -44,7 +44,10 @@ def planned():
     out = []
     base = yaml.safe_load(ALLEGRO.read_text())
     for kind, (shape, mass, count) in OBJECTS.items():
-        plan = plan_grasps(ALLEGRO, PlanSettings(count=count, seed=7), shape=shape, mass=mass)
+        # Uniform orientations, every touching candidate kept (the planner's defaults
+        # keep only held ones): the grasps that only balance their weight are wanted here.
+        plan = plan_grasps(ALLEGRO, PlanSettings(count=count, seed=7, orientation='random',
+                                                 hold_margin=None), shape=shape, mass=mass)
         assert len(plan.candidates) == count
         for margin in (0.0, 0.3):
             job = ScoreJob(scenario_text=yaml.safe_dump(merge(
