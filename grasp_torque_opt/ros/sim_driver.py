@@ -444,7 +444,8 @@ def _plot(args: argparse.Namespace, scenario, trace: list, node: bool) -> str:
     try:
         written = plot_runs(args.plot, {
             label: trace,
-            f'baseline: the node told only the scenario (no IMU, k 0), {outcome}': base},
+            f'baseline: the node told only the scenario (no IMU, no measured efforts, '
+            f'friction margin k = 0, i.e. the full cone), {outcome}': base},
             title, args.drift_limit)
     except OSError as e:
         return f'plot: not written, cannot write {args.plot}: {e.strerror}'
