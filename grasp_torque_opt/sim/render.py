@@ -19,10 +19,10 @@ length per newton: blue is dark and green light, both far in hue from the orange
 object (:data:`grasp_torque_opt.sim.model.OBJECT_RGBA`), and since the two agree
 closely they are drawn side by side (each 2.5 mm off the contact point, across the
 line of sight), not one inside the other. A legend in the picture names them and the
-scale. The camera is chosen from a fixed list of views (:data:`VIEWS`) by rays cast
-in the model: the view that shows the most contacts' arrows unhidden by the hand (the
-object is see-through; every contact where one exists), of those the one that sees
-its most foreshortened arrow most from the side.
+scale. The camera is chosen from a fixed list of views (:data:`VIEWS`) by small
+segmentation renderings of each: the view that shows the most contacts' arrows
+unhidden by the hand (the object is see-through; every contact where one exists), of
+those the one whose arrows are least foreshortened and least on top of one another.
 """
 
 from __future__ import annotations
@@ -50,6 +50,10 @@ VIEWS = tuple((a, e) for e in (-20.0, -45.0, 10.0, -70.0, 40.0)
                         60.0, 120.0, 90.0))
 #: Arrows side by side: each this far off the contact point [m].
 SIDE = 2.5e-3
+#: Arrows' middles this far apart across the line of sight count as apart [m].
+SEPARATE = 0.02
+#: The segmentation pass's object ids of the arrows: TAG + the contact's index.
+TAG = 100000
 
 
 class RenderUnavailable(RuntimeError):
@@ -89,44 +93,96 @@ def _across(force: np.ndarray, forward: np.ndarray) -> np.ndarray:
     return SIDE * _unit(np.cross(force, forward))
 
 
-def _seen(hsim: HandSim, eye: np.ndarray, points: list[np.ndarray]) -> bool:
-    """Return whether every point is seen from ``eye``, the object's body see-through."""
-    geomid = np.zeros(1, dtype=np.int32)
-    seen = 0
-    for p in points:
-        t = mujoco.mj_ray(hsim.model, hsim.data, eye, p - eye, None, 1,
-                          hsim.sim.object_body, geomid)
-        seen += t < 0 or t >= 0.999  # nothing before the point
-    return seen == len(points)
+def _draw_arrows(scene: mujoco.MjvScene, touching: list, predicted: list | None,
+                 forward: np.ndarray, scale: float, tag: bool = False) -> None:
+    """
+    Add each touching contact's arrows to the scene, side by side across the line of sight.
+
+    ``tag``: give each arrow the object id TAG + its contact's index (the segmentation
+    pass's way of telling whose pixels are seen).
+    """
+    for i, r in touching:
+        side = _across(r.force, forward) if predicted is not None else np.zeros(3)
+        ends = [(r.position + side, r.position + side + scale * r.force, SIMULATED_RGBA)]
+        if predicted is not None:
+            ends.append((r.position - side, r.position - side + scale * predicted[i],
+                         PREDICTED_RGBA))
+        for start, end, rgba in ends:
+            n = scene.ngeom
+            _arrow(scene, start, end, rgba, 0.003)
+            if tag and scene.ngeom > n:
+                geom = scene.geoms[n]
+                geom.segid, geom.objtype, geom.objid = n, mujoco.mjtObj.mjOBJ_UNKNOWN, TAG + i
 
 
-def choose_view(hsim: HandSim, lookat: np.ndarray, arrows: list[tuple[np.ndarray, ...]],
-                distance: float) -> tuple[float, float, int]:
+def _apart(shown: list, forward: np.ndarray, scale: float) -> float:
+    """Return the least distance between two arrows' middles across the line of sight [m]."""
+    middles = [r.position + 0.5 * scale * r.force for r in shown]
+    across = [m - (m @ forward) * forward for m in middles]
+    return min((np.linalg.norm(a - b) for k, a in enumerate(across) for b in across[k + 1:]),
+               default=SEPARATE)
+
+
+def _pixels(renderer: mujoco.Renderer, hsim: HandSim, camera: mujoco.MjvCamera,
+            touching: list, predicted: list | None, scale: float) -> np.ndarray:
+    """Return, per touching contact, how many pixels of its arrows the camera sees."""
+    forward = _forward(camera.azimuth, camera.elevation)
+    renderer.update_scene(hsim.data, camera=camera)
+    _draw_arrows(renderer.scene, touching, predicted, forward, scale, tag=True)
+    seg = renderer.render()
+    ids = seg[..., 0][seg[..., 1] == mujoco.mjtObj.mjOBJ_UNKNOWN]
+    return np.array([np.count_nonzero(ids == TAG + i) for i, _ in touching])
+
+
+def choose_view(hsim: HandSim, lookat: np.ndarray, touching: list, predicted: list | None,
+                scale: float, distance: float) -> tuple[float, float, int]:
     """
     Return the view of :data:`VIEWS` that shows the most arrows, the least foreshortened.
 
-    Among the views that show the most contacts' arrows unhidden, the one whose most
-    foreshortened arrow is seen at the largest angle to the line of sight (the first
-    in :data:`VIEWS` on a tie).
+    A contact is in view when at least half of its arrows' pixels show with the hand
+    drawn (the object hidden), against the hand hidden too: two small segmentation
+    renderings per view, exactly what the picture draws. Among the views that show the
+    most contacts, the best by its worst of: the sine of the angle between an arrow and
+    the line of sight (foreshortening), and the least distance between two arrows'
+    middles across it over :data:`SEPARATE` (overlap); the first in :data:`VIEWS` on
+    a tie.
 
     Args:
         hsim: the simulation, in the state to draw.
         lookat: the point looked at, world frame [m].
-        arrows: per contact, (start, end) of its arrows' shared line, world frame [m].
+        touching: (index, reading) of the contacts that touch.
+        predicted: the predicted forces, base axes [N], one per planned contact (or None).
+        scale: arrow length per newton [m/N].
         distance: the camera's distance from ``lookat`` [m].
 
     Returns:
         Azimuth [deg], elevation [deg] and how many contacts it shows.
     """
+    model = hsim.model
+    rgba = model.geom_rgba.copy()
+    hand = [g for g in range(model.ngeom) if model.geom_bodyid[g] != hsim.sim.object_body]
+    renderer = mujoco.Renderer(model, 120, 160)
+    renderer.enable_segmentation_rendering()
     best, key = (*VIEWS[0], 0), (-1, -1.0)
-    for azimuth, elevation in VIEWS:
-        forward = _forward(azimuth, elevation)
-        eye = lookat - distance * forward
-        sines = [np.linalg.norm(np.cross(_unit(b - a), forward)) for a, b in arrows
-                 if _seen(hsim, eye, [a + s * _across(b - a, forward) + f * (b - a)
-                                      for f in (0.1, 0.4, 0.7, 1.0) for s in (-2, 0, 2)])]
-        if (len(sines), min(sines, default=0.0)) > key:
-            key, best = (len(sines), min(sines, default=0.0)), (azimuth, elevation, len(sines))
+    try:
+        camera = mujoco.MjvCamera()
+        camera.lookat[:], camera.distance = lookat, distance
+        for azimuth, elevation in VIEWS:
+            camera.azimuth, camera.elevation = azimuth, elevation
+            model.geom_rgba[:, 3] = np.where(model.geom_bodyid == hsim.sim.object_body, 0.0,
+                                             rgba[:, 3])
+            seen = _pixels(renderer, hsim, camera, touching, predicted, scale)
+            model.geom_rgba[hand, 3] = 0.0
+            alone = _pixels(renderer, hsim, camera, touching, predicted, scale)
+            forward = _forward(azimuth, elevation)
+            shown = [r for (_, r), s, a in zip(touching, seen, alone) if a > 0 and 2 * s >= a]
+            quality = min([np.linalg.norm(np.cross(_unit(r.force), forward)) for r in shown]
+                          + [_apart(shown, forward, scale) / SEPARATE])
+            if (len(shown), quality) > key:
+                key, best = (len(shown), quality), (azimuth, elevation, len(shown))
+    finally:
+        model.geom_rgba[:] = rgba
+        renderer.close()
     return best
 
 
@@ -190,24 +246,14 @@ def render_grasp(hsim: HandSim, path: str | Path, predicted: list[np.ndarray] | 
     try:
         readings, _ = hsim.readings()
         touching = [(i, r) for i, r in enumerate(readings) if r.touching]
-        # Each contact's arrows, from the contact into the object: the push it gets.
-        arrows = [(r.position, r.position + scale * (r.force if predicted is None
-                                                     else 0.5 * (r.force + predicted[i])))
-                  for i, r in touching]
         lookat = hsim.data.xpos[hsim.sim.object_body].copy()
-        azimuth, elevation, shown = choose_view(hsim, lookat, arrows, distance)
+        azimuth, elevation, shown = choose_view(hsim, lookat, touching, predicted, scale,
+                                                distance)
         camera = mujoco.MjvCamera()
         camera.lookat[:] = lookat
         camera.distance, camera.azimuth, camera.elevation = distance, azimuth, elevation
         renderer.update_scene(hsim.data, camera=camera)
-        forward = _forward(azimuth, elevation)
-        for i, r in touching:
-            side = _across(r.force, forward) if predicted is not None else np.zeros(3)
-            _arrow(renderer.scene, r.position + side, r.position + side + scale * r.force,
-                   SIMULATED_RGBA, 0.003)
-            if predicted is not None:
-                _arrow(renderer.scene, r.position - side,
-                       r.position - side + scale * predicted[i], PREDICTED_RGBA, 0.003)
+        _draw_arrows(renderer.scene, touching, predicted, _forward(azimuth, elevation), scale)
         lines = [LEGEND[0]] + ([LEGEND[1]] if predicted is not None else [])
         lines.append((None, f'arrow length {1e3 * scale:g} mm per N; {shown} of '
                             f'{len(readings)} contacts in view'

@@ -56,7 +56,7 @@ def test_the_png_reads_back(tmp_path):
 
 
 def test_the_allegro_picture_shows_all_four_contacts_and_its_legend(tmp_path):
-    """The view is chosen by rays so that every contact's arrows are unhidden (issue 35)."""
+    """The view is chosen so that every contact's arrows are unhidden (issue 35)."""
     from conftest import ALLEGRO
     from grasp_torque_opt.core.scenario import load_scenario
     from grasp_torque_opt.ros.sim_plan import certified_forces, simulate_candidate
@@ -68,10 +68,16 @@ def test_the_allegro_picture_shows_all_four_contacts_and_its_legend(tmp_path):
                                                  EpisodeSettings(duration=0.3))
     readings, _ = rig.readings()
     assert report.held and all(r.touching for r in readings)
-    arrows = [(r.position, r.position + 0.03 * r.force) for r in readings]
+    predicted = certified_forces(controller)
     lookat = rig.data.xpos[rig.sim.object_body]
-    azimuth, elevation, shown = choose_view(rig, lookat, arrows, 0.25)
+    azimuth, elevation, shown = choose_view(rig, lookat, list(enumerate(readings)),
+                                            predicted, 0.03, 0.25)
     assert shown == 4 and (azimuth, elevation) != VIEWS[0]  # the old view showed two
-    path = render_grasp(rig, tmp_path / 'grasp.png', certified_forces(controller))
+    path = render_grasp(rig, tmp_path / 'grasp.png', predicted)
     with Image.open(path) as image:
         assert image.getpixel((20, 60)) == (255, 255, 255)  # the legend's box
+        rgb = np.asarray(image.convert('RGB'), dtype=float) / 255
+    # Both arrows' colours, shaded, are in the picture (below the legend's box).
+    r, g, b = (rgb[100:, :, k] for k in range(3))
+    assert np.count_nonzero((b > 0.4) & (b > r + 0.25) & (b > g + 0.15)) > 100  # blue
+    assert np.count_nonzero((g > 0.4) & (g > r + 0.25) & (g > b + 0.2)) > 100  # green
