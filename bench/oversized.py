@@ -33,6 +33,7 @@ import tempfile
 import time
 
 from cycle import machine, machine_line
+from grasp_torque_opt.ros.domains import private
 import numpy as np
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
@@ -115,11 +116,14 @@ def main() -> None:
     ap.add_argument('--repeats', type=int, default=3)
     ap.add_argument('--reader-policy', default='default',
                     choices=['default', 'DYNAMIC', 'DYNAMIC_REUSABLE'])
-    ap.add_argument('--domain', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 77)))
+    ap.add_argument('--domain', type=int, default=None,
+                    help='the ROS domain of the node and this process (default: '
+                         'ROS_DOMAIN_ID + 1, by grasp_torque_opt.ros.domains)')
     a = ap.parse_args()
     print(machine_line(machine()))
     print(f'reader history memory policy: {a.reader_policy}')
-    for what, rss in run(a.sizes, a.repeats, a.reader_policy, a.domain):
+    domain = private(0) if a.domain is None else a.domain
+    for what, rss in run(a.sizes, a.repeats, a.reader_policy, domain):
         print(f'{what:40s} node VmRSS {rss:8.1f} MiB')
 
 

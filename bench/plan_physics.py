@@ -11,12 +11,12 @@ Planned grasps in physics: does the ranking, and each prediction, hold in MuJoCo
 
 Usage: .venv/bin/python bench/plan_physics.py [--count 9] [--per-band 2] [--seed 0]
        [--margin K] [--unfiltered] [--out bench/results/plan_physics.json]
-       .venv/bin/python bench/plan_physics.py --simulate-best PLAN SCORES [--picture F]
 
 Per object (a sphere, a box, a cylinder of 0.15 kg on the bundled Allegro): plan
 ``--count`` candidates (``plan_grasps``), score them (``score_batch``, full metrics),
 rank by capacity and take ``--per-band`` from the top, the middle and the bottom.
-Each is simulated with the node's cycle (ros/sim_compare.node_controller) under the
+Each is simulated with the node's cycle (ros/sim_plan.simulate_candidate, as
+``grasp-torque-sim --plan PLAN --scores SCORES`` simulates the best) under the
 grasp benchmarks' protocol: gravity off, a force of the object's weight on its
 centre along +x, -x, +y, -y, +z, -z in turn (one episode of 2 s each after 0.3 s
 of settling), the node told that load. Success: the object moves < 5 cm and turns
@@ -26,16 +26,11 @@ has an axis capacity along the force (certified) of at least the force.
 ``--unfiltered`` plans as before issue 38 (uniform orientations, every candidate that
 touches kept, held or not): the population whose capacities of grasps that cannot
 hold their own load the prediction must get right.
-
-``--simulate-best`` is the loop's last step (README): the best-ranked line of SCORES
-(``score --out``) from PLAN, simulated on the base scenario's own load (its weight,
-gravity on) for 2 s, and a picture.
 """
 
 from __future__ import annotations
 
 import argparse
-import copy
 import json
 import math
 from pathlib import Path
@@ -45,16 +40,13 @@ import sys
 import tempfile
 import time
 
-from grasp_torque_opt.core.exceptions import InputError
-from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.object_geometry import ObjectShape
-from grasp_torque_opt.core.scenario import parse_scenario
 from grasp_torque_opt.methods.engines import score_batch
 from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
 from grasp_torque_opt.methods.ranking import rank
 from grasp_torque_opt.methods.score import ScoreJob
-from grasp_torque_opt.ros.sim_compare import node_controller
-from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
+from grasp_torque_opt.ros.sim_plan import candidate_scenario, simulate_candidate
+from grasp_torque_opt.sim.episode import EpisodeSettings
 import numpy as np
 import yaml
 
@@ -67,37 +59,13 @@ DIRECTIONS = {'+Fx': (0, 1.0), '-Fx': (0, -1.0), '+Fy': (1, 1.0), '-Fy': (1, -1.
 LOOSE, STRICT = (0.05, math.radians(15.0)), (2e-3, math.radians(2.0))
 
 
-def merged(line: dict, **over) -> dict:
-    """Return the base scenario with a candidate line in it, by score's merge rule."""
-    from grasp_torque_opt.methods.score import merge
-
-    doc = merge(yaml.safe_load(SCENARIO.read_text()),
-                {k: v for k, v in line.items() if k != 'id'})
-    doc = copy.deepcopy(doc)
-    doc.update(over)
-    return doc
-
-
-def episode(doc: dict, force: np.ndarray, duration: float = 2.0, picture: str | None = None):
-    """Simulate one candidate document with the node's cycle; return the report."""
-    scenario = parse_scenario(doc, SCENARIO.parent)
+def episode(line: dict, force: np.ndarray, duration: float = 2.0):
+    """Simulate a plan line holding the object against ``force`` (gravity off); the report."""
+    scenario = candidate_scenario(SCENARIO, line, gravity=[0.0, 0.0, 0.0], load={
+        'external_wrench': [*force.tolist(), 0.0, 0.0, 0.0]})
     settings = EpisodeSettings(duration=duration, drift_limit=LOOSE[0],
                                object_force=tuple(float(f) for f in force))
-    setup, rig = simulated(scenario, settings, GraspSetup.from_scenario(scenario))
-    node = node_controller(setup, scenario, rig, margin=scenario.friction.margin)
-
-    def guarded(reading):
-        # A finger pushed past its URDF limit (the object knocked away) is input the
-        # node refuses: it sends nothing new, the driver holds the last command.
-        try:
-            return node(reading)
-        except InputError:
-            return None
-    report = run_episode(rig, guarded, settings)
-    if picture:
-        from grasp_torque_opt.sim.render import render_grasp
-
-        render_grasp(rig, picture)
+    report, _, _ = simulate_candidate(scenario, settings)
     return report
 
 
@@ -126,9 +94,7 @@ def run_object(kind: str, count: int, per_band: int, seed: int, unfiltered: bool
             for name, (axis, sign) in DIRECTIONS.items():
                 force = np.zeros(3)
                 force[axis] = sign * weight
-                doc = merged(by_id[rec['id']], gravity=[0.0, 0.0, 0.0])
-                doc['load'] = {'external_wrench': [*force.tolist(), 0.0, 0.0, 0.0]}
-                rep = episode(doc, force)
+                rep = episode(by_id[rec['id']], force)
                 cap = (rec.get('capacities') or {}).get(name)
                 # The axis capacity is that direction's own LP (the status is the
                 # candidate's own load's, the weight along base +x: not this one).
@@ -166,24 +132,6 @@ def table(results: list[dict]) -> str:
     return '\n'.join(lines)
 
 
-def simulate_best(plan: str, scores: str, picture: str) -> int:
-    lines = {json.loads(t)['id']: json.loads(t) for t in Path(plan).read_text().splitlines()
-             if t.strip()}
-    records = [json.loads(t) for t in Path(scores).read_text().splitlines() if t.strip()]
-    best = min((r for r in records if r['status'] == 'optimal'), key=lambda r: r['rank'],
-               default=None)
-    if best is None:
-        print('no optimal candidate to simulate', file=sys.stderr)
-        return 3
-    rep = episode(merged(lines[best['id']]), np.zeros(3), picture=picture)
-    held = rep.max_drift < STRICT[0] and rep.max_rotation < STRICT[1]
-    print(f"best: {best['id']} (rank 1, capacity {best['capacity']:.3f}); simulated 2 s "
-          f"with the node's torques: {'held' if held else 'NOT held'}, drift "
-          f'{1e3 * rep.max_drift:.3g} mm, rotation {math.degrees(rep.max_rotation):.3g} deg; '
-          f'picture {picture}')
-    return 0 if held else 1
-
-
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     p.add_argument('--count', type=int, default=9)
@@ -191,8 +139,6 @@ def main() -> int:
     p.add_argument('--seed', type=int, default=0)
     p.add_argument('--objects', default='sphere,box,cylinder')
     p.add_argument('--out')
-    p.add_argument('--simulate-best', nargs=2, metavar=('PLAN', 'SCORES'))
-    p.add_argument('--picture', default='best.png')
     p.add_argument('--unfiltered', action='store_true',
                    help='plan uniform orientations and keep every candidate that touches '
                    '(the planner before issue 38)')
@@ -207,8 +153,6 @@ def main() -> int:
         margined = Path(tempfile.mkdtemp()) / SCENARIO.name
         margined.write_text(yaml.safe_dump(doc))
         SCENARIO = margined
-    if args.simulate_best:
-        return simulate_best(*args.simulate_best, args.picture)
     t0 = time.time()
     results = [run_object(k, args.count, args.per_band, args.seed, args.unfiltered)
                for k in args.objects.split(',')]

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-import random
 import resource
 import signal
 import subprocess
@@ -27,6 +26,7 @@ import sys
 import time
 from typing import Callable, IO
 
+from grasp_torque_opt.ros.domains import private
 import numpy as np
 
 BENCH = Path(__file__).resolve().parent
@@ -43,10 +43,14 @@ BUSY_WAIT_S = 300e-6
 
 
 def private_domains(n: int) -> list[int]:
-    """N distinct ROS domain ids in 1..100, none of them the caller's own."""
-    own = os.environ.get('ROS_DOMAIN_ID')
-    pool = [d for d in range(1, 101) if str(d) != own]
-    return random.sample(pool, n)
+    """
+    Return the ROS domains of ``n`` runs: ROS_DOMAIN_ID + 1 to + SPAN in turn.
+
+    The rule of grasp_torque_opt.ros.domains.
+
+    Consecutive runs never share one; ROS_DOMAIN_ID itself is left alone.
+    """
+    return [private(k) for k in range(n)]
 
 
 def isolated_env(domain: int) -> dict[str, str]:

@@ -34,6 +34,7 @@ import sys
 import time
 
 from cycle import machine, machine_line
+from grasp_torque_opt.ros.domains import private
 import numpy as np
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
@@ -132,11 +133,13 @@ def main() -> None:
     ap.add_argument('--duration', type=float, default=12.0)
     ap.add_argument('--bursts', type=int, default=3)
     ap.add_argument('--calls', type=int, default=1000)
-    ap.add_argument('--domain', type=int, default=int(os.environ.get('ROS_DOMAIN_ID', 78)))
+    ap.add_argument('--domain', type=int, default=None,
+                    help='the ROS domain of the node and this process (default: '
+                         'ROS_DOMAIN_ID + 1, by grasp_torque_opt.ros.domains)')
     ap.add_argument('--out', type=Path)
     a = ap.parse_args()
     m = machine()
-    r = run(a.rate, a.duration, a.bursts, a.calls, a.domain)
+    r = run(a.rate, a.duration, a.bursts, a.calls, private(0) if a.domain is None else a.domain)
     print(machine_line(m))
     q = r['quiet']
     print(f"before the bursts: commands {q['rate_hz']:.0f} Hz, longest gap "

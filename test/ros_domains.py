@@ -13,17 +13,14 @@ A run under ``ROS_DOMAIN_ID=B`` uses the domains B+1 to B+SPAN and no other: B i
 (the shell's own domain, perhaps a robot's) is left alone, and every role below has a
 domain of its own, so no two kinds of process of one run share one by accident. Two
 runs on one machine (or a run beside a robot) stay apart when their bases are at least
-SPAN apart. Without ROS_DOMAIN_ID the base is a multiple of SPAN from the process id
-(0 to 200), so two runs usually differ. Every process also discovers on localhost only.
-Plain module, no rclpy: the benchmarks and the subprocess scripts use it too.
+SPAN apart. Without ROS_DOMAIN_ID the base is a multiple of SPAN from the process id,
+so two runs usually differ. The base and the span are the package's rule
+(grasp_torque_opt.ros.domains, which the benchmarks and ``--with-node`` use too); the
+roles are the suite's. Every process also discovers on localhost only. Plain module,
+no rclpy: the subprocess scripts use it too.
 """
 
-import os
-
-#: How many domains one run uses above its base.
-SPAN = 12
-#: The highest domain id Fast DDS's default port mapping allows.
-MAX_DOMAIN = 232
+from grasp_torque_opt.ros.domains import base, SPAN
 
 #: Each role's offset above the base.
 ROLES = {
@@ -36,18 +33,6 @@ ROLES = {
     'workspace': 9,           # test_colcon_workspace.py: the node the workspace built
     'spare': 10,              # 10 to 12: free for a new role
 }
-
-
-def base(environ=os.environ) -> int:
-    """Return this run's base: ROS_DOMAIN_ID, or a multiple of SPAN from the process id."""
-    given = environ.get('ROS_DOMAIN_ID', '').strip()
-    if given:
-        b = int(given)
-        if not 0 <= b <= MAX_DOMAIN - SPAN:
-            raise ValueError(f'ROS_DOMAIN_ID {b}: the tests need ROS_DOMAIN_ID + 1 to + {SPAN}'
-                             f' within 0 to {MAX_DOMAIN}; choose 0 to {MAX_DOMAIN - SPAN}')
-        return b
-    return SPAN * (os.getpid() % ((MAX_DOMAIN - SPAN) // SPAN + 1))
 
 
 BASE = base()

@@ -136,5 +136,5 @@ def run(args: argparse.Namespace) -> int:
             return EXIT_FAILED
     else:
         sys.stdout.write(text)
-    print(result.summary(args.count, args.seed), file=sys.stderr)
-    return EXIT_OK if len(result.candidates) == args.count else EXIT_FEWER
+    print(result.summary(), file=sys.stderr)
+    return EXIT_OK if result.complete else EXIT_FEWER

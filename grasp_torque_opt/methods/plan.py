@@ -140,17 +140,31 @@ class PlanSettings:
 
 @dataclass
 class PlanResult:
-    """The candidates (score's JSON objects) and how many IKs it took."""
+    """
+    The candidates (score's JSON objects), how many IKs it took, and what was asked.
+
+    Attributes:
+        candidates: the lines found, as dicts.
+        attempts: the IKs run.
+        settings: the settings it planned with (how many wanted, the seed).
+        rejected: why IKs were refused -> how many.
+    """
 
     candidates: list[dict[str, Any]]
     attempts: int
+    settings: PlanSettings
     rejected: dict[str, int] = field(default_factory=dict)
 
-    def summary(self, count: int, seed: int) -> str:
+    @property
+    def complete(self) -> bool:
+        """Return whether every candidate asked for was found."""
+        return len(self.candidates) == self.settings.count
+
+    def summary(self) -> str:
         """Return one line: how many were found, in how many IKs, why others were not."""
         why = ', '.join(f'{n} {k}' for k, n in sorted(self.rejected.items())) or 'none'
-        return (f'planned {len(self.candidates)} of {count} candidates in {self.attempts} '
-                f'IKs (seed {seed}; rejected: {why})')
+        return (f'planned {len(self.candidates)} of {self.settings.count} candidates in '
+                f'{self.attempts} IKs (seed {self.settings.seed}; rejected: {why})')
 
     def lines(self) -> list[str]:
         """Return the candidates as JSON Lines (without line breaks)."""
@@ -242,7 +256,7 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
         out.append(_candidate(f'plan-{settings.seed}-{len(out)}', hand, sol.theta,
                               sol.position, R, shape, mass, found, settings,
                               scenario.gravity))
-    return PlanResult(out, tries, rejected)
+    return PlanResult(out, tries, settings, rejected)
 
 
 def _load(mass: float, gravity, extra) -> np.ndarray:

@@ -20,15 +20,23 @@ from collections.abc import Iterator
 import contextlib
 import os
 from pathlib import Path
-import random
 import signal
 import subprocess
 import sys
 
 
 def isolate() -> None:
-    """Use a private ROS domain (unless one is set) and localhost-only discovery."""
-    os.environ.setdefault('ROS_DOMAIN_ID', str(random.randint(1, 100)))
+    """
+    Use a private ROS domain and localhost-only discovery, unless the caller set them.
+
+    A ROS_DOMAIN_ID already set is the caller's choice and kept; without one, the
+    first private domain of :mod:`~grasp_torque_opt.ros.domains` (a base from the
+    process id, plus 1): the range the test suite and the benchmarks use, not a
+    random draw.
+    """
+    from grasp_torque_opt.ros.domains import private
+
+    os.environ.setdefault('ROS_DOMAIN_ID', str(private(0)))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
 

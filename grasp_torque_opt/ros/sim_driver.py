@@ -67,6 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     from grasp_torque_opt.sim.episode import simulated
     from grasp_torque_opt.sim.model import SimSettings
 
+    if args.plan is not None:
+        return _simulate_best(args)
     if args.with_node:
         isolate()
     try:
@@ -81,6 +83,25 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with node_process(params, args.with_node):
             return _run(args, scenario, setup, rig, baseline)
+    except KeyboardInterrupt:
+        print(f'{PROG}: interrupted', file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _simulate_best(args: argparse.Namespace) -> int:
+    """Simulate the best candidate of --plan by --scores: the planner's loop's last step."""
+    from grasp_torque_opt.core.exceptions import InputError
+    from grasp_torque_opt.core.resources import find_config
+    from grasp_torque_opt.ros.sim_plan import run
+    from grasp_torque_opt.sim.model import SimSettings
+
+    try:
+        base = find_config(scenario_of(find_config(args.params, '--params')))
+        return run(args, base, rig_settings(args), SimSettings(
+            mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional))
+    except (InputError, ValueError) as e:
+        print(f'{PROG}: error: {e}', file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -423,7 +444,8 @@ def _plot(args: argparse.Namespace, scenario, trace: list, node: bool) -> str:
     try:
         written = plot_runs(args.plot, {
             label: trace,
-            f'baseline: the node told only the scenario (no IMU, k 0), {outcome}': base},
+            f'baseline: the node told only the scenario (no IMU, no measured efforts, '
+            f'friction margin k = 0, i.e. the full cone), {outcome}': base},
             title, args.drift_limit)
     except OSError as e:
         return f'plot: not written, cannot write {args.plot}: {e.strerror}'

@@ -89,6 +89,14 @@ def parser(description: str) -> argparse.ArgumentParser:
                    help='start grasp_torque_node in a child process')
     p.add_argument('--wait', type=float, default=30.0,
                    help='how long to wait for the node and its first command [s]')
+    loop = p.add_argument_group(
+        "the planner's loop", 'simulate the best-ranked feasible candidate of a plan with '
+        "the node's own cycle, in simulated time without ROS (docs/planner.md)")
+    loop.add_argument('--plan', metavar='PLAN',
+                      help="candidate lines of 'grasp-torque-opt plan' (merged into the "
+                           "--params file's scenario)")
+    loop.add_argument('--scores', metavar='SCORES',
+                      help="their records from 'grasp-torque-opt score --out' (the rank)")
     return p
 
 
@@ -146,6 +154,11 @@ def check(args: argparse.Namespace) -> str:
         args.base_shake = shake
     if args.with_node and args.controller != 'node':
         return f'--with-node: only with --controller node (got {args.controller})'
+    if (args.plan is None) != (args.scores is None):
+        return '--plan and --scores: give both (the plan and its scores) or neither'
+    if args.plan is not None and (args.with_node or args.controller != 'node'):
+        return ("--plan: the node's own cycle simulates the candidate, without ROS: not "
+                'with --with-node or --controller ' + args.controller)
     return ''
 
 

@@ -9,14 +9,17 @@
 """
 The plot beside the picture: the object's drift and the hand's effort over the hold.
 
-One line per run (the node over ROS, the baseline in the same rig), drift in mm on
-top with the held limit, the RMS joint torque below. matplotlib draws it (the Agg
-backend: no display needed).
+One line per run (the node over ROS, the baseline in the same rig), drift in plain
+millimetres on top with the held limit (drawn when the drifts come within half of it;
+otherwise the axis ends above the largest drift, so that a held run's hundredths of a
+millimetre show), the RMS joint torque below. The labels are the caller's, each term
+explained in it. matplotlib draws it (the Agg backend: no display needed).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+import textwrap
 
 import numpy as np
 
@@ -46,21 +49,24 @@ def plot_runs(path: str | Path, runs: dict[str, list[tuple[float, float, float]]
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
 
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.0, 5.0), sharex=True,
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.0, 6.2), sharex=True,
                                       constrained_layout=True)
     for label, rows in runs.items():
         if not rows:
             continue
         a = np.asarray(rows, dtype=float)
-        top.plot(a[:, 0], 1e3 * a[:, 1], label=label)
-        bottom.plot(a[:, 0], a[:, 2], label=label)
+        top.plot(a[:, 0], 1e3 * a[:, 1], label=textwrap.fill(label, 95))
+        bottom.plot(a[:, 0], a[:, 2])
     top.axhline(drift_limit_mm, color='grey', linestyle='--', linewidth=1.0,
-                label=f'held limit {drift_limit_mm:g} mm')
+                label=f'held limit {drift_limit_mm:g} mm (off the axis when far above)')
     top.set_ylabel('drift of the object [mm]')
-    top.set_yscale('symlog', linthresh=0.1)
-    top.set_ylim(bottom=0.0)
+    # Plain millimetres: the limit drawn only when the drifts come within reach of it,
+    # so that a held run's 0.01 mm still shows.
+    most = max((1e3 * max(r[1] for r in rows) for rows in runs.values() if rows), default=0.0)
+    top.set_ylim(0.0, 1.15 * max(most, 1e-3) if most < 0.5 * drift_limit_mm
+                 else 1.15 * max(most, drift_limit_mm))
     top.set_title(title)
-    top.legend(loc='upper left', fontsize='small')
+    fig.legend(loc='outside lower center', fontsize='small')
     bottom.set_ylabel('RMS joint torque [N m]')
     bottom.set_xlabel('time since release [s]')
     for ax in (top, bottom):

@@ -219,6 +219,16 @@ def test_bad_options_are_named(argv, message, capsys):
     assert len(err.strip().splitlines()) == 1
 
 
+def test_the_summary_names_what_was_asked_without_being_told_again():
+    """A PlanResult keeps its settings: summary() takes no arguments (issue 35)."""
+    result = plan_grasps(ALLEGRO, PlanSettings(count=1, seed=3, attempts=2, region=0.001),
+                         shape=OBJECTS['sphere'])
+    assert result.settings == PlanSettings(count=1, seed=3, attempts=2, region=0.001)
+    assert result.summary().startswith(f'planned {len(result.candidates)} of 1 candidates in '
+                                       f'{result.attempts} IKs (seed 3; rejected: ')
+    assert result.complete == (len(result.candidates) == 1)
+
+
 def test_too_few_found_exits_3(capsys):
     # A ball far larger than the hand can close on: no IK reaches it.
     code = main(['plan', str(ALLEGRO), '--count', '1', '--attempts', '2', '--object',

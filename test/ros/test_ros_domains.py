@@ -14,9 +14,10 @@ import sys
 import time
 
 from conftest import ROOT
+from grasp_torque_opt.ros.domains import base, MAX_DOMAIN, private, SPAN
 import pytest
 import rclpy
-from ros_domains import BASE, MAX_DOMAIN, ROLES, SPAN
+from ros_domains import BASE, ROLES
 
 #: Two tests of the suite, one with the harness's in-process node, one with a script's.
 INNER = ['test/ros/test_node.py::'
@@ -87,3 +88,23 @@ def test_a_domain_id_without_room_for_the_span_is_refused(bad):
                           env=dict(os.environ, ROS_DOMAIN_ID=bad), capture_output=True,
                           text=True, timeout=60)
     assert done.returncode != 0 and f'ROS_DOMAIN_ID {bad}:' in done.stderr, done.stderr
+
+
+def test_the_drivers_and_benchmarks_private_domains_follow_the_same_rule():
+    """--with-node and the benchmarks: ROS_DOMAIN_ID + 1 on, never it, never random."""
+    assert [private(k, {'ROS_DOMAIN_ID': '40'}) for k in (0, 1, 11, 12)] == [41, 42, 52, 41]
+    # Without ROS_DOMAIN_ID: a multiple of SPAN from the process id, the same each time.
+    assert base({}, pid=12345) == base({}, pid=12345) == SPAN * (12345 % 19)
+    assert all(0 <= base({}, pid=p) <= MAX_DOMAIN - SPAN for p in range(0, 5000, 7))
+    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
+    code = ('import os; from grasp_torque_opt.ros.node_process import isolate; isolate(); '
+            'print(os.getpid(), os.environ["ROS_DOMAIN_ID"])')
+    done = subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,
+                          text=True, timeout=60, cwd=ROOT)
+    pid, chosen = (int(v) for v in done.stdout.split())
+    assert chosen == base({}, pid=pid) + 1
+    done = subprocess.run([sys.executable, '-c', 'import sys; sys.path.insert(0, "bench"); '
+                           'from ros_load import private_domains; print(*private_domains(14))'],
+                          env=dict(os.environ, ROS_DOMAIN_ID='40'), capture_output=True,
+                          text=True, timeout=60, cwd=ROOT)
+    assert [int(v) for v in done.stdout.split()] == [*range(41, 53), 41, 42], done.stderr
