@@ -38,8 +38,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from grasp_torque_opt.control.checks import finite, quaternion_matrix, show
-from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.control.plausible import pose_tolerance
+from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.geometry_contacts import ContactSet, GeometryContacts
 from grasp_torque_opt.core.object_from_hand import ObjectEstimate
 from grasp_torque_opt.core.object_geometry import object_pose
@@ -171,7 +171,7 @@ def pose_in_base(received: ObjectPose | None, scenario: pin.SE3, placements,
         if not off <= tol:
             raise InputError('object_pose.pose.position', f'is {1e3 * off:.4g} mm from where '
                              'the fingertips place the object (their kinematics since the '
-                             f'grasp\'s start), beyond uncertainty.pose ({1e3 * tol:g} mm)')
+                             f"grasp's start), beyond uncertainty.pose ({1e3 * tol:g} mm)")
     return pose
 
 

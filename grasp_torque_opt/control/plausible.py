@@ -10,10 +10,10 @@
 Whether estimated contacts can be the grasp's: on their own links, pushing into the object.
 
 A well-formed lie on ``contacts`` was certified before: four flipped normals (a
-perception sign bug) gave commands that pull, swapped fingertips put contacts 71 to
-95 mm from their own links, then index and middle tips swapped 33.6 mm (within the 50 mm
-of the frame rule) (docs/node.md, "Contacts and object pose against the hand"). The rules, in the base frame
-at the configuration of the moment:
+perception sign bug) gave commands that pull; swapped fingertips put contacts 71 to
+95 mm from their own links, and index and middle tips named the other way round 33.6 mm,
+within the 50 mm of the frame rule (docs/node.md, "Contacts and object pose against the
+hand"). The rules, in the base frame at the configuration of the moment:
 
 - a contact point at most ``max_contact_surface_distance`` from its own link's surface
   (the URDF's collision shapes of that link, :class:`~grasp_torque_opt.core.link_surfaces.

@@ -134,4 +134,3 @@ class LinkSurfaces:
         d = coal.distance(s.geometry, coal.Transform3s(oMs.rotation, oMs.translation),
                           self._point, coal.Transform3s(np.eye(3), point), self._request, res)
         return float(d) + POINT_RADIUS
-

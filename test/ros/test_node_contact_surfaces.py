@@ -103,7 +103,7 @@ def test_index_and_middle_swapped_are_refused_and_named(form):
         frame = '' if form == 'plain' else named(LINKS)
         refused_and_not_commanded(
             h, lambda: h.send_contacts(frame, points[SWAP], quat[SWAP]),
-            "contacts.poses[0].position: is 21.6 mm from the surface of its link "
+            'contacts.poses[0].position: is 21.6 mm from the surface of its link '
             "'link_3.0_tip' (its collision geometry), beyond max_contact_surface_distance")
     finally:
         h.close()

@@ -291,7 +291,7 @@ def bind_surfaces(ctrls: tuple[TorqueController, ...], scenario: Scenario, urdf:
         for c in ctrls:
             c.store.surfaces = c.solving.surfaces = None
         return (f"contacts: no link's collision geometry could be read ({e}); every contact "
-                'is checked by max_contact_link_distance from its link\'s frame only')
+                "is checked by max_contact_link_distance from its link's frame only")
     for c, s in zip(ctrls, surfaces):
         c.store.surfaces = c.solving.surfaces = s
     hand = ctrls[0].setup.hand
@@ -301,4 +301,4 @@ def bind_surfaces(ctrls: tuple[TorqueController, ...], scenario: Scenario, urdf:
     shown = ', '.join(bare[:8]) + (f' and {len(bare) - 8} more' if len(bare) > 8 else '')
     return (f'contacts: {len(bare)} link(s) a joint moves have no collision geometry in the '
             f'URDF ({shown}): a contact on one is checked by max_contact_link_distance from '
-            "its frame, not on its surface")
+            'its frame, not on its surface')
