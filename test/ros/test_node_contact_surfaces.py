@@ -18,14 +18,15 @@ and the Allegro URDF's coal shapes; the commands that follow must be the nominal
 
 import dataclasses
 
-from conftest import ALLEGRO
+from conftest import ALLEGRO, PLANAR
 from cycle_inputs import base_poses, joint_state
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.dispatch import solve
+from lifecycle_msgs.msg import Transition
 import numpy as np
 import pinocchio as pin
 import pytest
-from ros_harness import Harness
+from ros_harness import Harness, LifecycleHarness
 from test_name_map import NAME_MAP, renamed, write_renamed_urdf
 
 SETUP = GraspSetup.from_file(ALLEGRO)
@@ -131,5 +132,19 @@ def test_the_swap_through_name_map_is_refused_and_named(tmp_path):
         refused_and_not_commanded(
             h, lambda: h.send_contacts(named(links), points[SWAP], quat[SWAP]),
             "from the surface of its link 'ah_link03_tip'", rename=renamed)
+    finally:
+        h.close()
+
+
+def test_links_without_collision_geometry_keep_the_frame_rule_with_one_warning():
+    """The planar hand's URDF has no <collision>: its contacts keep max_contact_link_distance."""
+    h = LifecycleHarness(PLANAR)
+    try:
+        assert h.transition(Transition.TRANSITION_CONFIGURE)
+        assert h.spin_until(lambda: any('no collision geometry' in m.msg for m in h.logs), 3.0)
+        warned = [m.msg for m in h.logs if 'no collision geometry' in m.msg]
+        assert len(warned) == 1 and warned[0].startswith('contacts: 6 link(s) a joint moves ')
+        assert 'finger1_tip' in warned[0] and 'checked by max_contact_link_distance' in warned[0]
+        assert h.node.controller.store.surfaces.bare(h.node.controller.setup.hand)
     finally:
         h.close()
