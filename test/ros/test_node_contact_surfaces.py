@@ -38,23 +38,25 @@ def named(links, frame=''):
     return f"{frame};{','.join(links)}"
 
 
-def phantom():
+def phantom(links=('link_7.0',)):
     """
-    Give the four poses and a fifth at link_7.0's frame, its normal towards the ball.
+    Give the four poses and one more at each of ``links``' frames, its normal to the ball.
 
-    That point is on link_7.0's own box (its collision shape), 50 mm from nothing: the
+    Such a point is on its link's own box (its collision shape), 0 mm from its frame: the
     frame rule and the link's surface both take it; only the object's surface refuses it.
     """
     points, quat = base_poses(SETUP)
     data = SETUP.hand.model.createData()
     pin.framesForwardKinematics(SETUP.hand.model, data, SETUP.q)
-    p = data.oMf[SETUP.hand.model.getFrameId('link_7.0')].translation
-    z = SETUP.object_origin - p
-    z /= np.linalg.norm(z)
-    x = np.cross([0.0, 1.0, 0.0], z)
-    x /= np.linalg.norm(x)
-    R = np.column_stack((x, np.cross(z, x), z))
-    return np.vstack((points, p)), np.vstack((quat, pin.Quaternion(R).coeffs()))
+    for link in links:
+        p = data.oMf[SETUP.hand.model.getFrameId(link)].translation
+        z = SETUP.object_origin - p
+        z /= np.linalg.norm(z)
+        x = np.cross([0.0, 1.0, 0.0], z)
+        x /= np.linalg.norm(x)
+        R = np.column_stack((x, np.cross(z, x), z))
+        points, quat = np.vstack((points, p)), np.vstack((quat, pin.Quaternion(R).coeffs()))
+    return points, quat
 
 
 def refused_and_not_commanded(h, send, why, rename=str):
@@ -146,5 +148,17 @@ def test_links_without_collision_geometry_keep_the_frame_rule_with_one_warning()
         assert len(warned) == 1 and warned[0].startswith('contacts: 6 link(s) a joint moves ')
         assert 'finger1_tip' in warned[0] and 'checked by max_contact_link_distance' in warned[0]
         assert h.node.controller.store.surfaces.bare(h.node.controller.setup.hand)
+    finally:
+        h.close()
+
+
+def test_a_ten_link_set_is_refused_at_its_first_link_off_the_object():
+    h = Harness(ALLEGRO)
+    try:
+        extra = ['link_7.0', 'link_3.0', 'link_11.0', 'link_15.0', 'link_6.0', 'link_2.0']
+        points, quat = phantom(extra)
+        refused_and_not_commanded(
+            h, lambda: h.send_contacts(named(LINKS + extra), points, quat),
+            "contacts.poses[4].position: (on 'link_7.0') is ")
     finally:
         h.close()
