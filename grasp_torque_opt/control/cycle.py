@@ -92,6 +92,14 @@ class Cycle:
         self.load: np.ndarray | None = None
         #: Contacts from geometry (None: the scenario's), the object and its pose (.geometry).
         self.tracker = self.object = self.scenario_pose = None
+        #: The object's frame in the base frame at the last cycle (None: no object).
+        self.pose_in_use = None
+        #: The links' collision shapes the contacts topic's points are checked on (None:
+        #: none read; the frame rule, ``max_contact_link_distance``).
+        self.surfaces = None
+        #: Where the fingertips place the object
+        #: (:class:`~grasp_torque_opt.core.object_from_hand.ObjectFromHand`; None: no object).
+        self.hand_object = None
         #: The compiled cycle in use (None: the Python cycle), and why not when None.
         self.compiled_cycle: compiled.CompiledCycle | None = None
         self.compiled_reason = ''
@@ -109,10 +117,10 @@ class Cycle:
         compiled cycle reads both from the hand's Pinocchio data).
 
         Raises:
-            InputError: a contact point beyond ``max_contact_distance`` or farther than
-                ``max_contact_link_distance`` from its link, a normal pointing away from
-                the object origin (at this configuration), or the contacts cannot be
-                placed on their links.
+            InputError: a contact point beyond ``max_contact_distance`` or off its
+                link's surface or the object's, a normal pointing away from the object
+                origin (at this configuration), or the contacts cannot be placed on their
+                links.
         """
         setup = self.setup
         hand = setup.hand

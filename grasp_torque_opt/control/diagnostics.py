@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.core.friction import friction_usage
+import numpy as np
 
 # diagnostic_msgs/DiagnosticStatus levels, without importing ROS.
 OK, WARN, ERROR, STALE = 0, 1, 2, 3
@@ -180,6 +181,24 @@ def contact_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
     values += [('object_pose', "none received (the scenario's)" if inputs.object_pose is None
                 else 'in use'),
                ('age.object_pose_s', _ago(now, inputs.object_pose_time))]
+    return values + fingertip_values(c)
+
+
+def fingertip_values(c: TorqueController) -> list[tuple[str, str]]:
+    """Give where the fingertips place the object, and how far the object_pose is from it."""
+    est, q = c.store.hand_object, c.inputs.q
+    if est is None or q is None:
+        return []
+    hand = c.setup.hand
+    tips = est.estimate(hand.complete(q.copy()) if hand.coupling.mimics else q)
+    values = [('object.fingertips.drift_mm', f'{1e3 * np.linalg.norm(tips.translation):.3f}'),
+              ('object.fingertips.rotation_deg',
+               f'{np.degrees(np.linalg.norm(tips.rotation)):.3f}'),
+              ('object.fingertips.residual_mm', f'{1e3 * tips.residual:.3f}')]
+    pose = c.solving.pose_in_use
+    if c.inputs.object_pose is not None and pose is not None:
+        values.append(('object_pose.deviation_mm',
+                       f'{1e3 * np.linalg.norm(pose.translation - tips.pose.translation):.3f}'))
     return values
 
 

@@ -26,7 +26,9 @@ in contact may change from one cycle to the next. The rules:
 
 The object's pose (the ``object_pose`` input, else the scenario's held fixed in the
 hand's base frame) moves the object origin and the load's point with it
-(:func:`moved_origin`).
+(:func:`moved_origin`). A pose is refused beyond ``object_pose.max_offset`` of the
+scenario's, or beyond ``uncertainty.pose`` of where the fingertips place the object
+(:func:`pose_in_base`).
 """
 
 from __future__ import annotations
@@ -36,8 +38,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from grasp_torque_opt.control.checks import finite, quaternion_matrix, show
+from grasp_torque_opt.control.plausible import pose_tolerance
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.geometry_contacts import ContactSet, GeometryContacts
+from grasp_torque_opt.core.object_from_hand import ObjectEstimate
 from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.scenario import ObjectSpec
 from grasp_torque_opt.core.scenario_fields import ContactSpec
@@ -129,30 +133,45 @@ def subset(found: ContactSet, keep: list[int]) -> ContactSet:
                       distances=found.distances[k])
 
 
+def offset_limit(config) -> float:
+    """Return ``object_pose.max_offset`` in use [m]: 0 follows the stated pose uncertainty."""
+    return config.object_pose_max_offset or pose_tolerance(config)
+
+
 def pose_in_base(received: ObjectPose | None, scenario: pin.SE3, placements,
-                 limit: float) -> pin.SE3:
+                 config, fingertips: ObjectEstimate | None = None) -> pin.SE3:
     """
-    Give the object's pose in the base frame, checked within ``limit`` of the scenario's.
+    Give the object's pose in the base frame, checked against the scenario's and the hand's.
 
     Args:
         received: the input's pose (None: the scenario's, held fixed in the base frame).
         scenario: the scenario's pose in the base frame.
         placements: ``frame -> SE3`` of a model frame in the base frame, at the joint
             state of the moment.
-        limit: ``object_pose.max_offset`` [m].
+        config: ``object_pose_max_offset`` and ``uncertainty_pose`` [m].
+        fingertips: where the fingertips place the object at that joint state
+            (:class:`~grasp_torque_opt.core.object_from_hand.ObjectFromHand`), or None.
 
     Raises:
-        InputError: ``object_pose.pose.position`` farther than ``limit`` from the
-            scenario's.
+        InputError: ``object_pose.pose.position`` farther than ``object_pose.max_offset``
+            from the scenario's, or than ``uncertainty.pose`` from the fingertips'.
     """
     if received is None:
         return scenario
     pose = received.pose if not received.frame else placements(received.frame) * received.pose
+    limit = offset_limit(config)
     offset = float(np.linalg.norm(pose.translation - scenario.translation))
     if not offset <= limit:  # NaN too
         raise InputError('object_pose.pose.position', f'is {1e3 * offset:.4g} mm from the '
                          f"scenario's object position (base frame), beyond "
                          f'object_pose.max_offset ({1e3 * limit:g} mm)')
+    if fingertips is not None:
+        tol = pose_tolerance(config)
+        off = float(np.linalg.norm(pose.translation - fingertips.pose.translation))
+        if not off <= tol:
+            raise InputError('object_pose.pose.position', f'is {1e3 * off:.4g} mm from where '
+                             'the fingertips place the object (their kinematics since the '
+                             f"grasp's start), beyond uncertainty.pose ({1e3 * tol:g} mm)")
     return pose
 
 
@@ -205,10 +224,12 @@ def geometry_of(cycle, inputs, q: np.ndarray) -> tuple[list[ContactSpec], np.nda
     contacts, origin, at = setup.contacts, setup.object_origin, None
     pose = cycle.scenario_pose
     if inputs.object_pose is not None:
+        tips = None if cycle.hand_object is None else cycle.hand_object.estimate(q)
         pose = pose_in_base(inputs.object_pose, pose, placements_at(setup.hand, q, False),
-                            cycle.config.object_pose_max_offset)
+                            cycle.config, tips)
         origin = moved_origin(origin, cycle.scenario_pose, pose)
         at = (moved_object(cycle.object, pose), origin)
+    cycle.pose_in_use = pose
     if inputs.contacts is None and cycle.tracker is not None:
         contacts = cycle.tracker.update(q, pose, cycle.config.contact_release)
     return contacts, origin, at

@@ -27,7 +27,7 @@ each cycle (:func:`topic_contacts`, which also counts the changes of the set).
 from __future__ import annotations
 
 from grasp_torque_opt.control.checks import show
-from grasp_torque_opt.control.plausible import check_on_links, points_inward
+from grasp_torque_opt.control.plausible import check_surfaces, Placed, points_inward
 from grasp_torque_opt.core.contact_links import check_contact_links
 from grasp_torque_opt.core.exceptions import FrameNotFound, InputError
 from grasp_torque_opt.core.scenario_fields import ContactSpec
@@ -136,9 +136,9 @@ def topic_contacts(cycle, cp, origin: np.ndarray) -> list[ContactSpec]:
         origin: the object origin in use (base frame).
 
     Raises:
-        InputError: a contact point beyond ``max_contact_distance`` or farther than
-            ``max_contact_link_distance`` from its link, a normal pointing away from the
-            object origin (at this configuration).
+        InputError: a contact point beyond ``max_contact_distance``, off its link's
+            surface or the object's (:func:`~.plausible.check_surfaces`), a normal pointing
+            away from the object origin (at this configuration).
     """
     setup = cycle.setup
     hand = setup.hand
@@ -169,7 +169,8 @@ def topic_contacts(cycle, cp, origin: np.ndarray) -> list[ContactSpec]:
     # Checked whole on receipt (at the joint state of then); the cheap, vectorized part
     # runs again here, since the links have moved since.
     points, normals = np.array(points), np.array(normals)
-    check_on_links(points, np.array(origins), links, cycle.config.max_contact_link_distance)
+    check_surfaces(Placed(points, links, data, base, np.array(origins)), cycle.surfaces,
+                   cycle.config, cycle.object, cycle.pose_in_use)
     i = points_inward(points, normals, origin)
     if i >= 0:
         raise InputError(f'contacts.poses[{i}].orientation', 'the normal of the contact '

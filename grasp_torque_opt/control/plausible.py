@@ -10,11 +10,17 @@
 Whether estimated contacts can be the grasp's: on their own links, pushing into the object.
 
 A well-formed lie on ``contacts`` was certified before: four flipped normals (a
-perception sign bug) gave commands that pull, and swapped fingertips put contacts 71 to
-95 mm from their own links (docs/node.md, "Input checks"). The rules, in the base frame
-at the configuration of the moment:
+perception sign bug) gave commands that pull; swapped fingertips put contacts 71 to
+95 mm from their own links, and index and middle tips named the other way round 33.6 mm,
+within the 50 mm of the frame rule (docs/node.md, "Contacts and object pose against the
+hand"). The rules, in the base frame at the configuration of the moment:
 
-- a contact point at most ``max_contact_link_distance`` from its own link's frame;
+- a contact point at most ``max_contact_surface_distance`` from its own link's surface
+  (the URDF's collision shapes of that link, :class:`~grasp_torque_opt.core.link_surfaces.
+  LinkSurfaces`); on a link without collision shapes, at most ``max_contact_link_distance``
+  from its frame (the node warns once at configure time which links those are);
+- with the scenario's object, at most ``uncertainty.pose`` (at least 1 mm) plus
+  ``max_contact_surface_distance`` off the object's surface at the pose in use;
 - its normal points into the object (:func:`grasp_torque_opt.core.inward.check_inward_normals`:
   towards the object origin, and into the scenario object's surface where it has one);
 - a contact's link is not the root, a frame fixed to the root, nor a joint frame
@@ -24,17 +30,112 @@ at the configuration of the moment:
 
 from __future__ import annotations
 
-from grasp_torque_opt.core.exceptions import InputError
+from dataclasses import dataclass
+
+from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.inward import check_inward_normals
+from grasp_torque_opt.core.link_surfaces import LinkSurfaces
+from grasp_torque_opt.core.object_geometry import ObjectShape, point_distance
 from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
 import pinocchio as pin
 
+#: The least pose tolerance [m] when none is stated (uncertainty.pose 0): the fingers'
+#: own kinematic error, 0.01 rad of joint reading over 0.1 m of finger.
+MIN_POSE_TOLERANCE = 1e-3
+
+
+def pose_tolerance(config) -> float:
+    """Return the stated pose uncertainty in use [m]: ``uncertainty.pose``, at least 1 mm."""
+    return max(config.uncertainty_pose, MIN_POSE_TOLERANCE)
+
+
+@dataclass(frozen=True)
+class Placed:
+    """
+    Contact points placed at a configuration, with what the surface rules need.
+
+    Attributes:
+        points: the points in the grasp's base frame, shape (p, 3) [m].
+        links: each point's link.
+        data: the hand's Pinocchio data, its placements at that configuration.
+        base: the base link's placement in the world of ``data`` (None: the root's).
+        origins: the links' frame origins in the base frame, shape (p, 3) [m].
+    """
+
+    points: np.ndarray
+    links: tuple[str, ...]
+    data: pin.Data
+    base: pin.SE3 | None
+    origins: np.ndarray
+
+
+def check_surfaces(placed: Placed, surfaces: LinkSurfaces | None, config,
+                   obj: ObjectSpec | None = None, pose: pin.SE3 | None = None) -> None:
+    """
+    Refuse a contact point off its own link's surface, or off the object's.
+
+    Args:
+        placed: the points and their links, placed.
+        surfaces: the links' collision shapes (None: none could be read; the frame rule
+            for every link).
+        config: ``max_contact_surface_distance``, ``max_contact_link_distance`` and
+            ``uncertainty_pose`` [m].
+        obj: the scenario's object (None: no object rule).
+        pose: the object's frame in the base frame (the pose in use).
+
+    Raises:
+        InputError: ``contacts.poses[i].position``, naming the link and the distance.
+    """
+    links = placed.links
+    shaped = [surfaces is not None and surfaces.has(link) for link in links]
+    if not all(shaped):  # links without collision shapes: the frame rule
+        free = [i for i, s in enumerate(shaped) if not s]
+        check_on_links(placed.points[free], placed.origins[free],
+                       tuple(links[i] for i in free), config.max_contact_link_distance,
+                       free)
+    limit = config.max_contact_surface_distance
+    if any(shaped):
+        world = placed.points if placed.base is None else \
+            placed.points @ placed.base.rotation.T + placed.base.translation
+        d = surfaces.distances(placed.data, links, world)
+        bad = np.array(shaped) & ~(d <= limit)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise InputError(f'contacts.poses[{i}].position', f'is {1e3 * d[i]:.3g} mm from '
+                             f"the surface of its link '{links[i]}' (its collision geometry),"
+                             f' beyond max_contact_surface_distance ({1e3 * limit:g} mm): a '
+                             'contact of another finger or link, or a wrong frame')
+    if obj is not None and pose is not None:
+        check_on_object(placed.points, links, obj, pose, pose_tolerance(config) + limit)
+
+
+def check_on_object(points: np.ndarray, links: tuple[str, ...], obj: ObjectSpec,
+                    pose: pin.SE3, limit: float) -> None:
+    """
+    Refuse a contact point farther than ``limit`` off the object's surface (or inside it).
+
+    Raises:
+        InputError: ``contacts.poses[i].position``.
+    """
+    shape = ObjectShape.from_spec(obj)
+    for i, p in enumerate(points):
+        try:
+            d = abs(point_distance(shape, pose, p))
+        except GeometryError:  # at a sphere's centre: a radius off its surface
+            d = float(np.max(shape.size))
+        if not d <= limit:
+            raise InputError(f'contacts.poses[{i}].position', f"(on '{links[i]}') is "
+                             f"{1e3 * d:.3g} mm off the object's surface at the pose in use, "
+                             f'beyond uncertainty.pose + max_contact_surface_distance '
+                             f'({1e3 * limit:g} mm): the contact cannot touch the object')
+
 
 def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, frame: str,
-                   positions: np.ndarray, rotations: np.ndarray, limit: float,
-                   links: tuple[str, ...] | None = None) -> None:
+                   positions: np.ndarray, rotations: np.ndarray, config,
+                   links: tuple[str, ...] | None = None, surfaces: LinkSurfaces | None = None,
+                   pose: pin.SE3 | None = None) -> None:
     """
     Check contact poses at configuration ``q``: on their own links, pushing into the object.
 
@@ -45,11 +146,13 @@ def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, fra
         frame: model frame of the poses ('' = the base frame).
         positions: contact points, shape (p, 3) [m].
         rotations: contact frame axes, shape (p, 3, 3).
-        limit: ``max_contact_link_distance`` [m].
+        config: the limits (:func:`check_surfaces`).
         links: each pose's link (None: the scenario's contacts', by index).
+        surfaces: the links' collision shapes (None: the frame rule for every link).
+        pose: the object's frame in the base frame, in use at ``q`` (None: no object rule).
 
     Raises:
-        InputError: naming the contact (:func:`check_on_links`, :func:`check_inward`).
+        InputError: naming the contact (:func:`check_surfaces`, :func:`check_inward`).
     """
     hand = setup.hand
     model, data = hand.model, hand.data
@@ -66,12 +169,12 @@ def check_contacts(setup: GraspSetup, obj: ObjectSpec | None, q: np.ndarray, fra
     placements = [data.oMf[model.getFrameId(link)] for link in links]
     origins = np.array([(base.actInv(m) if base is not None else m).translation
                         for m in placements])
-    check_on_links(points, origins, links, limit)
+    check_surfaces(Placed(points, links, data, base, origins), surfaces, config, obj, pose)
     check_inward(points, normals, links, setup.object_origin, obj)
 
 
 def check_on_links(points: np.ndarray, link_origins: np.ndarray, links: tuple[str, ...],
-                   limit: float) -> None:
+                   limit: float, indices: list[int] | None = None) -> None:
     """
     Refuse a contact point farther than ``limit`` from its own link's frame.
 
@@ -80,6 +183,7 @@ def check_on_links(points: np.ndarray, link_origins: np.ndarray, links: tuple[st
         link_origins: their links' frame origins, base frame, shape (p, 3) [m].
         links: the links' names, for the message.
         limit: ``max_contact_link_distance`` [m].
+        indices: each point's index in the message (None: 0, 1, ...).
 
     Raises:
         InputError: ``contacts.poses[i].position``.
@@ -88,7 +192,8 @@ def check_on_links(points: np.ndarray, link_origins: np.ndarray, links: tuple[st
     if (d <= limit).all():  # False for NaN as well
         return
     i = int(np.argmax(np.where(np.isnan(d), np.inf, d)))
-    raise InputError(f'contacts.poses[{i}].position', f'is {d[i]:.4g} m from its link '
+    k = i if indices is None else indices[i]
+    raise InputError(f'contacts.poses[{k}].position', f'is {d[i]:.4g} m from its link '
                      f"'{links[i]}', beyond max_contact_link_distance ({limit} m): a "
                      'contact of another finger, or a wrong frame')
 

@@ -234,7 +234,7 @@ class GeometryContacts:
         for g in geom.geometryObjects:
             by_link.setdefault(model.frames[g.parentFrame].name, []).append(g)
         if links is None:
-            names = [n for n in frame_names(model) if n in by_link and _moved(hand, n)]
+            names = [n for n in frame_names(model) if n in by_link and moved_by_joint(hand, n)]
         else:
             names = list(links)
             for i, name in enumerate(names):
@@ -395,7 +395,7 @@ class GeometryContacts:
         return link, float(d), point, res.getNearestPoint2(), normal / norm, local
 
 
-def _moved(hand: Hand, name: str) -> bool:
+def moved_by_joint(hand: Hand, name: str) -> bool:
     """Tell whether a joint moves link ``name`` (relative to the base): it can push."""
     try:
         check_contact_links(hand.model, [name], base=hand.base_link)

@@ -117,7 +117,8 @@ def test_three_named_contacts_give_the_three_contact_grasps_command():
 BAD = [
     # The index tip's pose named on the thumb tip and back: 82 mm from the named link.
     ('wrong link', lambda p: named([LINKS[3]] + LINKS[1:3] + [LINKS[0]]),
-     'beyond max_contact_link_distance (0.05 m): a contact of another finger'),
+     "from the surface of its link 'link_15.0_tip' (its collision geometry), beyond "
+     'max_contact_surface_distance (5 mm): a contact of another finger'),
     ('unknown link', lambda p: named(LINKS[:3] + ['link_99_tip']),
      "contacts.header.frame_id link 4: unknown frame 'link_99_tip'"),
     ('root', lambda p: named(LINKS[:3] + [MODEL.frames[1].name]),

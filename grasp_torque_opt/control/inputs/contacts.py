@@ -12,8 +12,9 @@ Contact estimates (geometry_msgs/PoseArray): one pose per scenario contact, or p
 ``header.frame_id`` is ``FRAME`` (one pose per scenario contact, by index) or
 ``FRAME;LINK_1,...,LINK_n`` (one pose per named link, in order:
 :mod:`grasp_torque_opt.control.named_contacts`). Each pose is checked plausible at the
-latest joint state (:func:`grasp_torque_opt.control.plausible.check_contacts`); the cycle
-checks them again where the frame is placed.
+latest joint state (:func:`grasp_torque_opt.control.plausible.check_contacts`: on their
+own links' surfaces, on the object's, pushing into it); the cycle checks them again where
+the frame is placed.
 """
 
 from __future__ import annotations
@@ -22,10 +23,20 @@ from dataclasses import dataclass
 from typing import Any
 
 from grasp_torque_opt.control.checks import contact_rotations
+from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.control.inputs.base import aged, latest_q
 from grasp_torque_opt.control.named_contacts import named_frame, split_frame_id
 from grasp_torque_opt.control.plausible import check_contacts
 import numpy as np
+import pinocchio as pin
+
+
+def pose_in_use(store, q: np.ndarray) -> pin.SE3 | None:
+    """Give the object's frame in the base frame at ``q``: the input's, else the scenario's."""
+    got = store.inputs.object_pose
+    if got is None or store.scenario_pose is None:
+        return store.scenario_pose
+    return got.pose if not got.frame else placements_at(store.setup.hand, q)(got.frame) * got.pose
 
 
 @dataclass(frozen=True)
@@ -92,8 +103,9 @@ class Contacts:
         frame, links = named_frame(store.setup, reading.frame, len(positions))
         rotations = contact_rotations(store.setup.hand.model, len(positions), frame,
                                       positions, quaternions)
-        check_contacts(store.setup, store.object, latest_q(store), frame, positions,
-                       rotations, store.config.max_contact_link_distance, links)
+        q = latest_q(store)
+        check_contacts(store.setup, store.object, q, frame, positions, rotations,
+                       store.config, links, store.surfaces, pose_in_use(store, q))
         return ContactPoses(frame, positions, rotations, links)
 
     def keep(self, store, value: ContactPoses, now: float) -> dict[str, Any]:

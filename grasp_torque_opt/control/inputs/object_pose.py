@@ -11,8 +11,10 @@ The object's pose (geometry_msgs/PoseStamped): the contacts from geometry and th
 
 In the base frame, a model frame (placed at each cycle's joint state), or any frame tf2
 resolves (its transform, looked up by the ROS side at receipt). A pose farther than
-``object_pose.max_offset`` from the scenario's at the latest joint state is refused;
-the last accepted one is used while fresh (``object_pose.timeout``).
+``object_pose.max_offset`` from the scenario's at the latest joint state, or farther
+than ``uncertainty.pose`` from where the fingertips place the object there
+(:class:`~grasp_torque_opt.core.object_from_hand.ObjectFromHand`), is refused; the last
+accepted one is used while fresh (``object_pose.timeout``).
 """
 
 from __future__ import annotations
@@ -63,7 +65,8 @@ class ObjectPoseInput:
 
         Raises:
             InputError: not finite, a non-unit quaternion, an unknown frame, no scenario
-                object, farther than ``object_pose_max_offset`` from the scenario's pose
+                object, farther than ``object_pose.max_offset`` from the scenario's pose
+                or than ``uncertainty.pose`` from where the fingertips place the object,
                 at the latest joint state.
         """
         hand = store.setup.hand
@@ -71,8 +74,11 @@ class ObjectPoseInput:
                            reading.transform, reading.unresolved)
         if store.scenario_pose is None:
             raise InputError('object_pose', 'the scenario has no object')
-        pose_in_base(got, store.scenario_pose, placements_at(hand, latest_q(store)),
-                     store.config.object_pose_max_offset)
+        q = latest_q(store)
+        if hand.coupling.mimics:
+            q = hand.complete(q.copy())
+        tips = None if store.hand_object is None else store.hand_object.estimate(q)
+        pose_in_base(got, store.scenario_pose, placements_at(hand, q), store.config, tips)
         return got
 
     def keep(self, store, value: ObjectPose, now: float) -> dict[str, Any]:

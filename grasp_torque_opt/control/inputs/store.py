@@ -28,6 +28,8 @@ from grasp_torque_opt.control.motion import ImuTracker, Motion
 from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.grasp_setup import GraspSetup
+from grasp_torque_opt.core.link_surfaces import LinkSurfaces
+from grasp_torque_opt.core.object_from_hand import ObjectFromHand
 from grasp_torque_opt.core.scenario import ObjectSpec
 import numpy as np
 import pinocchio as pin
@@ -130,6 +132,10 @@ class InputStore:
         #: (config, URDF lower and upper limits widened by joint_limit_tolerance).
         self._limits: tuple[CycleConfig, np.ndarray, np.ndarray] | None = None
         self.object: ObjectSpec | None = None  #: the scenario's object (the inward rule)
+        #: The links' collision shapes contacts are checked on (None: the frame rule).
+        self.surfaces: LinkSurfaces | None = None
+        #: Where the fingertips place the object (None: no object; a pose is not compared).
+        self.hand_object: ObjectFromHand | None = None
         #: The scenario's object pose in the base frame (None: no object; a pose is refused).
         self.scenario_pose: pin.SE3 | None = None
         #: The last accepted joint state's names, which of its entries are model joints,

@@ -56,9 +56,19 @@ class CycleConfig:
         max_wrench_torque: A load whose moment norm exceeds this is rejected. [N m]
         max_contact_distance: A contact point farther than this from the base origin stops commands
             (a fault). [m]
-        max_contact_link_distance: A contact point on the contacts topic farther than this from its
-            own link's frame is rejected (another finger's contact, a wrong frame); in the cycle,
-            at the configuration of the moment, a fault. [m]
+        max_contact_link_distance: For a link without collision geometry in the URDF: a contact
+            point on the contacts topic farther than this from its own link's frame is rejected
+            (another finger's contact, a wrong frame); in the cycle, at the configuration of the
+            moment, a fault. A link with collision geometry is held to
+            max_contact_surface_distance. [m]
+        max_contact_surface_distance: A contact point on the contacts topic farther than this from
+            its own link's surface (the URDF's collision shapes of that link), or inside it deeper
+            than this, is rejected (another finger's contact, a wrong link, a wrong frame); in the
+            cycle, a fault. 5 mm covers a soft pad's compression and the collision shape's fit to
+            it (1-2 mm each) and the fingers' kinematic error (0.01 rad over 0.1 m: 1 mm), and is
+            well under a fingertip's radius (Allegro: 12 mm). With the scenario's object, the point
+            may also lie no farther than uncertainty.pose plus this from the object's surface at
+            the pose in use. [m]
         max_torque_rate: A certified command farther from the command in force than this rate
             allows since that command (at most command_period) is published as a step of at most
             this rate towards it (the rate rule, docs/node.md: flapping contacts or gravity cannot
@@ -113,7 +123,9 @@ class CycleConfig:
             stops commands (a fault); 0, never stale. [s]
         object_pose_max_offset: (``object_pose.max_offset``) An object pose whose position is
             farther than this from the scenario's (base frame, at the joint state of the moment) is
-            rejected, at receipt and in the cycle. [m]
+            rejected, at receipt and in the cycle. 0 (the default): follows the stated uncertainty,
+            uncertainty.pose (at least 1 mm): the friction margin covers a pose that far off, no
+            farther. [m]
         effort_estimation: (``effort_estimation.enabled``) Estimate the load the hand holds from
             joint_states' effort (least squares through J^T and G, g(q) taken out) and add to the
             planned load a bounded integral correction towards it (docs/node.md, "Load from
@@ -129,6 +141,11 @@ class CycleConfig:
         effort_max_load_ratio: (``effort_estimation.max_load_ratio``) The correction's force is at
             most this times the scenario's weight, its moment that force times the farthest
             contact's distance from the object origin.
+        uncertainty_pose: (``uncertainty.pose``) Contact position / object pose uncertainty (0.002:
+            2 mm): tilts a normal by pose/(R + r), R the scenario's object's radius (a box's flat
+            face: no tilt), r uncertainty.tip_radius. It also bounds how far an object pose may be
+            from where the fingertips place the object, and a contact point from the object's
+            surface (at least 1 mm: docs/node.md, "Contacts and object pose against the hand"). [m]
         joint_limit_tolerance: A joint state with a used position beyond its joint's URDF limits by
             more than this is rejected. [rad or m]
         stamp_future_tolerance: A header stamp more than this ahead of the node's clock is
@@ -161,6 +178,7 @@ class CycleConfig:
     max_wrench_torque: float = 100.0
     max_contact_distance: float = 1.0
     max_contact_link_distance: float = 0.05
+    max_contact_surface_distance: float = 0.005
     max_torque_rate: float = 20.0
     command_period: float = 0.005
     gravity_norm_bounds: tuple = (5.0, 15.0)
@@ -176,12 +194,13 @@ class CycleConfig:
     contact_geometry: bool = False
     contact_release: float = 2.0
     object_pose_timeout: float = 0.5
-    object_pose_max_offset: float = 0.03
+    object_pose_max_offset: float = 0.0
     effort_estimation: bool = False
     effort_time_constant: float = 0.05
     effort_filter: float = 0.01
     effort_mass_only: bool = True
     effort_max_load_ratio: float = 0.5
+    uncertainty_pose: float = 0.0
     joint_limit_tolerance: float = 0.1
     stamp_future_tolerance: float = 0.5
     cycle_budget: float = 0.05
@@ -272,7 +291,9 @@ class ParamsObjectPose:
         timeout: Once an object pose arrived, older than this stops commands (a fault); 0, never
             stale. [s]
         max_offset: An object pose whose position is farther than this from the scenario's (base
-            frame, at the joint state of the moment) is rejected, at receipt and in the cycle. [m]
+            frame, at the joint state of the moment) is rejected, at receipt and in the cycle. 0
+            (the default): follows the stated uncertainty, uncertainty.pose (at least 1 mm): the
+            friction margin covers a pose that far off, no farther. [m]
     """
 
     timeout: float | None
@@ -316,7 +337,9 @@ class ParamsUncertainty:
             (docs/node.md, "Margin from stated uncertainty").
         pose: Contact position / object pose uncertainty (0.002: 2 mm): tilts a normal by pose/(R +
             r), R the scenario's object's radius (a box's flat face: no tilt), r
-            uncertainty.tip_radius. [m]
+            uncertainty.tip_radius. It also bounds how far an object pose may be from where the
+            fingertips place the object, and a contact point from the object's surface (at least 1
+            mm: docs/node.md, "Contacts and object pose against the hand"). [m]
         tip_radius: The fingertips' radius r in the tilt pose/(R + r) (Allegro's, 12 mm). [m]
     """
 
@@ -431,9 +454,19 @@ class Params:
         max_wrench_torque: A load whose moment norm exceeds this is rejected. [N m]
         max_contact_distance: A contact point farther than this from the base origin stops commands
             (a fault). [m]
-        max_contact_link_distance: A contact point on the contacts topic farther than this from its
-            own link's frame is rejected (another finger's contact, a wrong frame); in the cycle,
-            at the configuration of the moment, a fault. [m]
+        max_contact_link_distance: For a link without collision geometry in the URDF: a contact
+            point on the contacts topic farther than this from its own link's frame is rejected
+            (another finger's contact, a wrong frame); in the cycle, at the configuration of the
+            moment, a fault. A link with collision geometry is held to
+            max_contact_surface_distance. [m]
+        max_contact_surface_distance: A contact point on the contacts topic farther than this from
+            its own link's surface (the URDF's collision shapes of that link), or inside it deeper
+            than this, is rejected (another finger's contact, a wrong link, a wrong frame); in the
+            cycle, a fault. 5 mm covers a soft pad's compression and the collision shape's fit to
+            it (1-2 mm each) and the fingers' kinematic error (0.01 rad over 0.1 m: 1 mm), and is
+            well under a fingertip's radius (Allegro: 12 mm). With the scenario's object, the point
+            may also lie no farther than uncertainty.pose plus this from the object's surface at
+            the pose in use. [m]
         max_torque_rate: A certified command farther from the command in force than this rate
             allows since that command (at most command_period) is published as a step of at most
             this rate towards it (the rate rule, docs/node.md: flapping contacts or gravity cannot
@@ -511,6 +544,7 @@ class Params:
     max_wrench_torque: float | None
     max_contact_distance: float | None
     max_contact_link_distance: float | None
+    max_contact_surface_distance: float | None
     max_torque_rate: float | None
     command_period: float | None
     gravity_norm_bounds: tuple | None
@@ -550,6 +584,7 @@ CYCLE_FIELDS = {
     'max_wrench_torque': 'max_wrench_torque',
     'max_contact_distance': 'max_contact_distance',
     'max_contact_link_distance': 'max_contact_link_distance',
+    'max_contact_surface_distance': 'max_contact_surface_distance',
     'max_torque_rate': 'max_torque_rate',
     'command_period': 'command_period',
     'gravity_norm_bounds': 'gravity_norm_bounds',
@@ -571,6 +606,7 @@ CYCLE_FIELDS = {
     'effort_filter': 'effort_estimation.filter',
     'effort_mass_only': 'effort_estimation.mass_only',
     'effort_max_load_ratio': 'effort_estimation.max_load_ratio',
+    'uncertainty_pose': 'uncertainty.pose',
     'joint_limit_tolerance': 'joint_limit_tolerance',
     'stamp_future_tolerance': 'stamp_future_tolerance',
     'cycle_budget': 'cycle_budget',

@@ -32,6 +32,8 @@ from grasp_torque_opt.core.exceptions import FrameNotFound, InputError, JointNot
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.hand import MAX_URDF_BYTES, resolve_urdf
+from grasp_torque_opt.core.link_surfaces import LinkSurfaces
+from grasp_torque_opt.core.object_from_hand import ObjectFromHand
 from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
 from grasp_torque_opt.core.scenario import load_scenario, Scenario, weight_wrench
@@ -255,6 +257,11 @@ def place_object(ctrl: TorqueController, scenario: Scenario, p: Any, urdf: str) 
     ctrl.solving.object, ctrl.solving.scenario_pose = obj, pose
     ctrl.store.scenario_pose = pose
     ctrl.solving.tracker = None
+    ctrl.store.hand_object = ctrl.solving.hand_object = None
+    if pose is not None:  # where the fingertips place it, from the scenario's grasp (its start)
+        setup = ctrl.setup
+        ctrl.store.hand_object, ctrl.solving.hand_object = (
+            ObjectFromHand(setup.hand, setup.contacts, setup.q, pose) for _ in range(2))
     if not p.contact_geometry.enabled:
         return
     if obj is None:
@@ -266,3 +273,32 @@ def place_object(ctrl: TorqueController, scenario: Scenario, p: Any, urdf: str) 
         p.contact_geometry.tolerance, None if links == ['auto'] else links,
         field='contact_geometry.links')
     ctrl.solving.tracker = ContactTracker(model, obj)
+
+
+def bind_surfaces(ctrls: tuple[TorqueController, ...], scenario: Scenario, urdf: str) -> str:
+    """
+    Give controllers the links' collision shapes their contact checks use; say what lacks them.
+
+    Returns:
+        A warning to log once ('' when every link a joint moves has collision shapes):
+        the links checked by ``max_contact_link_distance`` instead, or why no shape could
+        be read (then every link is).
+    """
+    try:
+        surfaces = [LinkSurfaces.bind(c.setup.hand, urdf or resolve_urdf(
+            scenario.urdf, scenario.base_dir)) for c in ctrls]
+    except InputError as e:
+        for c in ctrls:
+            c.store.surfaces = c.solving.surfaces = None
+        return (f"contacts: no link's collision geometry could be read ({e}); every contact "
+                "is checked by max_contact_link_distance from its link's frame only")
+    for c, s in zip(ctrls, surfaces):
+        c.store.surfaces = c.solving.surfaces = s
+    hand = ctrls[0].setup.hand
+    bare = surfaces[0].bare(hand)
+    if not bare:
+        return ''
+    shown = ', '.join(bare[:8]) + (f' and {len(bare) - 8} more' if len(bare) > 8 else '')
+    return (f'contacts: {len(bare)} link(s) a joint moves have no collision geometry in the '
+            f'URDF ({shown}): a contact on one is checked by max_contact_link_distance from '
+            'its frame, not on its surface')

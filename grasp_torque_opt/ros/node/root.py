@@ -31,6 +31,7 @@ from grasp_torque_opt.ros.node import controllers
 from grasp_torque_opt.ros.node.declared import DeclaredParameters
 from grasp_torque_opt.ros.node.grasp_source import (
     bind,
+    bind_surfaces,
     Grasp,
     load_of_gravity,
     place_object,
@@ -144,6 +145,9 @@ class GraspTorque:
         ctrl.store.object = service.store.object = grasp.scenario.object
         for c in (ctrl, service):
             place_object(c, grasp.scenario, p, self._urdf)
+        bare = bind_surfaces((ctrl, service), grasp.scenario, self._urdf)
+        if bare:
+            self.node.get_logger().warning(bare)
         ctrl.solving.weight = service.solving.weight = weight_of(grasp.scenario)
         # The service plans for the model's load (the scenario's, the IMU's): it does not
         # estimate, and a transient correction of the loop's is not its prediction.

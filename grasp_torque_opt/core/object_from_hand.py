@@ -1,0 +1,151 @@
+# Copyright 2026 grasp_torque_opt developers
+#
+# Use of this source code is governed by a BSD-style
+# license that can be found in the LICENSE file or at
+# https://developers.google.com/open-source/licenses/bsd
+#
+# SPDX-License-Identifier: BSD-3-Clause
+
+"""
+The object's state from the hand: where the fingertips say it is, and how it moves.
+
+Under the grasp constraint the contact points move with the object (they stick; a tip
+may roll): G^T xdot = J qdot, G^T's rows for contact i being [I, -[p_i - c]x] (the
+point's velocity from the object's twist [v, w] at its origin c, base axes) and J the
+point's translational Jacobian. :meth:`ObjectFromHand.estimate` solves it in least
+squares over the contacts:
+
+- the displacement, finite, from a reference (the grasp's start: a joint configuration
+  q0 and the object's pose there): the rigid motion that best carries the contact
+  points at q0 to the same material points at q (Kabsch's solution,
+  ``scipy.spatial.transform.Rotation.align_vectors``; for small motions it is the least
+  squares solution of G^T dx = J dq); the object's pose is that motion applied to the
+  reference pose;
+- the twist, from joint velocities: ``numpy.linalg.lstsq`` of G^T [v, w] = J qdot;
+- the residual: how far the worst contact point is from the rigid motion [m] (a slip, a
+  finger off the object, or a lie of the joint states).
+
+With fewer than three contacts the rotation is not observed: the displacement is the
+contact points' mean translation, the rotation none. ROS-free.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from grasp_torque_opt.core.hand import Hand
+from grasp_torque_opt.core.scenario_fields import ContactSpec
+import numpy as np
+import pinocchio as pin
+from scipy.spatial.transform import Rotation
+
+
+@dataclass(frozen=True)
+class ObjectEstimate:
+    """
+    The object's state the fingertips give.
+
+    Attributes:
+        pose: the object's frame in the base frame.
+        translation: its origin's displacement from the reference, base axes [m], (3,).
+        rotation: its rotation from the reference, a rotation vector in base axes [rad], (3,).
+        twist: [v, w] of the object at its origin, base axes [m/s, rad/s], shape (6,),
+            or None (no joint velocities given).
+        residual: the largest distance of a contact point from the rigid motion [m].
+    """
+
+    pose: pin.SE3
+    translation: np.ndarray
+    rotation: np.ndarray
+    twist: np.ndarray | None
+    residual: float
+
+
+class ObjectFromHand:
+    """
+    The object's pose and twist from the fingertips' kinematics, from a reference.
+
+    Args:
+        hand: the hand (its model; its base link, whose frame the poses are in).
+        contacts: the contacts (each a material point of its link: ``position`` in the
+            link's frame).
+        q0: the reference configuration, shape (model.nq,) (coupled joints completed).
+        pose0: the object's frame in the base frame at ``q0``.
+
+    Keeps its own Pinocchio data: not shared across threads.
+    """
+
+    def __init__(self, hand: Hand, contacts: list[ContactSpec], q0: np.ndarray,
+                 pose0: pin.SE3) -> None:
+        self.hand = hand
+        model = hand.model
+        self._data = model.createData()
+        self._frames = [model.getFrameId(c.link) for c in contacts]
+        self._local = np.array([np.asarray(c.position, dtype=float) for c in contacts])
+        self._base = None if hand.base_link is None else model.getFrameId(hand.base_link)
+        self.reset(q0, pose0)
+
+    def reset(self, q0: np.ndarray, pose0: pin.SE3) -> None:
+        """Take a new reference: the object at ``pose0`` when the hand is at ``q0``."""
+        self.q0 = np.array(q0, dtype=float)
+        self.pose0 = pose0.copy()
+        self.points0 = self.points(self.q0)
+
+    def points(self, q: np.ndarray) -> np.ndarray:
+        """Return the contact points at ``q``, base frame, shape (p, 3) [m]."""
+        model, data = self.hand.model, self._data
+        pin.framesForwardKinematics(model, data, q)
+        return self._placed(data)
+
+    def _placed(self, data: pin.Data) -> np.ndarray:
+        world = np.array([data.oMf[f].act(p) for f, p in zip(self._frames, self._local)])
+        if self._base is None:
+            return world
+        oMb = data.oMf[self._base]
+        return (world - oMb.translation) @ oMb.rotation
+
+    def estimate(self, q: np.ndarray, v: np.ndarray | None = None) -> ObjectEstimate:
+        """
+        Return the object's state at ``q`` (and joint velocities ``v``, shape (model.nv,)).
+
+        Args:
+            q: the configuration, shape (model.nq,) (coupled joints completed).
+            v: the joint velocities (coupled joints completed), or None: no twist.
+        """
+        p0, p = self.points0, self.points(q)
+        m0, m = p0.mean(axis=0), p.mean(axis=0)
+        R = np.eye(3)
+        if len(p) >= 3:
+            R = Rotation.align_vectors(p - m, p0 - m0)[0].as_matrix()
+        t = m - R @ m0
+        residual = float(np.linalg.norm(p - (p0 @ R.T + t), axis=1).max())
+        pose = pin.SE3(R, t) * self.pose0
+        twist = None if v is None else self._twist(q, v, p, pose.translation)
+        return ObjectEstimate(pose, pose.translation - self.pose0.translation, pin.log3(R),
+                              twist, residual)
+
+    def _twist(self, q: np.ndarray, v: np.ndarray, points: np.ndarray, c: np.ndarray
+               ) -> np.ndarray:
+        """Solve G^T [v, w] = J qdot in least squares (base axes, about ``c``)."""
+        model, data = self.hand.model, self._data
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        rows, rhs = [], []
+        for f, local, point in zip(self._frames, self._local, points):
+            rhs.append(self._point_velocity(f, local, v))
+            r = point - c
+            rows.append(np.hstack((np.eye(3), -pin.skew(r))))
+        x, *_ = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)
+        return x
+
+    def _point_velocity(self, frame: int, local: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Return a material point's velocity relative to the base, base axes [m/s]."""
+        model, data = self.hand.model, self._data
+        world = data.oMf[frame].act(local)
+
+        def velocity(f: int) -> np.ndarray:
+            J = pin.getFrameJacobian(model, data, f, pin.LOCAL_WORLD_ALIGNED) @ v
+            return J[:3] + np.cross(J[3:], world - data.oMf[f].translation)
+        if self._base is None:
+            return velocity(frame)
+        return data.oMf[self._base].rotation.T @ (velocity(frame) - velocity(self._base))
