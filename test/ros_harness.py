@@ -141,6 +141,24 @@ class Harness:
             msg.poses.append(pose)
         self.contacts_pub.publish(msg)
 
+    def assert_contacts_refused(self, why, names, positions, expected, atol, timeout) -> None:
+        # The contacts just sent: counted once, named in last_rejection and on
+        # /diagnostics, none in use, and five more joint states' commands stay expected.
+        controller = self.node.controller
+        assert self.spin_until(lambda: controller.counters.rejected['contacts'] == 1, timeout), \
+            controller.last_rejection
+        assert why in controller.last_rejection, controller.last_rejection
+        assert controller.inputs.contacts is None
+        n = len(self.commands)
+        for _ in range(5):
+            self.send_joint_state(names, positions)
+            self.next_command()
+        assert len(self.commands) > n
+        for _, cmd in self.commands[n:]:
+            np.testing.assert_allclose(cmd, expected, atol=atol)
+        assert self.spin_until(
+            lambda: self.diagnostics and why in self.diagnostics[-1]['last_rejection'], timeout)
+
     def send_gravity(self, frame, vector) -> None:
         msg = Vector3Stamped()
         msg.header.frame_id = frame

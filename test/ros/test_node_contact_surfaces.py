@@ -69,19 +69,7 @@ def refused_and_not_commanded(h, send, why, rename=str):
     nominal = solve(dataclasses.replace(SETUP)).tau
     np.testing.assert_allclose(first, nominal, atol=1e-6)
     send()
-    assert h.spin_until(lambda: h.node.controller.counters.rejected['contacts'] == 1, 3.0), \
-        h.node.controller.last_rejection
-    assert why in h.node.controller.last_rejection, h.node.controller.last_rejection
-    assert h.node.controller.inputs.contacts is None
-    n = len(h.commands)
-    for _ in range(5):
-        h.send_joint_state(names, pos)
-        h.next_command()
-    assert len(h.commands) > n
-    for _, cmd in h.commands[n:]:
-        np.testing.assert_allclose(cmd, nominal, atol=1e-6)
-    assert h.spin_until(lambda: h.diagnostics and why in h.diagnostics[-1]['last_rejection'],
-                        3.0)
+    h.assert_contacts_refused(why, names, pos, nominal, atol=1e-6, timeout=3.0)
 
 
 def test_the_true_contacts_are_on_their_links_surfaces_and_accepted():
