@@ -249,9 +249,12 @@ class TorqueController:
         The rate rule (docs/node.md): the command moves along the straight line from the
         command in force towards the certified command, no joint by more than
         ``max_torque_rate`` times the time since the command in force, and never more than
-        that rate times ``command_period`` (a long gap gives no bigger step). From zero
-        torques with gravity compensation the step starts at g(q), added whole: its
-        contact wrenches are ``s`` times the certified ones. Across a change of the
+        that rate times ``command_period`` (a long gap gives no bigger step). With gravity
+        compensation the contact torques are stepped and g(q) of the joint state it
+        answers is added whole: from zero torques the step starts at g(q), its contact
+        wrenches ``s`` times the certified ones; from a command whose g(q) was another
+        configuration's (or gravity's), that g is replaced by today's, else a step would
+        carry ``(1 - s)`` times their difference into the contact wrenches. Across a change of the
         contact set, a contact that left fades out and a new one fades in
         (:func:`~.rates.step_wrenches`). The step's contact wrenches must lie in the exact
         cone, finite, with the step within the torque limits: else, or when they are not
@@ -262,8 +265,11 @@ class TorqueController:
             return
         gap = min(max(now - policy.in_force_time, 0.0), config.command_period)
         known, start = policy.in_force_wrenches, policy.in_force
-        if known is not None and known.size == 0 and result.gravity_torque is not None:
-            start = result.gravity_torque  # zero torques: g(q) whole, the wrenches stepped
+        g, g_in_force = result.gravity_torque, policy.in_force_gravity
+        if known is not None and known.size == 0 and g is not None:
+            start = g  # zero torques: g(q) whole, the wrenches stepped
+        elif g is not None and g_in_force is not None and g_in_force.shape == start.shape:
+            start = start - g_in_force + g  # the contact torques in force, today's g(q)
         limits = self.setup.hand.torque_limits
         step = slewed(start, result.command, config.max_torque_rate * gap, limits)
         if step is None:
