@@ -168,19 +168,14 @@ def judge(case: str, rig: Rig, mark: Mark, inputs: int, seen: bool = True,
     holding the ball, with the scenario's contact points or, for contacts from geometry,
     the true shapes' (:data:`GEOMETRY_TRUTH`). ``truth_of``: a truth by the stamp of the
     joint state a command answers, where the truth changes from command to command. A
-    step is checked on the contact torques, the command less the truth's g(q) (zero for
-    zero torques), as the rate rule steps them (g(q) is added whole): at most
-    ``max_torque_rate`` x ``command_period`` whatever the timing.
+    step between two commands is at most ``max_torque_rate`` x ``command_period``
+    whatever the timing (the rate rule's bound); from zero torques, the contact torques'
+    (the command less the truth's g(q), which comes back whole).
     """
     published = rig.published[mark.published:]
     received = [c for _, c in rig.commands[mark.received:]]
     sent = {cmd.tobytes() for cmd, _ in rig.published}
-    # The contact torque in force before the attack (zero torques: none).
-    prev = None
-    if mark.published > 0:
-        before, stamp = rig.published[mark.published - 1]
-        at = truth if truth_of is None else truth_of.get(stamp, truth)
-        prev = before - at.rows()[1] if np.any(before != 0.0) else np.zeros_like(before)
+    prev = rig.published[mark.published - 1][0] if mark.published > 0 else None
     counts = {'received': len(received), 'published': len(published), 'forbidden': 0,
               'weak': 0, 'zero': 0, 'kinds': {}}
     for cmd in received:
@@ -192,19 +187,19 @@ def judge(case: str, rig: Rig, mark: Mark, inputs: int, seen: bool = True,
         at = truth if truth_of is None else truth_of[stamp]
         if cmd.shape == at.limits.shape and np.all(cmd == 0.0):
             counts['zero'] += 1
-            prev = np.zeros_like(cmd)
+            prev = cmd
             continue
         verdict = at.verdict(cmd, True)
-        contact = cmd - at.rows()[1]
-        if prev is not None and prev.shape == cmd.shape and verdict in ('ok', 'weak') \
-                and np.abs(contact - prev).max() > rate * PERIOD + 1e-9:
-            verdict = 'over the rate'
+        if prev is not None and prev.shape == cmd.shape and verdict in ('ok', 'weak'):
+            step = cmd - prev if np.any(prev != 0.0) else cmd - at.rows()[1]
+            if np.abs(step).max() > rate * PERIOD + 1e-9:
+                verdict = 'over the rate'
         if verdict == 'weak':
             counts['weak'] += 1
         elif verdict != 'ok':
             counts['forbidden'] += 1
             counts['kinds'][verdict] = counts['kinds'].get(verdict, 0) + 1
-        prev = contact
+        prev = cmd
     after = rig.rejected()
     counts['refused'] = {k: v - mark.rejected.get(k, 0) for k, v in after.items()
                          if v - mark.rejected.get(k, 0) > 0}
