@@ -31,6 +31,9 @@ import numpy as np
 #: Counts of the whole run, printed by conftest's terminal summary.
 COUNTS = {'inputs': 0, 'commands': 0, 'broken': 0, 'pulling': 0, 'chattering': 0, 'late': 0}
 
+#: Issue 33's cases (test_campaign_issue33.py): case -> its counts, printed after the run.
+ISSUE33: dict[str, dict] = {}
+
 #: Reproducible and bounded: CI sees the same examples every run.
 CAMPAIGN = settings(deadline=None, derandomize=True, database=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
@@ -147,3 +150,98 @@ def broken(why: str) -> None:
     """Count a broken invariant and fail."""
     COUNTS['broken'] += 1
     raise AssertionError(why)
+
+
+class TrueGrasp:
+    """
+    The contact wrenches a command exerts at the TRUE grasp, computed apart from the node.
+
+    The truth is what the scenario says: the still hand at its joint positions, holding
+    its object at its contact points (normals towards the object origin, as the
+    scenario's rule states), under its gravity. Nothing here comes from the package's
+    grasp maps: Pinocchio, built afresh from the URDF, gives each contact link's frame
+    Jacobian and g(q); the contact point's Jacobian is the link's shifted to the point
+    (v_p = v + w x r); the contact's rows are the force in a frame whose z is the inward
+    normal and the moment about that normal (the soft-finger model). The wrenches are
+    the least-squares solution of J^T f = tau - g(q) (tau alone without gravity
+    compensation): on the Allegro's four tips J^T is square and invertible (one
+    contact per finger), so f is exact; on a reduced set the fingers without a contact
+    are free and their torque moves them, reported as the residual, not checked.
+    With contacts from geometry the truth's contacts are where the true shapes touch
+    (``contacts``: coal's closest points and normals at the true configuration), since
+    the scenario then states the object and the links, not the points.
+
+    The cone is the exact soft-finger cone |f_t| / mu + |m_n| / mu_tors <= f_n: a
+    command outside it at the truth slips or twists, and f_n < 0 pulls. The reference
+    QP and SOCP (``grasp_torque_opt.reference``) were not used: they solve for forces
+    at the package's own maps, which is what this check must not lean on.
+    """
+
+    def __init__(self, setup, urdf, gravity, tol: float = 1e-6, contacts=None):
+        import pinocchio as pin
+
+        self.pin, self.tol = pin, tol
+        self.model = pin.buildModelFromUrdf(str(urdf))
+        assert self.model.nq == setup.q.size
+        self.model.gravity.linear = np.asarray(gravity, dtype=float)
+        self.data = self.model.createData()
+        self.q = setup.q.copy()
+        self.idx_v = np.asarray(setup.hand.idx_v)
+        self.origin = np.asarray(setup.object_origin, dtype=float)
+        self.contacts = [(c.link, np.asarray(c.position, dtype=float),
+                          None if c.normal is None else np.asarray(c.normal, dtype=float))
+                         for c in (setup.contacts if contacts is None else contacts)]
+        fr = setup.friction
+        self.mu, self.mu_tors, self.f_min = fr.mu1, fr.mu2, fr.min_normal_force
+        self.limits = np.asarray(setup.hand.torque_limits, dtype=float)
+
+    def rows(self, q=None, links=None) -> tuple[np.ndarray, np.ndarray]:
+        """J (4 rows a contact: f_x, f_y, f_n, m_n) and g(q) over the hand's joints, at q."""
+        pin, model, data = self.pin, self.model, self.data
+        q = self.q if q is None else q
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        g = pin.computeGeneralizedGravity(model, data, q)[self.idx_v]
+        out = []
+        for link, local, normal in self.contacts:
+            if links is not None and link not in links:
+                continue
+            fid = model.getFrameId(link)
+            oMf = data.oMf[fid]
+            p = oMf.act(local)
+            J = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:, self.idx_v]
+            Jp = J[:3] - pin.skew(p - oMf.translation) @ J[3:]
+            n = self.origin - p if normal is None else normal.copy()
+            n /= np.linalg.norm(n)
+            x = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+            x /= np.linalg.norm(x)
+            R = np.column_stack((x, np.cross(n, x), n))
+            out.append(np.vstack((R.T @ Jp, n @ J[3:])))
+        return np.vstack(out), g
+
+    def wrenches(self, cmd, compensated: bool, q=None, links=None):
+        """Give the contact wrenches, shape (p, 4), of a command at the truth; the residual."""
+        J, g = self.rows(q, links)
+        tau = np.asarray(cmd, dtype=float) - (g if compensated else 0.0)
+        f, *_ = np.linalg.lstsq(J.T, tau, rcond=None)
+        return f.reshape(-1, 4), float(np.abs(J.T @ f - tau).max())
+
+    def verdict(self, cmd, compensated: bool, q=None, links=None) -> str:
+        """
+        Say what a command is at the truth: 'ok', 'weak' (under f_min), or what forbids it.
+
+        Forbidden: not len(joints) finite values within the limits, 'pulling' (a normal
+        force below zero), 'outside the cone'.
+        """
+        cmd = np.asarray(cmd, dtype=float)
+        if cmd.shape != self.limits.shape or not np.all(np.isfinite(cmd)):
+            return 'malformed'
+        if np.any(np.abs(cmd) > self.limits):
+            return 'over a limit'
+        w, _ = self.wrenches(cmd, compensated, q, links)
+        if np.any(w[:, 2] < -self.tol):
+            return 'pulling'
+        if np.any(np.hypot(w[:, 0], w[:, 1]) / self.mu + np.abs(w[:, 3]) / self.mu_tors
+                  > w[:, 2] + self.tol):
+            return 'outside the cone'
+        return 'weak' if np.any(w[:, 2] < self.f_min - self.tol) else 'ok'

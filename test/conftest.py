@@ -77,10 +77,23 @@ def hyperstatic(planar_doc) -> GraspSetup:
 
 def pytest_terminal_summary(terminalreporter):
     """Print the adversarial campaign's counts (test_campaign*.py), even without -s."""
-    from campaign import COUNTS
+    from campaign import COUNTS, ISSUE33
 
     if COUNTS['inputs']:
         terminalreporter.write_line(
             f"campaign: {COUNTS['inputs']} inputs tried, {COUNTS['commands']} commands "
             f"published, {COUNTS['broken']} invariants broken; {COUNTS['pulling']} pulling, "
-            f"{COUNTS['chattering']} chattering, {COUNTS['late']} late commands")
+            f"{COUNTS['chattering']} chattering, {COUNTS['late']} late commands"
+            + (f"; {COUNTS['unseen']} forbidden from consistent lies no check can see"
+               if 'unseen' in COUNTS else ''))
+    for case, c in ISSUE33.items():
+        refused = ', '.join(f'{k} {v}' for k, v in c['refused'].items()) or 'none'
+        extra = ''.join(f'; {k} {c[k]}' for k in (
+            'joint states answered, still IMU then chatter', 'set changes', 'recovery steps')
+            if k in c)
+        terminalreporter.write_line(
+            f"issue 33: {case}: {c['inputs']} inputs, {c['published']} commands published, "
+            f"{c['received']} received, "
+            f"{c['forbidden']} forbidden {c['kinds'] or ''}"
+            f"{'' if c['seen'] else ' (unseen: a consistent lie)'}, {c['weak']} under "
+            f"f_min, {c['zero']} zero; refused: {refused}{extra}; last: {c['why'][:160]}")

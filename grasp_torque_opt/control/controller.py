@@ -249,10 +249,15 @@ class TorqueController:
         The rate rule (docs/node.md): the command moves along the straight line from the
         command in force towards the certified command, no joint by more than
         ``max_torque_rate`` times the time since the command in force, and never more than
-        that rate times ``command_period`` (a long gap gives no bigger step). From zero
-        torques with gravity compensation the step starts at g(q), added whole: its
-        contact wrenches are ``s`` times the certified ones. Across a change of the
-        contact set, a contact that left fades out and a new one fades in
+        that rate times ``command_period`` (a long gap gives no bigger step). With gravity
+        compensation the contact torques are stepped and g(q) of the joint state it
+        answers is taken whole: from zero torques the step starts at g(q), its contact
+        wrenches ``s`` times the certified ones; from a command whose g(q) was another
+        configuration's (or gravity's), that g is replaced by today's, else a step would
+        carry ``(1 - s)`` times their difference into the contact wrenches; no joint
+        moves more than the rate allows, so a g(q) that changed by more than that (the
+        first gravity message, one after the IMU went stale) is blended as before.
+        Across a change of the contact set, a contact that left fades out and a new one fades in
         (:func:`~.rates.step_wrenches`). The step's contact wrenches must lie in the exact
         cone, finite, with the step within the torque limits: else, or when they are not
         known, the certified command is published whole (``slew_refused``).
@@ -261,11 +266,17 @@ class TorqueController:
         if policy.in_force is None or policy.in_force_time is None:
             return
         gap = min(max(now - policy.in_force_time, 0.0), config.command_period)
-        known, start = policy.in_force_wrenches, policy.in_force
-        if known is not None and known.size == 0 and result.gravity_torque is not None:
-            start = result.gravity_torque  # zero torques: g(q) whole, the wrenches stepped
+        known, start, shift = policy.in_force_wrenches, policy.in_force, None
+        g, g_in_force = result.gravity_torque, policy.in_force_gravity
+        if known is not None and known.size == 0 and g is not None:
+            start = g  # zero torques: g(q) whole, the wrenches stepped
+        elif g is not None and g_in_force is not None and g_in_force.shape == start.shape:
+            shift = g - g_in_force  # the contact torques in force under today's g(q)
+        most = config.max_torque_rate * gap
+        if shift is not None and float(np.abs(shift).max()) > most:
+            shift = None  # g(q) moved more than a step: the whole commands are blended
         limits = self.setup.hand.torque_limits
-        step = slewed(start, result.command, config.max_torque_rate * gap, limits)
+        step = slewed(start, result.command, most, limits, shift)
         if step is None:
             return
         cmd, s = step

@@ -95,6 +95,9 @@ class FaultPolicy:
         #: The links of those wrenches' contacts (None: not known): a step combines the
         #: wrenches link by link (rates.step_wrenches).
         self.in_force_links: tuple[str, ...] | None = None
+        #: The gravity torque g(q) in the command in force (None: none, or zero torques):
+        #: a step re-bases it on the current one (the rate rule steps the contact torques).
+        self.in_force_gravity: np.ndarray | None = None
         #: The last result, certified or not.
         self.last: CycleResult | None = None
 
@@ -110,6 +113,7 @@ class FaultPolicy:
         self.in_force_links = (tuple(result.maps.links) if result.maps is not None else ()
                                if self.in_force_wrenches is not None
                                and self.in_force_wrenches.size == 0 else None)  # no contacts
+        self.in_force_gravity = result.gravity_torque
         if result.faded is not None and self.in_force_wrenches is not None \
                 and self.in_force_links is not None:
             # A step across a set change: the contacts fading out are in force too.
@@ -175,4 +179,5 @@ class FaultPolicy:
         self.counters.zero_commands += 1
         self.in_force = cmd
         self.in_force_wrenches = NO_WRENCH
+        self.in_force_gravity = None
         return CycleResult(cmd, 'zero', sol, maps, g, reason)

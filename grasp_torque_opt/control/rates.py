@@ -68,7 +68,8 @@ def turned_towards(old: np.ndarray, new: np.ndarray, step: float) -> np.ndarray:
 
 
 def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
-           limits: np.ndarray) -> tuple[np.ndarray, float] | None:
+           limits: np.ndarray, shift: np.ndarray | None = None
+           ) -> tuple[np.ndarray, float] | None:
     """
     Return the command that moves from ``in_force`` towards ``target`` by at most ``step``.
 
@@ -82,6 +83,11 @@ def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
         target: the certified command [N m], shape (m,).
         step: the largest change of any joint's torque [N m].
         limits: the torque limits [N m], shape (m,).
+        shift: the change of g(q) since ``in_force`` [N m], at most ``step`` a joint,
+            added whole (None: none). The step then starts at ``in_force + shift`` (the
+            contact torques in force under today's g(q)) and goes towards ``target`` by
+            the largest ``s`` with no joint moving from ``in_force`` by more than
+            ``step``.
 
     Returns:
         The step and its fraction ``s`` in [0, 1), or None when ``target`` is within
@@ -90,12 +96,32 @@ def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
     """
     if in_force.shape != target.shape or not (np.abs(in_force) <= limits).all():
         return None
+    if shift is not None:
+        return _shifted(in_force + shift, shift, target, step, limits)
     delta = target - in_force
     largest = float(np.abs(delta).max()) if delta.size else 0.0
     if largest <= step:
         return None
     s = max(step, 0.0) / largest
     return in_force + s * delta, s
+
+
+def _shifted(start: np.ndarray, shift: np.ndarray, target: np.ndarray, step: float,
+             limits: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """:func:`slewed` from ``start`` (``in_force + shift``): |shift + s delta| <= step."""
+    if not (np.abs(start) <= limits).all():
+        return None
+    delta = target - start
+    bound = np.maximum(max(step, 0.0), np.abs(shift))  # (|shift| <= step: the caller's)
+    moving = delta != 0.0
+    if not moving.any():
+        return None
+    # Per joint the largest s with |shift + s delta| <= bound (0 is always within).
+    ends = (np.sign(delta[moving]) * bound[moving] - shift[moving]) / delta[moving]
+    s = float(min(ends.min(), 1.0))
+    if s >= 1.0:
+        return None
+    return start + s * delta, max(s, 0.0)
 
 
 def step_wrenches(in_force: np.ndarray | None, in_links: tuple[str, ...] | None,

@@ -16,12 +16,16 @@ are that combination of theirs: inside the exact cone, never pulling.
 """
 
 import dataclasses
+from pathlib import Path
 
+from campaign import TrueGrasp
+from conftest import ALLEGRO_URDF
 from cycle_inputs import base_poses, fresh, joint_state, tilted
 from grasp_torque_opt.control.inputs.contacts import ContactsReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.rates import slewed, step_wrenches
 from grasp_torque_opt.core.friction import cone_margin
+from grasp_torque_opt.core.hand import resolve_urdf
 import numpy as np
 import pinocchio as pin
 
@@ -205,3 +209,38 @@ def test_a_recovery_from_zeros_steps_the_contact_wrenches_with_gravity_whole(all
         steps += 1
         assert 0.0 < s < 1.0
     assert steps >= 3
+
+
+def test_a_step_takes_the_gravity_torque_of_the_joint_state_it_answers(allegro):
+    # Issue 33's campaign (part 3): a finger leaving and touching at 1 kHz, with gravity
+    # compensation. A step blended the whole commands, so it carried (1 - s) of the
+    # gravity torque of the joint state before, (1 - s)(g(q_before) - g(q)): at q the
+    # finger fading in pushed with that on top of s times its certified wrench (the
+    # middle finger lifted by 0.1 rad and back: 100 of 200 commands outside the exact
+    # cone at q before the fix). Each command is judged at the joint state it answers,
+    # apart from the package's maps (campaign.TrueGrasp): there the lifted finger is
+    # free, the others hold the ball.
+    gravity = (9.81, 0.0, 0.0)
+    ctrl = fresh(allegro, max_torque_rate=20.0, gravity_compensation=True, gravity=gravity)
+    urdf = resolve_urdf(ALLEGRO_URDF, Path('.'))
+    q_lift = lifted(allegro)
+    links = [c.link for c in allegro.contacts]
+    keep = [i for i in range(4) if i != LIFT]
+    states = []
+    for q, idx in ((q_lift, keep), (allegro.q, list(range(4)))):  # lifted first
+        points, quat = base_poses(allegro, q)
+        reading = ContactsReading(';' + ','.join(links[i] for i in idx), points[idx], quat[idx])
+        truth = TrueGrasp(dataclasses.replace(allegro, q=q), urdf, gravity,
+                          contacts=[allegro.contacts[i] for i in idx])
+        states.append((JointStateReading(*joint_state(allegro, q)), reading, truth))
+    verdicts, steps = [], 0
+    for k in range(200):
+        js, reading, truth = states[k % 2]
+        ctrl.take('contacts', reading, 1e-3 * k)
+        ctrl.take('joint_states', js, 1e-3 * k)
+        result = ctrl.cycle(1e-3 * k)
+        assert result.kind == 'solution'
+        steps += result.wrenches is not None
+        verdicts.append(truth.verdict(result.command, True))
+    assert steps > 100 and ctrl.counters.slew_refused == 0
+    assert set(verdicts) <= {'ok', 'weak'}, {v: verdicts.count(v) for v in set(verdicts)}
