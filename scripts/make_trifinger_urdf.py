@@ -25,7 +25,9 @@ visuals dropped (the package draws none), effort limits 0.36 N m (the motors' ma
 torque that trifinger_simulation uses, in place of the URDF's placeholder 1000), and a
 collision sphere of radius 0.0095 m at each ``finger_tip_link`` (the tip of
 lower_link.stl is a hemisphere of that radius about that frame: its vertices there lie
-0.0094-0.0095 m from it), which the simulation and the contact checks use.
+0.0094-0.0095 m from it), which the simulation and the contact checks use; the lower
+link's izz, 0 in the source (MuJoCo refuses an inertia with a zero eigenvalue), set to
+1.5e-6 kg m^2 (its 0.0307 kg as a tube of 1 cm radius about its own axis, m r^2 / 2).
 """
 
 from __future__ import annotations
@@ -47,6 +49,8 @@ ANGLES = (0, 120, 240)
 TORQUE = 0.36
 #: Radius of the tip's collision sphere [m] (lower_link.stl's hemispherical tip).
 TIP_RADIUS = 0.0095
+#: The lower link's inertia about its axis [kg m^2] (0 in the source).
+LOWER_IZZ = 1.5e-6
 LINKS = ('finger_base_link', 'finger_upper_link', 'finger_middle_link', 'finger_lower_link',
          'finger_tip_link')
 
@@ -55,7 +59,8 @@ HEADER = f"""<?xml version="1.0"?>
      example-robot-data's {SOURCE}, laid out as the TriFingerEdu of
      open-dynamic-robot-initiative/robot_properties_fingers (xacro/edu/trifingeredu.urdf.xacro).
      Changes from the source: visuals dropped, effort limits {TORQUE} N m, a collision sphere
-     of radius {TIP_RADIUS} m at each finger_tip_link. Do not edit: regenerate. -->
+     of radius {TIP_RADIUS} m at each finger_tip_link, the lower links' izz {LOWER_IZZ} (was 0).
+     Do not edit: regenerate. -->
 """
 
 
@@ -68,6 +73,8 @@ def finger(source: ET.Element, suffix: str) -> list[ET.Element]:
             for visual in link.findall('visual'):
                 link.remove(visual)
             link.set('name', el.get('name') + suffix)
+            if el.get('name') == 'finger_lower_link':
+                link.find('inertial/inertia').set('izz', str(LOWER_IZZ))
             if el.get('name') == 'finger_tip_link':
                 collision = ET.SubElement(link, 'collision')
                 ET.SubElement(collision, 'origin', xyz='0 0 0', rpy='0 0 0')
