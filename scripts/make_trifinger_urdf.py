@@ -100,7 +100,7 @@ def mount(angle: int) -> ET.Element:
     ET.SubElement(joint, 'parent', link='trifinger_base_link')
     ET.SubElement(joint, 'child', link=f'finger_base_link_{angle}')
     x, y = -RADIUS * math.cos(-a), -RADIUS * math.sin(-a)
-    ET.SubElement(joint, 'origin', xyz=f'{x:.6f} {y:.6f} 0', rpy=f'0 0 {-a:.12f}')
+    ET.SubElement(joint, 'origin', xyz=f'{x:.9f} {y:.9f} 0', rpy=f'0 0 {-a:.12f}')
     return joint
 
 
