@@ -82,7 +82,7 @@ def test_the_contacts_lie_on_the_tip_spheres_and_the_cube_faces(scenario):
 
 
 def sum_of_squares_minimum(setup, maps):
-    """min ||J^T f||^2 over the planned polygon cones and limits, by SciPy's SLSQP."""
+    """Return min ||J^T f||^2 over the planned polygon cones and limits, by SciPy's SLSQP."""
     S, b, lim, off = _f_space(setup, maps)
     JT = maps.J.T
     f0 = np.tile([0.0, 0.0, 1.0, 0.0], maps.p)
