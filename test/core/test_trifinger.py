@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
+import yaml
 
 TRIFINGER = CONFIG / 'trifinger.yaml'
 TIP_RADIUS = 0.0095   # m, the tip of finger_edu's lower_link.stl (scripts/make_trifinger_urdf.py)
@@ -109,3 +110,13 @@ def test_the_grasp_is_certified_optimal_with_a_useful_capacity(scenario):
     # The cube's weight twice over (a 1 g shake along z) within the planned cones and limits.
     alpha, _ = lp_capacity(setup, maps, setup.external_wrench)
     assert alpha > 2.0, alpha
+
+
+def test_the_node_and_controllers_files_match_the_scenario(scenario):
+    params = yaml.safe_load((CONFIG / 'trifinger_node.yaml').read_text())['/**']
+    params = params['ros__parameters']
+    assert (CONFIG / params['scenario']).resolve() == TRIFINGER.resolve()
+    assert params['gravity_compensation'] is True and params['imu']['enabled'] is False
+    assert params['torque_limits'] == [0.36] * 9
+    controllers = yaml.safe_load((CONFIG / 'trifinger_controllers.yaml').read_text())
+    assert controllers['effort_controller']['ros__parameters']['joints'] == scenario.joints
