@@ -99,8 +99,6 @@ class SimDriver:
         self.values: np.ndarray | None = None
         self.position: np.ndarray | None = None
         self.velocity: np.ndarray | None = None
-        #: Commands whose current exceeded the limit (clipped, as a real driver does).
-        self.clipped = 0
 
     def receive(self, values: np.ndarray, position: np.ndarray | None = None,
                 velocity: np.ndarray | None = None) -> None:
@@ -109,9 +107,6 @@ class SimDriver:
         if self.settings.kind == 'hybrid':
             self.position = np.asarray(position, dtype=float)
             self.velocity = np.asarray(velocity, dtype=float)
-        if self.settings.kind == 'current' and np.any(
-                np.abs(self.values) > self.settings.current_limit):
-            self.clipped += 1
 
     def torque(self, q: np.ndarray) -> np.ndarray:
         """
