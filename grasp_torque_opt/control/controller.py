@@ -236,6 +236,11 @@ class TorqueController:
                                     result.solution, result.maps, result.gravity_torque)
         if result.kind == 'solution':
             self._slew(result, now)
+            why = policy.converted(result)
+            if why:  # the command interface refuses it: a fault, never a clip
+                result = policy.faulted(now, why, result.solution, result.maps,
+                                        result.gravity_torque)
+        if result.kind == 'solution':
             fallback = self.fallback
             policy.committed(result, now, fallback is not None
                              and result.solution.backend == fallback.name)

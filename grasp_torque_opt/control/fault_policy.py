@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from grasp_torque_opt.control.commands.base import Command, CommandInterface
+from grasp_torque_opt.control.commands.registry import make_interface
 from grasp_torque_opt.control.inputs.store import Counters
 from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -53,6 +55,8 @@ class CycleResult:
         faded: for a step across a change of the contact set, the links of the command
             in force that are not in ``maps`` and their fading wrenches, shape (k, 4)
             (None: none).
+        output: ``command`` in the driver's units, as the ``command_interface`` publishes
+            it (None: nothing to publish; docs/node.md, Command interfaces).
     """
 
     command: np.ndarray | None
@@ -65,6 +69,7 @@ class CycleResult:
     wrenches: np.ndarray | None = None
     q: np.ndarray | None = None
     faded: tuple[tuple[str, ...], np.ndarray] | None = None
+    output: Command | None = None
 
 
 class FaultPolicy:
@@ -100,6 +105,21 @@ class FaultPolicy:
         self.in_force_gravity: np.ndarray | None = None
         #: The last result, certified or not.
         self.last: CycleResult | None = None
+        #: The command interface (``command_interface``): the command in the driver's units.
+        self.interface: CommandInterface = make_interface(config, setup.hand)
+
+    def converted(self, result: CycleResult) -> str:
+        """
+        Put a certified command in the driver's units (``result.output``).
+
+        Returns:
+            Why it cannot be ('' if it is): a fault, as a failed gate is (a current over
+            its limit, a servo's torque over the torque limits).
+        """
+        hand = self.setup.hand
+        result.output, why = self.interface.command(result.command, result.q[hand.idx_q],
+                                                    hand.torque_limits)
+        return why
 
     def committed(self, result: CycleResult, now: float, from_fallback: bool) -> None:
         """Take a certified command for publishing: it is in force, a fault is over."""
@@ -180,4 +200,4 @@ class FaultPolicy:
         self.in_force = cmd
         self.in_force_wrenches = NO_WRENCH
         self.in_force_gravity = None
-        return CycleResult(cmd, 'zero', sol, maps, g, reason)
+        return CycleResult(cmd, 'zero', sol, maps, g, reason, output=self.interface.zero())

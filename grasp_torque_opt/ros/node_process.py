@@ -57,9 +57,13 @@ def scenario_of(params: Path) -> str:
 
 
 @contextlib.contextmanager
-def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]:
+def node_process(params: Path, start: bool, arguments: tuple[str, ...] = ()
+                 ) -> Iterator[subprocess.Popen | None]:
     """
     ``grasp_torque_node`` on ``params`` in a child process while the block runs (if ``start``).
+
+    ``arguments``: more ``--ros-args`` after the params file (``-p NAME:=VALUE``: the
+    simulated driver's command interface).
 
     It is stopped with SIGINT (its safe stop: zero torques with the zero policy),
     killed if it has not ended after 10 s.
@@ -67,7 +71,7 @@ def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]
     child = None
     if start:
         child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
-                                  '--ros-args', '--params-file', str(params),
+                                  '--ros-args', '--params-file', str(params), *arguments,
                                   '--log-level', 'error'], stderr=subprocess.PIPE,
                                  text=True, errors='replace')
         child.last_lines = collections.deque(maxlen=KEPT_LINES)

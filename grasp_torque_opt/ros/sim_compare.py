@@ -31,7 +31,8 @@ from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                     margin: float = 0.0, efforts: bool | None = None,
-                    imu_rate: float | None = None, imu_latency: float = 0.0):
+                    imu_rate: float | None = None, imu_latency: float = 0.0,
+                    commands: dict | None = None):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -44,13 +45,16 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     ``margin``: the friction margin k. ``imu_rate`` [Hz] (None: at every joint state)
     and ``imu_latency`` [s]: the IMU sampled at that rate and delivered that late (the
     readings are kept at every physics step asked, the one of ``imu_latency`` ago given).
+    ``commands``: the command interface's CycleConfig fields (``command_interface``,
+    ``position_stiffness``, ...; None: effort); the cycle's result, its ``output`` in the
+    driver's units, is ``command.controller.last``.
     """
     efforts = inputs if efforts is None else efforts
     setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
                                                                     margin=margin))
     config = CycleConfig(gravity_compensation=True,
                          gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=efforts)
+                         cycle_budget=1.0, effort_estimation=efforts, **(commands or {}))
     ctrl = TorqueController(setup, config, fallback='daqp')
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)

@@ -36,6 +36,7 @@ import sys
 import time
 
 from grasp_torque_opt.core.command_line import EXIT_INTERRUPTED
+from grasp_torque_opt.ros import sim_commands
 from grasp_torque_opt.ros.node_process import (
     isolate, node_process, scenario_of, startup_failure)
 from grasp_torque_opt.ros.sim_options import check, describe, parser, PROG, rig_settings
@@ -65,6 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     from grasp_torque_opt.core.exceptions import InputError
     from grasp_torque_opt.core.resources import find_config
     from grasp_torque_opt.core.scenario import load_scenario
+    from grasp_torque_opt.sim.drivers import attach
     from grasp_torque_opt.sim.episode import simulated
     from grasp_torque_opt.sim.model import SimSettings
 
@@ -78,11 +80,15 @@ def main(argv: list[str] | None = None) -> int:
         setup, rig = simulated(scenario, rig_settings(args), sim=SimSettings(
             mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional))
         baseline = _baseline(args, scenario, setup)
+        driver = sim_commands.settings(args)
+        if driver.kind != 'effort':  # the effort driver is the rig itself
+            attach(rig, driver)
     except (InputError, ValueError) as e:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
-        with node_process(params, args.with_node) as child:
+        with node_process(params, args.with_node,
+                          tuple(sim_commands.node_arguments(driver))) as child:
             return _run(args, scenario, setup, rig, baseline, child)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
@@ -150,8 +156,8 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline, child=None) 
     m = len(link.names)
     disturbed = describe(args)
     print(f'{PROG}: {Path(scenario.source).name} in MuJoCo {_mujoco_version()}, {m} joints, '
-          f'1 kHz physics, joint states at {args.rate:g} Hz, impedance Kp {args.kp:g} N m/rad '
-          f'Kd {args.kd:g} N m s/rad, controller {args.controller}'
+          f'1 kHz physics, joint states at {args.rate:g} Hz, '
+          f'{sim_commands.describe(sim_commands.settings(args))}, controller {args.controller}'
           + (f'; {disturbed}' if disturbed else ''), flush=True)
     deadline = time.monotonic() + args.wait
     while baseline is None and link.js_pub.get_subscription_count() == 0 and \
@@ -212,7 +218,6 @@ class _Link:
         import rclpy
         from rclpy.qos import qos_profile_sensor_data
         from sensor_msgs.msg import Imu, JointState
-        from std_msgs.msg import Float64MultiArray
         from std_srvs.srv import Trigger
 
         self.args, self.setup, self.hsim, self.baseline = args, setup, hsim, baseline
@@ -226,15 +231,16 @@ class _Link:
         self.solve = node.create_client(Trigger, f'{NODE_NAME}/solve', qos_profile=SERVICE_QOS)
         self.state = {'command': None, 'commands': 0, 'malformed': 0, 'predicted': None,
                       'pending': None}
-        node.create_subscription(Float64MultiArray, 'effort_commands', self.on_command,
-                                 COMMAND_QOS)
+        kind, topic = sim_commands.subscription(args.driver)
+        node.create_subscription(kind, topic, self.on_command, COMMAND_QOS)
 
     def on_command(self, msg) -> None:
-        cmd = np.array(msg.data, dtype=float)
-        if cmd.shape != (len(self.names),) or not np.all(np.isfinite(cmd)):
+        cmd = sim_commands.command_of(msg, len(self.names))
+        if cmd is None:
             self.state['malformed'] += 1
             return
-        self.state['command'] = cmd
+        # The effort driver is the rig (the torque is its command); the others, a model.
+        self.state['command'] = cmd[0] if self.hsim.driver is None else cmd
         self.state['commands'] += 1
 
     def close(self, code: int) -> int:
@@ -292,7 +298,10 @@ class _Link:
         next_pub, next_second = t0_wall, t0_wall + 1.0
         while (now := time.monotonic()) < t0_wall + seconds:
             if state['command'] is not None:
-                hsim.command = state['command']
+                if hsim.driver is None:
+                    hsim.command = state['command']
+                else:
+                    hsim.driver.receive(*state['command'])
                 hsim.hold_joints = False
             behind = round((now - t0_wall - (hsim.time - t0_sim)) / dt)
             if behind > 0:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 
 from grasp_torque_opt.core.command_line import add_version, HelpFormatter
+from grasp_torque_opt.ros import sim_commands
 import numpy as np
 
 PROG = 'grasp-torque-sim'
@@ -77,6 +78,7 @@ def parser(description: str) -> argparse.ArgumentParser:
     c.add_argument('--squeeze-depth', type=float, default=5.0,
                    help='impedance: how far inside the object the contacts are commanded '
                         '[mm]')
+    sim_commands.add_arguments(p)
     p.add_argument('--picture', default='grasp_sim.png',
                    help='PNG of the grasp written at the end, in the current folder unless a '
                         'path')
@@ -154,6 +156,9 @@ def check(args: argparse.Namespace) -> str:
         args.base_shake = shake
     if args.with_node and args.controller != 'node':
         return f'--with-node: only with --controller node (got {args.controller})'
+    driver = sim_commands.check(args)
+    if driver:
+        return driver
     if (args.plan is None) != (args.scores is None):
         return '--plan and --scores: give both (the plan and its scores) or neither'
     if args.plan is not None and (args.with_node or args.controller != 'node'):

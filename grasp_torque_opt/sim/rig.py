@@ -94,6 +94,10 @@ class RigSim(HandSim):
         self._square_sum, self._count = 0.0, 0
         #: Force on the object's centre after release, base axes [N].
         self.object_force = np.zeros(3)
+        #: The driver model that makes the joint torque from its last command at each
+        #: step's reading (:mod:`~grasp_torque_opt.sim.drivers`); None: ``command`` is the
+        #: torque (an effort controller).
+        self.driver = None
 
     def _encoder(self) -> np.ndarray:
         noise = self.disturbances.joint_noise
@@ -112,6 +116,8 @@ class RigSim(HandSim):
             for _ in range(n):
                 self._apparent_gravity()
                 self.reading = self._encoder()
+                if self.driver is not None:
+                    command = self.driver.torque(self.reading)
                 # Kp (q_ref - reading) = Kp (q_ref - q) - Kp noise: the noise goes in the command.
                 self.command = command - self.kp * (self.reading - self.q)
                 applied = command + self.kp * (self.q_ref - self.reading)

@@ -166,6 +166,31 @@ class CycleConfig:
             any answer it cannot certify, the Python cycle answers (diagnostics solver.compiled
             says which and why); false, the Python cycle always.
         certificate_tolerance: Tolerance of the certificate on every residual. [SI]
+        command_interface: What the node publishes, in its driver's units (docs/node.md, Command
+            interfaces): effort (joint torques [N m], std_msgs/Float64MultiArray on
+            effort_commands); position (q_hold + tau / position.stiffness [rad], Float64MultiArray
+            on position_commands); current (tau / (current.torque_constant current.gear_ratio) [A],
+            Float64MultiArray on current_commands); hybrid (sensor_msgs/JointState on
+            hybrid_commands: position q_hold, velocity 0, effort tau, for a driver's PD with
+            hybrid.kp and hybrid.kd). Every one certifies the same torque tau (+ g(q)).
+        position_stiffness: (``position.stiffness``) The position servo's stiffness K: the torque
+            it produces per radian of position error, one value for every joint or one per joint,
+            each > 0. Required by command_interface position. [N m/rad]
+        current_torque_constant: (``current.torque_constant``) The motor's torque constant k_t (at
+            the motor shaft), one value for every joint or one per joint, each > 0. Required by
+            command_interface current. [N m/A]
+        current_gear_ratio: (``current.gear_ratio``) Joint torque over motor torque (the gear ratio
+            times its efficiency), one value for every joint or one per joint, each > 0; [1.0] when
+            current.torque_constant is already the joint's.
+        current_limit: (``current.limit``) The driver's current limit, one value for every joint or
+            one per joint, each > 0: a command whose current would exceed it is a fault (not
+            published), not a clip. Required by command_interface current. [A]
+        hybrid_kp: (``hybrid.kp``) The driver's PD stiffness around the commanded position q_hold,
+            one value for every joint or one per joint, each > 0 (the driver must use the same).
+            Required by command_interface hybrid. [N m/rad]
+        hybrid_kd: (``hybrid.kd``) The driver's PD damping towards the commanded velocity 0, one
+            value for every joint or one per joint, each >= 0 (the driver must use the same).
+            Required by command_interface hybrid. [N m s/rad]
     """
 
     gravity_compensation: bool = False
@@ -212,6 +237,13 @@ class CycleConfig:
     method: str = 'tau-qp'
     compiled: bool = True
     certificate_tolerance: float = 1e-06
+    command_interface: str = 'effort'
+    position_stiffness: tuple = None
+    current_torque_constant: tuple = None
+    current_gear_ratio: tuple = (1.0,)
+    current_limit: tuple = None
+    hybrid_kp: tuple = None
+    hybrid_kd: tuple = None
 
 
 @dataclass(frozen=True)
@@ -395,6 +427,59 @@ class ParamsSolver:
 
 
 @dataclass(frozen=True)
+class ParamsPosition:
+    """
+    The ``position.*`` parameters.
+
+    Attributes:
+        stiffness: The position servo's stiffness K: the torque it produces per radian of position
+            error, one value for every joint or one per joint, each > 0. Required by
+            command_interface position. [N m/rad]
+    """
+
+    stiffness: tuple | None
+
+
+@dataclass(frozen=True)
+class ParamsCurrent:
+    """
+    The ``current.*`` parameters.
+
+    Attributes:
+        torque_constant: The motor's torque constant k_t (at the motor shaft), one value for every
+            joint or one per joint, each > 0. Required by command_interface current. [N m/A]
+        gear_ratio: Joint torque over motor torque (the gear ratio times its efficiency), one value
+            for every joint or one per joint, each > 0; [1.0] when current.torque_constant is
+            already the joint's.
+        limit: The driver's current limit, one value for every joint or one per joint, each > 0: a
+            command whose current would exceed it is a fault (not published), not a clip. Required
+            by command_interface current. [A]
+    """
+
+    torque_constant: tuple | None
+    gear_ratio: tuple | None
+    limit: tuple | None
+
+
+@dataclass(frozen=True)
+class ParamsHybrid:
+    """
+    The ``hybrid.*`` parameters.
+
+    Attributes:
+        kp: The driver's PD stiffness around the commanded position q_hold, one value for every
+            joint or one per joint, each > 0 (the driver must use the same). Required by
+            command_interface hybrid. [N m/rad]
+        kd: The driver's PD damping towards the commanded velocity 0, one value for every joint or
+            one per joint, each >= 0 (the driver must use the same). Required by command_interface
+            hybrid. [N m s/rad]
+    """
+
+    kp: tuple | None
+    kd: tuple | None
+
+
+@dataclass(frozen=True)
 class Params:
     """
     The frozen snapshot of every parameter, one class per namespace.
@@ -521,6 +606,16 @@ class Params:
         publish_stamped_command: Also publish each command on ~/effort_commands_stamped
             (sensor_msgs/JointState: joints, effort, and the stamp of the joint state it was
             computed from).
+        command_interface: What the node publishes, in its driver's units (docs/node.md, Command
+            interfaces): effort (joint torques [N m], std_msgs/Float64MultiArray on
+            effort_commands); position (q_hold + tau / position.stiffness [rad], Float64MultiArray
+            on position_commands); current (tau / (current.torque_constant current.gear_ratio) [A],
+            Float64MultiArray on current_commands); hybrid (sensor_msgs/JointState on
+            hybrid_commands: position q_hold, velocity 0, effort tau, for a driver's PD with
+            hybrid.kp and hybrid.kd). Every one certifies the same torque tau (+ g(q)).
+        position: the ``position.*`` parameters.
+        current: the ``current.*`` parameters.
+        hybrid: the ``hybrid.*`` parameters.
     """
 
     scenario: str | None
@@ -576,6 +671,10 @@ class Params:
     thread_priority: int | None
     marker_scale: float | None
     publish_stamped_command: bool | None
+    command_interface: str | None
+    position: ParamsPosition
+    current: ParamsCurrent
+    hybrid: ParamsHybrid
 
 
 #: CycleConfig field -> the parameter that gives it.
@@ -624,4 +723,11 @@ CYCLE_FIELDS = {
     'method': 'solver.method',
     'compiled': 'solver.compiled',
     'certificate_tolerance': 'certificate_tolerance',
+    'command_interface': 'command_interface',
+    'position_stiffness': 'position.stiffness',
+    'current_torque_constant': 'current.torque_constant',
+    'current_gear_ratio': 'current.gear_ratio',
+    'current_limit': 'current.limit',
+    'hybrid_kp': 'hybrid.kp',
+    'hybrid_kd': 'hybrid.kd',
 }

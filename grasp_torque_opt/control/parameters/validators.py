@@ -26,6 +26,7 @@ import math
 from typing import Any
 
 from grasp_torque_opt.backends.registry import available, BACKENDS
+from grasp_torque_opt.control.commands.registry import COMMAND_INTERFACES
 from grasp_torque_opt.control.motion import tilt_radius, uncertainty_margin
 from grasp_torque_opt.control.parameters.limits import (
     MAX_GRAVITY,
@@ -89,7 +90,8 @@ def _element_bounds(name: str, value: Any, args: tuple, ctx: Context) -> str:
 #: Choices that belong to a registry: validator -> the registry's names. The loader
 #: makes an entry's ``one_of_backends: [[EXTRA, ...]]`` a ``one_of<>`` over the
 #: registry's names and then the extra ones (``solver.fallback``'s ``none``).
-REGISTRY_CHOICES: dict[str, tuple[str, ...]] = {'one_of_backends': BACKENDS}
+REGISTRY_CHOICES: dict[str, tuple[str, ...]] = {'one_of_backends': BACKENDS,
+                                                'one_of_command_interfaces': COMMAND_INTERFACES}
 
 #: generate_parameter_library's validators that this schema uses.
 BUILT_IN: dict[str, Callable[[str, Any, tuple, Context], str]] = {
@@ -155,6 +157,18 @@ def validate_within_urdf_limits(name: str, value: Any, ctx: Context) -> str:
     return ''
 
 
+def validate_one_or_per_joint(name: str, value: Any, ctx: Context) -> str:
+    """One entry for every joint, or one per joint (unset: nothing to check)."""
+    if not value or len(value) == 1 or ctx.m is None or len(value) == ctx.m:
+        return ''
+    return f'must have 1 entry (every joint) or {ctx.m} (one per joint), got {len(value)}'
+
+
+def validate_non_negative_entries(name: str, value: Any, ctx: Context) -> str:
+    """Every entry >= 0."""
+    return '' if all(v >= 0 for v in value) else 'every entry must be >= 0'
+
+
 def validate_weight_range(name: str, value: Any, ctx: Context) -> str:
     """Refuse a weight outside WEIGHT_RANGE, or a ratio above MAX_WEIGHT_RATIO."""
     if not value:
@@ -198,6 +212,8 @@ VALIDATORS: dict[str, Validator] = {
     'size_of_joints': validate_size_of_joints,
     'positive_entries': validate_positive_entries,
     'within_urdf_limits': validate_within_urdf_limits,
+    'one_or_per_joint': validate_one_or_per_joint,
+    'non_negative_entries': validate_non_negative_entries,
     'weight_range': validate_weight_range,
     'gravity_norm': validate_gravity_norm,
     'ordered_pair': validate_ordered_pair,

@@ -8,12 +8,17 @@
 
 
 """
-The node's outputs: effort commands, the stamped copy, and the RViz arrows.
+The node's outputs: the commands in the driver's units, the stamped copy, the RViz arrows.
 
 A command leaves only through :meth:`Outputs.publish`, which keeps the node's own
 promise whatever the controller decided: the right length, finite, within the
-limits. The managed node's command publishers are lifecycle publishers (silent
-unless active): the root's configuration says which kind to make.
+limits, and its message in the ``command_interface``'s units the same (right length,
+finite, of that interface). The publisher's topic and type are the interface's
+(:data:`~grasp_torque_opt.control.commands.registry.REGISTRY`): ``effort_commands``
+(std_msgs/Float64MultiArray, unchanged), ``position_commands`` and ``current_commands``
+(Float64MultiArray), ``hybrid_commands`` (sensor_msgs/JointState). The managed node's
+command publishers are lifecycle publishers (silent unless active): the root's
+configuration says which kind to make.
 """
 
 from __future__ import annotations
@@ -22,6 +27,8 @@ from array import array
 from typing import Any, TYPE_CHECKING
 
 from geometry_msgs.msg import Point, WrenchStamped
+from grasp_torque_opt.control.commands.base import Command
+from grasp_torque_opt.control.commands.registry import REGISTRY
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.ros.node.qos import COMMAND_QOS
@@ -51,9 +58,11 @@ class Outputs:
     def start(self) -> list[tuple[str, Any]]:
         """Make the publishers; give them as (kind, publisher) for :meth:`stop`."""
         node, peers = self.node, self.root.peers
-        self.command_pub = self._command_publisher(Float64MultiArray, 'effort_commands')
+        entry = REGISTRY[self.root.params.command_interface]
+        kind = JointState if entry.message == 'joint_state' else Float64MultiArray
+        self.command_pub = self._command_publisher(kind, entry.topic)
         made = [('command_publisher', self.command_pub)]
-        peers.watch(self.command_pub, Float64MultiArray)
+        peers.watch(self.command_pub, kind)
         self.stamped_pub = None
         if self.root.params.publish_stamped_command:
             self.stamped_pub = self._command_publisher(JointState, '~/effort_commands_stamped')
@@ -107,7 +116,15 @@ class Outputs:
             self.node.get_logger().error('refused to publish a malformed command')
             return
         data = array('d', cmd.tobytes())
-        self.command_pub.publish(Float64MultiArray(data=data))
+        out = result.output
+        if out is None and self.root.params.command_interface == 'effort':
+            out = Command('effort', cmd, cmd)  # a result made without its interface's output
+        if out is None or out.interface != self.root.params.command_interface or \
+                not out.well_formed(hand.m):
+            if out is not None:
+                self.node.get_logger().error('refused to publish a malformed command')
+            return
+        self._publish_output(out, data, stamp)
         if self.stamped_pub is not None:
             msg = JointState(name=list(hand.joints), effort=data)
             msg.header.stamp = stamp if stamp is not None else \
@@ -115,9 +132,26 @@ class Outputs:
             msg.header.frame_id = hand.base_frame
             self.stamped_pub.publish(msg)
 
-    def publish_zeros(self, m: int) -> None:
-        """Publish zero torques (the safe stop of ``fault_policy: zero``)."""
-        self.command_pub.publish(Float64MultiArray(data=[0.0] * m))
+    def _publish_output(self, out: Command, data: Any = None, stamp: Any = None) -> None:
+        """Publish a command in its interface's message (effort: ``data``, the torques)."""
+        if out.position is None:  # Float64MultiArray
+            values = data if out.interface == 'effort' and data is not None else \
+                array('d', np.ascontiguousarray(out.values, dtype=float).tobytes())
+            self.command_pub.publish(Float64MultiArray(data=values))
+            return
+        hand = self.root.controller.setup.hand
+        msg = JointState(name=list(hand.joints), position=out.position.tolist(),
+                         velocity=out.velocity.tolist(), effort=out.values.tolist())
+        msg.header.stamp = stamp if stamp is not None else self.node.get_clock().now().to_msg()
+        msg.header.frame_id = hand.base_frame
+        self.command_pub.publish(msg)
+
+    def publish_zeros(self, zero: Command | None) -> bool:
+        """Publish the interface's zero torque (the safe stop of ``fault_policy: zero``)."""
+        if zero is None:
+            return False
+        self._publish_output(zero)
+        return True
 
     def on_markers(self) -> None:
         """Publish the last solution's contact forces as arrows (none when it has none)."""

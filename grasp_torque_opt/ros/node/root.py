@@ -307,7 +307,8 @@ class GraspTorque:
                     ctrl.counters.commands == 0 or not self.node.context.ok():
                 return False
             m = ctrl.setup.hand.m
-            self.outputs.publish_zeros(m)
+            if not self.outputs.publish_zeros(ctrl.policy.interface.zero()):
+                return False  # position-like, before a reference was held: nothing to hold
             ctrl.in_force = np.zeros(m)  # what the effort controller holds
         self.outputs.command_pub.wait_for_all_acked(Duration(seconds=0.5))
         self.node.get_logger().info('stopped: zero torques published (fault_policy zero)')
