@@ -265,8 +265,8 @@ class TorqueController:
         normals = None
         if self.config.tactile_source == 'wrench' and result.q is not None:
             placement = placements_at(self.setup.hand, result.q)
-            normals = (lambda i: placement(maps.links[i]).rotation.T  # noqa: E731
-                       @ maps.rotations[i][:, 2])
+            normals = np.array([placement(link).rotation.T @ R[:, 2]
+                                for link, R in zip(maps.links, maps.rotations)])
         return tactile_report(w, maps.links, self.inputs.tactile, normals, now,
                               self.config, self.setup.friction.mu1)
 

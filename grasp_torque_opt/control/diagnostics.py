@@ -210,8 +210,8 @@ def tactile_values(c: TorqueController, now: float) -> tuple[list[tuple[str, str
     """
     Give the tactile input's values, and what it warns of ('' for nothing).
 
-    Per contact of the last certified command: the measured normal force and the measured
-    friction usage (:mod:`grasp_torque_opt.control.tactile`); the contacts lost (measured
+    Per contact of the last certified command, against the readings aged at ``now``: the
+    measured normal force and the measured friction usage (:mod:`grasp_torque_opt.control.tactile`); the contacts lost (measured
     below ``tactile.loss_ratio`` times planned) and those without a fresh reading.
     """
     cfg, inputs = c.config, c.inputs
@@ -222,6 +222,7 @@ def tactile_values(c: TorqueController, now: float) -> tuple[list[tuple[str, str
     if inputs.tactile is None or rep is None:
         state = 'none received' if inputs.tactile is None else 'no certified command yet'
         return [('tactile', state)] + values, f'tactile: {state}'
+    rep = rep.at(inputs.tactile, now, cfg, c.setup.friction.mu1)  # the readings' ages now
     for i, link in enumerate(rep.links):
         key = f'contact{i}.{link}'
         values += [(f'{key}.measured_normal_force_N', f'{rep.measured[i]:.4f}'),
@@ -233,9 +234,9 @@ def tactile_values(c: TorqueController, now: float) -> tuple[list[tuple[str, str
     values += [('tactile.lost', ', '.join(lost) or 'none'),
                ('tactile.stale', ', '.join(stale) or 'none')]
     said = '; '.join(([f'contact lost: {", ".join(lost)}'] if lost else [])
-                     + ([f'tactile stale: {", ".join(stale)}'] if stale else []))
+                     + ([f'stale: {", ".join(stale)}'] if stale else []))
     values.insert(0, ('tactile', said or 'in use'))
-    return values, f'tactile: {said}' if said else ''
+    return values, f'tactile {said}' if said else ''
 
 
 def _vector(v) -> str:

@@ -30,7 +30,7 @@ squeeze following friction can take as its measurement.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,7 +51,15 @@ class TactileReport:
         lost: indices of the contacts measured below ``loss_ratio`` times planned.
         stale: indices of the contacts without a fresh reading.
         pulling: indices whose wrench form reads a normal force below the tolerance.
+        wrenches: the command's contact wrenches compared, shape (p, 4) (to compare again
+            later, :meth:`at`).
+        normals: the contacts' inward normals in their links' axes, shape (p, 3), or None.
     """
+
+    def at(self, readings: Mapping | None, now: float, config, mu1: float) -> TactileReport:
+        """Compare the same command with the readings at ``now`` (their ages then)."""
+        return tactile_report(self.wrenches, self.links, readings, self.normals, now,
+                              config, mu1)
 
     links: tuple[str, ...]
     planned: np.ndarray
@@ -60,6 +68,8 @@ class TactileReport:
     lost: tuple[int, ...]
     stale: tuple[int, ...]
     pulling: tuple[int, ...] = ()
+    wrenches: np.ndarray | None = None
+    normals: np.ndarray | None = None
 
 
 def measured_usage(tangential: np.ndarray, measured: np.ndarray, mu1: float) -> np.ndarray:
@@ -91,8 +101,8 @@ def lost_contacts(planned: np.ndarray, measured: np.ndarray, ratio: float) -> tu
 
 
 def tactile_report(wrenches: np.ndarray, links: Sequence[str], readings: Mapping | None,
-                   normal_in_link: Callable[[int], np.ndarray] | None, now: float,
-                   config, mu1: float) -> TactileReport:
+                   normals: np.ndarray | None, now: float, config, mu1: float
+                   ) -> TactileReport:
     """
     Compare a command's contact wrenches with the tactile readings.
 
@@ -101,8 +111,8 @@ def tactile_report(wrenches: np.ndarray, links: Sequence[str], readings: Mapping
         links: the contacts' links, shape (p,).
         readings: link -> :class:`~grasp_torque_opt.control.inputs.tactile.Touch` (None:
             none received).
-        normal_in_link: contact i's inward normal in its link's axes (the wrench form's
-            force is projected on it); None: only array readings are read.
+        normals: the contacts' inward normals in their links' axes, shape (p, 3) (the
+            wrench form's force is projected on them); None: only array readings are read.
         now: the time the readings are aged at (monotonic) [s].
         config: ``tactile_timeout``, ``tactile_loss_ratio``, ``tactile_negative_tolerance``.
         mu1: tangential friction [-].
@@ -118,10 +128,10 @@ def tactile_report(wrenches: np.ndarray, links: Sequence[str], readings: Mapping
         if touch.normal is not None:
             measured[i] = touch.normal
             continue
-        if normal_in_link is None:
+        if normals is None:
             stale.append(i)
             continue
-        value = float(np.asarray(touch.force) @ normal_in_link(i))
+        value = float(np.asarray(touch.force) @ normals[i])
         if value < -config.tactile_negative_tolerance:
             pulling.append(i)
             continue
@@ -130,4 +140,4 @@ def tactile_report(wrenches: np.ndarray, links: Sequence[str], readings: Mapping
     usage = measured_usage(np.hypot(w[:, 0], w[:, 1]), measured, mu1)
     return TactileReport(tuple(links), planned, measured, usage,
                          lost_contacts(planned, measured, config.tactile_loss_ratio),
-                         tuple(stale), tuple(pulling))
+                         tuple(stale), tuple(pulling), w, normals)

@@ -79,6 +79,11 @@ class TactileWrenchReading:
     torque: Any
 
 
+def mapped_links(config) -> tuple[str, ...]:
+    """Return ``tactile.links`` as given ('' entries included; unset: none)."""
+    return tuple(config.tactile_links or ())
+
+
 def _link_known(store, field: str, link: str) -> None:
     """Refuse a link that is not a frame of the hand's model (an unknown link)."""
     if not store.setup.hand.model.existFrame(link):
@@ -131,7 +136,7 @@ class _TactileBase:
         if config.tactile_source != self.form or not config.tactile_required:
             return ''
         got = inputs.tactile or {}
-        links = [x for x in config.tactile_links if x] or list(got)
+        links = [x for x in mapped_links(config) if x] or list(got)
         if not links:
             return f'{self.name} stale (none received; tactile.required)'
         for link in links:
@@ -153,7 +158,7 @@ class TactileArray(_TactileBase):
 
     def size(self, store, n: int, frame_id: str = '') -> None:
         """Refuse an array whose length is not tactile.links', unread."""
-        k = len(store.config.tactile_links)
+        k = len(mapped_links(store.config))
         if n != k:
             raise InputError('tactile.data', f'has {n} entries, tactile.links maps {k}')
 
@@ -169,10 +174,10 @@ class TactileArray(_TactileBase):
         c = store.config
         data = np.asarray(reading.data, dtype=float).ravel()
         self.size(store, data.size)
-        if not any(c.tactile_links):
+        if not any(mapped_links(c)):
             raise InputError('tactile.links', 'maps no entry to a link')
         out = {}
-        for i, (link, raw) in enumerate(zip(c.tactile_links, data)):
+        for i, (link, raw) in enumerate(zip(mapped_links(c), data)):
             value = _newtons(f'tactile.data[{i}]', float(raw) * c.tactile_scale, c)
             if link:
                 _link_known(store, f'tactile.links[{i}]', link)
@@ -200,7 +205,7 @@ class TactileWrench(_TactileBase):
         if not link:
             raise InputError(field, 'is empty: name the link the sensor is on')
         _link_known(store, field, link)
-        mapped = [x for x in c.tactile_links if x]
+        mapped = [x for x in mapped_links(c) if x]
         if mapped and link not in mapped:
             raise InputError(field, f"'{link[:64]}' is not in tactile.links (unmapped)")
         force = np.asarray(reading.force, dtype=float)

@@ -229,7 +229,7 @@ class CycleConfig:
     effort_mass_only: bool = True
     effort_max_load_ratio: float = 0.5
     tactile_source: str = 'none'
-    tactile_links: tuple = ()
+    tactile_links: tuple = None
     tactile_scale: float = 1.0
     tactile_timeout: float = 0.1
     tactile_required: bool = False

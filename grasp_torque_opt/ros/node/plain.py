@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import Any
 
 from grasp_torque_opt.control.controller import TorqueController
-from grasp_torque_opt.ros.node.parameters import PARAMETERS
+from grasp_torque_opt.ros.node.parameters import PARAMETERS, UNSET_PARAMETERS
 from grasp_torque_opt.ros.node.qos import NODE_NAME
 from grasp_torque_opt.ros.node.root import GraspTorque
 from grasp_torque_opt.ros.node.signals import stop_requested
@@ -58,10 +58,12 @@ class GraspTorqueNode(Node):
             grasp = root.rebind(list(joints))
             scenario = {k: v for k, v in root.defaults(grasp).items() if k != 'joints'}
         for name in PARAMETERS:
+            if self.has_parameter(name):
+                continue
             if name in scenario or name in defaults:
-                if self.has_parameter(name):
-                    continue
                 declared.declare(name, scenario[name] if name in scenario else defaults[name])
+            elif name in UNSET_PARAMETERS:  # a list that may stay empty (tactile.links)
+                declared.declare(name)
         root.build(grasp)
         declared.watch(root.apply)
         root.start_interfaces()
