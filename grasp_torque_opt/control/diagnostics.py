@@ -211,8 +211,9 @@ def tactile_values(c: TorqueController, now: float) -> tuple[list[tuple[str, str
     Give the tactile input's values, and what it warns of ('' for nothing).
 
     Per contact of the last certified command, against the readings aged at ``now``: the
-    measured normal force and the measured friction usage (:mod:`grasp_torque_opt.control.tactile`); the contacts lost (measured
-    below ``tactile.loss_ratio`` times planned) and those without a fresh reading.
+    measured normal force and the measured friction usage
+    (:mod:`grasp_torque_opt.control.tactile`); the contacts lost (measured below
+    ``tactile.loss_ratio`` times planned) and those without a fresh reading.
     """
     cfg, inputs = c.config, c.inputs
     if cfg.tactile_source == 'none':

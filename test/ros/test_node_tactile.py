@@ -129,9 +129,9 @@ def test_bad_arrays_are_rejected_named_and_never_used():
                 np.testing.assert_allclose(cmd, nominal, atol=1e-9)
             kept = h.node.controller.inputs.tactile
             assert {k: t.normal for k, t in kept.items()} == dict.fromkeys(TIPS, 1.0), what
+            shown = {k: v for k, v in d.items() if 'measured' in k or 'tactile' in k}
             assert all(float(d[f'contact{i}.{c.link}.measured_normal_force_N']) == 1.0
-                       for i, c in enumerate(SETUP.contacts)), (what, {
-                k: v for k, v in d.items() if 'measured' in k or 'tactile' in k})
+                       for i, c in enumerate(SETUP.contacts)), (what, shown)
         assert h.node.controller.counters.rejected['tactile'] == len(BAD_ARRAYS)
     finally:
         h.close()
