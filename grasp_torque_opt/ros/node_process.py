@@ -49,9 +49,12 @@ def scenario_of(params: Path) -> str:
 
 
 @contextlib.contextmanager
-def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]:
+def node_process(params: Path, start: bool, extra: list[str] | None = None
+                 ) -> Iterator[subprocess.Popen | None]:
     """
     ``grasp_torque_node`` on ``params`` in a child process while the block runs (if ``start``).
+
+    ``extra``: more ``--ros-args`` after the params file (``-p name:=value``).
 
     It is stopped with SIGINT (its safe stop: zero torques with the zero policy),
     killed if it has not ended after 10 s.
@@ -60,7 +63,7 @@ def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]
     if start:
         child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
                                   '--ros-args', '--params-file', str(params),
-                                  '--log-level', 'error'])
+                                  *(extra or []), '--log-level', 'error'])
     try:
         yield child
     finally:

@@ -17,7 +17,9 @@ the ball reads zero, and the node's tactile report (ROS-free) names it lost; wit
 ``touch`` the model has no sensor.
 """
 
-from conftest import ALLEGRO
+import re
+
+from conftest import ALLEGRO, CONFIG
 from cycle_inputs import fresh, joint_state
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.tactile import TactileArrayReading
@@ -27,6 +29,8 @@ from grasp_torque_opt.sim.model import build_model, SimSettings
 from grasp_torque_opt.sim.simulator import HandSim
 import numpy as np
 import pytest
+from test_sim_driver import run, summary_of
+import yaml
 
 SCENARIO = load_scenario(ALLEGRO)
 
@@ -111,3 +115,35 @@ def test_a_finger_pulled_off_reads_zero_and_is_reported_lost(grasp, allegro):
 def test_without_touch_there_is_no_sensor(grasp):
     hsim, _ = holding(grasp, touch=False)
     assert hsim.model.nsensor == 0 and hsim.touch().size == 0
+
+
+def required_params(tmp_path):
+    """The bundled node's params with tactile.required: the node commands only on tactile."""
+    doc = yaml.safe_load((CONFIG / 'allegro_right_node.yaml').read_text())
+    doc['/**']['ros__parameters']['tactile'] = {
+        'source': 'array', 'links': [c.link for c in SCENARIO.contacts], 'required': True,
+        'timeout': 0.2}
+    path = tmp_path / 'tactile_node.yaml'
+    path.write_text(yaml.safe_dump(doc))
+    return str(path)
+
+
+def test_the_node_commands_on_the_simulated_hands_tactile_over_ros(tmp_path):
+    """
+    grasp-torque-sim --tactile with the node over ROS, tactile.required on the node.
+
+    The node commands only while every tip's reading arrives fresh and accepted: the
+    ball is held; without --tactile the same node gets none and never commands.
+    """
+    params = required_params(tmp_path)
+    done = run('--with-node', '--params', params, '--tactile', '--duration', '1',
+               '--no-picture')
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert ('tactile.source array, tactile.links [link_3.0_tip,link_7.0_tip,link_11.0_tip,'
+            'link_15.0_tip]') in done.stdout
+    summary = summary_of(done)
+    assert summary.startswith('summary: held: drift '), summary
+    assert int(re.search(r'; (\d+) commands', summary).group(1)) > 100
+    done = run('--with-node', '--params', params, '--duration', '1', '--no-picture',
+               '--wait', '5')
+    assert done.returncode == 1 and 'no effort command' in done.stderr, done.stdout
