@@ -130,7 +130,7 @@ def required_params(tmp_path):
 
 def test_the_node_commands_on_the_simulated_hands_tactile_over_ros(tmp_path):
     """
-    grasp-torque-sim --tactile with the node over ROS, tactile.required on the node.
+    Run grasp-torque-sim --tactile with the node over ROS, tactile.required on the node.
 
     The node commands only while every tip's reading arrives fresh and accepted: the
     ball is held; without --tactile the same node gets none and never commands.
