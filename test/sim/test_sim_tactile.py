@@ -118,7 +118,7 @@ def test_without_touch_there_is_no_sensor(grasp):
 
 
 def required_params(tmp_path):
-    """The bundled node's params with tactile.required: the node commands only on tactile."""
+    """Write the bundled node's params with tactile required: it commands only on tactile."""
     doc = yaml.safe_load((CONFIG / 'allegro_right_node.yaml').read_text())
     doc['/**']['ros__parameters']['tactile'] = {
         'source': 'array', 'links': [c.link for c in SCENARIO.contacts], 'required': True,
