@@ -7,7 +7,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-Command line: ``grasp-torque-opt solve|compare|plan SCENARIO``, ``... score CANDIDATES``.
+Command line: ``grasp-torque-opt solve|compare|plan|init-node SCENARIO``, ``... score CANDIDATES``.
 
 One module per subcommand (:data:`COMMANDS`), each with ``add_parser(sub)`` and
 ``run(args) -> exit code``; every error becomes its exit code by one table,
@@ -21,12 +21,13 @@ from __future__ import annotations
 import argparse
 
 from grasp_torque_opt.backends import single_threaded_math
-from grasp_torque_opt.cli import compare, plan, score, solve
+from grasp_torque_opt.cli import compare, init_node, plan, score, solve
 from grasp_torque_opt.cli.args import EPILOG, PROG
 from grasp_torque_opt.core.command_line import add_version, HelpFormatter, run_command
 
 #: Subcommand -> its module, in the order of --help.
-COMMANDS = {'solve': solve, 'compare': compare, 'score': score, 'plan': plan}
+COMMANDS = {'solve': solve, 'compare': compare, 'score': score, 'plan': plan,
+            'init-node': init_node}
 
 
 def parser() -> argparse.ArgumentParser:

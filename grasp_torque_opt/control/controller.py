@@ -297,9 +297,10 @@ class TorqueController:
         if step is None:
             return
         cmd, s = step
-        links = None if result.maps is None else tuple(result.maps.links)
-        blend = step_wrenches(known, policy.in_force_links,
-                              getattr(result.solution, 'wrenches', None), links, s)
+        target = getattr(result.solution, 'wrenches', None)
+        links = tuple(result.maps.links) if result.maps is not None else (
+            () if target is not None and target.size == 0 else None)  # no contacts
+        blend = step_wrenches(known, policy.in_force_links, target, links, s)
         friction = self.setup.friction
         if (blend is None or not np.all(np.isfinite(cmd))
                 or not np.all(np.abs(cmd) <= limits)

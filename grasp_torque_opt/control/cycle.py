@@ -35,7 +35,7 @@ from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.solution import Solution
+from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
@@ -309,6 +309,50 @@ class Cycle:
             return None, f'command over the limit at {self.setup.hand.joints[k]}'
         return cmd, ''
 
+    def gravity_torque(self, inputs: Inputs) -> np.ndarray:
+        """
+        Return g(q) at a snapshot's joints, under the gravity in use, actuator space [N m].
+
+        The gravity in use is the fresh IMU's apparent gravity, else the gravity topic's,
+        else the ``gravity`` parameter (as :meth:`grasp_at` takes it).
+        """
+        hand = self.setup.hand
+        q = hand.complete(inputs.q.copy()) if hand.coupling.mimics else inputs.q
+        model, data = hand.model, hand.data
+        motion = self.motion_in_use(inputs)
+        gravity = self._gravity_in_use = np.asarray(
+            motion.gravity if motion is not None else self.config.gravity
+            if inputs.gravity is None else inputs.gravity, dtype=float)
+        if hand.base_link is not None:  # given in the base link's axes; Pinocchio's: root
+            pin.framesForwardKinematics(model, data, q)
+            gravity = data.oMf[model.getFrameId(hand.base_link)].rotation @ gravity
+        model.gravity.linear = gravity
+        return hand.actuator_torques(pin.computeGeneralizedGravity(model, data, q))
+
+    def free_hand(self, inputs: Inputs) -> CycleResult:
+        """
+        Return the command with no object in the hand (``hold_object`` false): g(q) alone.
+
+        No contact, no load, no QP: the solution is zero joint torques with no contact
+        wrenches, and the command the fingers' own gravity torques (zeros without
+        ``gravity_compensation``), gated as every command is (finite, sized, within the
+        torque limits). Its empty wrenches let the rate rule fade the grasp's contacts
+        out, and in again when ``hold_object`` is set back.
+        """
+        hand = self.setup.hand
+        t0 = time.perf_counter()
+        g = self.gravity_torque(inputs) if self.config.gravity_compensation else None
+        self.load = None
+        sol = Solution(status=OPTIMAL, method='gravity-only', joints=list(hand.joints),
+                       tau=np.zeros(hand.m), wrenches=np.zeros((0, 4)),
+                       message='hold_object false: no object, g(q) alone',
+                       backend='none', friction_usage=np.zeros(0))
+        sol.solve_time_s = time.perf_counter() - t0
+        cmd, why = self.gate(sol, g)
+        if cmd is None:
+            return CycleResult(None, 'none', sol, None, g, why)
+        return CycleResult(cmd, 'solution', sol, None, g, q=inputs.q)
+
     def attempt(self, inputs: Inputs, deadline: float) -> CycleResult:
         """
         Solve and gate; never raises.
@@ -318,6 +362,8 @@ class Cycle:
             kind ``none`` whose ``fault`` says why there is none.
         """
         try:
+            if not self.config.hold_object:
+                return self.free_hand(inputs)
             sol, maps, g = self.solve_inputs(inputs, deadline)
         except InputError as e:
             return CycleResult(None, 'none', fault=f'inputs do not make a grasp: {e}')

@@ -107,7 +107,9 @@ class FaultPolicy:
         self.in_force, self.in_force_time = result.command, now
         self.in_force_wrenches = (result.wrenches if result.wrenches is not None
                                   else getattr(result.solution, 'wrenches', None))
-        self.in_force_links = None if result.maps is None else tuple(result.maps.links)
+        self.in_force_links = (tuple(result.maps.links) if result.maps is not None else ()
+                               if self.in_force_wrenches is not None
+                               and self.in_force_wrenches.size == 0 else None)  # no contacts
         if result.faded is not None and self.in_force_wrenches is not None \
                 and self.in_force_links is not None:
             # A step across a set change: the contacts fading out are in force too.

@@ -34,7 +34,8 @@ import sys
 import time
 
 from grasp_torque_opt.core.command_line import add_version, EXIT_INTERRUPTED, HelpFormatter
-from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
+from grasp_torque_opt.ros.node_process import (
+    isolate, node_process, scenario_of, startup_failure)
 import numpy as np
 
 
@@ -92,13 +93,13 @@ def main(argv: list[str] | None = None) -> int:
         print(f'grasp-torque-demo: error: {e}', file=sys.stderr)
         return 2
     try:
-        with node_process(params, args.with_node):
-            return _play(args, scenario)
+        with node_process(params, args.with_node) as child:
+            return _play(args, scenario, child)
     except KeyboardInterrupt:  # Ctrl-C: a watch, or a demo, stopped by hand
         return EXIT_INTERRUPTED
 
 
-def _play(args: argparse.Namespace, scenario: Path) -> int:
+def _play(args: argparse.Namespace, scenario: Path, child=None) -> int:
     from grasp_torque_opt.core.grasp_setup import GraspSetup
     import rclpy
     from rclpy.executors import ExternalShutdownException
@@ -110,7 +111,7 @@ def _play(args: argparse.Namespace, scenario: Path) -> int:
     # the first spin) left a half-made executor whose __del__ printed a traceback.
     rclpy.get_global_executor()
     try:
-        return _spin(args, scenario, node, setup)
+        return _spin(args, scenario, node, setup, child)
     except (KeyboardInterrupt, ExternalShutdownException):
         print('grasp-torque-demo: interrupted', file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -137,7 +138,7 @@ def _commands_topic(node, name: str, until: float) -> str | None:
     return None
 
 
-def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
+def _spin(args: argparse.Namespace, scenario: Path, node, setup, child=None) -> int:
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseArray, WrenchStamped
     from grasp_torque_opt.ros.node import COMMAND_QOS
@@ -179,8 +180,11 @@ def _spin(args: argparse.Namespace, scenario: Path, node, setup) -> int:
               f'{args.rate:g} Hz for {args.duration:g} s (ROS_DOMAIN_ID {domain})')
     deadline = time.monotonic() + 30.0
     while not args.watch and node.count_subscribers('joint_states') == 0 and \
-            time.monotonic() < deadline:
+            time.monotonic() < deadline and not startup_failure(child):
         rclpy.spin_once(node, timeout_sec=0.1)
+    if startup_failure(child):  # the node's own error, not "no node"
+        print(f'grasp-torque-demo: {startup_failure(child)}', file=sys.stderr)
+        return 1
     if not args.watch and node.count_subscribers('joint_states') == 0:
         print('grasp-torque-demo: no grasp_torque_node is listening on joint_states',
               file=sys.stderr)

@@ -11,11 +11,15 @@ What the demo and the simulated hand share: a private ROS domain, and the node a
 
 Both drivers can start ``grasp_torque_node`` themselves (``--with-node``) on the
 same params file they read their scenario from, and stop it with SIGINT when
-they end, so that its safe stop runs.
+they end, so that its safe stop runs. The child's stderr is passed on line by line and
+its last lines kept, so that a node that exits at start-up (a params file for another
+hand, say) is named with its own error (:func:`startup_failure`), not taken for a node
+that was never started.
 """
 
 from __future__ import annotations
 
+import collections
 from collections.abc import Iterator
 import contextlib
 import os
@@ -23,6 +27,10 @@ from pathlib import Path
 import signal
 import subprocess
 import sys
+import threading
+
+#: How many of the child's last stderr lines are kept.
+KEPT_LINES = 20
 
 
 def isolate() -> None:
@@ -63,7 +71,12 @@ def node_process(params: Path, start: bool, extra: list[str] | None = None
     if start:
         child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
                                   '--ros-args', '--params-file', str(params),
-                                  *(extra or []), '--log-level', 'error'])
+                                  *(extra or []), '--log-level', 'error'],
+                                 stderr=subprocess.PIPE,
+                                 text=True, errors='replace')
+        child.last_lines = collections.deque(maxlen=KEPT_LINES)
+        child.relay = threading.Thread(target=_relay, args=(child,), daemon=True)
+        child.relay.start()
     try:
         yield child
     finally:
@@ -73,3 +86,31 @@ def node_process(params: Path, start: bool, extra: list[str] | None = None
                 child.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 child.kill()
+
+
+def _relay(child: subprocess.Popen) -> None:
+    """Pass the child's stderr on, line by line, keeping the last lines."""
+    for line in child.stderr:
+        child.last_lines.append(line.rstrip('\n'))
+        sys.stderr.write(line)
+        sys.stderr.flush()
+
+
+def startup_failure(child: subprocess.Popen | None) -> str:
+    """
+    Return why the child node ended, in one line ('' while it runs, or with no child).
+
+    The node's own error line (``grasp_torque_node: error: ...``) if it wrote one, else
+    its last line on stderr, else its exit code alone.
+    """
+    if child is None or child.poll() is None:
+        return ''
+    relay = getattr(child, 'relay', None)
+    if relay is not None:
+        relay.join(timeout=2.0)  # the rest of its stderr
+    lines = [line for line in getattr(child, 'last_lines', ()) if line.strip()]
+    errors = [line for line in lines if ': error: ' in line]
+    said = (errors or lines or [''])[-1].strip()
+    said = said.removeprefix('grasp_torque_node: ')
+    return (f'grasp_torque_node exited with code {child.returncode} at start-up'
+            + (f': {said}' if said else ''))

@@ -36,7 +36,8 @@ import sys
 import time
 
 from grasp_torque_opt.core.command_line import EXIT_INTERRUPTED
-from grasp_torque_opt.ros.node_process import isolate, node_process, scenario_of
+from grasp_torque_opt.ros.node_process import (
+    isolate, node_process, scenario_of, startup_failure)
 from grasp_torque_opt.ros.sim_options import check, describe, parser, PROG, rig_settings
 import numpy as np
 
@@ -82,8 +83,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
-        with node_process(params, args.with_node, _tactile_params(args, setup)):
-            return _run(args, scenario, setup, rig, baseline)
+        with node_process(params, args.with_node, _tactile_params(args, setup)) as child:
+            return _run(args, scenario, setup, rig, baseline, child)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -152,7 +153,7 @@ def _predicted(message: str) -> list[np.ndarray] | None:
         return None
 
 
-def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
+def _run(args: argparse.Namespace, scenario, setup, hsim, baseline, child=None) -> int:
     from grasp_torque_opt.ros.node import NODE_NAME
     import rclpy
 
@@ -165,8 +166,11 @@ def _run(args: argparse.Namespace, scenario, setup, hsim, baseline) -> int:
           + (f'; {disturbed}' if disturbed else ''), flush=True)
     deadline = time.monotonic() + args.wait
     while baseline is None and link.js_pub.get_subscription_count() == 0 and \
-            time.monotonic() < deadline:
+            time.monotonic() < deadline and not startup_failure(child):
         rclpy.spin_once(link.node, timeout_sec=0.1)
+    if startup_failure(child):  # the node's own error, not "no node"
+        print(f'{PROG}: {startup_failure(child)}', file=sys.stderr)
+        return link.close(1)
     if baseline is None and link.js_pub.get_subscription_count() == 0:
         print(f'{PROG}: no {NODE_NAME} is listening on joint_states (start one, or '
               'use --with-node)', file=sys.stderr)

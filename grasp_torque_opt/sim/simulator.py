@@ -102,6 +102,18 @@ class HandSim:
         """Joint torques the actuators apply, impedance included [N m]."""
         return self.command + self.kp * (self.q_ref - self.q) - self.kd * self.qdot
 
+    def remove_object(self, away: float = 1.0) -> None:
+        """
+        Take the object out of the hand: pinned ``away`` metres below the base, out of reach.
+
+        The hand then holds nothing (finger gravity compensation, the node's
+        ``hold_object`` false); :meth:`release` is not called.
+        """
+        self._pose[:3] = self._pose[:3] - np.array([0.0, 0.0, away])
+        self.pinned = True
+        self._constrain()
+        mujoco.mj_forward(self.model, self.data)
+
     def release(self) -> None:
         """Let the object go; the impedance now holds the settled configuration."""
         self.pinned = False

@@ -48,6 +48,8 @@ class NodeInput(Protocol):
             or, for an input with an ``enabled_when`` attribute, when it has that value
             (:func:`subscribed`).
         timeout: the parameter of its freshness rule, in words (docs).
+        grasp_only: it describes the grasp (contacts, load, object): its staleness does
+            not stop commands while the hand holds nothing (``hold_object`` false).
     """
 
     name: str
@@ -56,6 +58,7 @@ class NodeInput(Protocol):
     counted: bool
     enabled: str | None
     timeout: str
+    grasp_only: bool
 
     def check(self, store: InputStore, reading: Any) -> Any:
         """Check a reading whole; return the value to keep (raises InputError: not kept)."""

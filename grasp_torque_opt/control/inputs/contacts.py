@@ -84,6 +84,7 @@ class Contacts:
     counted = True
     enabled = None
     timeout = 'contacts_timeout'
+    grasp_only = True
 
     def size(self, store, n: int, frame_id: str = '') -> None:
         """Refuse a count of poses that the frame_id does not name, unread."""

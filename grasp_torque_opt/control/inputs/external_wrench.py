@@ -47,6 +47,7 @@ class ExternalWrench:
     counted = True
     enabled = None
     timeout = 'wrench_timeout'
+    grasp_only = True
 
     def check(self, store, reading: WrenchReading) -> tuple[str, np.ndarray]:
         """

@@ -55,6 +55,7 @@ class Gravity:
     counted = False
     enabled = None
     timeout = 'gravity_timeout'
+    grasp_only = False
 
     def check(self, store, reading: GravityReading) -> np.ndarray:
         """

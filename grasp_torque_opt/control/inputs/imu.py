@@ -56,6 +56,7 @@ class Imu:
     counted = False
     enabled = 'imu.enabled'
     timeout = 'imu.timeout_periods, imu.timeout_bounds'
+    grasp_only = False
 
     def check(self, store, reading: ImuReading) -> tuple:
         """

@@ -56,6 +56,7 @@ class JointStates:
     counted = True
     enabled = None
     timeout = 'joint_state_timeout'
+    grasp_only = False
 
     def size(self, store, n: int, frame_id: str = '') -> None:
         """Refuse more than ``max_joint_state_entries`` names or positions, unread."""

@@ -58,6 +58,7 @@ class ObjectPoseInput:
     counted = False
     enabled = None
     timeout = 'object_pose.timeout'
+    grasp_only = True
 
     def check(self, store, reading: PoseReading) -> ObjectPose:
         """

@@ -230,7 +230,10 @@ class InputStore:
     def stale(self, now: float, inputs: Inputs | None = None) -> str:
         """Why the inputs cannot be used at time ``now`` ('' if they can)."""
         i = inputs or self.inputs
+        free = not self.config.hold_object  # the grasp's inputs do not matter
         for given in REGISTRY.values():
+            if free and getattr(given, 'grasp_only', False):
+                continue
             why = given.stale(i, self.config, now)
             if why:
                 return why

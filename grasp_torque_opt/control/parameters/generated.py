@@ -35,6 +35,10 @@ class CycleConfig:
     Attributes:
         gravity_compensation: Add the fingers' own gravity torques g(q); the torque limits then
             bound tau + g(q).
+        hold_object: false: the hand holds no object: no grasp is solved, the command is g(q) alone
+            (finger gravity compensation; zero torques without gravity_compensation), the contacts'
+            wrenches fading out by the rate rule; true again: the grasp fades in (docs/node.md, "No
+            object: finger gravity compensation").
         gravity: Gravity in the base frame for g(q) and, where the scenario's load is its object's
             weight, for the load (the Allegro scenario: [9.81, 0, 0], palm down); once a message
             arrives on the gravity topic, the topic's gravity is used instead. [m/s^2]
@@ -193,6 +197,7 @@ class CycleConfig:
     """
 
     gravity_compensation: bool = False
+    hold_object: bool = True
     gravity: tuple = (0.0, 0.0, -9.81)
     joint_state_timeout: float = 0.1
     contacts_timeout: float = 0.5
@@ -510,6 +515,10 @@ class Params:
             solver.method tau-qp.
         gravity_compensation: Add the fingers' own gravity torques g(q); the torque limits then
             bound tau + g(q).
+        hold_object: false: the hand holds no object: no grasp is solved, the command is g(q) alone
+            (finger gravity compensation; zero torques without gravity_compensation), the contacts'
+            wrenches fading out by the rate rule; true again: the grasp fades in (docs/node.md, "No
+            object: finger gravity compensation").
         gravity: Gravity in the base frame for g(q) and, where the scenario's load is its object's
             weight, for the load (the Allegro scenario: [9.81, 0, 0], palm down); once a message
             arrives on the gravity topic, the topic's gravity is used instead. [m/s^2]
@@ -609,6 +618,7 @@ class Params:
     friction_margin: float | None
     objective: str | None
     gravity_compensation: bool | None
+    hold_object: bool | None
     gravity: tuple | None
     joint_state_timeout: float | None
     contacts_timeout: float | None
@@ -650,6 +660,7 @@ class Params:
 #: CycleConfig field -> the parameter that gives it.
 CYCLE_FIELDS = {
     'gravity_compensation': 'gravity_compensation',
+    'hold_object': 'hold_object',
     'gravity': 'gravity',
     'joint_state_timeout': 'joint_state_timeout',
     'contacts_timeout': 'contacts_timeout',

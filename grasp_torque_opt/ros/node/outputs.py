@@ -174,7 +174,7 @@ def markers(last: CycleResult | None, base: str, stamp: Any, scale: float,
         period: the marker period [s]; each arrow lives three.
     """
     clear = Marker(action=Marker.DELETEALL)
-    if last is None or last.kind != 'solution':
+    if last is None or last.kind != 'solution' or last.maps is None:  # None: no contacts
         return MarkerArray(markers=[clear])
     out = [clear]
     lifetime = Duration(seconds=3 * period).to_msg()
