@@ -51,9 +51,11 @@ from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.control.cycle import Cycle
 from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
+from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, InputStore
 from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.control.rates import slewed, step_wrenches
+from grasp_torque_opt.control.tactile import tactile_report, TactileReport
 from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -134,6 +136,10 @@ class TorqueController:
     load_of_gravity = _In('solving')
     compiled_cycle = _In('solving')
     compiled_reason = _In('solving')
+    #: The last certified command's contacts against the tactile readings
+    #: (:class:`~grasp_torque_opt.control.tactile.TactileReport`; None: no tactile source,
+    #: or no command yet): ``tactile.usage`` is the measured friction usage per contact.
+    tactile = _In('solving')
     #: The fault policy's: the fault, the last certified command and its time, the
     #: command in force, the last result.
     fault = _In('policy')
@@ -244,8 +250,30 @@ class TorqueController:
             fallback = self.fallback
             policy.committed(result, now, fallback is not None
                              and result.solution.backend == fallback.name)
+            if self.config.tactile_source != 'none':
+                self.solving.tactile = self.tactile_of(result, now)
         result.cycle_time = elapsed
         return result
+
+    def tactile_of(self, result: CycleResult, now: float) -> TactileReport | None:
+        """
+        Compare a certified command's contact wrenches with the tactile readings at ``now``.
+
+        The command's own wrenches (a rate-rule step's when it was one), at the contacts
+        it was solved for; the wrench form's forces are projected on each contact's inward
+        normal in its link's axes, at the command's configuration.
+        """
+        if result.kind != 'solution' or result.maps is None:
+            return None
+        maps = result.maps
+        w = result.wrenches if result.wrenches is not None else result.solution.wrenches
+        normals = None
+        if self.config.tactile_source == 'wrench' and result.q is not None:
+            placement = placements_at(self.setup.hand, result.q)
+            normals = np.array([placement(link).rotation.T @ R[:, 2]
+                                for link, R in zip(maps.links, maps.rotations)])
+        return tactile_report(w, maps.links, self.inputs.tactile, normals, now,
+                              self.config, self.setup.friction.mu1)
 
     def _slew(self, result: CycleResult, now: float) -> None:
         """

@@ -107,6 +107,8 @@ class Cycle:
         #: many times that set changed (the first set is not a change).
         self.topic_links: tuple[str, ...] | None = None
         self.topic_changes = 0
+        #: The last certified command's contacts against the tactile readings (None: none).
+        self.tactile = None
 
     def grasp_at(self, inputs: Inputs, jacobians: bool = False
                  ) -> tuple[GraspSetup, np.ndarray | None]:

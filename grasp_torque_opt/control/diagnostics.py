@@ -67,6 +67,10 @@ def report(controller: TorqueController, now: float) -> Report:
     values += contact_values(c, now)
     if level == OK and c.solving.imu_state:
         level, message = WARN, f'certified torques published; {c.solving.imu_state}'
+    tactile, said = tactile_values(c, now)
+    values += tactile
+    if level == OK and said:
+        level, message = WARN, f'certified torques published; {said}'
     values += [(f'rejected.{k}', str(v)) for k, v in n.rejected.items()]
     values.append(('last_rejection', c.last_rejection or 'none'))
     values += [('age.joint_states_s', _ago(now, c.inputs.q_time)),
@@ -200,6 +204,40 @@ def fingertip_values(c: TorqueController) -> list[tuple[str, str]]:
         values.append(('object_pose.deviation_mm',
                        f'{1e3 * np.linalg.norm(pose.translation - tips.pose.translation):.3f}'))
     return values
+
+
+def tactile_values(c: TorqueController, now: float) -> tuple[list[tuple[str, str]], str]:
+    """
+    Give the tactile input's values, and what it warns of ('' for nothing).
+
+    Per contact of the last certified command, against the readings aged at ``now``: the
+    measured normal force and the measured friction usage
+    (:mod:`grasp_torque_opt.control.tactile`); the contacts lost (measured below
+    ``tactile.loss_ratio`` times planned) and those without a fresh reading.
+    """
+    cfg, inputs = c.config, c.inputs
+    if cfg.tactile_source == 'none':
+        return [('tactile', 'off (tactile.source none)')], ''
+    values = [('age.tactile_s', _ago(now, inputs.tactile_time))]
+    rep = c.solving.tactile
+    if inputs.tactile is None or rep is None:
+        state = 'none received' if inputs.tactile is None else 'no certified command yet'
+        return [('tactile', state)] + values, f'tactile: {state}'
+    rep = rep.at(inputs.tactile, now, cfg, c.setup.friction.mu1)  # the readings' ages now
+    for i, link in enumerate(rep.links):
+        key = f'contact{i}.{link}'
+        values += [(f'{key}.measured_normal_force_N', f'{rep.measured[i]:.4f}'),
+                   (f'{key}.measured_friction_usage', f'{rep.usage[i]:.4f}')]
+    lost = [f'{rep.links[i]} ({rep.measured[i]:.3f} N of {rep.planned[i]:.3f} N planned)'
+            for i in rep.lost]
+    stale = [rep.links[i] for i in rep.stale]
+    stale += [f'{rep.links[i]} (pulling)' for i in rep.pulling]
+    values += [('tactile.lost', ', '.join(lost) or 'none'),
+               ('tactile.stale', ', '.join(stale) or 'none')]
+    said = '; '.join(([f'contact lost: {", ".join(lost)}'] if lost else [])
+                     + ([f'stale: {", ".join(stale)}'] if stale else []))
+    values.insert(0, ('tactile', said or 'in use'))
+    return values, f'tactile {said}' if said else ''
 
 
 def _vector(v) -> str:

@@ -78,7 +78,8 @@ def main(argv: list[str] | None = None) -> int:
         params = find_config(args.params, '--params')
         scenario = load_scenario(find_config(scenario_of(params)))
         setup, rig = simulated(scenario, rig_settings(args), sim=SimSettings(
-            mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional))
+            mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional,
+            touch=args.tactile))
         baseline = _baseline(args, scenario, setup)
         driver = sim_commands.settings(args)
         if driver.kind != 'effort':  # the effort driver is the rig itself
@@ -87,8 +88,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
-        with node_process(params, args.with_node,
-                          tuple(sim_commands.node_arguments(driver))) as child:
+        arguments = (*sim_commands.node_arguments(driver), *(_tactile_params(args, setup) or ()))
+        with node_process(params, args.with_node, arguments) as child:
             return _run(args, scenario, setup, rig, baseline, child)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
@@ -112,6 +113,16 @@ def _simulate_best(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def _tactile_params(args: argparse.Namespace, setup) -> list[str]:
+    """Return the node's parameters that read ``--tactile``'s array (and say them)."""
+    if not args.tactile:
+        return []
+    links = ','.join(c.link for c in setup.contacts)
+    print(f"{PROG}: touch sensors on 'tactile', one per contact; the node reads them with "
+          f'tactile.source array, tactile.links [{links}]', flush=True)
+    return ['-p', 'tactile.source:=array', '-p', f'tactile.links:=[{links}]']
 
 
 def _baseline(args: argparse.Namespace, scenario, setup):
@@ -228,6 +239,10 @@ class _Link:
         self.contacts_pub = node.create_publisher(PoseArray, 'contacts',
                                                   qos_profile_sensor_data)
         self.imu_pub = node.create_publisher(Imu, 'imu', qos_profile_sensor_data)
+        if args.tactile:  # the contact links' touch sensors, in the contacts' order
+            from std_msgs.msg import Float32MultiArray
+            self.tactile_pub = node.create_publisher(Float32MultiArray, 'tactile',
+                                                     qos_profile_sensor_data)
         self.solve = node.create_client(Trigger, f'{NODE_NAME}/solve', qos_profile=SERVICE_QOS)
         self.state = {'command': None, 'commands': 0, 'malformed': 0, 'predicted': None,
                       'pending': None}
@@ -282,6 +297,9 @@ class _Link:
         if self.baseline is not None:  # the driver's own controller, on what it publishes
             self.on_command(Float64MultiArray(data=[float(x)
                                                     for x in self.baseline(hsim.reading)]))
+        if self.args.tactile:
+            from std_msgs.msg import Float32MultiArray
+            self.tactile_pub.publish(Float32MultiArray(data=[float(x) for x in hsim.touch()]))
         if self.args.contacts:
             # In the root frame (MuJoCo's world), where the simulated contacts are read.
             publish_contacts(hsim, self.setup, self.contacts_pub, hand.root_frame, stamp,

@@ -47,6 +47,10 @@ def parser(description: str) -> argparse.ArgumentParser:
                    help='joint state (and IMU) rate [Hz]')
     p.add_argument('--contacts', action='store_true',
                    help="publish the contact frames measured in the simulation on 'contacts'")
+    p.add_argument('--tactile', action='store_true',
+                   help="publish the contact links' touch sensors on 'tactile' "
+                        '(std_msgs/Float32MultiArray, one normal force [N] per scenario '
+                        'contact, in their order; with --with-node the node reads them)')
     p.add_argument('--mu-tangential', type=float, default=None,
                    help="simulated tangential friction [-] (default: the scenario's)")
     p.add_argument('--mu-torsional', type=float, default=None,

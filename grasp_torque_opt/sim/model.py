@@ -70,6 +70,7 @@ class SimSettings:
         joint_damping: passive viscous damping of every joint in place of the
             URDF's [N m s/rad].
         mass: simulated object mass [kg]; None: the scenario's.
+        touch: give each contact link a MuJoCo touch sensor (:func:`touch_sensors`).
     """
 
     timestep: float = 1e-3
@@ -80,6 +81,7 @@ class SimSettings:
     mu_torsional: float | None = None
     joint_damping: float = 0.0
     mass: float | None = None
+    touch: bool = False
 
 
 @dataclass(frozen=True)
@@ -104,6 +106,8 @@ class SimModel:
             shape (3, 3): identity unless ``hand.base_link``.
         followers: coupled joints that move, (qpos address, its target's, multiplier,
             offset): a MuJoCo joint equality holds each; the simulator starts them on it.
+        touch_adr: per scenario contact, the ``sensordata`` address of its link's touch
+            sensor (empty without ``SimSettings.touch``).
     """
 
     model: mujoco.MjModel
@@ -119,6 +123,7 @@ class SimModel:
     mu_torsional: float
     base_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
     followers: tuple[tuple[int, int, float, float], ...] = ()
+    touch_adr: tuple[int, ...] = ()
 
 
 def adapt_urdf(xml: str, urdf_dir: Path | None = None) -> str:
@@ -238,6 +243,9 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
                          f'{str(e).strip().splitlines()[0]}') from e
 
     names, bodies = _checked_bodies(model, setup)
+    touch = ()
+    if settings.touch:
+        model, touch = touch_sensors(spec, model, bodies)
     joints = setup.hand.joints
     free = model.joint(f'{OBJECT_BODY}_free')
     hand_dofs = [model.jnt_dofadr[j] for j in range(model.njnt) if model.joint(j).name in names]
@@ -252,7 +260,43 @@ def build_model(scenario: Scenario, settings: SimSettings = SimSettings(),
         base_rotation=base[0],
         followers=tuple((int(model.joint(m.joint).qposadr[0]),
                          int(model.joint(m.target).qposadr[0]), m.multiplier, m.offset)
-                        for m in coupled))
+                        for m in coupled),
+        touch_adr=touch)
+
+
+#: How far a touch sensor's site reaches beyond its link's collision shapes [m].
+TOUCH_MARGIN = 0.002
+
+
+def touch_sensors(spec: mujoco.MjSpec, model: mujoco.MjModel, bodies: list[int]
+                  ) -> tuple[mujoco.MjModel, tuple[int, ...]]:
+    """
+    Put a touch sensor on each contact link, and compile again.
+
+    MuJoCo's touch sensor sums the normal force of the contacts whose point lies inside
+    its site and that involve its body: here a sphere around the link's collision shapes
+    (their bounding spheres, ``TOUCH_MARGIN`` beyond), so every contact of the link
+    counts, as a fingertip's tactile pad reads the whole tip.
+
+    Returns:
+        The model with the sensors, and per contact its sensor's ``sensordata`` address.
+    """
+    names = {}
+    for body in dict.fromkeys(bodies):
+        geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] == body]
+        pos = model.geom_pos[geoms]
+        centre = pos.mean(axis=0)
+        radius = max(float(np.linalg.norm(p - centre)) + model.geom_rbound[g]
+                     for g, p in zip(geoms, pos)) + TOUCH_MARGIN
+        name = model.body(body).name
+        spec.body(name).add_site(name=f'{name}_touch', pos=list(centre),
+                                 size=[radius, 0.0, 0.0], type=mujoco.mjtGeom.mjGEOM_SPHERE,
+                                 group=5)
+        spec.add_sensor(name=f'{name}_touch', type=mujoco.mjtSensor.mjSENS_TOUCH,
+                        objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f'{name}_touch')
+        names[body] = f'{name}_touch'
+    model = spec.compile()
+    return model, tuple(int(model.sensor_adr[model.sensor(names[b]).id]) for b in bodies)
 
 
 def _hand_spec(scenario: Scenario, urdf_xml: str | None) -> tuple[mujoco.MjSpec, str]:

@@ -160,6 +160,15 @@ class HandSim:
         dot = min(1.0, abs(float(quat @ self.release_pose[3:])))
         return drift, 2.0 * float(np.arccos(dot))
 
+    def touch(self) -> np.ndarray:
+        """
+        Return each planned contact's link's touch sensor reading [N], shape (p,).
+
+        The summed normal force of the link's contacts, as a fingertip's tactile sensor
+        reads it (a model built with ``SimSettings.touch``; else empty).
+        """
+        return self.data.sensordata[list(self.sim.touch_adr)].copy()
+
     def readings(self) -> tuple[list[ContactReading], float]:
         """
         Read what touches the object at each planned contact, and the unplanned contacts' force.

@@ -44,7 +44,9 @@ class NodeInput(Protocol):
         qos: one of :data:`QOS`.
         counted: whether its rejection counter is shown from the start (an optional
             input's from its first rejection).
-        enabled: the parameter that subscribes it (None: always subscribed).
+        enabled: the parameter that subscribes it (None: always subscribed): when true,
+            or, for an input with an ``enabled_when`` attribute, when it has that value
+            (:func:`subscribed`).
         timeout: the parameter of its freshness rule, in words (docs).
         grasp_only: it describes the grasp (contacts, load, object): its staleness does
             not stop commands while the hand holds nothing (``hold_object`` false).
@@ -69,6 +71,12 @@ class NodeInput(Protocol):
 
     def stale(self, inputs: Inputs, config: CycleConfig, now: float) -> str:
         """Say why its latest value cannot be used at ``now`` ('' if it can, or none came)."""
+
+
+def subscribed(given: NodeInput, value: Any) -> bool:
+    """Say whether ``given`` is subscribed when its ``enabled`` parameter is ``value``."""
+    want = getattr(given, 'enabled_when', None)
+    return bool(value) if want is None else value == want
 
 
 def stamp_seconds(sec: int, nanosec: int) -> float:

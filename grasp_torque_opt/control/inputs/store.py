@@ -48,7 +48,9 @@ class Inputs:
     fresh), ``effort`` the actuators' measured torques of the joint state (only with
     ``effort_estimation``; None when the driver reports none). ``object_pose`` is the
     object's frame (:class:`~grasp_torque_opt.control.geometry.ObjectPose`), None until
-    one arrives (then the scenario's pose, fixed in the base frame).
+    one arrives (then the scenario's pose, fixed in the base frame). ``tactile`` is each
+    sensing link's latest reading (:class:`~grasp_torque_opt.control.inputs.tactile.Touch`,
+    with its own receipt time), None until one arrives; ``tactile_time`` the latest's.
     """
 
     q: np.ndarray | None = None
@@ -65,6 +67,8 @@ class Inputs:
     effort_why: str = ''
     object_pose: ObjectPose | None = None
     object_pose_time: float | None = None
+    tactile: dict | None = None
+    tactile_time: float | None = None
 
 
 @dataclass

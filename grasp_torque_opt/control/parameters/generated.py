@@ -145,6 +145,34 @@ class CycleConfig:
         effort_max_load_ratio: (``effort_estimation.max_load_ratio``) The correction's force is at
             most this times the scenario's weight, its moment that force times the farthest
             contact's distance from the object origin.
+        tactile_source: (``tactile.source``) The fingertips' normal forces (docs/node.md, "Tactile
+            input"): none (the default), array (std_msgs/Float32MultiArray on the tactile topic,
+            entry i on the link tactile.links[i]: the Allegro V5 Sense's 16 values) or wrench
+            (geometry_msgs/WrenchStamped on tactile_wrench, one link per message, frame_id the
+            link, the force the link applies to the object in its axes). Used for contact-loss
+            reports and the measured friction usage; never for the command's certificate.
+        tactile_links: (``tactile.links``) array: the link of each entry, in order (an empty
+            string: an entry not used, e.g. the V5 Sense's palm and phalanx pads); a message of
+            another length is rejected. wrench: the links that carry a sensor (empty: any link of
+            the hand).
+        tactile_scale: (``tactile.scale``) Newtons per unit of an array entry (1: the entries are
+            newtons). The V5 Sense's values are uncalibrated pressure readings: calibrate against a
+            known load. [N per unit]
+        tactile_timeout: (``tactile.timeout``) A link's reading older than this is not used (its
+            usage and contact-loss checks say stale). [s]
+        tactile_required: (``tactile.required``) With a tactile source: no fresh reading of every
+            mapped link (none yet, or older than tactile.timeout) is a stale input, a fault
+            (commands stop, then the fault policy). False: the node commands on and says tactile
+            stale on /diagnostics.
+        tactile_max_force: (``tactile.max_force``) A tactile message with a normal force above this
+            (after tactile.scale) is rejected (a fingertip of the hands this package drives never
+            carries 50 N). [N]
+        tactile_negative_tolerance: (``tactile.negative_tolerance``) A normal force below minus
+            this is rejected (a sensor cannot pull); one between is read as zero (offset noise).
+            [N]
+        tactile_loss_ratio: (``tactile.loss_ratio``) A planned contact whose fresh measured normal
+            force is below this times the planned one (zero included) is reported lost on
+            /diagnostics (tactile.lost: a slip or a finger off the object).
         uncertainty_pose: (``uncertainty.pose``) Contact position / object pose uncertainty (0.002:
             2 mm): tilts a normal by pose/(R + r), R the scenario's object's radius (a box's flat
             face: no tilt), r uncertainty.tip_radius. It also bounds how far an object pose may be
@@ -230,6 +258,14 @@ class CycleConfig:
     effort_filter: float = 0.01
     effort_mass_only: bool = True
     effort_max_load_ratio: float = 0.5
+    tactile_source: str = 'none'
+    tactile_links: tuple = None
+    tactile_scale: float = 1.0
+    tactile_timeout: float = 0.1
+    tactile_required: bool = False
+    tactile_max_force: float = 50.0
+    tactile_negative_tolerance: float = 0.05
+    tactile_loss_ratio: float = 0.3
     uncertainty_pose: float = 0.0
     joint_limit_tolerance: float = 0.1
     stamp_future_tolerance: float = 0.5
@@ -360,6 +396,47 @@ class ParamsEffortEstimation:
     filter: float | None  # noqa: A003 -- the parameter's name
     mass_only: bool | None
     max_load_ratio: float | None
+
+
+@dataclass(frozen=True)
+class ParamsTactile:
+    """
+    The ``tactile.*`` parameters.
+
+    Attributes:
+        source: The fingertips' normal forces (docs/node.md, "Tactile input"): none (the default),
+            array (std_msgs/Float32MultiArray on the tactile topic, entry i on the link
+            tactile.links[i]: the Allegro V5 Sense's 16 values) or wrench
+            (geometry_msgs/WrenchStamped on tactile_wrench, one link per message, frame_id the
+            link, the force the link applies to the object in its axes). Used for contact-loss
+            reports and the measured friction usage; never for the command's certificate.
+        links: array: the link of each entry, in order (an empty string: an entry not used, e.g.
+            the V5 Sense's palm and phalanx pads); a message of another length is rejected. wrench:
+            the links that carry a sensor (empty: any link of the hand).
+        scale: Newtons per unit of an array entry (1: the entries are newtons). The V5 Sense's
+            values are uncalibrated pressure readings: calibrate against a known load. [N per unit]
+        timeout: A link's reading older than this is not used (its usage and contact-loss checks
+            say stale). [s]
+        required: With a tactile source: no fresh reading of every mapped link (none yet, or older
+            than tactile.timeout) is a stale input, a fault (commands stop, then the fault policy).
+            False: the node commands on and says tactile stale on /diagnostics.
+        max_force: A tactile message with a normal force above this (after tactile.scale) is
+            rejected (a fingertip of the hands this package drives never carries 50 N). [N]
+        negative_tolerance: A normal force below minus this is rejected (a sensor cannot pull); one
+            between is read as zero (offset noise). [N]
+        loss_ratio: A planned contact whose fresh measured normal force is below this times the
+            planned one (zero included) is reported lost on /diagnostics (tactile.lost: a slip or a
+            finger off the object).
+    """
+
+    source: str | None
+    links: tuple | None
+    scale: float | None
+    timeout: float | None
+    required: bool | None
+    max_force: float | None
+    negative_tolerance: float | None
+    loss_ratio: float | None
 
 
 @dataclass(frozen=True)
@@ -579,6 +656,7 @@ class Params:
         contact_geometry: the ``contact_geometry.*`` parameters.
         object_pose: the ``object_pose.*`` parameters.
         effort_estimation: the ``effort_estimation.*`` parameters.
+        tactile: the ``tactile.*`` parameters.
         uncertainty: the ``uncertainty.*`` parameters.
         joint_limit_tolerance: A joint state with a used position beyond its joint's URDF limits by
             more than this is rejected. [rad or m]
@@ -658,6 +736,7 @@ class Params:
     contact_geometry: ParamsContactGeometry
     object_pose: ParamsObjectPose
     effort_estimation: ParamsEffortEstimation
+    tactile: ParamsTactile
     uncertainty: ParamsUncertainty
     joint_limit_tolerance: float | None
     stamp_future_tolerance: float | None
@@ -716,6 +795,14 @@ CYCLE_FIELDS = {
     'effort_filter': 'effort_estimation.filter',
     'effort_mass_only': 'effort_estimation.mass_only',
     'effort_max_load_ratio': 'effort_estimation.max_load_ratio',
+    'tactile_source': 'tactile.source',
+    'tactile_links': 'tactile.links',
+    'tactile_scale': 'tactile.scale',
+    'tactile_timeout': 'tactile.timeout',
+    'tactile_required': 'tactile.required',
+    'tactile_max_force': 'tactile.max_force',
+    'tactile_negative_tolerance': 'tactile.negative_tolerance',
+    'tactile_loss_ratio': 'tactile.loss_ratio',
     'uncertainty_pose': 'uncertainty.pose',
     'joint_limit_tolerance': 'joint_limit_tolerance',
     'stamp_future_tolerance': 'stamp_future_tolerance',

@@ -29,7 +29,7 @@ import time
 from typing import Any, TYPE_CHECKING
 
 from geometry_msgs.msg import PoseArray, PoseStamped, Vector3Stamped, WrenchStamped
-from grasp_torque_opt.control.inputs.base import NO_TF, stamp_seconds
+from grasp_torque_opt.control.inputs.base import NO_TF, stamp_seconds, subscribed
 from grasp_torque_opt.control.inputs.contacts import ContactsReading
 from grasp_torque_opt.control.inputs.external_wrench import WrenchReading
 from grasp_torque_opt.control.inputs.gravity import GravityReading
@@ -37,6 +37,7 @@ from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.inputs.object_pose import PoseReading
 from grasp_torque_opt.control.inputs.registry import REGISTRY
+from grasp_torque_opt.control.inputs.tactile import TactileArrayReading, TactileWrenchReading
 from grasp_torque_opt.control.parameters.snapshot import value_of
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
@@ -45,6 +46,7 @@ import numpy as np
 from rclpy.qos import qos_profile_sensor_data
 from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import Float32MultiArray
 
 if TYPE_CHECKING:
     from grasp_torque_opt.ros.node.root import GraspTorque
@@ -82,7 +84,8 @@ class Inputs:
         """Make a subscription per input of the table (an input's ``enabled`` parameter on)."""
         made = []
         for name, given in REGISTRY.items():
-            if given.enabled and not value_of(self.root.params, given.enabled):
+            if given.enabled and not subscribed(given, value_of(self.root.params,
+                                                                given.enabled)):
                 continue
             msg_type = MESSAGES[name][0]
             take = self.on_joint_state if name == 'joint_states' else (
@@ -176,7 +179,8 @@ class Inputs:
         a rejection is logged (throttled) and counted, never commanded.
         """
         now = time.monotonic() if receipt is None else receipt
-        stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        header = getattr(msg, 'header', None)  # a std_msgs array has none: unstamped
+        stamp = 0.0 if header is None else stamp_seconds(header.stamp.sec, header.stamp.nanosec)
         with self.root.lock:
             ctrl = self.root.controller
             if ctrl is None:
@@ -242,6 +246,18 @@ def _object_pose(inputs: Inputs, msg: PoseStamped, hand: Any) -> PoseReading:
     return PoseReading(frame, [p.x, p.y, p.z], [o.x, o.y, o.z, o.w], transform, why)
 
 
+def _tactile(inputs: Inputs, msg: Float32MultiArray, hand: Any) -> TactileArrayReading:
+    """Give the tactile array's reading; its length is checked against tactile.links first."""
+    with inputs.root.lock:
+        inputs.root.controller.check_size('tactile', len(msg.data))
+    return TactileArrayReading(np.asarray(msg.data, dtype=float))
+
+
+def _tactile_wrench(inputs: Inputs, msg: WrenchStamped, hand: Any) -> TactileWrenchReading:
+    f, t = msg.wrench.force, msg.wrench.torque
+    return TactileWrenchReading(msg.header.frame_id, [f.x, f.y, f.z], [t.x, t.y, t.z])
+
+
 #: Input name -> (its message class, its conversion (inputs, message, hand) -> reading);
 #: the joint states are converted on their own short path (:meth:`Inputs.on_joint_state`).
 MESSAGES: dict[str, tuple[type, Any]] = {
@@ -251,4 +267,6 @@ MESSAGES: dict[str, tuple[type, Any]] = {
     'gravity': (Vector3Stamped, _gravity),
     'imu': (Imu, _imu),
     'object_pose': (PoseStamped, _object_pose),
+    'tactile': (Float32MultiArray, _tactile),
+    'tactile_wrench': (WrenchStamped, _tactile_wrench),
 }

@@ -62,7 +62,8 @@ class GraspTorqueNode(Node):
                 continue
             if name in scenario or name in defaults:
                 declared.declare(name, scenario[name] if name in scenario else defaults[name])
-            elif name in UNSET_PARAMETERS:  # a command interface's constants
+            elif name in UNSET_PARAMETERS:  # a command interface's constants, a list that
+                # may stay empty (tactile.links)
                 declared.declare(name)
         root.build(grasp)
         declared.watch(root.apply)
