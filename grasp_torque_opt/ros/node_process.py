@@ -57,9 +57,12 @@ def scenario_of(params: Path) -> str:
 
 
 @contextlib.contextmanager
-def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]:
+def node_process(params: Path, start: bool, overrides: tuple[str, ...] = ()
+                 ) -> Iterator[subprocess.Popen | None]:
     """
     ``grasp_torque_node`` on ``params`` in a child process while the block runs (if ``start``).
+
+    ``overrides``: parameters given after the file (``name:=value``), which win over it.
 
     It is stopped with SIGINT (its safe stop: zero torques with the zero policy),
     killed if it has not ended after 10 s.
@@ -68,6 +71,7 @@ def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]
     if start:
         child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
                                   '--ros-args', '--params-file', str(params),
+                                  *(a for o in overrides for a in ('-p', o)),
                                   '--log-level', 'error'], stderr=subprocess.PIPE,
                                  text=True, errors='replace')
         child.last_lines = collections.deque(maxlen=KEPT_LINES)

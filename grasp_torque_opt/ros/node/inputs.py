@@ -117,6 +117,19 @@ class Inputs:
             return time.time()
         return self.node.get_clock().now().nanoseconds * 1e-9
 
+    def now(self) -> float:
+        """
+        Now on the clock that ages inputs and paces the rate rules [s].
+
+        The monotonic clock; with ``use_sim_time`` the ROS clock (simulated time), so that
+        a simulation that waits for the node (``grasp-torque-sim --lockstep``) gets the
+        same commands whatever the machine's load (docs/node.md, "Which clock ages an
+        input").
+        """
+        if not self.sim_time:
+            return time.monotonic()
+        return self.node.get_clock().now().nanoseconds * 1e-9
+
     def on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
                       info: dict | None) -> None:
         """
@@ -124,7 +137,7 @@ class Inputs:
 
         Its length is checked, then it is deserialized and taken (``take(msg, receipt)``).
         """
-        receipt = received(info) if info is not None else None
+        receipt = received(info) if info is not None and not self.sim_time else None
         with self.root.lock:
             ctrl = self.root.controller
             if ctrl is None:
@@ -144,7 +157,7 @@ class Inputs:
             msg: the joint state.
             receipt: when the middleware received it (monotonic [s]; None: now).
         """
-        now = time.monotonic()
+        now = self.now()
         receipt = now if receipt is None else receipt
         header = msg.header.stamp
         stamp = stamp_seconds(header.sec, header.nanosec)
@@ -175,7 +188,7 @@ class Inputs:
         The conversion (:data:`MESSAGES`) may look a frame up with tf2, outside the lock;
         a rejection is logged (throttled) and counted, never commanded.
         """
-        now = time.monotonic() if receipt is None else receipt
+        now = self.now() if receipt is None else receipt
         stamp = stamp_seconds(msg.header.stamp.sec, msg.header.stamp.nanosec)
         with self.root.lock:
             ctrl = self.root.controller
