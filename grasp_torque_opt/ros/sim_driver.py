@@ -290,6 +290,12 @@ class _Link:
 
         if self.state['pending'] is None and self.solve.service_is_ready():
             self.state['pending'] = self.solve.call_async(Trigger.Request())
+            if self.args.lockstep:  # answered while the simulation waits, not during a cycle
+                import rclpy
+
+                rclpy.spin_until_future_complete(self.node, self.state['pending'],
+                                                 timeout_sec=LOCKSTEP_WAIT * 10)
+                self.take_prediction()
 
     def take_prediction(self) -> None:
         future = self.state['pending']
@@ -322,8 +328,9 @@ class _Link:
                         velocity=[float(x) for x in hsim.qdot],
                         effort=[float(x) for x in hsim.effort()])
         js.header.stamp = stamp
-        self.js_pub.publish(js)
+        # The IMU before the joint state: the node's cycle on the joint state uses it.
         self.imu_pub.publish(imu_message(Imu, *hsim.imu(), hand.base_frame, stamp))
+        self.js_pub.publish(js)
         if self.baseline is not None:  # the driver's own controller, on what it publishes
             self.on_command(Float64MultiArray(data=[float(x)
                                                     for x in self.baseline(hsim.reading)]),

@@ -81,7 +81,10 @@ class Inputs:
     def start(self) -> list[Any]:
         """Make a subscription per input of the table (an input's ``enabled`` parameter on)."""
         made = []
-        for name, given in REGISTRY.items():
+        # The joint states' subscription last: when messages of several inputs wait
+        # together, rclpy's executor takes them in the order their subscriptions were
+        # made, so the others are taken before the joint state whose cycle uses them.
+        for name, given in sorted(REGISTRY.items(), key=lambda item: item[0] == 'joint_states'):
             if given.enabled and not value_of(self.root.params, given.enabled):
                 continue
             msg_type = MESSAGES[name][0]
