@@ -98,7 +98,7 @@ LOCKSTEP_PARAMETERS = ('use_sim_time:=true', 'publish_stamped_command:=true',
                        'cycle_budget:=1.0', 'joint_state_timeout:=10.0')
 
 #: How long lockstep waits for the node's answer to a joint state [s, wall clock].
-LOCKSTEP_WAIT = 0.5
+LOCKSTEP_WAIT = 2.0
 
 
 def _lockstep_overrides(args: argparse.Namespace) -> tuple[str, ...]:
@@ -407,6 +407,8 @@ class _Link:
         fault, and the command in force stays). Before the first command the simulation
         waits (wall clock, up to ``seconds``) with its time stopped.
         """
+        import rclpy
+
         hsim, state = self.hsim, self.state
         dt = hsim.model.opt.timestep
         steps = max(1, round(1.0 / (self.args.rate * dt)))
@@ -414,7 +416,10 @@ class _Link:
             deadline = time.monotonic() + seconds
             while time.monotonic() < deadline:
                 self.publish()
-                if self.answer(0.1):
+                if self.answer(LOCKSTEP_WAIT):
+                    end = time.monotonic() + 0.2  # answers to its repeats: not taken
+                    while time.monotonic() < end:
+                        rclpy.spin_once(self.node, timeout_sec=0.05)
                     break
             return until is None or until()
         t_end, next_second = hsim.time + seconds - dt / 2, hsim.time + 1.0 - dt / 2
