@@ -94,7 +94,8 @@ def main(argv: list[str] | None = None) -> int:
 #: The node's parameters in --lockstep (docs/simulation.md, "Lockstep"): simulated time,
 #: the stamped command that names the joint state it answers, and the schema's largest
 #: cycle budget and joint state timeout, so that no solver is cut by the wall clock.
-LOCKSTEP_PARAMETERS = ('use_sim_time:=true', 'publish_stamped_command:=true',
+LOCKSTEP_PARAMETERS = ('use_sim_time:=true', 'age_on_sim_time:=true',
+                       'publish_stamped_command:=true',
                        'cycle_budget:=1.0', 'joint_state_timeout:=10.0')
 
 #: How long lockstep waits for the node's answer to a joint state [s, wall clock].
@@ -102,7 +103,7 @@ LOCKSTEP_WAIT = 2.0
 
 
 def _lockstep_overrides(args: argparse.Namespace) -> tuple[str, ...]:
-    """The parameters given to the child node: lockstep's, or none."""
+    """Return the parameters given to the child node: lockstep's, or none."""
     return LOCKSTEP_PARAMETERS if args.lockstep else ()
 
 
@@ -371,7 +372,6 @@ class _Link:
             rclpy.spin_once(self.node, timeout_sec=max(0.0, wait))
             self.take_prediction()
         return False
-
 
     def tick(self) -> None:
         """

@@ -23,7 +23,7 @@ CELL = ('--with-node', '--lockstep', '--no-picture', '--base-accel', '0,9.81,0',
 
 
 def _physics(done):
-    """The per-second lines and the summary's outcome, without wall-clock figures."""
+    """Return the per-second lines and the outcome, without wall-clock figures."""
     lines = [line for line in done.stdout.splitlines() if line.startswith('t=')]
     summary = summary_of(done)
     outcome = summary.split('; mean effort')[0]

@@ -120,16 +120,21 @@ class Inputs:
             return time.time()
         return self.node.get_clock().now().nanoseconds * 1e-9
 
+    @property
+    def sim_aged(self) -> bool:
+        """Whether inputs are aged on simulated time (``age_on_sim_time``, read-only)."""
+        return self.sim_time and bool(getattr(self.root.params, 'age_on_sim_time', False))
+
     def now(self) -> float:
         """
         Now on the clock that ages inputs and paces the rate rules [s].
 
-        The monotonic clock; with ``use_sim_time`` the ROS clock (simulated time), so that
-        a simulation that waits for the node (``grasp-torque-sim --lockstep``) gets the
-        same commands whatever the machine's load (docs/node.md, "Which clock ages an
-        input").
+        The monotonic clock; with ``use_sim_time`` and ``age_on_sim_time`` the ROS clock
+        (simulated time), so that a simulation that waits for the node
+        (``grasp-torque-sim --lockstep``) gets the same commands whatever the machine's
+        load (docs/node.md, "Which clock ages an input").
         """
-        if not self.sim_time:
+        if not self.sim_aged:
             return time.monotonic()
         return self.node.get_clock().now().nanoseconds * 1e-9
 
@@ -140,7 +145,7 @@ class Inputs:
 
         Its length is checked, then it is deserialized and taken (``take(msg, receipt)``).
         """
-        receipt = received(info) if info is not None and not self.sim_time else None
+        receipt = received(info) if info is not None and not self.sim_aged else None
         with self.root.lock:
             ctrl = self.root.controller
             if ctrl is None:
