@@ -39,7 +39,8 @@ from grasp_torque_opt.core.command_line import EXIT_INTERRUPTED
 from grasp_torque_opt.ros import sim_commands
 from grasp_torque_opt.ros.node_process import (
     isolate, node_process, scenario_of, startup_failure)
-from grasp_torque_opt.ros.sim_options import check, describe, parser, PROG, rig_settings
+from grasp_torque_opt.ros.sim_options import (
+    check, describe, friction, parser, PROG, rig_settings)
 import numpy as np
 
 
@@ -77,9 +78,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         params = find_config(args.params, '--params')
         scenario = load_scenario(find_config(scenario_of(params)))
+        mu_tangential, mu_torsional = friction(args, scenario)
         setup, rig = simulated(scenario, rig_settings(args), sim=SimSettings(
-            mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional,
-            touch=args.tactile))
+            mu_tangential=mu_tangential, mu_torsional=mu_torsional, touch=args.tactile))
         baseline = _baseline(args, scenario, setup)
         driver = sim_commands.settings(args)
         if driver.kind != 'effort':  # the effort driver is the rig itself
@@ -88,7 +89,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
-        arguments = (*sim_commands.node_arguments(driver), *(_tactile_params(args, setup) or ()))
+        arguments = (*sim_commands.node_arguments(driver), *_tactile_params(args, setup),
+                     *(a for o in _lockstep_overrides(args) for a in ('-p', o)))
         with node_process(params, args.with_node, arguments) as child:
             return _run(args, scenario, setup, rig, baseline, child)
     except KeyboardInterrupt:
@@ -96,17 +98,35 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_INTERRUPTED
 
 
+#: The node's parameters in --lockstep (docs/simulation.md, "Lockstep"): simulated time,
+#: the stamped command that names the joint state it answers, and the schema's largest
+#: cycle budget and joint state timeout, so that no solver is cut by the wall clock.
+LOCKSTEP_PARAMETERS = ('use_sim_time:=true', 'age_on_sim_time:=true',
+                       'publish_stamped_command:=true',
+                       'cycle_budget:=1.0', 'joint_state_timeout:=10.0')
+
+#: How long lockstep waits for the node's answer to a joint state [s, wall clock].
+LOCKSTEP_WAIT = 2.0
+
+
+def _lockstep_overrides(args: argparse.Namespace) -> tuple[str, ...]:
+    """Return the parameters given to the child node: lockstep's, or none."""
+    return LOCKSTEP_PARAMETERS if args.lockstep else ()
+
+
 def _simulate_best(args: argparse.Namespace) -> int:
     """Simulate the best candidate of --plan by --scores: the planner's loop's last step."""
     from grasp_torque_opt.core.exceptions import InputError
     from grasp_torque_opt.core.resources import find_config
+    from grasp_torque_opt.core.scenario import load_scenario
     from grasp_torque_opt.ros.sim_plan import run
     from grasp_torque_opt.sim.model import SimSettings
 
     try:
         base = find_config(scenario_of(find_config(args.params, '--params')))
+        mu_tangential, mu_torsional = friction(args, load_scenario(base))
         return run(args, base, rig_settings(args), SimSettings(
-            mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional))
+            mu_tangential=mu_tangential, mu_torsional=mu_torsional))
     except (InputError, ValueError) as e:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
@@ -248,8 +268,32 @@ class _Link:
                       'pending': None}
         kind, topic = sim_commands.subscription(args.driver)
         node.create_subscription(kind, topic, self.on_command, COMMAND_QOS)
+        if args.lockstep:
+            self._lockstep_interfaces(NODE_NAME, COMMAND_QOS)
 
-    def on_command(self, msg) -> None:
+    def _lockstep_interfaces(self, node_name: str, qos) -> None:
+        """--lockstep: /clock, and the stamped commands that name the joint state answered."""
+        from rosgraph_msgs.msg import Clock
+        from sensor_msgs.msg import JointState
+
+        self.clock_pub = self.node.create_publisher(Clock, '/clock', 10)
+        self.state.update(asked=None, unanswered=0)
+        self.node.create_subscription(JointState, f'{node_name}/effort_commands_stamped',
+                                      self.on_stamped, qos)
+
+    def on_stamped(self, msg) -> None:
+        """--lockstep: take the node's answer to the joint state last published, only."""
+        stamp = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+        if stamp != self.state['asked']:
+            return  # a late answer to an earlier joint state: not applied
+        from std_msgs.msg import Float64MultiArray
+
+        self.state['asked'] = None
+        self.on_command(Float64MultiArray(data=list(msg.effort)), lockstep=False)
+
+    def on_command(self, msg, lockstep: bool | None = None) -> None:
+        if self.args.lockstep if lockstep is None else lockstep:
+            return  # lockstep takes the stamped copy (on_stamped)
         cmd = sim_commands.command_of(msg, len(self.names))
         if cmd is None:
             self.state['malformed'] += 1
@@ -270,6 +314,12 @@ class _Link:
 
         if self.state['pending'] is None and self.solve.service_is_ready():
             self.state['pending'] = self.solve.call_async(Trigger.Request())
+            if self.args.lockstep:  # answered while the simulation waits, not during a cycle
+                import rclpy
+
+                rclpy.spin_until_future_complete(self.node, self.state['pending'],
+                                                 timeout_sec=LOCKSTEP_WAIT * 10)
+                self.take_prediction()
 
     def take_prediction(self) -> None:
         future = self.state['pending']
@@ -287,16 +337,28 @@ class _Link:
         from std_msgs.msg import Float64MultiArray
 
         hsim, hand = self.hsim, self.setup.hand
-        stamp = self.node.get_clock().now().to_msg()
+        if self.args.lockstep:  # the simulation's time, on /clock and in the stamps
+            from builtin_interfaces.msg import Time
+            from rosgraph_msgs.msg import Clock
+
+            ns = round(hsim.time * 1e9)
+            stamp = Time(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+            if self.state.get('clock') != ns:  # else on /clock since the step (tick)
+                self.clock_pub.publish(Clock(clock=stamp))
+            self.state['asked'] = (stamp.sec, stamp.nanosec)
+        else:
+            stamp = self.node.get_clock().now().to_msg()
         js = JointState(name=self.names, position=[float(x) for x in hsim.reading],
                         velocity=[float(x) for x in hsim.qdot],
                         effort=[float(x) for x in hsim.effort()])
         js.header.stamp = stamp
-        self.js_pub.publish(js)
+        # The IMU before the joint state: the node's cycle on the joint state uses it.
         self.imu_pub.publish(imu_message(Imu, *hsim.imu(), hand.base_frame, stamp))
+        self.js_pub.publish(js)
         if self.baseline is not None:  # the driver's own controller, on what it publishes
             self.on_command(Float64MultiArray(data=[float(x)
-                                                    for x in self.baseline(hsim.reading)]))
+                                                    for x in self.baseline(hsim.reading)]),
+                            lockstep=False)
         if self.args.tactile:
             from std_msgs.msg import Float32MultiArray
             self.tactile_pub.publish(Float32MultiArray(data=[float(x) for x in hsim.touch()]))
@@ -308,6 +370,9 @@ class _Link:
     def run_for(self, seconds: float, until=None, each_second=None) -> bool:
         """Step in real time; publish joint states, apply commands; stop early on until()."""
         import rclpy
+
+        if self.args.lockstep:
+            return self.run_lockstep(seconds, until, each_second)
 
         hsim, state = self.hsim, self.state
         dt = hsim.model.opt.timestep
@@ -335,6 +400,73 @@ class _Link:
             wait = min(next_pub, t0_wall + seconds) - time.monotonic()
             rclpy.spin_once(self.node, timeout_sec=max(0.0, wait))
             self.take_prediction()
+        return False
+
+    def tick(self) -> None:
+        """
+        --lockstep: publish the simulation's time on /clock as soon as it is stepped.
+
+        Well before the joint state of that time, so that the node's clock has moved
+        when the joint state comes (they are two topics: no order between them is sure).
+        """
+        from builtin_interfaces.msg import Time
+        from rosgraph_msgs.msg import Clock
+
+        ns = round(self.hsim.time * 1e9)
+        self.clock_pub.publish(Clock(clock=Time(sec=ns // 1_000_000_000,
+                                                nanosec=ns % 1_000_000_000)))
+        self.state['clock'] = ns
+
+    def answer(self, seconds: float) -> bool:
+        """--lockstep: spin until the node answers the joint state published, or ``seconds``."""
+        import rclpy
+
+        deadline = time.monotonic() + seconds
+        while self.state['asked'] is not None and (left := deadline - time.monotonic()) > 0:
+            rclpy.spin_once(self.node, timeout_sec=min(left, 0.05))
+        self.take_prediction()
+        return self.state['asked'] is None
+
+    def run_lockstep(self, seconds: float, until=None, each_second=None) -> bool:
+        """
+        Step in lockstep with the node: each joint state answered before the physics goes on.
+
+        Simulated time advances by one joint state period per answer (or per
+        ``LOCKSTEP_WAIT`` of the wall clock without one: the node published nothing, a
+        fault, and the command in force stays). Before the first command the simulation
+        waits (wall clock, up to ``seconds``) with its time stopped.
+        """
+        import rclpy
+
+        hsim, state = self.hsim, self.state
+        dt = hsim.model.opt.timestep
+        steps = max(1, round(1.0 / (self.args.rate * dt)))
+        if state['commands'] == 0:  # the node starts: simulated time stands still
+            deadline = time.monotonic() + seconds
+            while time.monotonic() < deadline:
+                self.publish()
+                if self.answer(LOCKSTEP_WAIT):
+                    end = time.monotonic() + 0.2  # answers to its repeats: not taken
+                    while time.monotonic() < end:
+                        rclpy.spin_once(self.node, timeout_sec=0.05)
+                    break
+            return until is None or until()
+        t_end, next_second = hsim.time + seconds - dt / 2, hsim.time + 1.0 - dt / 2
+        while hsim.time < t_end:
+            self.publish()
+            if not self.answer(LOCKSTEP_WAIT):
+                state['asked'] = None
+                state['unanswered'] += 1
+            if state['command'] is not None:
+                hsim.command = state['command']
+                hsim.hold_joints = False
+            hsim.step(steps)
+            self.tick()
+            if until is not None and until():
+                return True
+            if each_second is not None and hsim.time >= next_second:
+                next_second += 1.0
+                each_second()
         return False
 
 
@@ -419,13 +551,20 @@ def _summary(args: argparse.Namespace, track: _Track, commands: int, wall: float
     hsim = track.hsim
     simulated = hsim.time - track.sim_release
     drift, rotation = hsim.motion()
-    held = track.passed is None
+    turned = np.degrees(rotation) >= args.rotation_limit
+    held = track.passed is None and not turned
     if held:
         why = (f'held: drift {drift * 1e3:.3f} mm, rotation {np.degrees(rotation):.3f} deg '
-               f'after {simulated:.1f} s (limit {args.drift_limit:g} mm)')
+               f'after {simulated:.1f} s (limits {args.drift_limit:g} mm, '
+               f'{args.rotation_limit:g} deg)')
+    elif track.passed is None:
+        why = (f'NOT held: rotation {np.degrees(rotation):.3f} deg after {simulated:.1f} s, '
+               f'not under the rotation limit {args.rotation_limit:g} deg (drift '
+               f'{drift * 1e3:.3f} mm, under its limit {args.drift_limit:g} mm)')
     else:
         why = (f'NOT held: drift passed {args.drift_limit:g} mm at t = {track.passed:.2f} s'
-               f', {track.max_drift * 1e3:.1f} mm at most')
+               f', {track.max_drift * 1e3:.1f} mm at most (at the end {drift * 1e3:.3f} mm, '
+               f'rotation {np.degrees(rotation):.3f} deg)')
         if track.lost:
             first = min(track.lost, key=track.lost.get)
             why += f'; contact lost first at {first}'
@@ -444,6 +583,8 @@ def _summary(args: argparse.Namespace, track: _Track, commands: int, wall: float
                      "cone (MuJoCo's elliptic cone is wider)")
     extra.append(f'{commands} commands ({commands / max(wall, 1e-9):.0f}/s, malformed '
                  f'{malformed})')
+    if args.lockstep:
+        extra.append(f"lockstep, {track.link.state['unanswered']} joint states unanswered")
     extra.append(f'real-time factor {simulated / max(wall, 1e-9):.2f}')
     why += f'; mean effort {hsim.mean_effort():.4f} N m (RMS joint torque)'
     return held, 'summary: ' + why + '; ' + '; '.join(extra)
@@ -461,7 +602,8 @@ def _plot(args: argparse.Namespace, scenario, trace: list, node: bool) -> str:
     from grasp_torque_opt.sim.model import SimSettings
     from grasp_torque_opt.sim.plot import PLOT_CAPTION, plot_runs
 
-    sim = SimSettings(mu_tangential=args.mu_tangential, mu_torsional=args.mu_torsional)
+    mu_tangential, mu_torsional = friction(args, scenario)
+    sim = SimSettings(mu_tangential=mu_tangential, mu_torsional=mu_torsional)
     base = baseline_trace(scenario, rig_settings(args), sim)
     label = 'this run: the node over ROS, on its params file' if node else \
         f'this run: {args.controller}'

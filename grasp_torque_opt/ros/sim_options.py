@@ -55,8 +55,16 @@ def parser(description: str) -> argparse.ArgumentParser:
                    help="simulated tangential friction [-] (default: the scenario's)")
     p.add_argument('--mu-torsional', type=float, default=None,
                    help="simulated torsional friction [m] (default: the scenario's)")
-    p.add_argument('--drift-limit', type=float, default=1.0,
+    p.add_argument('--friction-scale', type=float, default=None,
+                   help="simulated friction over the scenario's, tangential and torsional "
+                        '[-] (not with --mu-tangential or --mu-torsional)')
+    p.add_argument('--drift-limit', type=float, default=2.0,
                    help='the object counts as held while it moves less than this [mm]')
+    p.add_argument('--rotation-limit', type=float, default=2.0,
+                   help='... and turns less than this [deg]')
+    p.add_argument('--lockstep', action='store_true',
+                   help='advance the simulation only when the node has answered the latest '
+                        'joint state (reproducible; slower than real time): docs/simulation.md')
     g = p.add_argument_group('disturbances the controller is not told')
     g.add_argument('--base-accel', metavar='AX,AY,AZ', default=None,
                    help="the hand base's extra static acceleration from release on, base "
@@ -135,16 +143,27 @@ def check(args: argparse.Namespace) -> str:
     Sets ``args.base_accel`` (m/s^2, shape (3,)), ``args.base_shake`` (amplitude [g],
     frequency [Hz], unit axis, or None) and ``args.object_offset`` (m, shape (3,)).
     """
-    for name in ('duration', 'rate', 'wait', 'drift_limit', 'mass_scale'):
+    for name in ('duration', 'rate', 'wait', 'drift_limit', 'rotation_limit', 'mass_scale'):
         if not getattr(args, name) > 0:
             return f"--{name.replace('_', '-')}: must be > 0"
     for name in ('settle', 'kp', 'kd', 'joint_noise', 'squeeze_depth'):
         if not getattr(args, name) >= 0:
             return f"--{name.replace('_', '-')}: must be >= 0"
-    for name in ('mu_tangential', 'mu_torsional', 'preset_level'):
+    for name in ('mu_tangential', 'mu_torsional', 'preset_level', 'friction_scale'):
         value = getattr(args, name)
         if value is not None and not value > 0:
             return f"--{name.replace('_', '-')}: must be > 0"
+    if args.friction_scale is not None and not np.isfinite(args.friction_scale):
+        return '--friction-scale: must be finite'
+    if args.friction_scale is not None and (args.mu_tangential is not None
+                                            or args.mu_torsional is not None):
+        return ('--friction-scale: not with --mu-tangential or --mu-torsional (give the '
+                'scale of both, or the values)')
+    if args.lockstep and args.controller != 'node':
+        return f'--lockstep: only with --controller node (got {args.controller})'
+    if args.lockstep and getattr(args, 'driver', 'effort') != 'effort':
+        return ('--lockstep: only with --driver effort (it applies the stamped torques), '
+                f'got {args.driver}')
     for name in ('base_accel', 'object_offset'):
         text = getattr(args, name)
         value = np.zeros(3) if text is None else _triple(text)
@@ -169,6 +188,14 @@ def check(args: argparse.Namespace) -> str:
         return ("--plan: the node's own cycle simulates the candidate, without ROS: not "
                 'with --with-node or --controller ' + args.controller)
     return ''
+
+
+def friction(args: argparse.Namespace, scenario) -> tuple[float | None, float | None]:
+    """Return the simulated (tangential, torsional) friction: the options, or the scaled."""
+    if args.friction_scale is None:
+        return args.mu_tangential, args.mu_torsional
+    return (args.friction_scale * scenario.friction.mu1,
+            args.friction_scale * scenario.friction.mu2)
 
 
 def rig_settings(args: argparse.Namespace):
@@ -205,6 +232,8 @@ def describe(args: argparse.Namespace) -> str:
     if np.any(args.object_offset):
         parts.append('object offset [' + ', '.join(f'{1e3 * v:g}' for v in args.object_offset)
                      + '] mm')
+    if args.friction_scale is not None and args.friction_scale != 1.0:
+        parts.append(f'friction x{args.friction_scale:g}')
     if args.joint_noise > 0:
         parts.append(f'joint noise {args.joint_noise:g} mrad')
     return ', '.join(parts)

@@ -85,7 +85,7 @@ def test_a_ball_three_times_heavier_than_the_node_is_told_falls():
     done = run('--with-node', '--duration', '1', '--no-picture', '--mass-scale', '3')
     assert done.returncode == 1, done.stdout + done.stderr
     summary = summary_of(done)
-    assert summary.startswith('summary: NOT held: drift passed 1 mm'), summary
+    assert summary.startswith('summary: NOT held: drift passed 2 mm'), summary
     assert 'mass x3' in done.stdout.splitlines()[0]
 
 

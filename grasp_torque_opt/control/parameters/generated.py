@@ -681,6 +681,10 @@ class Params:
             as it is. Off by default: it helps the 1 kHz answer rate and hurts the tails on a busy
             2-core machine (docs/node.md, The executor thread's priority).
         marker_scale: Arrow length per newton in ~/contact_wrenches. [m/N]
+        age_on_sim_time: With use_sim_time, age the inputs and pace the rate rules on the ROS clock
+            (simulated time) instead of the monotonic clock, for a simulation that waits for the
+            node (grasp-torque-sim --lockstep). A /clock that stops then stops staleness:
+            simulations only.
         publish_stamped_command: Also publish each command on ~/effort_commands_stamped
             (sensor_msgs/JointState: joints, effort, and the stamp of the joint state it was
             computed from).
@@ -749,6 +753,7 @@ class Params:
     startup_check_time: float | None
     thread_priority: int | None
     marker_scale: float | None
+    age_on_sim_time: bool | None
     publish_stamped_command: bool | None
     command_interface: str | None
     position: ParamsPosition

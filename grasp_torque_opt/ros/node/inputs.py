@@ -83,7 +83,10 @@ class Inputs:
     def start(self) -> list[Any]:
         """Make a subscription per input of the table (an input's ``enabled`` parameter on)."""
         made = []
-        for name, given in REGISTRY.items():
+        # The joint states' subscription last: when messages of several inputs wait
+        # together, rclpy's executor takes them in the order their subscriptions were
+        # made, so the others are taken before the joint state whose cycle uses them.
+        for name, given in sorted(REGISTRY.items(), key=lambda item: item[0] == 'joint_states'):
             if given.enabled and not subscribed(given, value_of(self.root.params,
                                                                 given.enabled)):
                 continue
@@ -120,6 +123,24 @@ class Inputs:
             return time.time()
         return self.node.get_clock().now().nanoseconds * 1e-9
 
+    @property
+    def sim_aged(self) -> bool:
+        """Whether inputs are aged on simulated time (``age_on_sim_time``, read-only)."""
+        return self.sim_time and bool(getattr(self.root.params, 'age_on_sim_time', False))
+
+    def now(self) -> float:
+        """
+        Now on the clock that ages inputs and paces the rate rules [s].
+
+        The monotonic clock; with ``use_sim_time`` and ``age_on_sim_time`` the ROS clock
+        (simulated time), so that a simulation that waits for the node
+        (``grasp-torque-sim --lockstep``) gets the same commands whatever the machine's
+        load (docs/node.md, "Which clock ages an input").
+        """
+        if not self.sim_aged:
+            return time.monotonic()
+        return self.node.get_clock().now().nanoseconds * 1e-9
+
     def on_serialized(self, topic: str, msg_type: type, data: bytes, take: Any,
                       info: dict | None) -> None:
         """
@@ -127,7 +148,7 @@ class Inputs:
 
         Its length is checked, then it is deserialized and taken (``take(msg, receipt)``).
         """
-        receipt = received(info) if info is not None else None
+        receipt = received(info) if info is not None and not self.sim_aged else None
         with self.root.lock:
             ctrl = self.root.controller
             if ctrl is None:
@@ -147,7 +168,7 @@ class Inputs:
             msg: the joint state.
             receipt: when the middleware received it (monotonic [s]; None: now).
         """
-        now = time.monotonic()
+        now = self.now()
         receipt = now if receipt is None else receipt
         header = msg.header.stamp
         stamp = stamp_seconds(header.sec, header.nanosec)
@@ -178,7 +199,7 @@ class Inputs:
         The conversion (:data:`MESSAGES`) may look a frame up with tf2, outside the lock;
         a rejection is logged (throttled) and counted, never commanded.
         """
-        now = time.monotonic() if receipt is None else receipt
+        now = self.now() if receipt is None else receipt
         header = getattr(msg, 'header', None)  # a std_msgs array has none: unstamped
         stamp = 0.0 if header is None else stamp_seconds(header.stamp.sec, header.stamp.nanosec)
         with self.root.lock:

@@ -22,7 +22,6 @@ from __future__ import annotations
 from collections.abc import Callable
 import dataclasses
 import threading
-import time
 from typing import Any
 
 from grasp_torque_opt.control.controller import TorqueController
@@ -186,7 +185,7 @@ class GraspTorque:
             if in_force is not None and not (np.abs(in_force) <= lim).all():
                 # A torque the user has just forbidden is not held until the request ends.
                 self._change_due = False
-                result = self.controller.reconfigured(time.monotonic())
+                result = self.controller.reconfigured(self.inputs.now())
                 if result is not None:
                     self.outputs.publish(result, self.last_stamp)
             if self._changed is not None:
@@ -200,7 +199,7 @@ class GraspTorque:
             if not (self._change_due and self.commanding):
                 return
             self._change_due = False
-            result = self.controller.reconfigured(time.monotonic())
+            result = self.controller.reconfigured(self.inputs.now())
             if result is not None:
                 self.outputs.publish(result, self.last_stamp)
 
@@ -269,7 +268,7 @@ class GraspTorque:
         if not self.commanding:
             return
         with self.lock:
-            result = self.controller.watchdog(time.monotonic())
+            result = self.controller.watchdog(self.inputs.now())
             if result is not None:
                 self.outputs.publish(result)
 
@@ -277,7 +276,7 @@ class GraspTorque:
         """Start commanding; fresh inputs command at once, a command over the limits zeroed."""
         with self.lock:
             self.active = True
-            decision = self.controller.reconfigured(time.monotonic())
+            decision = self.controller.reconfigured(self.inputs.now())
             if decision is not None:
                 self.outputs.publish(decision, self.last_stamp)
 

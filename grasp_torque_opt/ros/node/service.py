@@ -107,7 +107,7 @@ class SolveService:
         try:
             done = Future(executor=root.node.executor)
             done.add_done_callback(lambda _: None)  # completion wakes the executor
-            worker.submit(self.solve, inputs, time.monotonic(), done, ctrl)
+            worker.submit(self.solve, inputs, root.inputs.now(), done, ctrl)
             await done
         finally:
             self.pending -= 1
