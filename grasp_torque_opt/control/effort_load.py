@@ -31,14 +31,117 @@ read -1.6 N against the model's +1.47 N, and integrating it put the correction a
 bound at the moment of release, a 2.6 to 4.5 mm drop on a ball 3 to 5 mm off its
 place). Then the correction decays towards zero with the same time constant: the
 model's load is planned until the measurement is plausible again.
+
+**What the efforts are** (``effort_estimation.effort_report``): ``applied``, the torque
+each joint applies (current sensing; the simulated hand's default); ``commanded``, the
+node's own last command echoed (the Allegro V5's driver). An echo holds no news of the
+load: integrated, b moves the command, the echo follows, and b runs to its bound (4.4 s
+on a still simulated hand). The applied torque is then the command plus the driver's
+impedance, Kp (q_ref - q) (:func:`applied_torque`): ``effort_estimation.driver_stiffness``
+Kp and ``driver_reference`` q_ref (empty: the scenario's grasp configuration; the
+simulated driver holds that before release and the settled configuration after, a few
+hundredths of a millimetre away at the fingertips).
+
+**The gate** (:class:`Agreement`): the efforts give the load only while the fingertips
+and the object agree, the object held still and rigidly. A slipping ball pulls on the
+fingers less than its weight (the hand does not hold it, it falls through it), and a
+ball off its place is touched elsewhere than the contacts the estimate inverts through:
+both read as a lighter load, and the correction, integrated, gave way (-0.7 N, its
+bound, on a ball 5 mm off its place, before and just after release). From where the
+fingertips place the object
+(:class:`~grasp_torque_opt.core.object_from_hand.ObjectFromHand`): while a fingertip is
+farther than ``effort_estimation.max_residual`` from the object's rigid motion since
+the grasp's start, or the object moves faster than ``effort_estimation.max_object_speed``
+(the fastest contact point under the object's motion between cycles, low-passed with
+``effort_estimation.filter``), the correction is frozen (held, not integrated, not
+decayed) and the estimate starts again from the first reading after.
 """
 
 from __future__ import annotations
+
+from collections import deque
 
 import numpy as np
 
 #: A load error beyond this many times the correction's force bound is not integrated.
 IMPLAUSIBLE = 2.0
+#: What joint_states' effort may be (``effort_estimation.effort_report``).
+EFFORT_REPORTS = ('applied', 'commanded')
+
+
+def applied_torque(effort: np.ndarray, report: str, stiffness: float,
+                   reference: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """
+    Return the torque the joints apply [N m], from the efforts a driver reports.
+
+    Args:
+        effort: joint_states' effort, actuators [N m], shape (m,).
+        report: ``applied`` (the effort is it) or ``commanded`` (the node's last command:
+            the driver adds stiffness (reference - q)).
+        stiffness: the driver's Kp [N m/rad].
+        reference: the position its impedance holds [rad], shape (m,).
+        q: the actuators' positions [rad], shape (m,).
+    """
+    if report == 'applied':
+        return effort
+    return effort + stiffness * (np.asarray(reference, dtype=float) - q)
+
+
+class Agreement:
+    """
+    The gate: whether the fingertips and the object agree (held still and rigidly).
+
+    Attributes:
+        speed: the speed of the fastest contact point under the object's motion [m/s],
+            the slope of its displacement over the window (inf until the window is full).
+        state: why the correction is frozen ('' while the gate is open).
+    """
+
+    def __init__(self) -> None:
+        """Start closed: no motion seen yet."""
+        self.speed = float('inf')
+        self.state = 'frozen: starting'
+        self._seen: deque = deque()
+
+    def check(self, tips, arms: np.ndarray, now: float, window: float, gap: float,
+              limits: tuple[float, float]) -> str:
+        """
+        Take where the fingertips place the object; return why frozen ('' for open).
+
+        Args:
+            tips: :meth:`ObjectFromHand.estimate
+                <grasp_torque_opt.core.object_from_hand.ObjectFromHand.estimate>` now.
+            arms: the contact points less the object origin, base axes [m], shape (p, 3).
+            now: the cycle's time [s].
+            window: the speed is the least-squares slope of the displacement over this
+                much time [s] (a slope, not a difference: the encoders' noise averages).
+            gap: a longer time between readings starts the window again [s].
+            limits: ``max_object_speed`` [m/s] and ``max_residual`` [m].
+        """
+        seen = self._seen
+        if seen and not 0.0 < now - seen[-1][0] <= gap:
+            seen.clear()
+        seen.append((now, np.concatenate((tips.translation, tips.rotation))))
+        while now - seen[0][0] > window:
+            seen.popleft()
+        self.speed = float('inf')
+        if len(seen) >= 3 and now - seen[0][0] >= 0.5 * window:
+            t = np.array([x[0] for x in seen])
+            A = np.column_stack((t - t.mean(), np.ones_like(t)))
+            slope = np.linalg.lstsq(A, np.array([x[1] for x in seen]), rcond=None)[0][0]
+            points = slope[:3] + np.cross(slope[3:], arms)
+            self.speed = float(np.linalg.norm(points, axis=1).max())
+        max_speed, max_residual = limits
+        if not tips.residual <= max_residual:
+            self.state = (f'frozen: a fingertip {1e3 * tips.residual:.3g} mm off the '
+                          f'rigid hold (max_residual {1e3 * max_residual:g} mm)')
+        elif not self.speed <= max_speed:
+            self.state = ('frozen: starting' if not np.isfinite(self.speed) else
+                          f'frozen: the object moves at {1e3 * self.speed:.3g} mm/s '
+                          f'(max_object_speed {1e3 * max_speed:g} mm/s)')
+        else:
+            self.state = ''
+        return self.state
 
 
 class EffortLoad:
@@ -59,10 +162,15 @@ class EffortLoad:
         self.off = ''
         self.said = False
         self._last: float | None = None
+        self._history: deque = deque()
+        #: The gate (:class:`Agreement`), None: none (no fingertips' estimate).
+        self.agreement: Agreement | None = None
 
     def reset(self) -> None:
         """Drop the estimate and the correction (inputs lost, the feature turned off)."""
         self.estimate, self.correction, self._last = None, np.zeros(6), None
+        self.agreement = None
+        self._history.clear()
 
     def turn_off(self, why: str) -> None:
         """Stop estimating, for a reason said once."""
@@ -103,7 +211,8 @@ class EffortLoad:
 
     def update(self, measured: np.ndarray, model: np.ndarray, now: float, filter_s: float,
                time_constant: float, bounds: tuple[float, float], gap: float,
-               along: np.ndarray | None = None) -> np.ndarray:
+               along: np.ndarray | None = None, frozen: str = '', window: float = 0.0
+               ) -> np.ndarray:
         """
         Take one measurement; return the correction b to add to the model's load.
 
@@ -117,11 +226,23 @@ class EffortLoad:
             gap: a longer time between cycles starts the filter again [s].
             along: a unit vector: only the force error along it is integrated (the
                 mass-only estimate, along the apparent gravity); None: the whole wrench.
+            frozen: why the gate is closed ('' open): then the correction is held at
+                its value ``window`` ago (before the motion was seen) and the estimate
+                starts again at the first reading after.
+            window: the gate's window [s] (:class:`Agreement`).
         """
         if not np.all(np.isfinite(measured)):
             return self.correction
         last = self._last
         self._last = now
+        if frozen:
+            # Held at its value before the motion was seen (the window's oldest): the
+            # readings of the window were integrated before the slope could tell.
+            if self._history:
+                self.correction = self._history[0][1]
+                self._history.clear()
+            self.estimate = None
+            return self.correction
         dt = now - last if last is not None and 0.0 < now - last <= gap else None
         if float(np.linalg.norm(self._error(measured, model, along)[:3])) \
                 > IMPLAUSIBLE * bounds[0]:
@@ -138,7 +259,15 @@ class EffortLoad:
         error = self._error(self.estimate, model, along)
         b = self.correction + dt / (time_constant + dt) * error
         self.correction = clipped(b, bounds)
+        self._remember(now, window)
         return self.correction
+
+    def _remember(self, now: float, window: float) -> None:
+        """Keep the corrections of the gate's last window (the one before motion is seen)."""
+        history = self._history
+        history.append((now, self.correction.copy()))
+        while now - history[0][0] > window:
+            history.popleft()
 
     def _error(self, estimate: np.ndarray, model: np.ndarray,
                along: np.ndarray | None) -> np.ndarray:
