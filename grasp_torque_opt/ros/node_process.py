@@ -49,17 +49,21 @@ def scenario_of(params: Path) -> str:
 
 
 @contextlib.contextmanager
-def node_process(params: Path, start: bool) -> Iterator[subprocess.Popen | None]:
+def node_process(params: Path, start: bool, overrides: tuple[str, ...] = ()
+                 ) -> Iterator[subprocess.Popen | None]:
     """
     ``grasp_torque_node`` on ``params`` in a child process while the block runs (if ``start``).
+
+    ``overrides``: ``NAME:=VALUE`` parameters given after the file (``-p``).
 
     It is stopped with SIGINT (its safe stop: zero torques with the zero policy),
     killed if it has not ended after 10 s.
     """
     child = None
     if start:
+        extra = [arg for o in overrides for arg in ('-p', o)]
         child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
-                                  '--ros-args', '--params-file', str(params),
+                                  '--ros-args', '--params-file', str(params), *extra,
                                   '--log-level', 'error'])
     try:
         yield child

@@ -11,7 +11,8 @@ A simulated hand driver: the scenario's hand and object in MuJoCo, on the node's
 
 What a real hand with a ros2_control effort controller would be (docs/simulation.md):
 MuJoCo steps in real time at 1 kHz; ``joint_states`` carries positions,
-velocities and the efforts applied; the latest ``effort_commands`` is applied
+velocities and the efforts applied (``--effort-report commanded``: the last command
+received, as the Allegro V5's driver reports it); the latest ``effort_commands`` is applied
 as joint torques and held until the next one (no timeout, as the effort
 controller does), plus a joint impedance Kp, Kd around the configuration the
 fingers settled in, as real hand drivers add. Until the first command the
@@ -81,7 +82,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
-        with node_process(params, args.with_node):
+        told = () if args.effort_report == 'applied' else (  # the node told what they are
+            'effort_estimation.driver_stiffness:=' + repr(float(args.kp)),
+            'effort_estimation.effort_report:=commanded')
+        with node_process(params, args.with_node, told):
             return _run(args, scenario, setup, rig, baseline)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
@@ -265,7 +269,7 @@ class _Link:
         stamp = self.node.get_clock().now().to_msg()
         js = JointState(name=self.names, position=[float(x) for x in hsim.reading],
                         velocity=[float(x) for x in hsim.qdot],
-                        effort=[float(x) for x in hsim.effort()])
+                        effort=[float(x) for x in hsim.reported_effort()])
         js.header.stamp = stamp
         self.js_pub.publish(js)
         self.imu_pub.publish(imu_message(Imu, *hsim.imu(), hand.base_frame, stamp))
