@@ -225,7 +225,8 @@ class Cycle:
         return est.update(est.measured(maps.G, maps.J, tau, g), model,
                           inputs.q_time, c.effort_filter, c.effort_time_constant, bounds,
                           gap=c.joint_state_timeout, along=along, frozen=frozen,
-                          window=c.effort_speed_window)
+                          window=c.effort_speed_window,
+                          unwind=est.agreement is not None and est.agreement.off_hold)
 
     def _gate(self, at: GraspSetup, positions: np.ndarray, now: float) -> str:
         """Return why the effort estimate is frozen ('' open; :class:`.effort_load.Agreement`)."""

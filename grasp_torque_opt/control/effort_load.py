@@ -49,12 +49,21 @@ ball off its place is touched elsewhere than the contacts the estimate inverts t
 both read as a lighter load, and the correction, integrated, gave way (-0.7 N, its
 bound, on a ball 5 mm off its place, before and just after release). From where the
 fingertips place the object
-(:class:`~grasp_torque_opt.core.object_from_hand.ObjectFromHand`): while a fingertip is
-farther than ``effort_estimation.max_residual`` from the object's rigid motion since
-the grasp's start, or the object moves faster than ``effort_estimation.max_object_speed``
-(the fastest contact point under the object's motion between cycles, low-passed with
-``effort_estimation.filter``), the correction is frozen (held, not integrated, not
-decayed) and the estimate starts again from the first reading after.
+(:class:`~grasp_torque_opt.core.object_from_hand.ObjectFromHand`), nothing is
+integrated while
+
+- the object moves faster than ``effort_estimation.max_object_speed`` (the fastest
+  contact point under the object's motion, the least-squares slope of its displacement
+  over ``effort_estimation.speed_window``): the correction is held at its value one
+  window before (the readings the slope needed to see the motion are undone);
+- a fingertip is farther than ``effort_estimation.max_residual`` from the object's
+  rigid motion since the grasp's start (a slip or roll of a tip, the object not where
+  the scenario says): the correction also decays towards zero with the integral's time
+  constant, as for an implausible reading. What was learned was learned on another
+  grasp: on a ball 1 mm off its place that slipped at release, a correction held at
+  -0.28 N left it 3.1 mm down where the model's load held it.
+
+The estimate starts again from the first reading after.
 """
 
 from __future__ import annotations
@@ -95,12 +104,14 @@ class Agreement:
         speed: the speed of the fastest contact point under the object's motion [m/s],
             the slope of its displacement over the window (inf until the window is full).
         state: why the correction is frozen ('' while the gate is open).
+        off_hold: a fingertip is off the rigid hold (then the correction unwinds).
     """
 
     def __init__(self) -> None:
         """Start closed: no motion seen yet."""
         self.speed = float('inf')
         self.state = 'frozen: starting'
+        self.off_hold = False
         self._seen: deque = deque()
 
     def check(self, tips, arms: np.ndarray, now: float, window: float, gap: float,
@@ -132,7 +143,8 @@ class Agreement:
             points = slope[:3] + np.cross(slope[3:], arms)
             self.speed = float(np.linalg.norm(points, axis=1).max())
         max_speed, max_residual = limits
-        if not tips.residual <= max_residual:
+        self.off_hold = not tips.residual <= max_residual
+        if self.off_hold:
             self.state = (f'frozen: a fingertip {1e3 * tips.residual:.3g} mm off the '
                           f'rigid hold (max_residual {1e3 * max_residual:g} mm)')
         elif not self.speed <= max_speed:
@@ -211,8 +223,8 @@ class EffortLoad:
 
     def update(self, measured: np.ndarray, model: np.ndarray, now: float, filter_s: float,
                time_constant: float, bounds: tuple[float, float], gap: float,
-               along: np.ndarray | None = None, frozen: str = '', window: float = 0.0
-               ) -> np.ndarray:
+               along: np.ndarray | None = None, frozen: str = '', window: float = 0.0,
+               unwind: bool = False) -> np.ndarray:
         """
         Take one measurement; return the correction b to add to the model's load.
 
@@ -230,20 +242,25 @@ class EffortLoad:
                 its value ``window`` ago (before the motion was seen) and the estimate
                 starts again at the first reading after.
             window: the gate's window [s] (:class:`Agreement`).
+            unwind: frozen, the correction also decays towards zero with
+                ``time_constant`` (a fingertip off the rigid hold: what was learned
+                was learned on another grasp).
         """
         if not np.all(np.isfinite(measured)):
             return self.correction
         last = self._last
         self._last = now
+        dt = now - last if last is not None and 0.0 < now - last <= gap else None
         if frozen:
             # Held at its value before the motion was seen (the window's oldest): the
             # readings of the window were integrated before the slope could tell.
             if self._history:
                 self.correction = self._history[0][1]
                 self._history.clear()
+            if unwind and dt is not None:  # the grasp is not the model's: back to it
+                self.correction = self.correction * (time_constant / (time_constant + dt))
             self.estimate = None
             return self.correction
-        dt = now - last if last is not None and 0.0 < now - last <= gap else None
         if float(np.linalg.norm(self._error(measured, model, along)[:3])) \
                 > IMPLAUSIBLE * bounds[0]:
             # Not this object's load alone: back towards the model, and the filter starts
