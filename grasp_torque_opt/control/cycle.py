@@ -212,11 +212,8 @@ class Cycle:
         maps = at.maps()
         bounds = est.bound(self.weight, c.effort_max_load_ratio, maps.positions,
                            at.object_origin)
-        along = None
-        if c.effort_mass_only:
-            gravity = self._gravity_in_use
-            norm = float(np.linalg.norm(gravity))
-            along = gravity / norm if norm > 1e-6 else np.zeros(3)
+        gravity = self._gravity_in_use if c.effort_mass_only else None
+        nominal = float(np.linalg.norm(c.gravity))
         frozen = self._gate(at, maps.positions, inputs.q_time)
         q = at.q[at.hand.idx_q]
         reference = c.effort_driver_reference or self.setup.q[at.hand.idx_q]
@@ -224,9 +221,10 @@ class Cycle:
                              reference, q)
         return est.update(est.measured(maps.G, maps.J, tau, g), model,
                           inputs.q_time, c.effort_filter, c.effort_time_constant, bounds,
-                          gap=c.joint_state_timeout, along=along, frozen=frozen,
+                          gap=c.joint_state_timeout, gravity=gravity, frozen=frozen,
                           window=c.effort_speed_window,
-                          unwind=est.agreement is not None and est.agreement.off_hold)
+                          unwind=est.agreement is not None and est.agreement.off_hold,
+                          mass_bound=bounds[0] / nominal if nominal > 0 else 0.0)
 
     def _gate(self, at: GraspSetup, positions: np.ndarray, now: float) -> str:
         """Return why the effort estimate is frozen ('' open; :class:`.effort_load.Agreement`)."""

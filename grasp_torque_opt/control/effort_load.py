@@ -24,6 +24,16 @@ scenario's weight, its moment by that force times the farthest contact's distanc
 the object origin (:meth:`EffortLoad.bound`). The sum is planned and certified as every
 load is: the estimate moves what is planned, never what is checked.
 
+The mass-only estimate (``effort_estimation.mass_only``) integrates a mass error dm
+instead, from the force error along the apparent gravity g_a:
+
+    d(dm)/dt = ((w_est - (w_model + b)) . g_a / |g_a|^2) / T,     b = dm g_a,
+
+|dm| at most ``max_load_ratio`` times the scenario's mass. A mass is what does not
+change when the hand shakes: b follows the apparent gravity at once (a force learned at
+1 g and held through a shake was 0.3 N short at 2 g and 0.3 N over at 0 g), and a
+frozen dm (the gate, below) stays right through the shake.
+
 An error beyond ``IMPLAUSIBLE`` times the force bound is no load the correction could
 meet: the hand is not holding the modelled object alone (it is still being placed in
 the hand, or held by something else: in the simulation, the pinned ball before release
@@ -74,6 +84,8 @@ import numpy as np
 
 #: A load error beyond this many times the correction's force bound is not integrated.
 IMPLAUSIBLE = 2.0
+#: Below this apparent gravity [m/s^2] the mass error is not integrated (nothing to weigh).
+MIN_GRAVITY = 1.0
 #: What joint_states' effort may be (``effort_estimation.effort_report``).
 EFFORT_REPORTS = ('applied', 'commanded')
 
@@ -171,6 +183,7 @@ class EffortLoad:
         """Start with no estimate and no correction."""
         self.estimate: np.ndarray | None = None
         self.correction = np.zeros(6)
+        self.mass = 0.0
         self.off = ''
         self.said = False
         self._last: float | None = None
@@ -181,6 +194,7 @@ class EffortLoad:
     def reset(self) -> None:
         """Drop the estimate and the correction (inputs lost, the feature turned off)."""
         self.estimate, self.correction, self._last = None, np.zeros(6), None
+        self.mass = 0.0
         self.agreement = None
         self._history.clear()
 
@@ -223,8 +237,8 @@ class EffortLoad:
 
     def update(self, measured: np.ndarray, model: np.ndarray, now: float, filter_s: float,
                time_constant: float, bounds: tuple[float, float], gap: float,
-               along: np.ndarray | None = None, frozen: str = '', window: float = 0.0,
-               unwind: bool = False) -> np.ndarray:
+               gravity: np.ndarray | None = None, frozen: str = '', window: float = 0.0,
+               unwind: bool = False, mass_bound: float = np.inf) -> np.ndarray:
         """
         Take one measurement; return the correction b to add to the model's load.
 
@@ -234,65 +248,77 @@ class EffortLoad:
             now: the cycle's time [s].
             filter_s: the estimate's low-pass time constant [s].
             time_constant: T of the integral action [s].
-            bounds: the force and moment bounds (:meth:`bound`).
+            bounds: the force and moment bounds (:meth:`bound`; the whole wrench's).
             gap: a longer time between cycles starts the filter again [s].
-            along: a unit vector: only the force error along it is integrated (the
-                mass-only estimate, along the apparent gravity); None: the whole wrench.
-            frozen: why the gate is closed ('' open): then the correction is held at
-                its value ``window`` ago (before the motion was seen) and the estimate
+            gravity: the apparent gravity [m/s^2], base axes: the mass-only estimate, a
+                mass error dm integrated from the force error along it, b = dm gravity
+                (it follows the apparent gravity at once); None: the whole wrench.
+            frozen: why the gate is closed ('' open): then the integral is held at its
+                value ``window`` ago (before the motion was seen) and the estimate
                 starts again at the first reading after.
             window: the gate's window [s] (:class:`Agreement`).
-            unwind: frozen, the correction also decays towards zero with
+            unwind: frozen, the integral also decays towards zero with
                 ``time_constant`` (a fingertip off the rigid hold: what was learned
                 was learned on another grasp).
+            mass_bound: |dm| at most this [kg] (the mass-only estimate).
         """
         if not np.all(np.isfinite(measured)):
-            return self.correction
-        last = self._last
-        self._last = now
+            return self._out(gravity)
+        last, self._last = self._last, now
         dt = now - last if last is not None and 0.0 < now - last <= gap else None
+        decay = 1.0 if dt is None else time_constant / (time_constant + dt)
         if frozen:
             # Held at its value before the motion was seen (the window's oldest): the
             # readings of the window were integrated before the slope could tell.
             if self._history:
-                self.correction = self._history[0][1]
+                _, self.correction, self.mass = self._history[0]
                 self._history.clear()
-            if unwind and dt is not None:  # the grasp is not the model's: back to it
-                self.correction = self.correction * (time_constant / (time_constant + dt))
+            if unwind:  # the grasp is not the model's: back to it
+                self.correction, self.mass = self.correction * decay, self.mass * decay
             self.estimate = None
-            return self.correction
-        if float(np.linalg.norm(self._error(measured, model, along)[:3])) \
-                > IMPLAUSIBLE * bounds[0]:
+            return self._out(gravity)
+        if self._off_by(measured, model, gravity) > IMPLAUSIBLE * bounds[0]:
             # Not this object's load alone: back towards the model, and the filter starts
             # again from the first plausible measurement (it would carry this one).
             self.estimate = None
-            if dt is not None:
-                self.correction = self.correction * (time_constant / (time_constant + dt))
-            return self.correction
+            self.correction, self.mass = self.correction * decay, self.mass * decay
+            return self._out(gravity)
         if dt is None or self.estimate is None:
             self.estimate = measured.copy()
-            return self.correction
+            return self._out(gravity)
         self.estimate = self.estimate + dt / (filter_s + dt) * (measured - self.estimate)
-        error = self._error(self.estimate, model, along)
-        b = self.correction + dt / (time_constant + dt) * error
-        self.correction = clipped(b, bounds)
+        error = self.estimate - model - self._out(gravity)
+        gain = dt / (time_constant + dt)
+        if gravity is None:
+            self.correction = clipped(self.correction + gain * error, bounds)
+        elif float(np.linalg.norm(gravity)) > MIN_GRAVITY:  # else no weight to weigh by
+            dm = float(error[:3] @ gravity) / float(gravity @ gravity)
+            self.mass = float(np.clip(self.mass + gain * dm, -mass_bound, mass_bound))
         self._remember(now, window)
+        return self._out(gravity)
+
+    def _out(self, gravity: np.ndarray | None) -> np.ndarray:
+        """Return the correction: b, or the mass error times the apparent gravity."""
+        if gravity is not None:
+            self.correction = np.concatenate((self.mass * np.asarray(gravity, dtype=float),
+                                              np.zeros(3)))
         return self.correction
 
+    def _off_by(self, measured: np.ndarray, model: np.ndarray,
+                gravity: np.ndarray | None) -> float:
+        """Return the force error's norm [N] (along the apparent gravity, mass-only)."""
+        error = (measured - model - self._out(gravity))[:3]
+        if gravity is None:
+            return float(np.linalg.norm(error))
+        norm = float(np.linalg.norm(gravity))
+        return abs(float(error @ gravity)) / norm if norm > 0 else 0.0
+
     def _remember(self, now: float, window: float) -> None:
-        """Keep the corrections of the gate's last window (the one before motion is seen)."""
+        """Keep the integral of the gate's last window (its value before motion is seen)."""
         history = self._history
-        history.append((now, self.correction.copy()))
+        history.append((now, self.correction.copy(), self.mass))
         while now - history[0][0] > window:
             history.popleft()
-
-    def _error(self, estimate: np.ndarray, model: np.ndarray,
-               along: np.ndarray | None) -> np.ndarray:
-        """Return the load error the correction would move by (along ``along`` only)."""
-        error = estimate - model - self.correction
-        if along is not None:  # a mass error: the force along the apparent gravity only
-            error = np.concatenate((along * float(error[:3] @ along), np.zeros(3)))
-        return error
 
 
 def clipped(b: np.ndarray, bounds: tuple[float, float]) -> np.ndarray:

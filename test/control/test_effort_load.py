@@ -33,14 +33,16 @@ import pytest
 WEIGHT = 1.4715  # N: 0.15 kg
 MODEL = np.array([WEIGHT, 0.0, 0.0, 0.0, 0.0, 0.0])
 BOUNDS = (0.5 * WEIGHT, 0.5 * WEIGHT * 0.05)
-DOWN = np.array([1.0, 0.0, 0.0])
+GRAVITY = np.array([9.81, 0.0, 0.0])  # the scenario's: palm down
+MASS_BOUND = BOUNDS[0] / 9.81  # kg: half the ball's mass
 
 
 def run(est: EffortLoad, load: float, t0: float, seconds: float) -> float:
     """Feed a constant measured load along gravity at 1 kHz; return the correction's x."""
     measured = np.array([load, 0.0, 0.0, 0.0, 0.0, 0.0])
     for k in range(int(seconds * 1000)):
-        est.update(measured, MODEL, t0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, DOWN)
+        est.update(measured, MODEL, t0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, GRAVITY,
+                   mass_bound=MASS_BOUND)
     return float(est.correction[0])
 
 
@@ -96,13 +98,38 @@ def test_while_frozen_the_correction_is_held_at_its_value_before_the_motion():
     met = float(est.correction[0])
     lighter = np.array([0.6 * WEIGHT, 0.0, 0.0, 0.0, 0.0, 0.0])  # a slip, read lighter
     for k in range(20):  # seen only after 20 ms of it (the slope's window)
-        est.update(lighter, MODEL, 1.0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, DOWN, '', 0.05)
+        est.update(lighter, MODEL, 1.0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, GRAVITY, '', 0.05,
+                   mass_bound=MASS_BOUND)
     assert est.correction[0] < met - 0.05 * WEIGHT
     for k in range(20, 500):
-        est.update(lighter, MODEL, 1.0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, DOWN,
-                   'frozen: the object moves', 0.05)
+        est.update(lighter, MODEL, 1.0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, GRAVITY,
+                   'frozen: the object moves', 0.05, mass_bound=MASS_BOUND)
     assert abs(est.correction[0] - met) < 1e-3 * WEIGHT  # as before the slip
     assert est.estimate is None  # and the estimate starts again once still
+
+
+def test_a_fingertip_off_the_rigid_hold_unwinds_the_correction_to_the_model():
+    est = EffortLoad()
+    run(est, 1.3 * WEIGHT, 0.0, 1.0)
+    for k in range(500):  # 0.5 s, ten time constants
+        est.update(MODEL, MODEL, 1.0 + 1e-3 * k, 0.01, 0.05, BOUNDS, 0.05, GRAVITY,
+                   'frozen: a fingertip off the rigid hold', 0.05, unwind=True,
+                   mass_bound=MASS_BOUND)
+    assert abs(est.correction[0]) < 1e-3 * WEIGHT
+
+
+def test_the_mass_error_follows_the_apparent_gravity():
+    """Learned at 1 g, the correction is the mass error times 2 g at 2 g, frozen or not."""
+    est = EffortLoad()
+    run(est, 1.3 * WEIGHT, 0.0, 1.0)
+    assert abs(est.mass - 0.3 * 0.15) < 1e-4  # kg
+    twice = est.update(2.6 * MODEL, 2.0 * MODEL, 1.0, 0.01, 0.05, BOUNDS, 0.05, 2.0 * GRAVITY,
+                       'frozen: the object moves', 0.05, mass_bound=MASS_BOUND)
+    assert abs(twice[0] - 0.6 * WEIGHT) < 2e-3 * WEIGHT and not np.any(twice[1:])
+    # Weightless, nothing to weigh: not integrated, and no correction.
+    still = est.update(np.zeros(6), np.zeros(6), 1.001, 0.01, 0.05, BOUNDS, 0.05, np.zeros(3),
+                       mass_bound=MASS_BOUND)
+    assert not np.any(still) and abs(est.mass - 0.3 * 0.15) < 1e-4
 
 
 def test_a_commanded_effort_is_the_command_plus_the_drivers_impedance():
