@@ -224,7 +224,8 @@ class Cycle:
                           gap=c.joint_state_timeout, gravity=gravity, frozen=frozen,
                           window=c.effort_speed_window,
                           unwind=est.agreement is not None and est.agreement.off_hold,
-                          mass_bound=bounds[0] / nominal if nominal > 0 else 0.0)
+                          mass_bound=bounds[0] / nominal if nominal > 0 else 0.0,
+                          nominal=nominal)
 
     def _gate(self, at: GraspSetup, positions: np.ndarray, now: float) -> str:
         """Return why the effort estimate is frozen ('' open; :class:`.effort_load.Agreement`)."""

@@ -27,9 +27,11 @@ load is: the estimate moves what is planned, never what is checked.
 The mass-only estimate (``effort_estimation.mass_only``) integrates a mass error dm
 instead, from the force error along the apparent gravity g_a:
 
-    d(dm)/dt = ((w_est - (w_model + b)) . g_a / |g_a|^2) / T,     b = dm g_a,
+    d(dm)/dt = k ((w_est - (w_model + b)) . g_a / |g_a|^2) / T,     b = dm g_a,
 
-|dm| at most ``max_load_ratio`` times the scenario's mass. A mass is what does not
+k = min(1, |g_a|^2 / |g|^2), g the configured gravity (a force error says less of the
+mass the less the apparent gravity: at a tenth of g its noise would be integrated ten
+times over), |dm| at most ``max_load_ratio`` times the scenario's mass. A mass is what does not
 change when the hand shakes: b follows the apparent gravity at once (a force learned at
 1 g and held through a shake was 0.3 N short at 2 g and 0.3 N over at 0 g), and a
 frozen dm (the gate, below) stays right through the shake.
@@ -84,8 +86,6 @@ import numpy as np
 
 #: A load error beyond this many times the correction's force bound is not integrated.
 IMPLAUSIBLE = 2.0
-#: Below this apparent gravity [m/s^2] the mass error is not integrated (nothing to weigh).
-MIN_GRAVITY = 1.0
 #: What joint_states' effort may be (``effort_estimation.effort_report``).
 EFFORT_REPORTS = ('applied', 'commanded')
 
@@ -238,7 +238,8 @@ class EffortLoad:
     def update(self, measured: np.ndarray, model: np.ndarray, now: float, filter_s: float,
                time_constant: float, bounds: tuple[float, float], gap: float,
                gravity: np.ndarray | None = None, frozen: str = '', window: float = 0.0,
-               unwind: bool = False, mass_bound: float = np.inf) -> np.ndarray:
+               unwind: bool = False, mass_bound: float = np.inf,
+               nominal: float = 9.81) -> np.ndarray:
         """
         Take one measurement; return the correction b to add to the model's load.
 
@@ -261,6 +262,8 @@ class EffortLoad:
                 ``time_constant`` (a fingertip off the rigid hold: what was learned
                 was learned on another grasp).
             mass_bound: |dm| at most this [kg] (the mass-only estimate).
+            nominal: the gravity the integral's gain is set for [m/s^2]: below it, the
+                mass error's gain falls as (|g_a| / nominal)^2.
         """
         if not np.all(np.isfinite(measured)):
             return self._out(gravity)
@@ -291,8 +294,13 @@ class EffortLoad:
         gain = dt / (time_constant + dt)
         if gravity is None:
             self.correction = clipped(self.correction + gain * error, bounds)
-        elif float(np.linalg.norm(gravity)) > MIN_GRAVITY:  # else no weight to weigh by
-            dm = float(error[:3] @ gravity) / float(gravity @ gravity)
+        elif float(gravity @ gravity) > 0.0:
+            # Weighed as a force at the nominal gravity would be: the less the apparent
+            # gravity, the less a force error tells of the mass (its noise divided by
+            # |g_a| is not integrated at full gain near weightlessness).
+            square = float(gravity @ gravity)
+            weight = min(1.0, square / nominal ** 2) if nominal > 0 else 1.0
+            dm = weight * float(error[:3] @ gravity) / square
             self.mass = float(np.clip(self.mass + gain * dm, -mass_bound, mass_bound))
         self._remember(now, window)
         return self._out(gravity)

@@ -135,12 +135,14 @@ class CycleConfig:
             action on the estimated load. [s]
         effort_filter: (``effort_estimation.filter``) Time constant of the low-pass on the
             estimated load. [s]
-        effort_mass_only: (``effort_estimation.mass_only``) Correct only the force along the
-            apparent gravity (a mass error: one number, far less noisy); false, the whole wrench
-            (an unmodelled push or moment too).
+        effort_mass_only: (``effort_estimation.mass_only``) Correct only the mass: a mass error
+            from the force error along the apparent gravity, the correction that mass times the
+            apparent gravity (one number, far less noisy, and right through a shake); false, the
+            whole wrench (an unmodelled push or moment too).
         effort_max_load_ratio: (``effort_estimation.max_load_ratio``) The correction's force is at
             most this times the scenario's weight, its moment that force times the farthest
-            contact's distance from the object origin.
+            contact's distance from the object origin (mass_only: the mass error at most this times
+            the scenario's mass).
         effort_report: (``effort_estimation.effort_report``) What joint_states' effort is. applied:
             the torque each joint applies (current sensing, or a driver that reports its command
             plus its impedance); commanded: the node's own last command (the Allegro V5's driver),
@@ -339,10 +341,13 @@ class ParamsEffortEstimation:
             gravity; a driver that reports no effort (empty or NaN): off, said once.
         time_constant: Time constant T of the integral action on the estimated load. [s]
         filter: Time constant of the low-pass on the estimated load. [s]
-        mass_only: Correct only the force along the apparent gravity (a mass error: one number, far
-            less noisy); false, the whole wrench (an unmodelled push or moment too).
+        mass_only: Correct only the mass: a mass error from the force error along the apparent
+            gravity, the correction that mass times the apparent gravity (one number, far less
+            noisy, and right through a shake); false, the whole wrench (an unmodelled push or
+            moment too).
         max_load_ratio: The correction's force is at most this times the scenario's weight, its
-            moment that force times the farthest contact's distance from the object origin.
+            moment that force times the farthest contact's distance from the object origin
+            (mass_only: the mass error at most this times the scenario's mass).
         effort_report: What joint_states' effort is. applied: the torque each joint applies
             (current sensing, or a driver that reports its command plus its impedance); commanded:
             the node's own last command (the Allegro V5's driver), then the applied torque is taken
