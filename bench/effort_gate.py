@@ -76,7 +76,7 @@ def slip(kp: float) -> None:
                                    object_offset=tuple(5e-3 * np.array(d, dtype=float)))
         for gate in (True, False):
             r, rows = episode(settings, gate)
-            at = rows[np.searchsorted(rows[:, 0], 0.0), 1]
+            at = rows[np.searchsorted(rows[:, 0], 0.0, side='right') - 1, 1]  # last pinned
             print(f"| 5 mm {name} | {'on' if gate else 'opened'} | {at:+.3f} | "
                   f'{rows[:, 1].min():+.3f} | {1e3 * r.drift:.2f} | '
                   f'{np.degrees(r.rotation):.2f} |', flush=True)
@@ -93,7 +93,7 @@ def still(kp: float, hold: float) -> None:
         past = np.nonzero(np.abs(after[:, 1]) > 0.02 * WEIGHT)[0]
         print(f'| {told} | {np.abs(after[:, 1]).max() / WEIGHT:.4f} | '
               f'{np.abs(est - WEIGHT).max() / WEIGHT if len(est) else float("nan"):.4f} | '
-              f"{after[past[0], 0] if len(past) else 'never'} | {1e3 * r.drift:.3f} |",
+              f"{f'{after[past[0], 0]:.3f}' if len(past) else 'never'} | {1e3 * r.drift:.3f} |",
               flush=True)
 
 
