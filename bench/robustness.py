@@ -10,7 +10,7 @@ Robustness benchmark (issue 24, item 6): the node and two baselines on a disturb
 
 Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--rate 250]
        [--out bench/results/robustness.json] [--node-inputs on|imu|off]
-       [--margin K] [--imu-rate HZ] [--imu-latency S]
+       [--margin K] [--imu-rate HZ] [--imu-latency S] [--effort-report applied|commanded]
        [--controllers node preset impedance] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
@@ -24,6 +24,8 @@ controllers:
   with --node-inputs on, also the rig's palm IMU and measured efforts at each joint
   state (imu and effort_estimation on, as config/allegro_right_node.yaml turns them on);
   with --node-inputs imu, the IMU alone; --margin: its friction margin k;
+  --effort-report commanded: the rig's driver reports the node's last command as effort
+  (the Allegro V5's) and the node is told so (its stiffness the rig's Kp);
 - preset: fixed closing torques along the normals, one level tuned once per Kp on the
   nominal load (grasp_torque_opt.sim.baselines.tune_preset);
 - impedance: the grasp pose commanded 5 mm inside the ball, position control at the
@@ -94,7 +96,7 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
             preset_level: float, inputs: str = 'off', margin: float = 0.0,
             imu: tuple[float | None, float] = (None, 0.0)) -> dict:
     """Run one episode; return its record (``inputs``: the node's IMU and efforts, on/imu/off)."""
-    setup, rig = simulated(scenario, settings)
+    setup, rig = simulated(scenario, settings)  # settings.effort_report: what the rig reports
     reference = None
     if controller == 'node':
         command = node_controller(setup, scenario, rig, inputs != 'off', margin,
@@ -116,16 +118,18 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
 def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0,
         inputs: str = 'off', margin: float = 0.0,
         controllers: tuple[str, ...] = CONTROLLERS,
-        imu: tuple[float | None, float] = (None, 0.0)) -> dict:
+        imu: tuple[float | None, float] = (None, 0.0), effort_report: str = 'applied') -> dict:
     scenario = load_scenario(find_config('allegro_right.yaml'))
     out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
            'presets': {}, 'node_inputs': inputs, 'margin': margin,
+           'effort_report': effort_report,
            'controllers': list(controllers), 'imu_rate_hz': imu[0], 'imu_latency_s': imu[1]}
     for kp in gains:
         tuned = tune_preset(scenario, kp, 0.01, rate=rate)
         out['presets'][str(kp)] = {'level_N': tuned.level, 'drift_mm': 1e3 * tuned.drift}
         for family, label, fields in grid(smoke):
-            settings = EpisodeSettings(kp=kp, duration=duration, rate=rate, **fields)
+            settings = EpisodeSettings(kp=kp, duration=duration, rate=rate,
+                                       effort_report=effort_report, **fields)
             out['rows'].append({'kp': kp, 'family': family, 'case': label, **{
                 c: episode(scenario, c, settings, tuned.level, inputs, margin, imu)
                 for c in controllers}})
@@ -139,7 +143,8 @@ def tables(r: dict) -> str:
              f"{r['rate_hz']:g} Hz; node inputs (IMU, efforts) "
              f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}, IMU "
              f"{r.get('imu_rate_hz') or r['rate_hz']:g} Hz "
-             f"{1e3 * (r.get('imu_latency_s') or 0.0):g} ms late; preset levels: "
+             f"{1e3 * (r.get('imu_latency_s') or 0.0):g} ms late, efforts "
+             f"{r.get('effort_report', 'applied')}; preset levels: "
              + ', '.join(f"Kp {k}: {p['level_N']:.2f} N" for k, p in r['presets'].items()),
              '', '| Kp | family | cases | ' + ' | '.join(
                  f'{c} held | {c} effort [N m]' for c in shown) + ' |',
@@ -181,13 +186,15 @@ def main() -> int:
     p.add_argument('--node-inputs', choices=('on', 'imu', 'off'), default='off',
                    help="the node's IMU and effort estimation (issue 24): on, as the "
                         'bundled params, or off (the scenario only)')
+    p.add_argument('--effort-report', choices=('applied', 'commanded'), default='applied',
+                   help="what the driver's joint_states effort is (the node is told)")
     p.add_argument('--smoke', action='store_true',
                    help='one case per family, Kp 1, 0.5 s: that it runs')
     a = p.parse_args()
     gains = (1.0,) if a.smoke else tuple(float(k) for k in a.gains.split(','))
     duration = 0.5 if a.smoke else a.duration
     r = run(duration, gains, a.smoke, a.rate, a.node_inputs, a.margin, tuple(a.controllers),
-            (a.imu_rate, a.imu_latency))
+            (a.imu_rate, a.imu_latency), a.effort_report)
     r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
     report(r, tables(r), None if a.smoke else a.out,
            f"commit {r['commit']}, {len(r['rows']) * len(CONTROLLERS)} episodes"

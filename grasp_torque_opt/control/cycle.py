@@ -25,7 +25,7 @@ from grasp_torque_opt.backends.daqp import DaqpSettings
 from grasp_torque_opt.backends.proxsuite import ProxSuiteSettings
 from grasp_torque_opt.backends.registry import is_backend, settings_for
 from grasp_torque_opt.control import compiled
-from grasp_torque_opt.control.effort_load import EffortLoad
+from grasp_torque_opt.control.effort_load import Agreement, applied_torque, EffortLoad
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, replaced
@@ -205,19 +205,42 @@ class Cycle:
         if inputs.effort is None:
             est.turn_off('effort_estimation off: ' + (inputs.effort_why or 'no effort'))
             return est.correction
+        c = self.config
+        if c.effort_report == 'commanded' and not c.effort_driver_stiffness > 0:
+            est.turn_off('effort_estimation off: effort_report commanded needs '
+                         'effort_estimation.driver_stiffness > 0')
+            return est.correction
         est.off = ''
         maps = at.maps()
-        c = self.config
         bounds = est.bound(self.weight, c.effort_max_load_ratio, maps.positions,
                            at.object_origin)
-        along = None
-        if c.effort_mass_only:
-            gravity = self._gravity_in_use
-            norm = float(np.linalg.norm(gravity))
-            along = gravity / norm if norm > 1e-6 else np.zeros(3)
-        return est.update(est.measured(maps.G, maps.J, inputs.effort, g), model,
+        gravity = self._gravity_in_use if c.effort_mass_only else None
+        nominal = float(np.linalg.norm(c.gravity))
+        frozen = self._gate(at, maps.positions, inputs.q_time)
+        q = at.q[at.hand.idx_q]
+        reference = c.effort_driver_reference or self.setup.q[at.hand.idx_q]
+        tau = applied_torque(inputs.effort, c.effort_report, c.effort_driver_stiffness,
+                             reference, q)
+        return est.update(est.measured(maps.G, maps.J, tau, g), model,
                           inputs.q_time, c.effort_filter, c.effort_time_constant, bounds,
-                          gap=c.joint_state_timeout, along=along)
+                          gap=c.joint_state_timeout, gravity=gravity, frozen=frozen,
+                          window=c.effort_speed_window,
+                          unwind=est.agreement is not None and est.agreement.off_hold,
+                          mass_bound=bounds[0] / nominal if nominal > 0 else 0.0,
+                          nominal=nominal)
+
+    def _gate(self, at: GraspSetup, positions: np.ndarray, now: float) -> str:
+        """Return why the effort estimate is frozen ('' open; :class:`.effort_load.Agreement`)."""
+        est, c = self.effort_load, self.config
+        if self.hand_object is None:  # no object: no fingertips' estimate, no gate
+            est.agreement = None
+            return ''
+        if est.agreement is None:
+            est.agreement = Agreement()
+        tips = self.hand_object.estimate(at.q)
+        return est.agreement.check(tips, positions - at.object_origin, now,
+                                   c.effort_speed_window, c.joint_state_timeout,
+                                   (c.effort_max_object_speed, c.effort_max_residual))
 
     def budget(self) -> float:
         """

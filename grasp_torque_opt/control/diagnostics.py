@@ -160,9 +160,12 @@ def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
         values.append(('effort_estimation', 'off (effort_estimation.enabled false)'))
     else:
         values.append(('effort_estimation', est.off or 'on'))
+        if est.agreement is not None and not est.off:  # the gate (Load from efforts)
+            values.append(('load.gate', est.agreement.state or 'open'))
         if est.estimate is not None:
-            values += [('load.estimated', _vector(est.estimate)),
-                       ('load.correction', _vector(est.correction))]
+            values.append(('load.estimated', _vector(est.estimate)))
+        if est.estimate is not None or est.agreement is not None:
+            values.append(('load.correction', _vector(est.correction)))
     if solving.load is not None:
         values.append(('load.planned', _vector(solving.load)))
     return values

@@ -24,6 +24,8 @@ from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters.generated import CycleConfig
+from grasp_torque_opt.core.object_from_hand import ObjectFromHand
+from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.scenario import Scenario
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
@@ -32,7 +34,7 @@ from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                     margin: float = 0.0, efforts: bool | None = None,
                     imu_rate: float | None = None, imu_latency: float = 0.0,
-                    commands: dict | None = None):
+                    commands: dict | None = None, effort_report: str | None = None):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -48,16 +50,28 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     ``commands``: the command interface's CycleConfig fields (``command_interface``,
     ``position_stiffness``, ...; None: effort); the cycle's result, its ``output`` in the
     driver's units, is ``command.controller.last``.
+    The efforts are what the rig's driver reports (:meth:`RigSim.reported_effort
+    <grasp_torque_opt.sim.rig.RigSim.reported_effort>`); ``effort_report``: what the
+    cycle is told they are (None: what they are), with ``commanded`` the driver's
+    stiffness the rig's Kp and its reference the scenario's grasp (the default).
+    The fingertips' estimate of the object is placed as the node places it (the gate).
     """
     efforts = inputs if efforts is None else efforts
+    report = effort_report or (rig.effort_report if rig is not None else 'applied')
     setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
                                                                     margin=margin))
     config = CycleConfig(gravity_compensation=True,
                          gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=efforts, **(commands or {}))
+                         cycle_budget=1.0, effort_estimation=efforts, effort_report=report,
+                         effort_driver_stiffness=rig.kp if rig is not None else 0.0,
+                         **(commands or {}))
     ctrl = TorqueController(setup, config, fallback='daqp')
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
+    if scenario.object is not None:
+        ctrl.solving.hand_object = ObjectFromHand(
+            setup.hand, setup.contacts, setup.q,
+            object_pose(scenario.object.position, scenario.object.rpy))
     names = list(setup.hand.joints)
     clock = {'t': 0.0, 'imu': -1.0}
     readings: collections.deque = collections.deque()
@@ -77,7 +91,7 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                 clock['imu'] = sampled
                 ctrl.take('imu', ImuReading('', force, omega), clock['t'])
         if efforts:
-            measured = rig.effort().tolist()
+            measured = rig.reported_effort().tolist()
         ctrl.take('joint_states', JointStateReading(names, reading.tolist(), efforts=measured),
                   clock['t'], 0.0, None)
         return ctrl.cycle(clock['t']).command

@@ -11,7 +11,8 @@ A simulated hand driver: the scenario's hand and object in MuJoCo, on the node's
 
 What a real hand with a ros2_control effort controller would be (docs/simulation.md):
 MuJoCo steps in real time at 1 kHz; ``joint_states`` carries positions,
-velocities and the efforts applied; the latest ``effort_commands`` is applied
+velocities and the efforts applied (``--effort-report commanded``: the last command
+received, as the Allegro V5's driver reports it); the latest ``effort_commands`` is applied
 as joint torques and held until the next one (no timeout, as the effort
 controller does), plus a joint impedance Kp, Kd around the configuration the
 fingers settled in, as real hand drivers add. Until the first command the
@@ -89,8 +90,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f'{PROG}: error: {e}', file=sys.stderr)
         return 2
     try:
+        told = () if args.effort_report == 'applied' else (  # the node told what they are
+            'effort_estimation.driver_stiffness:=' + repr(float(args.kp)),
+            'effort_estimation.effort_report:=commanded')
         arguments = (*sim_commands.node_arguments(driver), *_tactile_params(args, setup),
-                     *(a for o in _lockstep_overrides(args) for a in ('-p', o)))
+                     *(a for o in (*_lockstep_overrides(args), *told) for a in ('-p', o)))
         with node_process(params, args.with_node, arguments) as child:
             return _run(args, scenario, setup, rig, baseline, child)
     except KeyboardInterrupt:
@@ -350,7 +354,7 @@ class _Link:
             stamp = self.node.get_clock().now().to_msg()
         js = JointState(name=self.names, position=[float(x) for x in hsim.reading],
                         velocity=[float(x) for x in hsim.qdot],
-                        effort=[float(x) for x in hsim.effort()])
+                        effort=[float(x) for x in hsim.reported_effort()])
         js.header.stamp = stamp
         # The IMU before the joint state: the node's cycle on the joint state uses it.
         self.imu_pub.publish(imu_message(Imu, *hsim.imu(), hand.base_frame, stamp))

@@ -24,6 +24,8 @@ import numpy as np
 
 PROG = 'grasp-torque-sim'
 CONTROLLERS = ('node', 'preset', 'impedance')
+#: What joint_states' effort may be (grasp_torque_opt.sim.rig.EFFORT_REPORTS).
+EFFORT_REPORTS = ('applied', 'commanded')
 AXES = {'x': (1, 0, 0), 'y': (0, 1, 0), 'z': (0, 0, 1)}
 
 
@@ -80,6 +82,11 @@ def parser(description: str) -> argparse.ArgumentParser:
                    help='encoder noise, standard deviation per 1 ms reading [mrad]: on the '
                         'published joint states and in the impedance')
     g.add_argument('--seed', type=int, default=0, help='seed of the encoder noise')
+    g.add_argument('--effort-report', choices=EFFORT_REPORTS, default='applied',
+                   help="what joint_states' effort is: applied, the torque the joints apply "
+                        "(command plus impedance); commanded, the controller's last command "
+                        "(as the Allegro V5's driver reports it; with --with-node the node is "
+                        'told so, and the driver stiffness --kp)')
     c = p.add_argument_group('controller')
     c.add_argument('--controller', choices=CONTROLLERS, default='node',
                    help='node: grasp_torque_node over ROS; preset: fixed closing torques of '
@@ -177,6 +184,9 @@ def check(args: argparse.Namespace) -> str:
             return ('--base-shake: AMPLITUDE_G,FREQUENCY_HZ,AXIS with amplitude >= 0, '
                     f'frequency > 0 and axis x, y or z, got {args.base_shake!r}')
         args.base_shake = shake
+    if args.effort_report == 'commanded' and not args.kp > 0:
+        return ('--effort-report commanded: needs --kp > 0 (the command alone says nothing '
+                'of the load; the position error times Kp does)')
     if args.with_node and args.controller != 'node':
         return f'--with-node: only with --controller node (got {args.controller})'
     driver = sim_commands.check(args)
@@ -214,7 +224,8 @@ def rig_settings(args: argparse.Namespace):
         drift_limit=args.drift_limit * 1e-3,
         disturbances=Disturbances(motion=motion, joint_noise=args.joint_noise * 1e-3,
                                   seed=args.seed),
-        mass_scale=args.mass_scale, object_offset=tuple(args.object_offset))
+        mass_scale=args.mass_scale, object_offset=tuple(args.object_offset),
+        effort_report=args.effort_report)
 
 
 def describe(args: argparse.Namespace) -> str:
@@ -236,4 +247,6 @@ def describe(args: argparse.Namespace) -> str:
         parts.append(f'friction x{args.friction_scale:g}')
     if args.joint_noise > 0:
         parts.append(f'joint noise {args.joint_noise:g} mrad')
+    if args.effort_report != 'applied':
+        parts.append(f'efforts reported: {args.effort_report}')
     return ', '.join(parts)

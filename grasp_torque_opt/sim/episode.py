@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import Scenario
 from grasp_torque_opt.sim.model import build_model, SimSettings
-from grasp_torque_opt.sim.rig import Disturbances, RigSim
+from grasp_torque_opt.sim.rig import Disturbances, EFFORT_REPORTS, RigSim
 import numpy as np
 
 #: A controller: the encoder's reading [rad] -> the command [N m] (None: keep the last).
@@ -51,6 +51,8 @@ class EpisodeSettings:
         object_offset: the simulated object's centre minus the scenario's, base frame [m].
         object_force: a constant force on the object's centre from release on, base
             axes [N] (the controller is not told).
+        effort_report: what the driver's joint states' effort is, ``applied`` or
+            ``commanded`` (:attr:`~grasp_torque_opt.sim.rig.RigSim.effort_report`).
     """
 
     kp: float = 1.0
@@ -63,6 +65,13 @@ class EpisodeSettings:
     mass_scale: float = 1.0
     object_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
     object_force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    effort_report: str = 'applied'
+
+    def __post_init__(self) -> None:
+        """Refuse an effort report that is neither applied nor commanded."""
+        if self.effort_report not in EFFORT_REPORTS:
+            raise ValueError(f'effort_report must be one of {", ".join(EFFORT_REPORTS)}, got '
+                             f'{self.effort_report!r}')
 
 
 @dataclass(frozen=True)
@@ -113,6 +122,7 @@ def simulated(scenario: Scenario, settings: EpisodeSettings, setup: GraspSetup |
     rig = RigSim(build_model(truth, sim), setup.q[setup.hand.idx_q], settings.kp, settings.kd,
                  settings.disturbances, setup.hand.base_frame)
     rig.object_force = np.asarray(settings.object_force, dtype=float)
+    rig.effort_report = settings.effort_report
     return setup, rig
 
 

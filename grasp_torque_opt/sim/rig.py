@@ -22,7 +22,12 @@ The simulated hand as a test rig: a moving base, encoder noise, and the torques 
 - keeps the mean effort since release: the RMS of the applied joint torques over
   every step and joint [N m];
 - pushes the object, once released, with a constant force at its centre
-  (:attr:`RigSim.object_force`, base axes [N]): the grasp benchmarks' disturbance.
+  (:attr:`RigSim.object_force`, base axes [N]): the grasp benchmarks' disturbance;
+- reports in its joint states' effort (:meth:`RigSim.reported_effort`) either the
+  torque it applied (``effort_report`` ``applied``, a driver with current sensing) or the
+  controller's last command (``commanded``, as the Allegro V5's driver does): the
+  impedance around ``q_ref`` (the grasp configuration while the object is pinned, the
+  settled configuration from release on) is then not in it.
 """
 
 from __future__ import annotations
@@ -35,6 +40,9 @@ from grasp_torque_opt.sim.model import SimModel
 from grasp_torque_opt.sim.simulator import HandSim
 import mujoco
 import numpy as np
+
+#: What a driver's joint states' effort may be: the torque applied, or the command.
+EFFORT_REPORTS = ('applied', 'commanded')
 
 
 @dataclass(frozen=True)
@@ -98,6 +106,8 @@ class RigSim(HandSim):
         #: step's reading (:mod:`~grasp_torque_opt.sim.drivers`); None: ``command`` is the
         #: torque (an effort controller).
         self.driver = None
+        #: What the joint states' effort is: 'applied' or 'commanded' (EFFORT_REPORTS).
+        self.effort_report = 'applied'
 
     def _encoder(self) -> np.ndarray:
         noise = self.disturbances.joint_noise
@@ -135,6 +145,17 @@ class RigSim(HandSim):
     def effort(self) -> np.ndarray:
         """Joint torques applied in the last step, impedance and damping included [N m]."""
         return self.applied.copy()
+
+    def reported_effort(self) -> np.ndarray:
+        """
+        Return what the driver publishes as effort [N m]: :meth:`effort` or the command.
+
+        ``commanded``: the controller's last command as it was sent (the encoder noise
+        that the rig's impedance adds to it is not in it).
+        """
+        if self.effort_report == 'commanded':
+            return np.array(self.command, dtype=float)
+        return self.effort()
 
     def mean_effort(self) -> float:
         """RMS of the applied joint torques since release, over steps and joints [N m]."""

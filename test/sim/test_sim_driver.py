@@ -148,6 +148,31 @@ def test_the_preset_runs_the_imu_reads_the_base_and_efforts_are_published():
     assert np.abs(efforts[-1]).max() > 0.01  # the preset presses
 
 
+def test_a_driver_that_reports_its_command_publishes_the_command_as_effort():
+    """--effort-report commanded: joint_states' effort is the last command (the preset's)."""
+    args = ['--controller', 'preset', '--preset-level', '1.0', '--duration', '0.3',
+            '--settle', '1', '--effort-report', 'commanded', '--no-picture']
+    for attempt in range(3):
+        _, states, out, err, code = listen(args, ros_domains.domain('sim_commanded', attempt))
+        if states:
+            break
+    assert code in (0, 1), out + err
+    assert 'efforts reported: commanded' in out.splitlines()[0]
+    efforts = np.array([m.effort for m in states])
+    pressing = efforts[np.abs(efforts).max(axis=1) > 0]  # from the first command on
+    assert len(pressing) > 10, out + err
+    # The preset's one command, whatever the impedance adds to the applied torque.
+    np.testing.assert_array_equal(pressing, np.broadcast_to(pressing[0], pressing.shape))
+
+
+def test_the_node_is_told_the_drivers_effort_meaning():
+    """--with-node --effort-report commanded: the node starts told so (and its stiffness)."""
+    done = run('--with-node', '--duration', '0.5', '--no-picture', '--kp', '0.3',
+               '--effort-report', 'commanded')
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert summary_of(done).startswith('summary: held'), done.stdout
+
+
 def test_the_position_squeeze_runs_and_reports():
     done = run('--controller', 'impedance', '--duration', '0.5', '--no-picture')
     assert done.returncode in (0, 1), done.stdout + done.stderr
@@ -161,6 +186,9 @@ def test_bad_disturbances_give_one_line_and_exit_2():
              "amplitude >= 0, frequency > 0 and axis x, y or z, got '1,1,w'",
              ('--base-accel', '1,2'): "--base-accel: three numbers separated by commas, got '1,2'",
              ('--mass-scale', '0'): '--mass-scale: must be > 0',
+             ('--effort-report', 'commanded', '--kp', '0'): '--effort-report commanded: needs '
+             '--kp > 0 (the command alone says nothing of the load; the position error times '
+             'Kp does)',
              ('--with-node', '--controller', 'preset'):
                  '--with-node: only with --controller node (got preset)'}
     for args, message in cases.items():

@@ -139,12 +139,35 @@ class CycleConfig:
             action on the estimated load. [s]
         effort_filter: (``effort_estimation.filter``) Time constant of the low-pass on the
             estimated load. [s]
-        effort_mass_only: (``effort_estimation.mass_only``) Correct only the force along the
-            apparent gravity (a mass error: one number, far less noisy); false, the whole wrench
-            (an unmodelled push or moment too).
+        effort_mass_only: (``effort_estimation.mass_only``) Correct only the mass: a mass error
+            from the force error along the apparent gravity, the correction that mass times the
+            apparent gravity (one number, far less noisy, and right through a shake); false, the
+            whole wrench (an unmodelled push or moment too).
         effort_max_load_ratio: (``effort_estimation.max_load_ratio``) The correction's force is at
             most this times the scenario's weight, its moment that force times the farthest
-            contact's distance from the object origin.
+            contact's distance from the object origin (mass_only: the mass error at most this times
+            the scenario's mass).
+        effort_report: (``effort_estimation.effort_report``) What joint_states' effort is. applied:
+            the torque each joint applies (current sensing, or a driver that reports its command
+            plus its impedance); commanded: the node's own last command (the Allegro V5's driver),
+            then the applied torque is taken as effort + driver_stiffness (driver_reference - q).
+        effort_driver_stiffness: (``effort_estimation.driver_stiffness``) The driver's joint
+            stiffness Kp, every joint (effort_report commanded: needed, > 0; applied: unused).
+            [N m/rad]
+        effort_driver_reference: (``effort_estimation.driver_reference``) The joint positions the
+            driver's impedance holds, command order (effort_report commanded); empty: the
+            scenario's grasp.joint_positions. [rad]
+        effort_max_object_speed: (``effort_estimation.max_object_speed``) The gate: while the
+            object moves faster than this (the fastest contact point under the object's motion that
+            the fingertips give, its slope over speed_window), the correction is frozen at its
+            value before the motion and the estimate starts again once the object is still. [m/s]
+        effort_speed_window: (``effort_estimation.speed_window``) The gate's window: the object's
+            speed is the least-squares slope of its displacement over this long (longer: less
+            encoder noise, a later freeze, undone by holding the correction at its value this long
+            before). [s]
+        effort_max_residual: (``effort_estimation.max_residual``) The gate: while a fingertip is
+            farther than this from the rigid motion of the object since the grasp's start (a slip,
+            a roll, the object not where the scenario says), the correction is frozen. [m]
         tactile_source: (``tactile.source``) The fingertips' normal forces (docs/node.md, "Tactile
             input"): none (the default), array (std_msgs/Float32MultiArray on the tactile topic,
             entry i on the link tactile.links[i]: the Allegro V5 Sense's 16 values) or wrench
@@ -258,6 +281,12 @@ class CycleConfig:
     effort_filter: float = 0.01
     effort_mass_only: bool = True
     effort_max_load_ratio: float = 0.5
+    effort_report: str = 'applied'
+    effort_driver_stiffness: float = 0.0
+    effort_driver_reference: tuple = ()
+    effort_max_object_speed: float = 0.005
+    effort_speed_window: float = 0.05
+    effort_max_residual: float = 0.001
     tactile_source: str = 'none'
     tactile_links: tuple = None
     tactile_scale: float = 1.0
@@ -385,10 +414,31 @@ class ParamsEffortEstimation:
             gravity; a driver that reports no effort (empty or NaN): off, said once.
         time_constant: Time constant T of the integral action on the estimated load. [s]
         filter: Time constant of the low-pass on the estimated load. [s]
-        mass_only: Correct only the force along the apparent gravity (a mass error: one number, far
-            less noisy); false, the whole wrench (an unmodelled push or moment too).
+        mass_only: Correct only the mass: a mass error from the force error along the apparent
+            gravity, the correction that mass times the apparent gravity (one number, far less
+            noisy, and right through a shake); false, the whole wrench (an unmodelled push or
+            moment too).
         max_load_ratio: The correction's force is at most this times the scenario's weight, its
-            moment that force times the farthest contact's distance from the object origin.
+            moment that force times the farthest contact's distance from the object origin
+            (mass_only: the mass error at most this times the scenario's mass).
+        effort_report: What joint_states' effort is. applied: the torque each joint applies
+            (current sensing, or a driver that reports its command plus its impedance); commanded:
+            the node's own last command (the Allegro V5's driver), then the applied torque is taken
+            as effort + driver_stiffness (driver_reference - q).
+        driver_stiffness: The driver's joint stiffness Kp, every joint (effort_report commanded:
+            needed, > 0; applied: unused). [N m/rad]
+        driver_reference: The joint positions the driver's impedance holds, command order
+            (effort_report commanded); empty: the scenario's grasp.joint_positions. [rad]
+        max_object_speed: The gate: while the object moves faster than this (the fastest contact
+            point under the object's motion that the fingertips give, its slope over speed_window),
+            the correction is frozen at its value before the motion and the estimate starts again
+            once the object is still. [m/s]
+        speed_window: The gate's window: the object's speed is the least-squares slope of its
+            displacement over this long (longer: less encoder noise, a later freeze, undone by
+            holding the correction at its value this long before). [s]
+        max_residual: The gate: while a fingertip is farther than this from the rigid motion of the
+            object since the grasp's start (a slip, a roll, the object not where the scenario
+            says), the correction is frozen. [m]
     """
 
     enabled: bool | None
@@ -396,6 +446,12 @@ class ParamsEffortEstimation:
     filter: float | None  # noqa: A003 -- the parameter's name
     mass_only: bool | None
     max_load_ratio: float | None
+    effort_report: str | None
+    driver_stiffness: float | None
+    driver_reference: tuple | None
+    max_object_speed: float | None
+    speed_window: float | None
+    max_residual: float | None
 
 
 @dataclass(frozen=True)
@@ -800,6 +856,12 @@ CYCLE_FIELDS = {
     'effort_filter': 'effort_estimation.filter',
     'effort_mass_only': 'effort_estimation.mass_only',
     'effort_max_load_ratio': 'effort_estimation.max_load_ratio',
+    'effort_report': 'effort_estimation.effort_report',
+    'effort_driver_stiffness': 'effort_estimation.driver_stiffness',
+    'effort_driver_reference': 'effort_estimation.driver_reference',
+    'effort_max_object_speed': 'effort_estimation.max_object_speed',
+    'effort_speed_window': 'effort_estimation.speed_window',
+    'effort_max_residual': 'effort_estimation.max_residual',
     'tactile_source': 'tactile.source',
     'tactile_links': 'tactile.links',
     'tactile_scale': 'tactile.scale',

@@ -143,6 +143,11 @@ def validate_size_of_joints(name: str, value: Any, ctx: Context) -> str:
     return _check_size(name, value, ctx.m)
 
 
+def validate_size_of_joints_or_empty(name: str, value: Any, ctx: Context) -> str:
+    """Empty, or one entry per actuated joint."""
+    return '' if len(value) == 0 else _check_size(name, value, ctx.m)
+
+
 def validate_positive_entries(name: str, value: Any, ctx: Context) -> str:
     """Every entry > 0."""
     return '' if all(v > 0 for v in value) else 'every entry must be > 0'
@@ -210,6 +215,7 @@ def validate_method_available(name: str, value: Any, ctx: Context) -> str:
 VALIDATORS: dict[str, Validator] = {
     'name_map': validate_name_map,
     'size_of_joints': validate_size_of_joints,
+    'size_of_joints_or_empty': validate_size_of_joints_or_empty,
     'positive_entries': validate_positive_entries,
     'within_urdf_limits': validate_within_urdf_limits,
     'one_or_per_joint': validate_one_or_per_joint,
@@ -228,8 +234,9 @@ def check_pairs(values: Mapping[str, Any], ctx: Context | None = None) -> None:
 
     Raises:
         InputError: gravity's norm outside gravity_norm_bounds; min-max with a method
-            other than tau-qp (docs/planner.md); a stated uncertainty that leaves no
-            friction, or a pose uncertainty without the scenario's object (with ``ctx``).
+            other than tau-qp (docs/planner.md); effort_estimation.effort_report commanded
+            without a driver_stiffness; a stated uncertainty that leaves no friction, or a
+            pose uncertainty without the scenario's object (with ``ctx``).
     """
     if ctx is not None and ctx.m is not None:
         stated_margin(values, ctx.scenario_object)
@@ -240,6 +247,11 @@ def check_pairs(values: Mapping[str, Any], ctx: Context | None = None) -> None:
             raise InputError('gravity', f'norm {norm:.6g} m/s^2 is outside gravity_norm_bounds '
                              f'[{bounds[0]:g}, {bounds[1]:g}] (set those to allow it, e.g. '
                              '[0.0, 15.0] for zero gravity)')
+    if (values.get('effort_estimation.effort_report') == 'commanded'
+            and not values.get('effort_estimation.driver_stiffness', 0.0) > 0):
+        raise InputError('effort_estimation.driver_stiffness', 'must be > 0 with '
+                         'effort_estimation.effort_report commanded (the position error '
+                         'times it is what the efforts measure; set it first)')
     if values.get('objective') == 'min-max' and values.get('solver.method') != 'tau-qp':
         raise InputError('objective', 'min-max needs solver.method tau-qp, not '
                          f"{values.get('solver.method')}")
