@@ -31,7 +31,8 @@ from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                     margin: float = 0.0, efforts: bool | None = None,
-                    imu_rate: float | None = None, imu_latency: float = 0.0):
+                    imu_rate: float | None = None, imu_latency: float = 0.0,
+                    config: dict | None = None):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -50,7 +51,7 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                                                                     margin=margin))
     config = CycleConfig(gravity_compensation=True,
                          gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=efforts)
+                         cycle_budget=1.0, effort_estimation=efforts, **(config or {}))
     ctrl = TorqueController(setup, config, fallback='daqp')
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
