@@ -197,11 +197,14 @@ class Cycle:
                                     loop.previous, gap)
             else:
                 loop.squeeze.reset()
-        if loop.squeeze.normal_force is not None and \
-                loop.squeeze.normal_force != friction.min_normal_force:
-            friction = dataclasses.replace(friction,
-                                           min_normal_force=loop.squeeze.normal_force)
-        return loop.wrench, friction
+        return loop.wrench, self.squeezed()
+
+    def squeezed(self) -> Any:
+        """Return the grasp's friction with the squeeze's minimum normal force (if any)."""
+        friction, force = self.setup.friction, self.object_loop.squeeze.normal_force
+        if not self.config.object_loop or force is None or force == friction.min_normal_force:
+            return friction
+        return dataclasses.replace(friction, min_normal_force=force)
 
     def motion_in_use(self, inputs: Inputs) -> Motion | None:
         """
@@ -272,8 +275,12 @@ class Cycle:
             InputError: the inputs do not make a grasp (e.g. a tangent parallel to
                 its normal).
         """
-        fast = self._compiled(self.setup)
+        # The compiled cycle is made for the squeeze's friction (:meth:`squeezed`); made
+        # again when this cycle's grasp moved it.
+        fast = self._compiled(replaced(self.setup, friction=self.squeezed()))
         setup, g = self.grasp_at(inputs, jacobians=fast is not None)
+        if fast is not None and setup.friction is not self.setup.friction:
+            fast = self._compiled(setup)
         solver, fallback, handed_back = self.solver, self.fallback, ''
         if fast is not None:
             sol, maps = fast.solve(setup, None if deadline is None else

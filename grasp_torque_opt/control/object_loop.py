@@ -310,7 +310,7 @@ class Squeeze:
         elif worst < gains.relax_at or not certified or at_limit:
             level = max(level - gains.rate * dt, base)
         self._level = level
-        self.normal_force = base + STEP * np.floor((level - base) / STEP + 1e-9)
+        self.normal_force = base + STEP * np.floor((level - base) / STEP + 1e-6)
         return self.normal_force
 
     def reset(self) -> None:
