@@ -192,7 +192,7 @@ class Cycle:
             gap = self.config.joint_state_timeout
             loop.update(self.setup.hand, contacts, q, now, origin, self.weight, gains, gap)
             if gains.squeeze:
-                slip = loop.residual / gains.slip_residual
+                slip = loop.slip / gains.slip_residual
                 loop.squeeze.update(friction.min_normal_force, slip, now, gains,
                                     loop.previous, gap)
             else:

@@ -40,21 +40,26 @@ times the farthest contact's distance from the object origin (as the effort
 estimation's correction is bounded); the whole w_r by ``object_loop.max_force_ratio``
 likewise.
 
-**Anti-windup.** The integral is frozen while a contact slips (a contact point farther
-than ``object_loop.slip_residual`` from the rigid motion: the error is then no object
-motion the grasp can undo), and unwound (decays with ``object_loop.unwind_time``) after
+**Slip.** A contact's residual is its point's distance from the rigid motion that best
+fits all the points (a finger sliding on the object, or off it); its slip is how far the
+residual rose above its own low-passed value (time constant ``object_loop.slip_memory``):
+what slid lately, so that a slip once over stops counting.
+
+**Anti-windup.** The integral is frozen while a contact slips (its slip beyond
+``object_loop.slip_residual``: the error is then no object motion the grasp can undo),
+and unwound (decays with ``object_loop.unwind_time``) after
 a cycle that gave no certified command (infeasible, failed, faulted) or whose command
 had a joint at its torque limit (``LIMIT_FRACTION`` of it).
 
 **The squeeze.** The grasp's minimum normal force follows the friction usage measured
 at each contact (0: no tangential load, 1: at the cone): above ``squeeze.raise_at`` it
 rises at ``squeeze.rate`` [N/s] up to ``squeeze.max_normal_force``, below
-``squeeze.relax_at`` it falls back at the same rate to the scenario's
-``min_normal_force``; it does not rise after a cycle at a torque limit or without a
+``squeeze.relax_at`` it falls back at ``squeeze.relax_rate`` to the scenario's
+``min_normal_force`` (slower: a shake's next peak finds the squeeze still there); it does not rise after a cycle at a torque limit or without a
 certified command (the QP keeps the torque limits; the squeeze does not ask past them).
-The usage comes from a source: by default (``slip``) the contact's distance from the
-rigid motion over ``object_loop.slip_residual`` (a finger sliding on the object), which
-a hand without torque or tactile sensing can measure; another source (a tactile
+The usage comes from a source: by default (``slip``) the contact's slip over
+``object_loop.slip_residual`` (a finger sliding on the object), which a hand without
+torque or tactile sensing can measure; another source (a tactile
 plug-in's per-contact normal and tangential forces) sets it with
 :meth:`Squeeze.measured` and its time, and is used while fresh. The minimum normal force
 moves in steps of ``STEP`` (the compiled cycle is built again for each).
@@ -93,10 +98,12 @@ class LoopGains:
         settle_time: the reference is re-taken for this long [s].
         velocity_filter: the error rate's low-pass time constant [s].
         unwind_time: the integral's decay time constant at a limit [s].
-        slip_residual: a contact this far from the rigid motion slips [m].
+        slip_residual: a contact whose residual rose this far lately slips [m].
+        slip_memory: the residual's low-pass time constant (what is lately) [s].
         squeeze: the squeeze on.
         raise_at, relax_at: friction usages where the squeeze rises, relaxes [-].
-        rate: the squeeze's rate [N/s].
+        rate: the squeeze's rate of rise [N/s].
+        relax_rate: its rate of relaxing [N/s].
         max_normal_force: its ceiling [N].
         usage_timeout: a measured usage older than this is not used [s].
     """
@@ -113,10 +120,12 @@ class LoopGains:
     velocity_filter: float = 0.01
     unwind_time: float = 0.1
     slip_residual: float = 1e-3
+    slip_memory: float = 0.2
     squeeze: bool = False
     raise_at: float = 0.5
     relax_at: float = 0.2
     rate: float = 2.0
+    relax_rate: float = 0.5
     max_normal_force: float = 1.0
     usage_timeout: float = 0.05
 
@@ -141,6 +150,8 @@ class ObjectLoop:
         error: the last error e [m, rad], (6,) (zeros while settling).
         rate: the last filtered rate of e [m/s, rad/s], (6,).
         residual: per contact, the distance from the rigid motion at the last cycle [m].
+        slip: per contact, the residual's rise over its low-passed value
+            (``object_loop.slip_memory``): how far the contact slid lately [m].
         engaged: the reference is taken and the loop pushes.
         why_frozen: why the integral did not move at the last cycle ('' when it did).
         changes: how many times the reference was taken (settlings started).
@@ -157,7 +168,7 @@ class ObjectLoop:
         """Drop the reference and the integral: the next cycle starts a settling."""
         self.wrench, self.integral = np.zeros(6), np.zeros(6)
         self.error, self.rate = np.zeros(6), np.zeros(6)
-        self.residual = np.zeros(0)
+        self.residual = self.slip = self._slow = np.zeros(0)
         self.engaged, self.why_frozen = False, ''
         self._start = self._last = None
         self._links: tuple[str, ...] | None = None
@@ -198,12 +209,17 @@ class ObjectLoop:
         if not self.engaged:
             self.tracker.reset(q, pin.SE3(np.eye(3), np.asarray(origin, dtype=float)))
             self.engaged = now - self._start >= gains.settle_time
-            self.residual = np.zeros(len(contacts))
+            self.residual = self.slip = self._slow = np.zeros(len(contacts))
             return self.wrench
         est = self.tracker.estimate(q)
         moved = est.pose * self.tracker.pose0.inverse()
         carried = np.array([moved.act(p) for p in self.tracker.points0])
-        self.residual = np.linalg.norm(self.tracker.points(q) - carried, axis=1)
+        residual = np.linalg.norm(self.tracker.points(q) - carried, axis=1)
+        if self._slow.shape != residual.shape:
+            self._slow = residual.copy()
+        self.residual = residual
+        self.slip = np.maximum(residual - self._slow, 0.0)
+        self._slow = self._slow + dt / (gains.slip_memory + dt) * (residual - self._slow)
         error = np.concatenate((est.translation, est.rotation))
         a = dt / (gains.velocity_filter + dt)
         self.rate = self.rate + a * ((error - self.error) / dt - self.rate)
@@ -230,7 +246,7 @@ class ObjectLoop:
                    lever: float) -> None:
         """Move the integral by e dt, or freeze or unwind it (anti-windup)."""
         certified, at_limit = self._previous
-        slipping = self.residual.size and float(self.residual.max()) > gains.slip_residual
+        slipping = self.slip.size and float(self.slip.max()) > gains.slip_residual
         if not certified or at_limit:
             self.why_frozen = 'no certified command' if not certified else 'at a torque limit'
             self.integral = self.integral * (gains.unwind_time / (gains.unwind_time + dt))
@@ -308,7 +324,7 @@ class Squeeze:
         if worst > gains.raise_at and certified and not at_limit:
             level = min(level + gains.rate * dt, max(base, gains.max_normal_force))
         elif worst < gains.relax_at or not certified or at_limit:
-            level = max(level - gains.rate * dt, base)
+            level = max(level - gains.relax_rate * dt, base)
         self._level = level
         self.normal_force = base + STEP * np.floor((level - base) / STEP + 1e-6)
         return self.normal_force

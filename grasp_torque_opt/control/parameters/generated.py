@@ -175,10 +175,13 @@ class CycleConfig:
         loop_unwind_time: (``object_loop.unwind_time``) After a cycle without a certified command
             or with a joint at its torque limit, the integral decays with this time constant
             (anti-windup). [s]
-        loop_slip_residual: (``object_loop.slip_residual``) A contact point farther than this from
-            the object's rigid motion slips: the integral is frozen (the error is no motion the
-            grasp can undo); the squeeze's usage from slip evidence is this distance's fraction.
-            [m]
+        loop_slip_residual: (``object_loop.slip_residual``) A contact whose distance from the
+            object's rigid motion rose this far lately (object_loop.slip_memory) slips: the
+            integral is frozen (the error is no motion the grasp can undo); the squeeze's usage
+            from slip evidence is this distance's fraction. [m]
+        loop_slip_memory: (``object_loop.slip_memory``) The time constant of the low-pass a
+            contact's residual is compared with: a slip counts for about this long, then the
+            squeeze may relax. [s]
         loop_squeeze: (``squeeze.enabled``) The squeeze that follows friction (with
             object_loop.enabled): the minimum normal force rises while a contact's measured
             friction usage is above squeeze.raise_at, falls back to the scenario's below
@@ -186,7 +189,9 @@ class CycleConfig:
         loop_raise_at: (``squeeze.raise_at``) The friction usage (1 at the cone) above which the
             squeeze rises.
         loop_relax_at: (``squeeze.relax_at``) The friction usage below which the squeeze relaxes.
-        loop_rate: (``squeeze.rate``) How fast the minimum normal force rises and relaxes. [N/s]
+        loop_rate: (``squeeze.rate``) How fast the minimum normal force rises. [N/s]
+        loop_relax_rate: (``squeeze.relax_rate``) How fast it relaxes (slower than it rises, so
+            that the next peak of a shake finds the squeeze still there). [N/s]
         loop_max_normal_force: (``squeeze.max_normal_force``) The squeeze's ceiling on the minimum
             normal force. [N]
         loop_usage_timeout: (``squeeze.usage_timeout``) A friction usage measured by a source
@@ -263,10 +268,12 @@ class CycleConfig:
     loop_velocity_filter: float = 0.01
     loop_unwind_time: float = 0.1
     loop_slip_residual: float = 0.001
+    loop_slip_memory: float = 0.2
     loop_squeeze: bool = False
     loop_raise_at: float = 0.5
     loop_relax_at: float = 0.2
     loop_rate: float = 2.0
+    loop_relax_rate: float = 0.5
     loop_max_normal_force: float = 1.0
     loop_usage_timeout: float = 0.05
     uncertainty_pose: float = 0.0
@@ -427,9 +434,12 @@ class ParamsObjectLoop:
         velocity_filter: Time constant of the low-pass on the error's rate (edot). [s]
         unwind_time: After a cycle without a certified command or with a joint at its torque limit,
             the integral decays with this time constant (anti-windup). [s]
-        slip_residual: A contact point farther than this from the object's rigid motion slips: the
-            integral is frozen (the error is no motion the grasp can undo); the squeeze's usage
-            from slip evidence is this distance's fraction. [m]
+        slip_residual: A contact whose distance from the object's rigid motion rose this far lately
+            (object_loop.slip_memory) slips: the integral is frozen (the error is no motion the
+            grasp can undo); the squeeze's usage from slip evidence is this distance's fraction.
+            [m]
+        slip_memory: The time constant of the low-pass a contact's residual is compared with: a
+            slip counts for about this long, then the squeeze may relax. [s]
     """
 
     enabled: bool | None
@@ -445,6 +455,7 @@ class ParamsObjectLoop:
     velocity_filter: float | None
     unwind_time: float | None
     slip_residual: float | None
+    slip_memory: float | None
 
 
 @dataclass(frozen=True)
@@ -458,7 +469,9 @@ class ParamsSqueeze:
             back to the scenario's below squeeze.relax_at, within the torque limits.
         raise_at: The friction usage (1 at the cone) above which the squeeze rises.
         relax_at: The friction usage below which the squeeze relaxes.
-        rate: How fast the minimum normal force rises and relaxes. [N/s]
+        rate: How fast the minimum normal force rises. [N/s]
+        relax_rate: How fast it relaxes (slower than it rises, so that the next peak of a shake
+            finds the squeeze still there). [N/s]
         max_normal_force: The squeeze's ceiling on the minimum normal force. [N]
         usage_timeout: A friction usage measured by a source (tactile) older than this is not used:
             the slip evidence is. [s]
@@ -468,6 +481,7 @@ class ParamsSqueeze:
     raise_at: float | None
     relax_at: float | None
     rate: float | None
+    relax_rate: float | None
     max_normal_force: float | None
     usage_timeout: float | None
 
@@ -770,10 +784,12 @@ CYCLE_FIELDS = {
     'loop_velocity_filter': 'object_loop.velocity_filter',
     'loop_unwind_time': 'object_loop.unwind_time',
     'loop_slip_residual': 'object_loop.slip_residual',
+    'loop_slip_memory': 'object_loop.slip_memory',
     'loop_squeeze': 'squeeze.enabled',
     'loop_raise_at': 'squeeze.raise_at',
     'loop_relax_at': 'squeeze.relax_at',
     'loop_rate': 'squeeze.rate',
+    'loop_relax_rate': 'squeeze.relax_rate',
     'loop_max_normal_force': 'squeeze.max_normal_force',
     'loop_usage_timeout': 'squeeze.usage_timeout',
     'uncertainty_pose': 'uncertainty.pose',
