@@ -19,20 +19,52 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+from pathlib import Path
+from typing import Any
 
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters.generated import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig, Params
+from grasp_torque_opt.control.parameters.schema import SCHEMA
+from grasp_torque_opt.control.parameters.snapshot import params_from
+from grasp_torque_opt.core.bounded_yaml import BoundedLoader
 from grasp_torque_opt.core.scenario import Scenario
+from grasp_torque_opt.ros.node.controllers import configure
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
+from grasp_torque_opt.ros.node.parameters import scenario_defaults
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
+import yaml
+
+
+def params_file(path: str | Path, scenario: Scenario, setup) -> Params:
+    """
+    Read a node's params file (``/**: ros__parameters:``) as the node would take it.
+
+    The schema's defaults, then the scenario's (:func:`scenario_defaults`), then the
+    file's values by dotted name (every node key's ``ros__parameters``), each checked by
+    the schema; the file's ``scenario`` is not read (the caller's is used).
+    """
+    with open(path, encoding='utf-8') as f:
+        doc = yaml.load(f, Loader=BoundedLoader) or {}
+    values = {**SCHEMA.defaults(), **scenario_defaults(scenario, setup)}
+
+    def flat(prefix: str, body: Any) -> None:
+        for key, value in body.items():
+            if isinstance(value, dict):
+                flat(f'{prefix}{key}.', value)
+            elif f'{prefix}{key}' != 'scenario':
+                SCHEMA.check(f'{prefix}{key}', value)
+                values[f'{prefix}{key}'] = value
+    for body in doc.values():
+        flat('', (body or {}).get('ros__parameters', {}))
+    return params_from(values)
 
 
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                     margin: float = 0.0, efforts: bool | None = None,
                     imu_rate: float | None = None, imu_latency: float = 0.0,
-                    config: dict | None = None):
+                    config: dict | None = None, params: str | Path | None = None):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -45,14 +77,28 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     ``margin``: the friction margin k. ``imu_rate`` [Hz] (None: at every joint state)
     and ``imu_latency`` [s]: the IMU sampled at that rate and delivered that late (the
     readings are kept at every physics step asked, the one of ``imu_latency`` ago given).
+    ``config``: further CycleConfig fields by name (the object loop's, e.g.
+    ``{'object_loop': True}``), over those.
+
+    With ``params`` (a node's params file, config/allegro_right_node.yaml), the controller
+    is the node's own, made from the file as the node makes it (:func:`params_file`,
+    :func:`~grasp_torque_opt.ros.node.controllers.configure`): ``margin`` and
+    ``efforts`` are the file's, the IMU is given if ``inputs`` and the file's
+    ``imu.enabled``; only the cycle's budget stays generous (simulated time is not
+    timed), and ``config`` still goes over the file's.
     """
-    efforts = inputs if efforts is None else efforts
-    setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
-                                                                    margin=margin))
-    config = CycleConfig(gravity_compensation=True,
-                         gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=efforts, **(config or {}))
-    ctrl = TorqueController(setup, config, fallback='daqp')
+    if params is not None:
+        p = params_file(params, scenario, setup)
+        ctrl = configure(None, setup, p, obj=scenario.object)
+        ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=1.0, **(config or {}))
+        inputs, efforts = inputs and p.imu.enabled, ctrl.config.effort_estimation
+    else:
+        efforts = inputs if efforts is None else efforts
+        setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
+                                                                        margin=margin))
+        ctrl = TorqueController(setup, CycleConfig(
+            gravity_compensation=True, gravity=tuple(float(x) for x in scenario.gravity),
+            cycle_budget=1.0, effort_estimation=efforts, **(config or {})), fallback='daqp')
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
     names = list(setup.hand.joints)
