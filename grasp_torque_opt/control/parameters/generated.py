@@ -147,7 +147,7 @@ class CycleConfig:
             integral(e)), added to what the hand applies; the load planned and certified is the
             scenario's less w_r. Needs the scenario's object and gravity (the weight bounds w_r).
         loop_stiffness: (``object_loop.stiffness``) K on the object's displacement: the force that
-            pushes a sagging object back before the integral has caught up (300 N/m: 0.3 N at 1
+            pushes a sagging object back before the integral has caught up (600 N/m: 0.6 N at 1
             mm). [N/m]
         loop_rotational_stiffness: (``object_loop.rotational_stiffness``) K on the object's
             rotation (0.3 N m/rad, 5 mN m at 1 deg). [N m/rad]
@@ -256,11 +256,11 @@ class CycleConfig:
     effort_mass_only: bool = True
     effort_max_load_ratio: float = 0.5
     object_loop: bool = False
-    loop_stiffness: float = 300.0
+    loop_stiffness: float = 600.0
     loop_rotational_stiffness: float = 0.3
-    loop_damping: float = 2.0
+    loop_damping: float = 4.0
     loop_rotational_damping: float = 0.0
-    loop_integral: float = 3000.0
+    loop_integral: float = 6000.0
     loop_rotational_integral: float = 3.0
     loop_max_integral_ratio: float = 0.6
     loop_max_force_ratio: float = 1.0
@@ -413,7 +413,7 @@ class ParamsObjectLoop:
             applies; the load planned and certified is the scenario's less w_r. Needs the
             scenario's object and gravity (the weight bounds w_r).
         stiffness: K on the object's displacement: the force that pushes a sagging object back
-            before the integral has caught up (300 N/m: 0.3 N at 1 mm). [N/m]
+            before the integral has caught up (600 N/m: 0.6 N at 1 mm). [N/m]
         rotational_stiffness: K on the object's rotation (0.3 N m/rad, 5 mN m at 1 deg). [N m/rad]
         damping: D on the object's velocity (from the fingertips, low-passed): damps what K and Ki
             start; more amplifies encoder noise. [N s/m]
