@@ -199,7 +199,7 @@ def main() -> int:
                    help="the node's IMU and effort estimation (issue 24): on, as the "
                         'bundled params, or off (the scenario only)')
     p.add_argument('--params', type=Path, default=None,
-                   help="the node made from this params file, as the node makes it (e.g. "
+                   help='the node made from this params file, as the node makes it (e.g. '
                         'config/allegro_right_node.yaml: the bundled params)')
     p.add_argument('--object-loop', choices=('on', 'off'), default=None,
                    help="the node's object loop (issue 32) on or off, over the params")

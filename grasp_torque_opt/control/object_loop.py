@@ -55,8 +55,9 @@ had a joint at its torque limit (``LIMIT_FRACTION`` of it).
 at each contact (0: no tangential load, 1: at the cone): above ``squeeze.raise_at`` it
 rises at ``squeeze.rate`` [N/s] up to ``squeeze.max_normal_force``, below
 ``squeeze.relax_at`` it falls back at ``squeeze.relax_rate`` to the scenario's
-``min_normal_force`` (slower: a shake's next peak finds the squeeze still there); it does not rise after a cycle at a torque limit or without a
-certified command (the QP keeps the torque limits; the squeeze does not ask past them).
+``min_normal_force`` (slower: a shake's next peak finds the squeeze still there); it
+does not rise after a cycle at a torque limit or without a certified command (the QP
+keeps the torque limits; the squeeze does not ask past them).
 The usage comes from a source: by default (``slip``) the contact's slip over
 ``object_loop.slip_residual`` (a finger sliding on the object), which a hand without
 torque or tactile sensing can measure; another source (a tactile
