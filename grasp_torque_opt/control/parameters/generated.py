@@ -257,11 +257,11 @@ class CycleConfig:
     effort_max_load_ratio: float = 0.5
     object_loop: bool = False
     loop_stiffness: float = 600.0
-    loop_rotational_stiffness: float = 0.3
+    loop_rotational_stiffness: float = 0.0
     loop_damping: float = 4.0
     loop_rotational_damping: float = 0.0
     loop_integral: float = 6000.0
-    loop_rotational_integral: float = 3.0
+    loop_rotational_integral: float = 0.0
     loop_max_integral_ratio: float = 0.6
     loop_max_force_ratio: float = 1.0
     loop_settle_time: float = 0.2
