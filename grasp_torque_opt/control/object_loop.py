@@ -110,11 +110,11 @@ class LoopGains:
     """
 
     stiffness: float = 600.0
-    rotational_stiffness: float = 0.3
+    rotational_stiffness: float = 0.0
     damping: float = 4.0
     rotational_damping: float = 0.0
     integral: float = 6000.0
-    rotational_integral: float = 3.0
+    rotational_integral: float = 0.0
     max_integral_ratio: float = 0.5
     max_force_ratio: float = 1.0
     settle_time: float = 0.2

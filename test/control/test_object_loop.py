@@ -162,7 +162,7 @@ def test_reference_retaken_when_the_contact_set_changes():
 
 def test_squeeze_rises_with_usage_and_relaxes_within_its_bounds():
     loop = ObjectLoop()
-    gains = LoopGains(squeeze=True, raise_at=0.5, relax_at=0.2, rate=2.0,
+    gains = LoopGains(squeeze=True, raise_at=0.5, relax_at=0.2, rate=2.0, relax_rate=2.0,
                       max_normal_force=1.0)
     base, t = 0.2, 0.0
     squeeze = loop.squeeze

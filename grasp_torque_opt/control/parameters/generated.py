@@ -150,7 +150,7 @@ class CycleConfig:
             pushes a sagging object back before the integral has caught up (600 N/m: 0.6 N at 1
             mm). [N/m]
         loop_rotational_stiffness: (``object_loop.rotational_stiffness``) K on the object's
-            rotation (0.3 N m/rad, 5 mN m at 1 deg). [N m/rad]
+            rotation (0 by default, docs/node.md "The object loop"). [N m/rad]
         loop_damping: (``object_loop.damping``) D on the object's velocity (from the fingertips,
             low-passed): damps what K and Ki start; more amplifies encoder noise. [N s/m]
         loop_rotational_damping: (``object_loop.rotational_damping``) D on the object's angular
@@ -414,7 +414,8 @@ class ParamsObjectLoop:
             scenario's object and gravity (the weight bounds w_r).
         stiffness: K on the object's displacement: the force that pushes a sagging object back
             before the integral has caught up (600 N/m: 0.6 N at 1 mm). [N/m]
-        rotational_stiffness: K on the object's rotation (0.3 N m/rad, 5 mN m at 1 deg). [N m/rad]
+        rotational_stiffness: K on the object's rotation (0 by default, docs/node.md "The object
+            loop"). [N m/rad]
         damping: D on the object's velocity (from the fingertips, low-passed): damps what K and Ki
             start; more amplifies encoder noise. [N s/m]
         rotational_damping: D on the object's angular velocity. [N m s/rad]
