@@ -11,7 +11,7 @@ Robustness benchmark (issue 24, item 6): the node and two baselines on a disturb
 Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--rate 250]
        [--out bench/results/robustness.json] [--node-inputs on|imu|off]
        [--margin K] [--imu-rate HZ] [--imu-latency S] [--effort-report applied|commanded]
-       [--controllers node preset impedance] [--smoke]
+       [--params FILE] [--object-loop on|off] [--controllers node preset impedance] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
 Allegro grasp, in simulated time (the rig of grasp-torque-sim, without ROS): the
@@ -26,6 +26,10 @@ controllers:
   with --node-inputs imu, the IMU alone; --margin: its friction margin k;
   --effort-report commanded: the rig's driver reports the node's last command as effort
   (the Allegro V5's) and the node is told so (its stiffness the rig's Kp);
+  with --params FILE (config/allegro_right_node.yaml: the bundled params), the node made
+  from that params file as the node makes it (its margin, effort estimation, object loop;
+  the IMU given when --node-inputs is not off and the file enables it; --margin unused);
+  --object-loop on|off: the object loop (issue 32) turned on or off over the params;
 - preset: fixed closing torques along the normals, one level tuned once per Kp on the
   nominal load (grasp_torque_opt.sim.baselines.tune_preset);
 - impedance: the grasp pose commanded 5 mm inside the ball, position control at the
@@ -60,6 +64,7 @@ from grasp_torque_opt.sim.episode import (  # noqa: E402
     run_episode,
     simulated,
 )
+from grasp_torque_opt.sim.model import SimSettings  # noqa: E402
 from grasp_torque_opt.sim.rig import Disturbances  # noqa: E402
 from physics import commit  # noqa: E402
 
@@ -94,14 +99,23 @@ def grid(smoke: bool) -> list[tuple[str, str, dict]]:
 
 def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
             preset_level: float, inputs: str = 'off', margin: float = 0.0,
-            imu: tuple[float | None, float] = (None, 0.0)) -> dict:
-    """Run one episode; return its record (``inputs``: the node's IMU and efforts, on/imu/off)."""
-    setup, rig = simulated(scenario, settings)  # settings.effort_report: what the rig reports
+            imu: tuple[float | None, float] = (None, 0.0), node: dict | None = None,
+            sim: SimSettings | None = None) -> dict:
+    """
+    Run one episode; return its record (``inputs``: the node's IMU and efforts, on/imu/off).
+
+    ``node``: ``params`` (a params file) and ``config`` (CycleConfig fields) for
+    :func:`node_controller`; ``sim``: the simulation's settings (friction, ...).
+    ``settings.effort_report``: what the rig reports.
+    """
+    setup, rig = simulated(scenario, settings, sim=sim or SimSettings())
     reference = None
+    node = node or {}
     if controller == 'node':
         command = node_controller(setup, scenario, rig, inputs != 'off', margin,
-                                  efforts=inputs == 'on', imu_rate=imu[0],
-                                  imu_latency=imu[1])
+                                  efforts=None if node.get('params') else inputs == 'on',
+                                  imu_rate=imu[0], imu_latency=imu[1],
+                                  config=node.get('config'), params=node.get('params'))
     elif controller == 'preset':
         command = Preset(setup, scenario.gravity, preset_level)
     else:
@@ -118,12 +132,15 @@ def episode(scenario: Scenario, controller: str, settings: EpisodeSettings,
 def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 250.0,
         inputs: str = 'off', margin: float = 0.0,
         controllers: tuple[str, ...] = CONTROLLERS,
-        imu: tuple[float | None, float] = (None, 0.0), effort_report: str = 'applied') -> dict:
+        imu: tuple[float | None, float] = (None, 0.0), effort_report: str = 'applied',
+        node: dict | None = None) -> dict:
     scenario = load_scenario(find_config('allegro_right.yaml'))
+    node = node or {}
     out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
            'presets': {}, 'node_inputs': inputs, 'margin': margin,
            'effort_report': effort_report,
-           'controllers': list(controllers), 'imu_rate_hz': imu[0], 'imu_latency_s': imu[1]}
+           'controllers': list(controllers), 'imu_rate_hz': imu[0], 'imu_latency_s': imu[1],
+           'params': str(node.get('params') or ''), 'node_config': node.get('config') or {}}
     for kp in gains:
         tuned = tune_preset(scenario, kp, 0.01, rate=rate)
         out['presets'][str(kp)] = {'level_N': tuned.level, 'drift_mm': 1e3 * tuned.drift}
@@ -131,7 +148,7 @@ def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 25
             settings = EpisodeSettings(kp=kp, duration=duration, rate=rate,
                                        effort_report=effort_report, **fields)
             out['rows'].append({'kp': kp, 'family': family, 'case': label, **{
-                c: episode(scenario, c, settings, tuned.level, inputs, margin, imu)
+                c: episode(scenario, c, settings, tuned.level, inputs, margin, imu, node)
                 for c in controllers}})
     return out
 
@@ -141,7 +158,9 @@ def tables(r: dict) -> str:
     lines = ['Held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
              f"joint torque after release) over {r['duration_s']:g} s, controllers asked at "
              f"{r['rate_hz']:g} Hz; node inputs (IMU, efforts) "
-             f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}, IMU "
+             f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}"
+             + (f", params {r['params']}" if r.get('params') else '')
+             + (f", {r['node_config']}" if r.get('node_config') else '') + ', IMU '
              f"{r.get('imu_rate_hz') or r['rate_hz']:g} Hz "
              f"{1e3 * (r.get('imu_latency_s') or 0.0):g} ms late, efforts "
              f"{r.get('effort_report', 'applied')}; preset levels: "
@@ -188,16 +207,23 @@ def main() -> int:
                         'bundled params, or off (the scenario only)')
     p.add_argument('--effort-report', choices=('applied', 'commanded'), default='applied',
                    help="what the driver's joint_states effort is (the node is told)")
+    p.add_argument('--params', type=Path, default=None,
+                   help='the node made from this params file, as the node makes it (e.g. '
+                        'config/allegro_right_node.yaml: the bundled params)')
+    p.add_argument('--object-loop', choices=('on', 'off'), default=None,
+                   help="the node's object loop (issue 32) on or off, over the params")
     p.add_argument('--smoke', action='store_true',
                    help='one case per family, Kp 1, 0.5 s: that it runs')
     a = p.parse_args()
     gains = (1.0,) if a.smoke else tuple(float(k) for k in a.gains.split(','))
     duration = 0.5 if a.smoke else a.duration
+    node = {'params': a.params, 'config': None if a.object_loop is None
+            else {'object_loop': a.object_loop == 'on'}}
     r = run(duration, gains, a.smoke, a.rate, a.node_inputs, a.margin, tuple(a.controllers),
-            (a.imu_rate, a.imu_latency), a.effort_report)
+            (a.imu_rate, a.imu_latency), a.effort_report, node)
     r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
     report(r, tables(r), None if a.smoke else a.out,
-           f"commit {r['commit']}, {len(r['rows']) * len(CONTROLLERS)} episodes"
+           f"commit {r['commit']}, {len(r['rows']) * len(a.controllers)} episodes"
            + (' (smoke run)' if a.smoke else ''))
     return 0
 

@@ -18,7 +18,9 @@ is a fault reason for the fault policy.
 
 from __future__ import annotations
 
+import dataclasses
 import time
+from typing import Any
 
 from grasp_torque_opt.backends.base import Backend
 from grasp_torque_opt.backends.daqp import DaqpSettings
@@ -31,6 +33,7 @@ from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.named_contacts import topic_contacts
+from grasp_torque_opt.control.object_loop import LoopGains, ObjectLoop
 from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -85,6 +88,9 @@ class Cycle:
         #: ``estimating``: this cycle updates it (the loop's; the service's reads it).
         self.effort_load = EffortLoad()
         self.estimating = True
+        #: The object loop (:mod:`.object_loop`): the restoring wrench and the squeeze,
+        #: moved by the loop's cycles (``estimating``), read by the service's.
+        self.object_loop = ObjectLoop()
         self._gravity_in_use = np.zeros(3)  # base axes, of the last grasp_at
         #: Why the IMU is not used, at the last cycle ('' while it is, or none came).
         self.imu_state = ''
@@ -169,9 +175,38 @@ class Cycle:
             self.effort_load.reset()  # turned off: turned on again, it starts anew
         if not self.config.gravity_compensation:
             g = None
+        friction = setup.friction
+        if self.config.object_loop:
+            restoring, friction = self._object_loop(q, contacts, origin, inputs.q_time)
+            wrench = wrench - restoring  # the hand adds w_r: G f = -(w_ext - w_r)
+        elif self.estimating and self.object_loop.tracker is not None:
+            self.object_loop = ObjectLoop()  # turned off: turned on again, it settles anew
         self.load = wrench
         return replaced(setup, q=q, contacts=contacts, external_wrench=wrench,
-                        torque_offset=g, object_origin=origin), g
+                        torque_offset=g, object_origin=origin, friction=friction), g
+
+    def _object_loop(self, q: np.ndarray, contacts: list, origin: np.ndarray, now: float
+                     ) -> tuple[np.ndarray, Any]:
+        """Return the object loop's restoring wrench and the squeezed friction."""
+        loop, friction = self.object_loop, self.setup.friction
+        if self.estimating:
+            gains = loop_gains(self.config)
+            gap = self.config.joint_state_timeout
+            loop.update(self.setup.hand, contacts, q, now, origin, self.weight, gains, gap)
+            if gains.squeeze:
+                slip = loop.slip / gains.slip_residual
+                loop.squeeze.update(friction.min_normal_force, slip, now, gains,
+                                    loop.previous, gap)
+            else:
+                loop.squeeze.reset()
+        return loop.wrench, self.squeezed()
+
+    def squeezed(self) -> Any:
+        """Return the grasp's friction with the squeeze's minimum normal force (if any)."""
+        friction, force = self.setup.friction, self.object_loop.squeeze.normal_force
+        if not self.config.object_loop or force is None or force == friction.min_normal_force:
+            return friction
+        return dataclasses.replace(friction, min_normal_force=force)
 
     def motion_in_use(self, inputs: Inputs) -> Motion | None:
         """
@@ -265,8 +300,12 @@ class Cycle:
             InputError: the inputs do not make a grasp (e.g. a tangent parallel to
                 its normal).
         """
-        fast = self._compiled(self.setup)
+        # The compiled cycle is made for the squeeze's friction (:meth:`squeezed`); made
+        # again when this cycle's grasp moved it.
+        fast = self._compiled(replaced(self.setup, friction=self.squeezed()))
         setup, g = self.grasp_at(inputs, jacobians=fast is not None)
+        if fast is not None and setup.friction is not self.setup.friction:
+            fast = self._compiled(setup)
         solver, fallback, handed_back = self.solver, self.fallback, ''
         if fast is not None:
             sol, maps = fast.solve(setup, None if deadline is None else
@@ -380,10 +419,20 @@ class Cycle:
         """
         Solve and gate; never raises.
 
+        The object loop is told the outcome (its anti-windup, :meth:`ObjectLoop.after`).
+
         Returns:
             A certified command (kind ``solution``, not yet committed), or a result of
             kind ``none`` whose ``fault`` says why there is none.
         """
+        result = self._attempt(inputs, deadline)
+        if self.estimating:
+            self.object_loop.after(result.kind == 'solution', result.command,
+                                   self.setup.hand.torque_limits)
+        return result
+
+    def _attempt(self, inputs: Inputs, deadline: float) -> CycleResult:
+        """Solve and gate (:meth:`attempt`)."""
         try:
             if not self.config.hold_object:
                 return self.free_hand(inputs)
@@ -402,3 +451,9 @@ class Cycle:
         if cmd is None:
             return CycleResult(None, 'none', sol, maps, g, why)
         return CycleResult(cmd, 'solution', sol, maps, g, q=inputs.q)
+
+
+def loop_gains(config: CycleConfig) -> LoopGains:
+    """Return the object loop's settings from the cycle's (``object_loop.*``, ``squeeze.*``)."""
+    return LoopGains(**{f.name: getattr(config, f'loop_{f.name}')
+                        for f in dataclasses.fields(LoopGains)})

@@ -70,7 +70,6 @@ def node_process(params: Path, start: bool, arguments: tuple[str, ...] = ()
     """
     child = None
     if start:
-        extra = [arg for o in overrides for arg in ('-p', o)]
         child = subprocess.Popen([sys.executable, '-m', 'grasp_torque_opt.ros.node',
                                   '--ros-args', '--params-file', str(params), *arguments,
                                   '--log-level', 'error'], stderr=subprocess.PIPE,

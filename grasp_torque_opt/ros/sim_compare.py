@@ -19,22 +19,85 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+from pathlib import Path
+from typing import Any
 
 from grasp_torque_opt.control.controller import TorqueController
 from grasp_torque_opt.control.inputs.imu import ImuReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.parameters.generated import CycleConfig
+from grasp_torque_opt.control.parameters.generated import CycleConfig, Params
+from grasp_torque_opt.control.parameters.schema import SCHEMA
+from grasp_torque_opt.control.parameters.snapshot import params_from
+from grasp_torque_opt.core.bounded_yaml import BoundedLoader
 from grasp_torque_opt.core.object_from_hand import ObjectFromHand
 from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.scenario import Scenario
+from grasp_torque_opt.ros.node.controllers import configure
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
+from grasp_torque_opt.ros.node.parameters import scenario_defaults
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
+import yaml
+
+
+def params_file(path: str | Path, scenario: Scenario, setup) -> Params:
+    """
+    Read a node's params file (``/**: ros__parameters:``) as the node would take it.
+
+    The schema's defaults, then the scenario's (:func:`scenario_defaults`), then the
+    file's values by dotted name (every node key's ``ros__parameters``), each checked by
+    the schema; the file's ``scenario`` is not read (the caller's is used).
+    """
+    with open(path, encoding='utf-8') as f:
+        doc = yaml.load(f, Loader=BoundedLoader) or {}
+    values = {**SCHEMA.defaults(), **scenario_defaults(scenario, setup)}
+
+    def flat(prefix: str, body: Any) -> None:
+        for key, value in body.items():
+            if isinstance(value, dict):
+                flat(f'{prefix}{key}.', value)
+            elif f'{prefix}{key}' != 'scenario':
+                SCHEMA.check(f'{prefix}{key}', value)
+                values[f'{prefix}{key}'] = value
+    for body in doc.values():
+        flat('', (body or {}).get('ros__parameters', {}))
+    return params_from(values)
+
+
+def _controller(setup, scenario: Scenario, rig, inputs: bool, margin: float,
+                efforts: bool | None, effort_report: str | None, over: dict,
+                params: str | Path | None) -> tuple[TorqueController, bool, bool]:
+    """Make :func:`node_controller`'s cycle; return it, whether the IMU and efforts go in."""
+    report = effort_report or (rig.effort_report if rig is not None else 'applied')
+    told = {'effort_report': report,
+            'effort_driver_stiffness': rig.kp if rig is not None else 0.0}
+    if params is not None:
+        p = params_file(params, scenario, setup)
+        ctrl = configure(None, setup, p, obj=scenario.object)
+        if effort_report is not None or report != 'applied':
+            over = {**told, **over}
+        ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=1.0, **over)
+        inputs, efforts = inputs and p.imu.enabled, ctrl.config.effort_estimation
+    else:
+        efforts = inputs if efforts is None else efforts
+        setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
+                                                                        margin=margin))
+        ctrl = TorqueController(setup, CycleConfig(
+            gravity_compensation=True, gravity=tuple(float(x) for x in scenario.gravity),
+            cycle_budget=1.0, effort_estimation=efforts, **{**told, **over}), fallback='daqp')
+    ctrl.load_of_gravity = load_of_gravity(scenario)
+    ctrl.solving.weight = weight_of(scenario)
+    if scenario.object is not None:
+        ctrl.solving.hand_object = ObjectFromHand(
+            setup.hand, setup.contacts, setup.q,
+            object_pose(scenario.object.position, scenario.object.rpy))
+    return ctrl, inputs, efforts
 
 
 def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
                     margin: float = 0.0, efforts: bool | None = None,
                     imu_rate: float | None = None, imu_latency: float = 0.0,
-                    commands: dict | None = None, effort_report: str | None = None):
+                    commands: dict | None = None, effort_report: str | None = None,
+                    config: dict | None = None, params: str | Path | None = None):
     """
     Return the node's cycle as a controller: a joint state in, its command out.
 
@@ -55,23 +118,19 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     cycle is told they are (None: what they are), with ``commanded`` the driver's
     stiffness the rig's Kp and its reference the scenario's grasp (the default).
     The fingertips' estimate of the object is placed as the node places it (the gate).
+    ``config``: further CycleConfig fields by name (the object loop's, e.g.
+    ``{'object_loop': True}``), over those.
+
+    With ``params`` (a node's params file, config/allegro_right_node.yaml), the controller
+    is the node's own, made from the file as the node makes it (:func:`params_file`,
+    :func:`~grasp_torque_opt.ros.node.controllers.configure`): ``margin`` and
+    ``efforts`` are the file's, the IMU is given if ``inputs`` and the file's
+    ``imu.enabled``; only the cycle's budget stays generous (simulated time is not
+    timed), and ``config`` still goes over the file's.
     """
-    efforts = inputs if efforts is None else efforts
-    report = effort_report or (rig.effort_report if rig is not None else 'applied')
-    setup = dataclasses.replace(setup, friction=dataclasses.replace(setup.friction,
-                                                                    margin=margin))
-    config = CycleConfig(gravity_compensation=True,
-                         gravity=tuple(float(x) for x in scenario.gravity),
-                         cycle_budget=1.0, effort_estimation=efforts, effort_report=report,
-                         effort_driver_stiffness=rig.kp if rig is not None else 0.0,
-                         **(commands or {}))
-    ctrl = TorqueController(setup, config, fallback='daqp')
-    ctrl.load_of_gravity = load_of_gravity(scenario)
-    ctrl.solving.weight = weight_of(scenario)
-    if scenario.object is not None:
-        ctrl.solving.hand_object = ObjectFromHand(
-            setup.hand, setup.contacts, setup.q,
-            object_pose(scenario.object.position, scenario.object.rpy))
+    ctrl, inputs, efforts = _controller(setup, scenario, rig, inputs, margin, efforts,
+                                        effort_report, {**(commands or {}), **(config or {})},
+                                        params)
     names = list(setup.hand.joints)
     clock = {'t': 0.0, 'imu': -1.0}
     readings: collections.deque = collections.deque()

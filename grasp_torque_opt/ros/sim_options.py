@@ -29,6 +29,30 @@ EFFORT_REPORTS = ('applied', 'commanded')
 AXES = {'x': (1, 0, 0), 'y': (0, 1, 0), 'z': (0, 0, 1)}
 
 
+def _disturbances(p: argparse.ArgumentParser) -> None:
+    """Add the disturbances' group (what the controller is not told)."""
+    g = p.add_argument_group('disturbances the controller is not told')
+    g.add_argument('--base-accel', metavar='AX,AY,AZ', default=None,
+                   help="the hand base's extra static acceleration from release on, base "
+                        'axes [m/s^2] (simulated as apparent gravity)')
+    g.add_argument('--base-shake', metavar='AMPLITUDE_G,FREQUENCY_HZ,AXIS', default=None,
+                   help='sinusoidal base acceleration from release on: peak [g], frequency '
+                        '[Hz], base axis x, y or z (e.g. 1,1,z)')
+    g.add_argument('--mass-scale', type=float, default=1.0,
+                   help="the simulated object's mass over the scenario's [-]")
+    g.add_argument('--object-offset', metavar='DX,DY,DZ', default=None,
+                   help="the simulated object's centre minus the scenario's, base axes [mm]")
+    g.add_argument('--joint-noise', type=float, default=0.0,
+                   help='encoder noise, standard deviation per 1 ms reading [mrad]: on the '
+                        'published joint states and in the impedance')
+    g.add_argument('--seed', type=int, default=0, help='seed of the encoder noise')
+    g.add_argument('--effort-report', choices=EFFORT_REPORTS, default='applied',
+                   help="what joint_states' effort is: applied, the torque the joints apply "
+                        "(command plus impedance); commanded, the controller's last command "
+                        "(as the Allegro V5's driver reports it; with --with-node the node is "
+                        'told so, and the driver stiffness --kp)')
+
+
 def parser(description: str) -> argparse.ArgumentParser:
     """Return the argument parser."""
     p = argparse.ArgumentParser(prog=PROG, formatter_class=HelpFormatter,
@@ -67,26 +91,7 @@ def parser(description: str) -> argparse.ArgumentParser:
     p.add_argument('--lockstep', action='store_true',
                    help='advance the simulation only when the node has answered the latest '
                         'joint state (reproducible; slower than real time): docs/simulation.md')
-    g = p.add_argument_group('disturbances the controller is not told')
-    g.add_argument('--base-accel', metavar='AX,AY,AZ', default=None,
-                   help="the hand base's extra static acceleration from release on, base "
-                        'axes [m/s^2] (simulated as apparent gravity)')
-    g.add_argument('--base-shake', metavar='AMPLITUDE_G,FREQUENCY_HZ,AXIS', default=None,
-                   help='sinusoidal base acceleration from release on: peak [g], frequency '
-                        '[Hz], base axis x, y or z (e.g. 1,1,z)')
-    g.add_argument('--mass-scale', type=float, default=1.0,
-                   help="the simulated object's mass over the scenario's [-]")
-    g.add_argument('--object-offset', metavar='DX,DY,DZ', default=None,
-                   help="the simulated object's centre minus the scenario's, base axes [mm]")
-    g.add_argument('--joint-noise', type=float, default=0.0,
-                   help='encoder noise, standard deviation per 1 ms reading [mrad]: on the '
-                        'published joint states and in the impedance')
-    g.add_argument('--seed', type=int, default=0, help='seed of the encoder noise')
-    g.add_argument('--effort-report', choices=EFFORT_REPORTS, default='applied',
-                   help="what joint_states' effort is: applied, the torque the joints apply "
-                        "(command plus impedance); commanded, the controller's last command "
-                        "(as the Allegro V5's driver reports it; with --with-node the node is "
-                        'told so, and the driver stiffness --kp)')
+    _disturbances(p)
     c = p.add_argument_group('controller')
     c.add_argument('--controller', choices=CONTROLLERS, default='node',
                    help='node: grasp_torque_node over ROS; preset: fixed closing torques of '

@@ -196,6 +196,61 @@ class CycleConfig:
         tactile_loss_ratio: (``tactile.loss_ratio``) A planned contact whose fresh measured normal
             force is below this times the planned one (zero included) is reported lost on
             /diagnostics (tactile.lost: a slip or a finger off the object).
+        object_loop: (``object_loop.enabled``) The object loop (docs/node.md, "The object loop"):
+            the object's displacement and rotation from the fingertips (from a reference taken once
+            the hand has settled) push back through the grasp, w_r = -(K e + D edot + Ki
+            integral(e)), added to what the hand applies; the load planned and certified is the
+            scenario's less w_r. Needs the scenario's object and gravity (the weight bounds w_r).
+        loop_stiffness: (``object_loop.stiffness``) K on the object's displacement: the force that
+            pushes a sagging object back before the integral has caught up (600 N/m: 0.6 N at 1
+            mm). [N/m]
+        loop_rotational_stiffness: (``object_loop.rotational_stiffness``) K on the object's
+            rotation (0 by default, docs/node.md "The object loop"). [N m/rad]
+        loop_damping: (``object_loop.damping``) D on the object's velocity (from the fingertips,
+            low-passed): damps what K and Ki start; more amplifies encoder noise. [N s/m]
+        loop_rotational_damping: (``object_loop.rotational_damping``) D on the object's angular
+            velocity. [N m s/rad]
+        loop_integral: (``object_loop.integral``) Ki on the integrated displacement: takes over a
+            load the model misses (a heavier object, a push) so that the object goes back to where
+            it was, not only less far. [N/(m s)]
+        loop_rotational_integral: (``object_loop.rotational_integral``) Ki on the integrated
+            rotation (an unmodelled moment, an offset centre). [N m/(rad s)]
+        loop_max_integral_ratio: (``object_loop.max_integral_ratio``) The integral's force is at
+            most this times the scenario's weight, its moment that force times the farthest
+            contact's distance from the object origin (the load error the loop may take over for
+            good).
+        loop_max_force_ratio: (``object_loop.max_force_ratio``) The whole restoring force's bound
+            over the scenario's weight (moment likewise).
+        loop_settle_time: (``object_loop.settle_time``) The reference (where the object should
+            stay) is re-taken at every cycle for this long after the loop starts, is turned on, the
+            contact set changes or the joint states come back after a gap; then the loop pushes.
+            [s]
+        loop_velocity_filter: (``object_loop.velocity_filter``) Time constant of the low-pass on
+            the error's rate (edot). [s]
+        loop_unwind_time: (``object_loop.unwind_time``) After a cycle without a certified command
+            or with a joint at its torque limit, the integral decays with this time constant
+            (anti-windup). [s]
+        loop_slip_residual: (``object_loop.slip_residual``) A contact whose distance from the
+            object's rigid motion rose this far lately (object_loop.slip_memory) slips: the
+            integral is frozen (the error is no motion the grasp can undo); the squeeze's usage
+            from slip evidence is this distance's fraction. [m]
+        loop_slip_memory: (``object_loop.slip_memory``) The time constant of the low-pass a
+            contact's residual is compared with: a slip counts for about this long, then the
+            squeeze may relax. [s]
+        loop_squeeze: (``squeeze.enabled``) The squeeze that follows friction (with
+            object_loop.enabled): the minimum normal force rises while a contact's measured
+            friction usage is above squeeze.raise_at, falls back to the scenario's below
+            squeeze.relax_at, within the torque limits.
+        loop_raise_at: (``squeeze.raise_at``) The friction usage (1 at the cone) above which the
+            squeeze rises.
+        loop_relax_at: (``squeeze.relax_at``) The friction usage below which the squeeze relaxes.
+        loop_rate: (``squeeze.rate``) How fast the minimum normal force rises. [N/s]
+        loop_relax_rate: (``squeeze.relax_rate``) How fast it relaxes (slower than it rises, so
+            that the next peak of a shake finds the squeeze still there). [N/s]
+        loop_max_normal_force: (``squeeze.max_normal_force``) The squeeze's ceiling on the minimum
+            normal force. [N]
+        loop_usage_timeout: (``squeeze.usage_timeout``) A friction usage measured by a source
+            (tactile) older than this is not used: the slip evidence is. [s]
         uncertainty_pose: (``uncertainty.pose``) Contact position / object pose uncertainty (0.002:
             2 mm): tilts a normal by pose/(R + r), R the scenario's object's radius (a box's flat
             face: no tilt), r uncertainty.tip_radius. It also bounds how far an object pose may be
@@ -295,6 +350,27 @@ class CycleConfig:
     tactile_max_force: float = 50.0
     tactile_negative_tolerance: float = 0.05
     tactile_loss_ratio: float = 0.3
+    object_loop: bool = False
+    loop_stiffness: float = 600.0
+    loop_rotational_stiffness: float = 0.0
+    loop_damping: float = 4.0
+    loop_rotational_damping: float = 0.0
+    loop_integral: float = 6000.0
+    loop_rotational_integral: float = 0.0
+    loop_max_integral_ratio: float = 0.6
+    loop_max_force_ratio: float = 1.0
+    loop_settle_time: float = 0.2
+    loop_velocity_filter: float = 0.01
+    loop_unwind_time: float = 0.1
+    loop_slip_residual: float = 0.001
+    loop_slip_memory: float = 0.2
+    loop_squeeze: bool = False
+    loop_raise_at: float = 0.5
+    loop_relax_at: float = 0.2
+    loop_rate: float = 2.0
+    loop_relax_rate: float = 0.5
+    loop_max_normal_force: float = 1.0
+    loop_usage_timeout: float = 0.05
     uncertainty_pose: float = 0.0
     joint_limit_tolerance: float = 0.1
     stamp_future_tolerance: float = 0.5
@@ -493,6 +569,92 @@ class ParamsTactile:
     max_force: float | None
     negative_tolerance: float | None
     loss_ratio: float | None
+
+
+@dataclass(frozen=True)
+class ParamsObjectLoop:
+    """
+    The ``object_loop.*`` parameters.
+
+    Attributes:
+        enabled: The object loop (docs/node.md, "The object loop"): the object's displacement and
+            rotation from the fingertips (from a reference taken once the hand has settled) push
+            back through the grasp, w_r = -(K e + D edot + Ki integral(e)), added to what the hand
+            applies; the load planned and certified is the scenario's less w_r. Needs the
+            scenario's object and gravity (the weight bounds w_r).
+        stiffness: K on the object's displacement: the force that pushes a sagging object back
+            before the integral has caught up (600 N/m: 0.6 N at 1 mm). [N/m]
+        rotational_stiffness: K on the object's rotation (0 by default, docs/node.md "The object
+            loop"). [N m/rad]
+        damping: D on the object's velocity (from the fingertips, low-passed): damps what K and Ki
+            start; more amplifies encoder noise. [N s/m]
+        rotational_damping: D on the object's angular velocity. [N m s/rad]
+        integral: Ki on the integrated displacement: takes over a load the model misses (a heavier
+            object, a push) so that the object goes back to where it was, not only less far.
+            [N/(m s)]
+        rotational_integral: Ki on the integrated rotation (an unmodelled moment, an offset
+            centre). [N m/(rad s)]
+        max_integral_ratio: The integral's force is at most this times the scenario's weight, its
+            moment that force times the farthest contact's distance from the object origin (the
+            load error the loop may take over for good).
+        max_force_ratio: The whole restoring force's bound over the scenario's weight (moment
+            likewise).
+        settle_time: The reference (where the object should stay) is re-taken at every cycle for
+            this long after the loop starts, is turned on, the contact set changes or the joint
+            states come back after a gap; then the loop pushes. [s]
+        velocity_filter: Time constant of the low-pass on the error's rate (edot). [s]
+        unwind_time: After a cycle without a certified command or with a joint at its torque limit,
+            the integral decays with this time constant (anti-windup). [s]
+        slip_residual: A contact whose distance from the object's rigid motion rose this far lately
+            (object_loop.slip_memory) slips: the integral is frozen (the error is no motion the
+            grasp can undo); the squeeze's usage from slip evidence is this distance's fraction.
+            [m]
+        slip_memory: The time constant of the low-pass a contact's residual is compared with: a
+            slip counts for about this long, then the squeeze may relax. [s]
+    """
+
+    enabled: bool | None
+    stiffness: float | None
+    rotational_stiffness: float | None
+    damping: float | None
+    rotational_damping: float | None
+    integral: float | None
+    rotational_integral: float | None
+    max_integral_ratio: float | None
+    max_force_ratio: float | None
+    settle_time: float | None
+    velocity_filter: float | None
+    unwind_time: float | None
+    slip_residual: float | None
+    slip_memory: float | None
+
+
+@dataclass(frozen=True)
+class ParamsSqueeze:
+    """
+    The ``squeeze.*`` parameters.
+
+    Attributes:
+        enabled: The squeeze that follows friction (with object_loop.enabled): the minimum normal
+            force rises while a contact's measured friction usage is above squeeze.raise_at, falls
+            back to the scenario's below squeeze.relax_at, within the torque limits.
+        raise_at: The friction usage (1 at the cone) above which the squeeze rises.
+        relax_at: The friction usage below which the squeeze relaxes.
+        rate: How fast the minimum normal force rises. [N/s]
+        relax_rate: How fast it relaxes (slower than it rises, so that the next peak of a shake
+            finds the squeeze still there). [N/s]
+        max_normal_force: The squeeze's ceiling on the minimum normal force. [N]
+        usage_timeout: A friction usage measured by a source (tactile) older than this is not used:
+            the slip evidence is. [s]
+    """
+
+    enabled: bool | None
+    raise_at: float | None
+    relax_at: float | None
+    rate: float | None
+    relax_rate: float | None
+    max_normal_force: float | None
+    usage_timeout: float | None
 
 
 @dataclass(frozen=True)
@@ -713,6 +875,8 @@ class Params:
         object_pose: the ``object_pose.*`` parameters.
         effort_estimation: the ``effort_estimation.*`` parameters.
         tactile: the ``tactile.*`` parameters.
+        object_loop: the ``object_loop.*`` parameters.
+        squeeze: the ``squeeze.*`` parameters.
         uncertainty: the ``uncertainty.*`` parameters.
         joint_limit_tolerance: A joint state with a used position beyond its joint's URDF limits by
             more than this is rejected. [rad or m]
@@ -797,6 +961,8 @@ class Params:
     object_pose: ParamsObjectPose
     effort_estimation: ParamsEffortEstimation
     tactile: ParamsTactile
+    object_loop: ParamsObjectLoop
+    squeeze: ParamsSqueeze
     uncertainty: ParamsUncertainty
     joint_limit_tolerance: float | None
     stamp_future_tolerance: float | None
@@ -870,6 +1036,27 @@ CYCLE_FIELDS = {
     'tactile_max_force': 'tactile.max_force',
     'tactile_negative_tolerance': 'tactile.negative_tolerance',
     'tactile_loss_ratio': 'tactile.loss_ratio',
+    'object_loop': 'object_loop.enabled',
+    'loop_stiffness': 'object_loop.stiffness',
+    'loop_rotational_stiffness': 'object_loop.rotational_stiffness',
+    'loop_damping': 'object_loop.damping',
+    'loop_rotational_damping': 'object_loop.rotational_damping',
+    'loop_integral': 'object_loop.integral',
+    'loop_rotational_integral': 'object_loop.rotational_integral',
+    'loop_max_integral_ratio': 'object_loop.max_integral_ratio',
+    'loop_max_force_ratio': 'object_loop.max_force_ratio',
+    'loop_settle_time': 'object_loop.settle_time',
+    'loop_velocity_filter': 'object_loop.velocity_filter',
+    'loop_unwind_time': 'object_loop.unwind_time',
+    'loop_slip_residual': 'object_loop.slip_residual',
+    'loop_slip_memory': 'object_loop.slip_memory',
+    'loop_squeeze': 'squeeze.enabled',
+    'loop_raise_at': 'squeeze.raise_at',
+    'loop_relax_at': 'squeeze.relax_at',
+    'loop_rate': 'squeeze.rate',
+    'loop_relax_rate': 'squeeze.relax_rate',
+    'loop_max_normal_force': 'squeeze.max_normal_force',
+    'loop_usage_timeout': 'squeeze.usage_timeout',
     'uncertainty_pose': 'uncertainty.pose',
     'joint_limit_tolerance': 'joint_limit_tolerance',
     'stamp_future_tolerance': 'stamp_future_tolerance',
