@@ -86,8 +86,9 @@ class Rig:
         overrides += [Parameter(k, value=v) for k, v in params.items()]
         self.node = GraspTorqueNode(context=self.context, parameter_overrides=overrides)
         values = self.node.root.parameters.values()
-        self.defaults = [Parameter(n, value=v) for n, v in values.items()
-                         if not PARAMETERS[n].read_only]
+        # Typed as declared: an empty list's own type would be a byte array (tactile.links).
+        self.defaults = [Parameter(n, self.node.get_parameter(n).type_, v)
+                         for n, v in values.items() if not PARAMETERS[n].read_only]
         self.recorder = Recorder(self.node)
         self.setup = setup
         names, pos = joint_state(setup)
