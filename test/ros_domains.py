@@ -31,8 +31,11 @@ ROLES = {
     'without_mujoco': 7,      # test_without_mujoco.py's script
     'without_optional': 8,    # test_without_optional_solvers.py's script
     'workspace': 9,           # test_colcon_workspace.py: the node the workspace built
-    'spare': 10,              # 10 to 12: free for a new role
+    'sim_commanded': 10,      # test_sim_driver.py's commanded-effort listener: 10, 11, 12
 }
+
+#: The roles with three domains, one per attempt.
+ATTEMPTS = ('sim_listen', 'sim_commanded')
 
 
 BASE = base()
@@ -40,10 +43,10 @@ BASE = base()
 
 def domain(role: str, attempt: int = 0) -> int:
     """Return the domain of ``role`` in this run (``attempt`` for a role with several)."""
-    if attempt and role != 'sim_listen':
+    if attempt and role not in ATTEMPTS:
         raise ValueError(f'{role} has one domain')
     if not 0 <= attempt < 3:
-        raise ValueError('sim_listen has 3 domains')
+        raise ValueError(f'{role} has 3 domains')
     return BASE + ROLES[role] + attempt
 
 
