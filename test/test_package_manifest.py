@@ -38,6 +38,8 @@ ROSDEP_KEYS = {
     'geometry_msgs': 'geometry_msgs',
     'visualization_msgs': 'visualization_msgs',
     'diagnostic_msgs': 'diagnostic_msgs',
+    'rosgraph_msgs': 'rosgraph_msgs',  # grasp-torque-sim --lockstep's /clock
+    'builtin_interfaces': 'builtin_interfaces',
     # launch/grasp_torque.launch.py
     'launch': 'launch',
     'launch_ros': 'launch_ros',
