@@ -166,8 +166,9 @@ def test_stale_tactile_is_said_or_a_fault_when_required():
         h.send_array(tips(dict.fromkeys(TIPS, 1.0)))
         h.spin_for(0.3)
         assert len(h.commands_after()) == 3  # commands go on
-        d = h.diag(lambda d: 'stale' in d.get('tactile', ''))
-        assert d['_level'] == 1 and 'tactile stale' in d['_message'], d
+        # The first report that says it (one a moment earlier, under load, may not yet).
+        d = h.diag(lambda d: 'stale' in d.get('tactile', '') and d['_level'] == 1
+                   and 'tactile stale' in d['_message'])
     finally:
         h.close()
     h = TactileHarness(tactile__timeout=0.1, tactile__required=True)
