@@ -119,3 +119,25 @@ class Slow:
 
 FAULT_MODES = ['raise-solver', 'raise-other', 'nan-data', 'inverted-bounds', 'max-iter',
                'wrong-x', 'nan-x', 'wrong-size-x']
+
+
+def phantom(setup, links=('link_7.0',)):
+    """
+    Give the grasp's contact poses and one more at each of ``links``' frames.
+
+    Each extra pose's normal points to the object origin: a point on its link, 0 mm from
+    its frame, off the object's surface.
+    """
+    points, quat = base_poses(setup)
+    model = setup.hand.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, setup.q)
+    for link in links:
+        p = data.oMf[model.getFrameId(link)].translation
+        z = setup.object_origin - p
+        z /= np.linalg.norm(z)
+        x = np.cross([0.0, 1.0, 0.0], z)
+        x /= np.linalg.norm(x)
+        R = np.column_stack((x, np.cross(z, x), z))
+        points, quat = np.vstack((points, p)), np.vstack((quat, pin.Quaternion(R).coeffs()))
+    return points, quat

@@ -43,7 +43,7 @@ import time
 
 from campaign import COUNTS, ISSUE33, TrueGrasp
 from conftest import ALLEGRO, ALLEGRO_URDF
-from cycle_inputs import base_poses, joint_state
+from cycle_inputs import base_poses, joint_state, phantom as shared_phantom
 from geometry_msgs.msg import PoseStamped
 from grasp_torque_opt.core.geometry_contacts import GeometryContacts
 from grasp_torque_opt.core.grasp_setup import GraspSetup
@@ -51,7 +51,6 @@ from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.scenario import load_scenario
 import numpy as np
-import pinocchio as pin
 import pytest
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
@@ -300,18 +299,7 @@ def named(links, frame=''):
 
 def phantom(links):
     """Give the four poses and one more at each of ``links``' frames, normal to the ball."""
-    points, quat = base_poses(SETUP)
-    data = SETUP.hand.model.createData()
-    pin.framesForwardKinematics(SETUP.hand.model, data, SETUP.q)
-    for link in links:
-        p = data.oMf[SETUP.hand.model.getFrameId(link)].translation
-        z = SETUP.object_origin - p
-        z /= np.linalg.norm(z)
-        x = np.cross([0.0, 1.0, 0.0], z)
-        x /= np.linalg.norm(x)
-        R = np.column_stack((x, np.cross(z, x), z))
-        points, quat = np.vstack((points, p)), np.vstack((quat, pin.Quaternion(R).coeffs()))
-    return points, quat
+    return shared_phantom(SETUP, links)
 
 
 POINTS, QUAT = base_poses(SETUP)

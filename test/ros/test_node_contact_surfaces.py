@@ -19,12 +19,11 @@ and the Allegro URDF's coal shapes; the commands that follow must be the nominal
 import dataclasses
 
 from conftest import ALLEGRO, PLANAR
-from cycle_inputs import base_poses, joint_state
+from cycle_inputs import base_poses, joint_state, phantom as shared_phantom
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.dispatch import solve
 from lifecycle_msgs.msg import Transition
 import numpy as np
-import pinocchio as pin
 import pytest
 from ros_harness import Harness, LifecycleHarness
 from test_name_map import NAME_MAP, renamed, write_renamed_urdf
@@ -45,18 +44,7 @@ def phantom(links=('link_7.0',)):
     Such a point is on its link's own box (its collision shape), 0 mm from its frame: the
     frame rule and the link's surface both take it; only the object's surface refuses it.
     """
-    points, quat = base_poses(SETUP)
-    data = SETUP.hand.model.createData()
-    pin.framesForwardKinematics(SETUP.hand.model, data, SETUP.q)
-    for link in links:
-        p = data.oMf[SETUP.hand.model.getFrameId(link)].translation
-        z = SETUP.object_origin - p
-        z /= np.linalg.norm(z)
-        x = np.cross([0.0, 1.0, 0.0], z)
-        x /= np.linalg.norm(x)
-        R = np.column_stack((x, np.cross(z, x), z))
-        points, quat = np.vstack((points, p)), np.vstack((quat, pin.Quaternion(R).coeffs()))
-    return points, quat
+    return shared_phantom(SETUP, links)
 
 
 def refused_and_not_commanded(h, send, why, rename=str):
