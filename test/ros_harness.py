@@ -85,6 +85,16 @@ class Harness:
         self.solve_client = t.create_client(Trigger, 'grasp_torque_node/solve',
                                             qos_profile=SERVICE_QOS)
         assert self.spin_until(self.ready, 10.0)
+        # An earlier test's node of this name may linger in the graph a moment after it
+        # was destroyed: the node would report it (an ERROR on /diagnostics) as a namesake.
+        assert self.spin_until(lambda: self.namesakes() == 0, 10.0), \
+            'an earlier node named grasp_torque_node stayed on this domain for 10 s'
+        self.diagnostics = [d for d in self.diagnostics if d.get('duplicate_nodes') == '0']
+
+    def namesakes(self) -> int:
+        """Count the other nodes named grasp_torque_node the tester sees."""
+        me = ('grasp_torque_node', '/')
+        return sum(1 for n in self.tester.get_node_names_and_namespaces() if tuple(n) == me) - 1
 
     def make_node(self, overrides):
         return GraspTorqueNode(context=self.context, parameter_overrides=overrides)

@@ -356,13 +356,8 @@ class _Link:
                         velocity=[float(x) for x in hsim.qdot],
                         effort=[float(x) for x in hsim.reported_effort()])
         js.header.stamp = stamp
-        # The IMU before the joint state: the node's cycle on the joint state uses it.
+        # Every other input before the joint state: the node's cycle on it uses them.
         self.imu_pub.publish(imu_message(Imu, *hsim.imu(), hand.base_frame, stamp))
-        self.js_pub.publish(js)
-        if self.baseline is not None:  # the driver's own controller, on what it publishes
-            self.on_command(Float64MultiArray(data=[float(x)
-                                                    for x in self.baseline(hsim.reading)]),
-                            lockstep=False)
         if self.args.tactile:
             from std_msgs.msg import Float32MultiArray
             self.tactile_pub.publish(Float32MultiArray(data=[float(x) for x in hsim.touch()]))
@@ -370,6 +365,11 @@ class _Link:
             # In the root frame (MuJoCo's world), where the simulated contacts are read.
             publish_contacts(hsim, self.setup, self.contacts_pub, hand.root_frame, stamp,
                              compute_grasp_maps, Pose, PoseArray)
+        self.js_pub.publish(js)
+        if self.baseline is not None:  # the driver's own controller, on what it publishes
+            self.on_command(Float64MultiArray(data=[float(x)
+                                                    for x in self.baseline(hsim.reading)]),
+                            lockstep=False)
 
     def run_for(self, seconds: float, until=None, each_second=None) -> bool:
         """Step in real time; publish joint states, apply commands; stop early on until()."""

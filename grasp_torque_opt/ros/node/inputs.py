@@ -169,9 +169,14 @@ class Inputs:
             receipt: when the middleware received it (monotonic [s]; None: now).
         """
         now = self.now()
-        receipt = now if receipt is None else receipt
         header = msg.header.stamp
         stamp = stamp_seconds(header.sec, header.nanosec)
+        if self.sim_aged:
+            # /clock and joint_states are two topics: no order between them is sure, and
+            # a cycle run before its /clock would see no time pass (a lockstep run would
+            # then depend on the machine's load). The joint state's stamp is the time.
+            now = max(now, stamp)
+        receipt = now if receipt is None else receipt
         root = self.root
         with root.lock:
             ctrl = root.controller
