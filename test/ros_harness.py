@@ -81,10 +81,13 @@ class Harness:
         t.create_subscription(DiagnosticArray, '/diagnostics', self._on_diag, 10)
         t.create_subscription(MarkerArray, 'grasp_torque_node/contact_wrenches',
                               self.markers.append, 1)
-        t.create_subscription(Log, '/rosout', self._on_log, 100)
+        self.log_sub = t.create_subscription(Log, '/rosout', self._on_log, 100)
         self.solve_client = t.create_client(Trigger, 'grasp_torque_node/solve',
                                             qos_profile=SERVICE_QOS)
         assert self.spin_until(self.ready, 10.0)
+        # /rosout matched to the node's and the tester's own publishers: a warning logged at
+        # once (a test's first bad message) reaches self.logs.
+        assert self.spin_until(lambda: self.log_sub.get_publisher_count() >= 2, 10.0)
         # An earlier test's node of this name may linger in the graph a moment after it
         # was destroyed: the node would report it (an ERROR on /diagnostics) as a namesake.
         assert self.spin_until(lambda: self.namesakes() == 0, 10.0), \

@@ -340,7 +340,9 @@ def test_a_cycle_ends_within_its_budget_whatever_the_solver_settings(allegro):
     ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     t0 = time.perf_counter()
     r = ctrl.cycle(0.0)
-    assert time.perf_counter() - t0 < 0.05 + 0.5
+    # Stopped by the budget, not by the solver: a bound far under the 11 minutes that
+    # still holds on a loaded machine (how close to the budget: bench/, not a unit test).
+    assert time.perf_counter() - t0 < 5.0
     assert r.command is None and 'time budget spent' in r.fault
 
 
@@ -366,8 +368,11 @@ def test_the_adaptive_method_keeps_the_budget_too(allegro):
                             'proxsuite', True, 'daqp')
     ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 0.0)
     t0 = time.perf_counter()
-    ctrl.cycle(0.0)
-    assert time.perf_counter() - t0 < 0.05 + 0.5
+    r = ctrl.cycle(0.0)
+    # Stopped by the budget (far under the 90 s), however loaded the machine.
+    assert time.perf_counter() - t0 < 5.0
+    assert r.command is None and ('time budget spent' in r.fault
+                                  or r.fault.startswith('cycle overrun (')), r.fault
 
 
 def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar):
