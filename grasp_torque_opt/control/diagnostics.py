@@ -64,6 +64,7 @@ def report(controller: TorqueController, now: float) -> Report:
                ('cycle_budget_s', f'{cfg.cycle_budget:.6f}')]
     values += solver_values(c)
     values += motion_values(c, now)
+    values += object_loop_values(c)
     values += contact_values(c, now)
     if level == OK and c.solving.imu_state:
         level, message = WARN, f'certified torques published; {c.solving.imu_state}'
@@ -168,6 +169,34 @@ def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
             values.append(('load.correction', _vector(est.correction)))
     if solving.load is not None:
         values.append(('load.planned', _vector(solving.load)))
+    return values
+
+
+def object_loop_values(c: TorqueController) -> list[tuple[str, str]]:
+    """
+    Give the object loop's state: engaged or settling, the object's deviation, its wrench.
+
+    The deviation is the loop's own error (the object's displacement from the fingertips,
+    since the reference was taken), not the fingertips' drift from the scenario's pose.
+    """
+    if not c.config.object_loop:
+        return [('object_loop', 'off (object_loop.enabled false)')]
+    loop = c.solving.object_loop
+    state = ('engaged' if loop.engaged else 'settling' if loop.tracker is not None
+             else 'no reference (no contacts or no weight)')
+    e, w = loop.error, loop.wrench
+    values = [('object_loop', state),
+              ('object_loop.deviation_mm', f'{1e3 * np.linalg.norm(e[:3]):.3f}'),
+              ('object_loop.rotation_deg', f'{np.degrees(np.linalg.norm(e[3:])):.3f}'),
+              ('object_loop.wrench', _vector(w)),
+              ('object_loop.integral', loop.why_frozen and f'frozen: {loop.why_frozen}'
+               or 'moving'),
+              ('object_loop.settlings', str(loop.changes)),
+              ('object_loop.max_slip_mm', f'{1e3 * float(loop.slip.max()):.3f}'
+               if loop.slip.size else 'none')]
+    force = loop.squeeze.normal_force
+    if force is not None:
+        values.append(('squeeze.min_normal_force_N', f'{force:.4f}'))
     return values
 
 

@@ -184,3 +184,37 @@ def test_squeeze_rises_with_usage_and_relaxes_within_its_bounds():
         squeeze.update(base, np.zeros(4), t + 1.0 + k * DT, gains, (True, False), 0.05)
     assert squeeze.source == 'slip'
     assert squeeze.normal_force == pytest.approx(base)
+
+
+def test_the_loop_state_is_on_the_diagnostic_report():
+    from cycle_inputs import fresh, joint_state
+    from grasp_torque_opt.control.diagnostics import report
+    from grasp_torque_opt.control.inputs.joint_states import JointStateReading
+
+    ctrl = fresh(SETUP, object_loop=True, loop_settle_time=0.02, joint_state_timeout=1.0)
+    assert dict(report(ctrl, 0.0).values)['object_loop'].startswith('no reference')
+    ctrl.solving.weight = WEIGHT  # as the node sets it from the scenario
+    t = 0.0
+
+    def cycle(q):
+        nonlocal t
+        t += DT
+        ctrl.take('joint_states', JointStateReading(*joint_state(SETUP, q)), t)
+        ctrl.cycle(t)
+        return dict(report(ctrl, t).values)
+
+    v = cycle(SETUP.q)
+    assert v['object_loop'] == 'settling' and v['object_loop.settlings'] == '1', v
+    while v['object_loop'] != 'engaged' and t < 0.1:
+        v = cycle(SETUP.q)
+    assert v['object_loop'] == 'engaged' and float(v['object_loop.deviation_mm']) < 1e-3
+    # The fingertips carry the object 1 mm along -x and 1 deg about z: the report says so.
+    for _ in range(3):
+        v = cycle(carried(np.array([-1e-3, 0.0, 0.0, 0.0, 0.0, np.radians(1.0)])))
+    assert float(v['object_loop.deviation_mm']) == pytest.approx(1.0, abs=0.02), v
+    assert float(v['object_loop.rotation_deg']) == pytest.approx(1.0, abs=0.02), v
+    assert v['object_loop.integral'] == 'moving' and v['object_loop.max_slip_mm'] != 'none'
+    force = [float(x) for x in v['object_loop.wrench'].strip('[]').split(',')[:3]]
+    assert force[0] > 0  # pushing back along +x
+    off = fresh(SETUP)
+    assert dict(report(off, 0.0).values)['object_loop'] == 'off (object_loop.enabled false)'
