@@ -296,6 +296,10 @@ def test_startup_errors_name_the_parameter():
             GraspTorqueNode(context=ctx, parameter_overrides=[
                 Parameter('scenario', value=str(PLANAR)),
                 Parameter('torque_limits', value=[1.0])])
+        # A node refused at start is gone from the graph at once (not at garbage collection).
+        probe = rclpy.create_node('probe', context=ctx)
+        assert ('grasp_torque_node', '/') not in probe.get_node_names_and_namespaces()
+        probe.destroy_node()
     finally:
         rclpy.try_shutdown(context=ctx)
 

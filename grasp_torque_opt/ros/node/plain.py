@@ -43,6 +43,16 @@ class GraspTorqueNode(Node):
             InputError: a parameter, the scenario or the URDF is refused (named).
         """
         super().__init__(NODE_NAME, **kwargs)
+        try:
+            self._build(message_info)
+        except BaseException:
+            # A node refused at start leaves no namesake in the graph for whoever comes
+            # next in this process (it would otherwise stay until garbage-collected).
+            self.destroy_node()
+            raise
+
+    def _build(self, message_info: bool) -> None:
+        """Load, declare and start (:meth:`__init__`'s body)."""
         self.root = root = GraspTorque(self, managed=False, message_info=message_info)
         declared = root.parameters
         defaults = PARAMETERS.defaults()
