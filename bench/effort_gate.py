@@ -27,7 +27,6 @@ it (IMU and efforts on, friction margin 0.31) on the rig of grasp-torque-sim.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 from pathlib import Path
 import sys
 
@@ -38,8 +37,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, machine_line  # noqa: E402, I100
 from grasp_torque_opt.core.resources import find_config  # noqa: E402
 from grasp_torque_opt.core.scenario import load_scenario  # noqa: E402
-from grasp_torque_opt.ros.sim_compare import node_controller  # noqa: E402
-from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated  # noqa: E402
+from grasp_torque_opt.ros.sim_compare import effort_episode  # noqa: E402
+from grasp_torque_opt.sim.episode import EpisodeSettings  # noqa: E402
 from physics import commit  # noqa: E402
 
 SCENARIO = load_scenario(find_config('allegro_right.yaml'))
@@ -49,23 +48,8 @@ DIRECTIONS = {'+x': (1, 0, 0), '-x': (-1, 0, 0), '+y': (0, 1, 0), '-y': (0, -1, 
 
 
 def episode(settings: EpisodeSettings, gate: bool = True, report: str | None = None):
-    """Run the node's cycle; return the report and rows (time, correction x, estimate x)."""
-    setup, rig = simulated(SCENARIO, settings)
-    command = node_controller(setup, SCENARIO, rig, inputs=True, margin=0.31, efforts=True,
-                              effort_report=report)
-    ctrl = command.controller
-    if not gate:
-        ctrl.config = dataclasses.replace(ctrl.config, effort_max_residual=0.1,
-                                          effort_max_object_speed=1.0)
-    rows = []
-
-    def recorded(reading):
-        out = command(reading)
-        est = ctrl.solving.effort_load
-        rows.append((rig.time - (rig.release_time or rig.time), float(est.correction[0]),
-                     np.nan if est.estimate is None else float(est.estimate[0])))
-        return out
-    return run_episode(rig, recorded, settings), np.array(rows)
+    """Run the node's cycle on the rig (sim_compare.effort_episode)."""
+    return effort_episode(SCENARIO, settings, gate, report)
 
 
 def slip(kp: float) -> None:

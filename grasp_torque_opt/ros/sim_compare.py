@@ -171,3 +171,36 @@ def baseline_trace(scenario: Scenario, settings: EpisodeSettings, sim=None) -> l
     run_episode(rig, node_controller(setup, scenario, rig, inputs=False), settings,
                 trace=trace)
     return trace
+
+
+def effort_episode(scenario: Scenario, settings: EpisodeSettings, gate: bool = True,
+                   report: str | None = None, margin: float = 0.31):
+    """
+    Run the node's cycle with the load from efforts on the rig; trace its correction.
+
+    The bench (bench/effort_gate.py) and the tests of the effort gate run this one
+    episode: the IMU and efforts on, the bundled params' friction margin; ``gate`` False
+    opens the gate (its limits beyond anything the rig does: the node before issue 32).
+
+    Returns:
+        The episode's outcome and rows (time after release [s], correction x [N],
+        estimate x [N] or NaN).
+    """
+    import numpy as np
+
+    setup, rig = simulated(scenario, settings)
+    command = node_controller(setup, scenario, rig, inputs=True, margin=margin, efforts=True,
+                              effort_report=report)
+    ctrl = command.controller
+    if not gate:
+        ctrl.config = dataclasses.replace(ctrl.config, effort_max_residual=0.1,
+                                          effort_max_object_speed=1.0)
+    rows = []
+
+    def recorded(reading):
+        out = command(reading)
+        est = ctrl.solving.effort_load
+        rows.append((rig.time - (rig.release_time or rig.time), float(est.correction[0]),
+                     np.nan if est.estimate is None else float(est.estimate[0])))
+        return out
+    return run_episode(rig, recorded, settings), np.array(rows)

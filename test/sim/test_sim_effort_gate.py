@@ -25,18 +25,14 @@ efforts on, the bundled params' friction margin 0.31) on the rig at Kp 0.3.
 """
 
 import dataclasses
-from pathlib import Path
-import sys
 
 from grasp_torque_opt.control.effort_load import applied_torque
 from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import load_scenario
-from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
+from grasp_torque_opt.ros.sim_compare import effort_episode
+from grasp_torque_opt.sim.episode import EpisodeSettings, simulated
 import numpy as np
 import pytest
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'bench'))
-from robustness import node_controller  # noqa: E402, I100
 
 SCENARIO = load_scenario(find_config('allegro_right.yaml'))
 WEIGHT = SCENARIO.object.mass * float(np.linalg.norm(SCENARIO.gravity))  # 1.4715 N
@@ -47,23 +43,8 @@ LONG_HOLD = 20.0
 
 
 def episode(settings: EpisodeSettings, gate: bool = True, report: str | None = None):
-    """Run the node's cycle; return the report and rows (time, correction x, estimate x)."""
-    setup, rig = simulated(SCENARIO, settings)
-    command = node_controller(setup, SCENARIO, rig, inputs=True, margin=0.31, efforts=True,
-                              effort_report=report)
-    ctrl = command.controller
-    if not gate:  # limits beyond anything the rig does: the node before the gate
-        ctrl.config = dataclasses.replace(ctrl.config, effort_max_residual=0.1,
-                                          effort_max_object_speed=1.0)
-    rows = []
-
-    def recorded(reading):
-        out = command(reading)
-        est = ctrl.solving.effort_load
-        rows.append((rig.time - (rig.release_time or rig.time), float(est.correction[0]),
-                     np.nan if est.estimate is None else float(est.estimate[0])))
-        return out
-    return run_episode(rig, recorded, settings), np.array(rows)
+    """Run the node's cycle on the rig (sim_compare.effort_episode)."""
+    return effort_episode(SCENARIO, settings, gate, report)
 
 
 @pytest.mark.parametrize('offset', [(0.0, 0.0, 5e-3), (5e-3, 0.0, 0.0)])
