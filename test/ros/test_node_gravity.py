@@ -193,8 +193,9 @@ def test_stale_gravity_stops_commands_as_any_stale_input(allegro):
             h.spin_for(period)
         times = [t for t, _ in h.commands]
         assert len([t for t in times if t <= t_gravity + timeout]) >= 2
-        # 30 ms for delivery and scheduling on a loaded 2-core machine.
-        assert max(times) <= t_gravity + timeout + period + 0.03
+        # The node's own time of its last command (the cycle's clock, which ages inputs):
+        # the tester's callback times also count this process being descheduled.
+        assert h.node.controller.last_command_time <= t_gravity + timeout
         assert h.node.controller.fault.startswith('gravity stale')
         # Fresh gravity again: commands resume at once.
         h.send_gravity('', [9.81, 0.0, 0.0])

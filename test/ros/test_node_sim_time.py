@@ -53,7 +53,12 @@ def test_use_sim_time_is_fixed_after_start(planar):
 def _stops_on(module, args, name, sig):
     p = NodeProcess(module, ['--ros-args', *args, '-p', 'startup_check_time:=0.0'], name)
     try:
-        time.sleep(3.0)  # started (and, for the managed node, waiting unconfigured)
+        # Started (its signal handlers are in before its node exists) and, for the managed
+        # node, waiting unconfigured: seen in the graph, however loaded the machine.
+        assert p.spin_until(lambda: ('grasp_torque_node', '/') in
+                            p.tester.get_node_names_and_namespaces()
+                            or p.child.poll() is not None, 60.0)
+        time.sleep(0.5)
         assert p.child.poll() is None, p.finish()[1]
         p.child.send_signal(sig)
         code, err = p.finish(timeout=5.0)
