@@ -251,7 +251,11 @@ class TorqueController:
             policy.committed(result, now, fallback is not None
                              and result.solution.backend == fallback.name)
             if self.config.tactile_source != 'none':
-                self.solving.tactile = self.tactile_of(result, now)
+                self.solving.tactile = report = self.tactile_of(result, now)
+                if report is not None and self.config.object_loop and self.config.loop_squeeze:
+                    # The squeeze follows the touch sensors' usage while it is fresh and
+                    # whole (every contact read), else the slip evidence.
+                    self.solving.object_loop.squeeze.measured(report.usage, now, 'tactile')
         result.cycle_time = elapsed
         return result
 

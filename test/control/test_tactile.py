@@ -186,3 +186,40 @@ def test_no_source_no_report(allegro):
     assert dict(report(ctrl, 1.0).values)['tactile'] == 'off (tactile.source none)'
     assert dataclasses.fields(type(ctrl.config))  # a CycleConfig: tactile_source 'none'
     assert ctrl.config.tactile_source == 'none'
+
+
+def test_the_squeeze_follows_the_touch_sensors_usage(allegro):
+    ctrl = array_controller(allegro, object_loop=True, loop_squeeze=True, loop_rate=10.0,
+                            loop_raise_at=0.8, loop_relax_at=0.5)
+    base = allegro.friction.min_normal_force
+    first = ctrl.cycle(1.0)
+    links = first.maps.links
+    squeeze = ctrl.solving.object_loop.squeeze
+    # The sensors read every contact at a fifth of its planned normal force: the planned
+    # tangential forces use the cone five times over (the slip evidence says nothing).
+    planned = dict(zip(links, ctrl.tactile.planned))
+    t = 1.0
+    for _ in range(20):
+        t += 0.004
+        ctrl.take('tactile', TactileArrayReading(v5_array({k: 0.2 * v for k, v in
+                                                           planned.items()})), t)
+        ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), t)
+        ctrl.cycle(t)
+    assert squeeze.source == 'tactile' and np.nanmax(squeeze.usage) > 1.0
+    assert squeeze.normal_force > base
+    raised = squeeze.normal_force
+    # Without the squeeze the sensors' usage is reported, never used.
+    plain = array_controller(allegro, object_loop=True)
+    plain.cycle(1.0)
+    plain.take('tactile', TactileArrayReading(v5_array({k: 0.2 * v for k, v in
+                                                        planned.items()})), 1.004)
+    plain.take('joint_states', JointStateReading(*joint_state(allegro)), 1.004)
+    plain.cycle(1.004)
+    assert plain.solving.object_loop.squeeze.normal_force is None
+    # Stale sensors (no reading for longer than squeeze.usage_timeout): back to the slip
+    # evidence, which sees none, and the squeeze relaxes.
+    for _ in range(100):
+        t += 0.02
+        ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), t)
+        ctrl.cycle(t)
+    assert squeeze.source == 'slip' and squeeze.normal_force < raised
