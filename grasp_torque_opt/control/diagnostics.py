@@ -49,6 +49,7 @@ def report(controller: TorqueController, now: float) -> Report:
     # The order of the command's values: a controller with a fixed joint list must match it.
     values.append(('command_joints', ','.join(c.setup.hand.joints)))
     values.append(('fault_policy', cfg.fault_policy))
+    values += interface_values(c)
     values += solution_values(c)
     last = c.last
     if last is not None and last.gravity_torque is not None:
@@ -169,6 +170,17 @@ def motion_values(c: TorqueController, now: float) -> list[tuple[str, str]]:
             values.append(('load.correction', _vector(est.correction)))
     if solving.load is not None:
         values.append(('load.planned', _vector(solving.load)))
+    return values
+
+
+def interface_values(c: TorqueController) -> list[tuple[str, str]]:
+    """Give the command interface, and for a position-like one the held reference q_hold."""
+    interface = c.policy.interface
+    values = [('command_interface', interface.name)]
+    held = getattr(interface, 'held', None)
+    if held is not None:
+        values.append(('command_interface.q_hold', 'not taken (no certified command yet)'
+                       if held.q_hold is None else _vector(held.q_hold)))
     return values
 
 

@@ -19,6 +19,7 @@ counters and reason say so.
 
 from cycle_inputs import fresh, joint_state
 from grasp_torque_opt.control.commands.registry import COMMAND_INTERFACES, make_interface
+from grasp_torque_opt.control.diagnostics import report
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import InputError
@@ -84,6 +85,20 @@ def test_q_hold_is_the_first_commands_measured_position_then_kept(allegro, name)
     zero = ctrl.policy.interface.zero()
     np.testing.assert_allclose(zero.position if name == 'hybrid' else zero.values, q0)
     np.testing.assert_array_equal(zero.torque, np.zeros(allegro.hand.m))
+    # /diagnostics says the interface and the reference held.
+    d = dict(report(ctrl, 0.01).values)
+    assert d['command_interface'] == name
+    np.testing.assert_allclose([float(x) for x in d['command_interface.q_hold'].split(',')],
+                               q0, rtol=1e-4)
+
+
+def test_the_diagnostics_name_the_interface_and_a_reference_not_yet_taken(allegro):
+    ctrl = fresh(allegro, command_interface='position', **INTERFACES['position'])
+    d = dict(report(ctrl, 0.0).values)
+    assert d['command_interface'] == 'position'
+    assert d['command_interface.q_hold'] == 'not taken (no certified command yet)'
+    d = dict(report(fresh(allegro), 0.0).values)
+    assert d['command_interface'] == 'effort' and 'command_interface.q_hold' not in d
 
 
 def test_a_current_over_its_limit_is_a_fault_not_a_clip(allegro):
