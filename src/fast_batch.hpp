@@ -97,7 +97,7 @@ struct LeanBuild
 
 // The maps and build stages for N candidates with p contacts each. oMf (N, p, 4, 4),
 // J6 (N, p, 6, nv), points, normals, tangents (N, p, 3), has_normal, has_tangent (N, p),
-// c (3), w_ext (N, 6). Returns a dict: ok (N) and why (N strings: '' where ok), and for
+// c (3: one object origin for all, or N, 3: each candidate's), w_ext (N, 6). Returns a dict: ok (N) and why (N strings: '' where ok), and for
 // each candidate G (6, 4p), J (4p, m), M1w = M1 w (4p), M2 (4p, m), positions (p, 3),
 // rotations (p, 3, 3), and its tau-QP in DAQP's form (backends/daqp.DaqpSolver): A =
 // [A_eq; C] (n_eq + n_in, m), bupper and blower (m + n_eq + n_in): the box (within
@@ -124,7 +124,8 @@ py::dict build_batch(
   expect(
     has_normal.size() == N * p && has_tangent.size() == N * p,
     "has_normal or has_tangent of the wrong shape");
-  expect(c.size() == 3, "c of the wrong shape");
+  expect(c.size() == 3 || c.size() == 3 * N, "c of the wrong shape");
+  const py::ssize_t c_step = c.size() == 3 ? 0 : 3;
   expect(
     w_ext.ndim() == 2 && w_ext.shape(0) == N && w_ext.shape(1) == 6,
     "w_ext of the wrong shape");
@@ -147,7 +148,6 @@ py::dict build_batch(
     Kinematics k;
     k.p = static_cast<int>(p);
     k.nv = static_cast<int>(nv);
-    k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
     Maps maps;
     LeanBuild lean;
     const double box_margin = fc.settings().box_margin;
@@ -159,6 +159,7 @@ py::dict build_batch(
       k.tangents = tangents.data() + 3 * p * i;
       k.has_normal = has_normal.data() + p * i;
       k.has_tangent = has_tangent.data() + p * i;
+      k.c = Eigen::Map<const Eigen::Vector3d>(c.data() + c_step * i);
       const Wrench w = Eigen::Map<const Wrench>(w_ext.data() + 6 * i);
       bool good = fc.maps(k, maps, why[i]) && lean.run(fc, maps.G, maps.J, w, why[i]);
       if (good && lean.T.rows() - lean.X.rows() != n_eq) {

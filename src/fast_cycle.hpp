@@ -799,7 +799,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 3;
+  mod.attr("API") = 4;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
