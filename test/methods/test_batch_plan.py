@@ -20,6 +20,7 @@ capacity LPs solved by SciPy's HiGHS (test/independent.py).
 """
 
 import copy
+from importlib import metadata
 import json
 import warnings
 
@@ -27,6 +28,7 @@ from conftest import ALLEGRO, scenario_doc, setup_from_doc
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.core.exceptions import GeometryWarning
 from grasp_torque_opt.methods.batch import BatchScorer
+from grasp_torque_opt.methods.batch_capacity import DAQP_C_VERSIONS
 from grasp_torque_opt.methods.capacity import DIRECTIONS
 from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
 from grasp_torque_opt.methods.score import ScoreJob, Scorer
@@ -110,6 +112,7 @@ def test_full_metrics_of_plan_lines_match_the_single_path_and_highs(planned):
     batch = BatchScorer(Scorer(job))
     fast = batch.score_lines(lines)
     assert batch.single == 0 and batch.staged == len(lines)
+    assert batch.capacity.redone == 0  # every LP answered by the batch's own DAQP calls
     assert_same(fast, Scorer(job).score_lines(lines), tol=1e-6)
     for (_, line), rec in list(zip(lines, fast))[:4]:  # one of each kind, and one more
         setup, maps, w = bound(line)
@@ -121,3 +124,30 @@ def test_full_metrics_of_plan_lines_match_the_single_path_and_highs(planned):
             d[i] = sign
             value, _ = lp_capacity(setup, maps, d)
             assert rec['capacities'][name] == pytest.approx(value, rel=1e-6, abs=1e-9)
+
+
+def test_the_compiled_lps_give_the_python_loops_answers(planned):
+    # The 14 LPs per candidate solved in the compiled batch (DAQP's C entry) and from
+    # Python (one daqp.solve each): the same DAQP code on the same rows, the same answers.
+    lines = moved(planned)
+    job = ScoreJob.from_file(ALLEGRO, metrics='full')
+    compiled_lps, python_lps = BatchScorer(Scorer(job)), BatchScorer(Scorer(job))
+    if metadata.version('daqp') in DAQP_C_VERSIONS:
+        assert compiled_lps.capacity.entry is not None
+    python_lps.capacity.entry = None
+    fast, slow = compiled_lps.score_lines(lines), python_lps.score_lines(lines)
+    assert compiled_lps.staged == python_lps.staged == len(lines)
+    assert_same(fast, slow, tol=1e-12)
+
+
+def test_contacts_found_from_geometry_take_the_single_path():
+    # plan --contacts links: each line's contacts are found from geometry at its own
+    # configuration and object (the single path), not read as points at the link origins.
+    plan = plan_grasps(ALLEGRO, PlanSettings(count=3, seed=1, contacts='links'))
+    lines = list(enumerate(plan.lines(), 1))
+    assert all('position' not in c for _, line in lines
+               for c in json.loads(line)['grasp']['contacts'])
+    job = ScoreJob.from_file(ALLEGRO, metrics='basic')
+    batch = BatchScorer(Scorer(job))
+    assert_same(batch.score_lines(lines), Scorer(job).score_lines(lines))
+    assert batch.single == len(lines) and batch.staged == 0
