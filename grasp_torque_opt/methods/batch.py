@@ -45,6 +45,7 @@ from typing import Any
 
 from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
+from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.friction import contact_block
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup, issue_once
@@ -64,6 +65,7 @@ FAST_KEYS = frozenset(('id', 'grasp', 'load', 'gravity', 'object'))
 GRASP_KEYS = frozenset(('joint_positions', 'contacts', 'object_origin', 'contact_tolerance'))
 _CONTACT_KEYS = frozenset(('link', 'position', 'normal', 'tangent'))
 _OBJECT_KEYS = frozenset(('shape', 'size', 'mass', 'position', 'rpy'))
+_ORIGIN = [0.0, 0.0, 0.0]
 
 
 class _Skip(Exception):
@@ -97,52 +99,77 @@ def _numbers(values: list) -> list:
 
 
 def _vec3(v: Any) -> list[float]:
+    """Return ``v`` if it is a list of 3 finite JSON numbers (:func:`_numbers`, unrolled)."""
     if not isinstance(v, list) or len(v) != 3:
         raise _Skip
-    return _numbers(v)
+    x, y, z = v
+    types = _NUMBER_TYPES
+    # A sum that overflows raises OverflowError (an int of more than 308 digits): the
+    # caller skips the line then too.
+    if (type(x) not in types or type(y) not in types or type(z) not in types
+            or not math.isfinite(x + y + z)):
+        raise _Skip
+    return v
 
 
 def parse_contacts(raw: Any, hand) -> tuple:
     """
     Return the contact arrays of a line's ``grasp.contacts``, read as parse_scenario does.
 
+    Plain lists (points, normals, has_normal, tangents, has_tangent: one entry per
+    contact), made arrays once per group (:meth:`BatchScorer._group`).
+
     Raises:
-        _Skip: anything it does not take.
+        _Skip: anything it does not take, and a contact without a ``position`` (found
+            from geometry by the single path).
     """
     if not isinstance(raw, list) or not 0 < len(raw) <= MAX_CONTACTS:
         raise _Skip
-    model = hand.model
-    p = len(raw)
-    points, normals, tangents = np.zeros((p, 3)), np.zeros((p, 3)), np.zeros((p, 3))
-    has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
-    links, fids = [], []
-    for i, c in enumerate(raw):
+    points, normals, tangents, has_n, has_t, links, fids = [], [], [], [], [], [], []
+    for c in raw:
         if not isinstance(c, dict) or not _CONTACT_KEYS.issuperset(c):
             raise _Skip
         link = c.get('link')
-        if not isinstance(link, str) or not link or not model.existFrame(link):
+        if not isinstance(link, str) or not link:
             raise _Skip
+        try:
+            fids.append(hand.frame_index(link, 'link'))
+        except InputError as e:
+            raise _Skip from e
         links.append(link)
-        fids.append(hand.frame_index(link, 'link'))
         if c.get('position') is None:  # found from geometry (or an error): the single path
             raise _Skip
-        points[i] = _vec3(c['position'])
-        if c.get('normal') is not None:
-            n = np.array(_vec3(c['normal']))
-            norm = np.linalg.norm(n)
-            if norm < 1e-9:
-                raise _Skip
-            normals[i], has_n[i] = n / norm, True
-        if c.get('tangent') is not None:
-            t = np.array(_vec3(c['tangent']))
-            if np.linalg.norm(t) < 1e-9:
-                raise _Skip
-            if has_n[i]:
-                u = t / np.linalg.norm(t)
-                if np.linalg.norm(u - (u @ normals[i]) * normals[i]) < 1e-6:
-                    raise _Skip
-            tangents[i], has_t[i] = t, True
+        points.append(_vec3(c['position']))
+        normal = _unit(c.get('normal'))
+        normals.append(normal or _ORIGIN)
+        has_n.append(normal is not None)
+        tangents.append(_tangent(c.get('tangent'), normal))
+        has_t.append(c.get('tangent') is not None)
     return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
+
+
+def _unit(v: Any) -> list[float] | None:
+    """Return a contact's normal divided by its norm, or None if not given (else _Skip)."""
+    if v is None:
+        return None
+    x, y, z = _vec3(v)
+    norm = math.hypot(x, y, z)
+    if not (1e-9 <= norm < math.inf):
+        raise _Skip
+    return [x / norm, y / norm, z / norm]
+
+
+def _tangent(v: Any, normal: list[float] | None) -> list[float]:
+    """Return a contact's tangent as given (zeros if not), checked as parse_scenario does."""
+    if v is None:
+        return _ORIGIN
+    t = _vec3(v)
+    u = _unit(t)
+    if normal is not None:
+        along = sum(a * b for a, b in zip(u, normal))
+        if math.hypot(*(a - along * b for a, b in zip(u, normal))) < 1e-6:
+            raise _Skip
+    return t
 
 
 def object_weight(value: Any) -> tuple[float, list | None]:
@@ -533,9 +560,11 @@ class BatchScorer:
         base = self.scorer.base
         fids, links, points, normals, has_n, tangents, has_t = contacts
         specs = base.contacts if contacts is self.contacts else [
-            type(base.contacts[0])(link=link, position=points[j],
-                                   normal=normals[j] if has_n[j] else None,
-                                   tangent=tangents[j] if has_t[j] else None)
+            type(base.contacts[0])(link=link, position=np.array(points[j], dtype=float),
+                                   normal=np.array(normals[j], dtype=float) if has_n[j]
+                                   else None,
+                                   tangent=np.array(tangents[j], dtype=float) if has_t[j]
+                                   else None)
             for j, link in enumerate(links)]
         setup = GraspSetup(hand=base.hand, q=q, contacts=specs, object_origin=origin,
                            friction=base.friction, external_wrench=wrench,
