@@ -556,7 +556,8 @@ struct CapacitySolver
 // bl, bu and sense (DAQP's form, nf + 1 + rows) and bl0, bu0, sense0 for the zero-load LP.
 // Returns a dict: passes (N, 2 + L: KKT-checked, below alpha_max, certified; the zero-load
 // LP first, then the load's, then the axes'), alpha (N, 2 + L; NaN where DAQP gave none),
-// iterations (N, 2 + L).
+// iterations (N, 2 + L). The zero-load LP is solved only where the axes' answers do not
+// already certify wrenches that hold zero load (its entry then says passes, 0 iterations).
 py::dict capacity_batch(
   const FastCycle & fc, int64_t quadprog, int64_t defaults, Array G, Array J, Array W,
   Array axes, Array S, Array bl, Array bu, py::array_t<int32_t> sense, Array bl0, Array bu0,
@@ -592,6 +593,7 @@ py::dict capacity_batch(
   py::array_t<bool> passes({N, K});
   auto alpha = zeros({N, K});
   py::array_t<int32_t> iterations({N, K});
+  const Vec tau_max = fc.limits(), tau_min = -fc.limits();
   {
     py::gil_scoped_release release;
     RowMat A = RowMat::Zero(rows, n);
@@ -603,25 +605,62 @@ py::dict capacity_batch(
       A.block(6, 0, m, nf) = Ji.transpose();
       const Wrench w = Eigen::Map<const Wrench>(W.data() + 6 * i);
       const double scale = w.cwiseAbs().maxCoeff();
-      for (py::ssize_t k = 0; k < K; ++k) {
-        Wrench load = Wrench::Zero();
-        double s = 1.0;
-        if (k == 1) {
-          load = w;
-          s = scale;
-        } else if (k > 1) {
-          load = Eigen::Map<const Wrench>(axes.data() + 6 * (k - 2));
+      auto lp = [&](py::ssize_t k) {
+          Wrench load = Wrench::Zero();
+          double s = 1.0;
+          if (k == 1) {
+            load = w;
+            s = scale;
+          } else if (k > 1) {
+            load = Eigen::Map<const Wrench>(axes.data() + 6 * (k - 2));
+          }
+          bool good = false;
+          double a = std::numeric_limits<double>::quiet_NaN();
+          int it = 0;
+          if (k != 1 || (std::isfinite(scale) && scale > 0.0)) {
+            A.topRightCorner(6, 1) = load / s;  // the zero-load LP: alpha fixed at 0
+            good = solver.solve(A, Gi, Ji, load, s, k == 0, a, it);
+          }
+          passes.mutable_data()[K * i + k] = good;
+          alpha.mutable_data()[K * i + k] = a;
+          iterations.mutable_data()[K * i + k] = it;
+          return good;
+        };
+      // The axes first: zero load is held, certified, where an axis LP's answer holds
+      // alpha = 0, or by the combination of two opposite axes' answers that holds zero
+      // (a_- f_+ + a_+ f_-) / (a_+ + a_-); else the zero-load LP says.
+      bool zero = false, last = false;
+      double a_last = 0.0;
+      Vec f_last;
+      for (py::ssize_t k = 2; k < K; ++k) {
+        const bool good = lp(k);
+        const double a = alpha.data()[K * i + k];
+        const Vec f = Eigen::Map<const Vec>(solver.x.data(), nf);
+        if (good && !zero) {
+          const bool opposite = k % 2 == 1 && last && a_last > 0.0 && a > 0.0 &&
+            (Eigen::Map<const Wrench>(axes.data() + 6 * (k - 2)) +
+            Eigen::Map<const Wrench>(axes.data() + 6 * (k - 3))).isZero(0.0);
+          if (a == 0.0) {
+            zero = true;  // certified at 0 times its axis
+          } else if (opposite) {
+            const Vec f0 = (a * f_last + a_last * f) / (a + a_last);
+            const Vec tau = Ji.transpose() * f0;
+            zero = fc.passes(fc.certify(Gi, Ji, Wrench::Zero(), tau_min, tau_max, tau, f0));
+          }
         }
-        bool good = false;
-        double a = std::numeric_limits<double>::quiet_NaN();
-        int it = 0;
-        if (k != 1 || (std::isfinite(scale) && scale > 0.0)) {
-          A.topRightCorner(6, 1) = load / s;  // the zero-load LP: alpha fixed at 0
-          good = solver.solve(A, Gi, Ji, load, s, k == 0, a, it);
+        if (k % 2 == 0) {
+          last = good;
+          a_last = a;
+          f_last = f;
         }
-        passes.mutable_data()[K * i + k] = good;
-        alpha.mutable_data()[K * i + k] = a;
-        iterations.mutable_data()[K * i + k] = it;
+      }
+      lp(1);
+      if (zero) {
+        passes.mutable_data()[K * i] = true;
+        alpha.mutable_data()[K * i] = 0.0;
+        iterations.mutable_data()[K * i] = 0;
+      } else {
+        lp(0);
       }
     }
   }

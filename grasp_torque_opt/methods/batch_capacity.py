@@ -18,7 +18,10 @@ in place, calls DAQP's C entry (``daqp_quadprog``, the function ``daqp.solve`` r
 found in the daqp module's own extension: :func:`daqp_entry`), and checks each answer
 as the single path does in Python (the KKT check with DAQP's multipliers, alpha, the
 certificate of the answer at alpha times the load, and the zero-load LP's wrenches
-certified at zero load). Where the installed daqp is not a release whose C structs the
+certified at zero load). The axes go first: where an axis's answer holds alpha = 0, or
+two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e)) combine into
+(alpha- f+ + alpha+ f-) / (alpha+ + alpha-), which holds zero load (the cones and limits
+are convex) and is certified there, zero load is held and its LP is not solved. Where the installed daqp is not a release whose C structs the
 compiled batch declares (:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one
 ``daqp.solve`` each, their checks in one compiled call per few candidates
 (``lp_finish_batch``). Either way an LP whose answer does not pass, or that DAQP does

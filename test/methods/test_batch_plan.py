@@ -27,6 +27,7 @@ import warnings
 from conftest import ALLEGRO, scenario_doc, setup_from_doc
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.core.exceptions import GeometryWarning
+from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.batch import BatchScorer
 from grasp_torque_opt.methods.batch_capacity import DAQP_C_VERSIONS
 from grasp_torque_opt.methods.capacity import DIRECTIONS
@@ -151,3 +152,28 @@ def test_contacts_found_from_geometry_take_the_single_path():
     batch = BatchScorer(Scorer(job))
     assert_same(batch.score_lines(lines), Scorer(job).score_lines(lines))
     assert batch.single == len(lines) and batch.staged == 0
+
+
+def test_a_grasp_that_cannot_hold_zero_load_has_capacity_zero_on_the_batch_path():
+    # Two fingertips of the bundled grasp (index and middle) press the ball the same way:
+    # their minimum normal forces push it, so zero load is not held, while a load
+    # opposite their push is. The compiled LPs must not call zero load held (from an
+    # axis's answer, or two opposite axes' combined): every capacity of such a
+    # candidate is the single path's, 0 and infeasible.
+    base = GraspSetup.from_file(ALLEGRO)
+    maps = base.maps()
+    two = [0, 1]
+    push = maps.rotations[two, :, 2].sum(axis=0)  # inward normals: the object is pushed
+    contacts = [{'link': base.contacts[i].link, 'position': base.contacts[i].position.tolist()}
+                for i in two]
+    lines = [(k + 1, json.dumps({'gravity': None, 'grasp': {'contacts': contacts}, 'load': {
+        'external_wrench': [*(-scale * push), 0.0, 0.0, 0.0]}}))
+        for k, scale in enumerate([0.6, 1.0, 1.5])]
+    job = ScoreJob.from_file(ALLEGRO, metrics='full')
+    batch = BatchScorer(Scorer(job))
+    fast = batch.score_lines(lines)
+    assert_same(fast, Scorer(job).score_lines(lines), tol=1e-6)
+    assert batch.staged == len(lines)  # the tau-QP holds each load: the batch answered
+    for rec in fast:
+        assert (rec['capacity'], rec['capacity_status']) == (0.0, 'infeasible')
+        assert set(rec['capacities'].values()) == {0.0}
