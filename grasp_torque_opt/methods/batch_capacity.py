@@ -21,9 +21,9 @@ certificate of the answer at alpha times the load, and the zero-load LP's wrench
 certified at zero load). The axes go first: where an axis's answer holds alpha = 0, or
 two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e)) combine into
 (alpha- f+ + alpha+ f-) / (alpha+ + alpha-), which holds zero load (the cones and limits
-are convex) and is certified there, zero load is held and its LP is not solved. Where the installed daqp is not a release whose C structs the
-compiled batch declares (:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one
-``daqp.solve`` each, their checks in one compiled call per few candidates
+are convex) and is certified there, zero load is held and its LP is not solved. Where
+the installed daqp is not a release whose C structs the compiled batch declares
+(:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one ``daqp.solve`` each, their checks in one compiled call per few candidates
 (``lp_finish_batch``). Either way an LP whose answer does not pass, or that DAQP does
 not call optimal, is solved again by the single path's :meth:`CapacityLP.solve` (HiGHS
 behind DAQP, the unbounded and infeasible verdicts), whose answer is then the value;
