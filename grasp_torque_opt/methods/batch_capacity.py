@@ -11,23 +11,24 @@ Full metrics of many candidates: their 14 capacity LPs solved and checked in one
 
 For each candidate the batch stages (:mod:`.batch`) certified: its zero-load LP, the
 load capacity and the 12 axis capacities of :mod:`.capacity`, the same LPs solved the
-same way: DAQP as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the rows
-and bounds of :class:`~grasp_torque_opt.methods.capacity.CapacityLP`. The compiled
-batch (``capacity_batch``, src/fast_batch.hpp) runs them all: it writes each LP's rows
-in place, calls DAQP's C entry (``daqp_quadprog``, the function ``daqp.solve`` runs,
-found in the daqp module's own extension: :func:`daqp_entry`), and checks each answer
-as the single path does in Python (the KKT check with DAQP's multipliers, alpha, the
+same way: DAQP as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the rows and
+bounds of :class:`~grasp_torque_opt.methods.capacity.CapacityLP`. The compiled batch
+(``capacity_batch``, src/fast_batch.hpp) runs them all: it writes each LP's rows in
+place, calls DAQP's C entry (``daqp_quadprog``, the function ``daqp.solve`` runs, found
+in the daqp module's own extension: :func:`daqp_entry`), and checks each answer as the
+single path does in Python (the KKT check with DAQP's multipliers, alpha, the
 certificate of the answer at alpha times the load, and the zero-load LP's wrenches
 certified at zero load). The axes go first: where an axis's answer holds alpha = 0, or
-two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e)) combine into
-(alpha- f+ + alpha+ f-) / (alpha+ + alpha-), which holds zero load (the cones and limits
-are convex) and is certified there, zero load is held and its LP is not solved. Where
-the installed daqp is not a release whose C structs the compiled batch declares
-(:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one ``daqp.solve`` each, their checks in one compiled call per few candidates
-(``lp_finish_batch``). Either way an LP whose answer does not pass, or that DAQP does
-not call optimal, is solved again by the single path's :meth:`CapacityLP.solve` (HiGHS
-behind DAQP, the unbounded and infeasible verdicts), whose answer is then the value;
-so are all of a candidate's LPs when its zero-load LP does not pass.
+two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e)) combine into (alpha- f+ +
+alpha+ f-) / (alpha+ + alpha-), which holds zero load (the cones and limits are convex)
+and is certified there, zero load is held and its LP is not solved. Where the installed
+daqp is not a release whose C structs the compiled batch declares
+(:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one ``daqp.solve`` each, their
+checks in one compiled call per few candidates (``lp_finish_batch``). Either way an LP
+whose answer does not pass, or that DAQP does not call optimal, is solved again by the
+single path's :meth:`CapacityLP.solve` (HiGHS behind DAQP, the unbounded and infeasible
+verdicts), whose answer is then the value; so are all of a candidate's LPs when its
+zero-load LP does not pass.
 """
 
 from __future__ import annotations
