@@ -25,7 +25,9 @@ writes: each line with its ``object``, ``grasp.object_origin`` and
   load and the 12 axes; :class:`~grasp_torque_opt.methods.capacity.CapacityLP`'s rows)
   by ``daqp.solve`` as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it;
 - how many lines the batch stages took and how many the single path scored (all of
-  plan's lines should take the stages).
+  plan's lines should take the stages);
+- the single path alone (``Scorer.score_lines``, as every plan line was scored before
+  issue 36) on the ``--plan`` distinct lines, for the ratio.
 
 Each figure is the median of ``--repeats`` runs, each raw run right after a scored run.
 Rates depend on the machine's load: time on a quiet machine.
@@ -121,17 +123,23 @@ def run(plan: int = 300, times: int = 20, seed: int = 0, repeats: int = 3) -> di
         staged, single = batch.staged, batch.single
         qps = tau_qps(batch, lines[:len(found.candidates)])
         lps = capacity_lps(job, lines[:len(found.candidates)]) if metrics == 'full' else []
-        rates, raws, records = [], [], []
+        single_path = Scorer(job)
+        distinct = lines[:len(found.candidates)]
+        rates, raws, singles, records = [], [], [], []
         for _ in range(repeats):
             t0 = time.perf_counter()
             records = engines.score_batch(job, lines, engine='serial')
             rates.append(len(lines) / (time.perf_counter() - t0))
             raws.append(raw_rate(qps, lps, len(qps)))
+            t0 = time.perf_counter()
+            single_path.score_lines(distinct)
+            singles.append(len(distinct) / (time.perf_counter() - t0))
         row = {'metrics': metrics, 'lines': len(lines),
                'optimal': sum(r['status'] == 'optimal' for r in records),
                'batch_stages': (batch.staged - staged) // repeats,
                'single_path': (batch.single - single) // repeats,
                'per_s': statistics.median(rates), 'raw_daqp_per_s': statistics.median(raws),
+               'single_path_per_s': statistics.median(singles),
                'share_of_raw': statistics.median(r / w for r, w in zip(rates, raws))}
         out['rows'].append(row)
     return out
@@ -140,12 +148,13 @@ def run(plan: int = 300, times: int = 20, seed: int = 0, repeats: int = 3) -> di
 def table(results: dict) -> str:
     """Markdown: one row per metrics."""
     lines = ['| metrics | lines | optimal | batch stages / single path | plan lines /s, '
-             'one worker | raw DAQP /s, same run | share of raw |',
-             '|---|---:|---:|---|---:|---:|---:|']
+             'one worker | raw DAQP /s, same run | share of raw | single path alone /s |',
+             '|---|---:|---:|---|---:|---:|---:|---:|']
     for r in results['rows']:
         lines.append(f"| {r['metrics']} | {r['lines']} | {r['optimal']} | "
                      f"{r['batch_stages']} / {r['single_path']} | {r['per_s']:.0f} | "
-                     f"{r['raw_daqp_per_s']:.0f} | {100 * r['share_of_raw']:.1f}% |")
+                     f"{r['raw_daqp_per_s']:.0f} | {100 * r['share_of_raw']:.1f}% | "
+                     f"{r['single_path_per_s']:.0f} |")
     lines.append(f"\n{results['planned']} planned x {results['times']}, seed "
                  f"{results['seed']}; medians of {results['repeats']} runs")
     return '\n'.join(lines)
