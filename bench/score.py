@@ -85,12 +85,12 @@ def raw_daqp(job, lines) -> dict:
         if item[2] is batch.contacts:
             parsed.append(item)
     fids, _, points, normals, has_n, tangents, has_t = batch.contacts
-    Q, W = batch.inputs(parsed)
+    Q, W, C = batch.inputs(parsed)
     k = len(parsed)
     oMf, J6 = batch.kinematics.frames(Q, fids)
     b = batch.cycle.build_batch(oMf, J6, *(np.repeat(a[None], k, 0) for a in
                                            (points, normals, has_n, tangents, has_t)),
-                                batch.origin, W)
+                                C, W)
     A, bu, bl = b['A'][b['ok']], b['bupper'][b['ok']], b['blower'][b['ok']]
     m = batch.H.shape[0]
     H, f = batch.H.copy(), np.zeros(m)

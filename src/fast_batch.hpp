@@ -97,7 +97,8 @@ struct LeanBuild
 
 // The maps and build stages for N candidates with p contacts each. oMf (N, p, 4, 4),
 // J6 (N, p, 6, nv), points, normals, tangents (N, p, 3), has_normal, has_tangent (N, p),
-// c (3), w_ext (N, 6). Returns a dict: ok (N) and why (N strings: '' where ok), and for
+// c (3: one object origin for all, or N, 3: each candidate's),
+// w_ext (N, 6). Returns a dict: ok (N) and why (N strings: '' where ok), and for
 // each candidate G (6, 4p), J (4p, m), M1w = M1 w (4p), M2 (4p, m), positions (p, 3),
 // rotations (p, 3, 3), and its tau-QP in DAQP's form (backends/daqp.DaqpSolver): A =
 // [A_eq; C] (n_eq + n_in, m), bupper and blower (m + n_eq + n_in): the box (within
@@ -124,7 +125,8 @@ py::dict build_batch(
   expect(
     has_normal.size() == N * p && has_tangent.size() == N * p,
     "has_normal or has_tangent of the wrong shape");
-  expect(c.size() == 3, "c of the wrong shape");
+  expect(c.size() == 3 || c.size() == 3 * N, "c of the wrong shape");
+  const py::ssize_t c_step = c.size() == 3 ? 0 : 3;
   expect(
     w_ext.ndim() == 2 && w_ext.shape(0) == N && w_ext.shape(1) == 6,
     "w_ext of the wrong shape");
@@ -147,7 +149,6 @@ py::dict build_batch(
     Kinematics k;
     k.p = static_cast<int>(p);
     k.nv = static_cast<int>(nv);
-    k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
     Maps maps;
     LeanBuild lean;
     const double box_margin = fc.settings().box_margin;
@@ -159,6 +160,7 @@ py::dict build_batch(
       k.tangents = tangents.data() + 3 * p * i;
       k.has_normal = has_normal.data() + p * i;
       k.has_tangent = has_tangent.data() + p * i;
+      k.c = Eigen::Map<const Eigen::Vector3d>(c.data() + c_step * i);
       const Wrench w = Eigen::Map<const Wrench>(w_ext.data() + 6 * i);
       bool good = fc.maps(k, maps, why[i]) && lean.run(fc, maps.G, maps.J, w, why[i]);
       if (good && lean.T.rows() - lean.X.rows() != n_eq) {
@@ -465,6 +467,207 @@ py::dict lp_finish_batch(
   d["kkt"] = kkt;
   d["alpha"] = alpha;
   d["passes"] = passes;
+  return d;
+}
+
+// DAQP's C interface (version 0.11.0: include/types.h and include/api.h), as the daqp
+// Python module's extension exports it: the three structs daqp_quadprog reads and writes.
+// grasp_torque_opt.methods.batch_capacity passes the functions' addresses only where the
+// installed daqp is that version, so that these layouts are its own.
+struct DaqpProblem
+{
+  int n, m, ms;
+  double * H, * f, * A, * bupper, * blower;
+  int * sense, * break_points;
+  int nh, problem_type;
+};
+struct DaqpSettings
+{
+  double primal_tol, dual_tol, zero_tol, pivot_tol, progress_tol;
+  int cycle_tol, iter_limit;
+  double fval_bound, eps_prox, eta_prox, rho_soft, rel_subopt, abs_subopt, sing_tol;
+  double refactor_tol, time_limit, w_soft;
+  int eq_reduction, presolve;
+};
+struct DaqpResult
+{
+  double * x, * lam;
+  double fval, soft_slack;
+  int exitflag, iter, nodes;
+  double solve_time, setup_time;
+};
+using DaqpQuadprog = void (*)(DaqpResult *, DaqpProblem *, DaqpSettings *);
+using DaqpDefaults = void (*)(DaqpSettings *);
+
+// One capacity LP (methods/capacity.CapacityLP) solved by DAQP as methods/lp.solve_lp
+// calls it (daqp.solve: daqp_quadprog, the default settings but primal_tol, iter_limit and
+// eps_prox), then checked as lp_finish_batch checks it. A holds the LP's rows; its alpha
+// column (the first 6 rows' last entry) is the load direction. Returns passes; alpha.
+struct CapacitySolver
+{
+  const FastCycle & fc;
+  DaqpQuadprog quadprog;
+  DaqpSettings settings;
+  int nf, m, rows;
+  std::vector<double> H, x, lam, bu, bl, bu0, bl0, c;
+  std::vector<int> sense, sense0, sense_copy;
+  double kkt_tolerance, alpha_max;
+
+  bool solve(
+    RowMat & A, const RowMat & G, const RowMat & J, const Wrench & load, double scale,
+    bool zero, double & alpha, int & iterations)
+  {
+    const int n = nf + 1;
+    std::vector<double> & up = zero ? bu0 : bu, & lo = zero ? bl0 : bl;
+    sense_copy = zero ? sense0 : sense;  // daqp.solve passes its own array each call
+    DaqpProblem qp{n, n + rows, n, H.data(), c.data(), A.data(), up.data(), lo.data(),
+      sense_copy.data(), nullptr, 0, 0};
+    DaqpResult res{x.data(), lam.data(), 0.0, 0.0, 0, 0, 0, 0.0, 0.0};
+    DaqpSettings st = settings;
+    quadprog(&res, &qp, &st);
+    iterations = res.iter;
+    alpha = std::numeric_limits<double>::quiet_NaN();
+    if (res.exitflag != 1 && res.exitflag != 2) {
+      return false;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (!std::isfinite(x[i])) {
+        return false;
+      }
+    }
+    const Vec hdiag = Vec::Zero(n);
+    const double kkt = daqp_kkt(
+      hdiag, c.data(), A.data(), up.data(), lo.data(), x.data(), lam.data(), n, rows);
+    alpha = x[nf] / scale;
+    if (!(kkt <= kkt_tolerance) || !(x[nf] < (1.0 - 1e-9) * alpha_max)) {
+      return false;
+    }
+    const Vec f = Eigen::Map<const Vec>(x.data(), nf);
+    const Vec tau = J.transpose() * f;
+    const Vec tau_max = fc.limits(), tau_min = -fc.limits();
+    return fc.passes(fc.certify(G, J, alpha * load, tau_min, tau_max, tau, f));
+  }
+};
+
+// The capacity LPs of N candidates (methods/batch_capacity.CapacityBatch): for each, its
+// zero-load LP (alpha fixed at 0), its load's LP (W[i] on the unit direction W[i] / max
+// |W[i]|) and one per row of axes (L, 6), over x = [f; alpha] with the rows [G; J^T; S]
+// (S, the friction rows of the planned polygons and f_min, shape (rows_S, nf)), the bounds
+// bl, bu and sense (DAQP's form, nf + 1 + rows) and bl0, bu0, sense0 for the zero-load LP.
+// Returns a dict: passes (N, 2 + L: KKT-checked, below alpha_max, certified; the zero-load
+// LP first, then the load's, then the axes'), alpha (N, 2 + L; NaN where DAQP gave none),
+// iterations (N, 2 + L). The zero-load LP is solved only where the axes' answers do not
+// already certify wrenches that hold zero load (its entry then says passes, 0 iterations).
+py::dict capacity_batch(
+  const FastCycle & fc, int64_t quadprog, int64_t defaults, Array G, Array J, Array W,
+  Array axes, Array S, Array bl, Array bu, py::array_t<int32_t> sense, Array bl0, Array bu0,
+  py::array_t<int32_t> sense0, double primal_tol, int iter_limit, double eps_prox,
+  double kkt_tolerance, double alpha_max)
+{
+  const int m = fc.m();
+  expect(quadprog != 0 && defaults != 0, "no DAQP");
+  expect(G.ndim() == 3 && G.shape(1) == 6, "G of the wrong shape");
+  const py::ssize_t N = G.shape(0), nf = G.shape(2), n = nf + 1;
+  expect(J.size() == N * nf * m && W.size() == N * 6, "J or W of the wrong shape");
+  expect(axes.ndim() == 2 && axes.shape(1) == 6, "axes of the wrong shape");
+  expect(S.ndim() == 2 && S.shape(1) == nf, "S of the wrong shape");
+  const py::ssize_t L = axes.shape(0), rows = 6 + m + S.shape(0), nb = n + rows;
+  for (const Array * a : {&bl, &bu, &bl0, &bu0}) {
+    expect(a->size() == nb, "bounds of the wrong shape");
+  }
+  expect(sense.size() == nb && sense0.size() == nb, "sense of the wrong shape");
+  CapacitySolver solver{fc, reinterpret_cast<DaqpQuadprog>(quadprog), DaqpSettings{},
+    static_cast<int>(nf), m, static_cast<int>(rows),
+    std::vector<double>(n * n, 0.0), std::vector<double>(n), std::vector<double>(nb),
+    std::vector<double>(bu.data(), bu.data() + nb), std::vector<double>(bl.data(), bl.data() + nb),
+    std::vector<double>(bu0.data(), bu0.data() + nb),
+    std::vector<double>(bl0.data(), bl0.data() + nb), std::vector<double>(n, 0.0),
+    std::vector<int>(sense.data(), sense.data() + nb),
+    std::vector<int>(sense0.data(), sense0.data() + nb), {}, kkt_tolerance, alpha_max};
+  reinterpret_cast<DaqpDefaults>(defaults)(&solver.settings);
+  solver.settings.primal_tol = primal_tol;
+  solver.settings.iter_limit = iter_limit;
+  solver.settings.eps_prox = eps_prox;
+  solver.c[nf] = -1.0;
+  const py::ssize_t K = 2 + L;
+  py::array_t<bool> passes({N, K});
+  auto alpha = zeros({N, K});
+  py::array_t<int32_t> iterations({N, K});
+  const Vec tau_max = fc.limits(), tau_min = -fc.limits();
+  {
+    py::gil_scoped_release release;
+    RowMat A = RowMat::Zero(rows, n);
+    A.bottomLeftCorner(S.shape(0), nf) = Eigen::Map<const RowMat>(S.data(), S.shape(0), nf);
+    for (py::ssize_t i = 0; i < N; ++i) {
+      const RowMat Gi = Eigen::Map<const RowMat>(G.data() + 6 * nf * i, 6, nf);
+      const RowMat Ji = Eigen::Map<const RowMat>(J.data() + nf * m * i, nf, m);
+      A.topLeftCorner(6, nf) = Gi;
+      A.block(6, 0, m, nf) = Ji.transpose();
+      const Wrench w = Eigen::Map<const Wrench>(W.data() + 6 * i);
+      const double scale = w.cwiseAbs().maxCoeff();
+      auto lp = [&](py::ssize_t k) {
+          Wrench load = Wrench::Zero();
+          double s = 1.0;
+          if (k == 1) {
+            load = w;
+            s = scale;
+          } else if (k > 1) {
+            load = Eigen::Map<const Wrench>(axes.data() + 6 * (k - 2));
+          }
+          bool good = false;
+          double a = std::numeric_limits<double>::quiet_NaN();
+          int it = 0;
+          if (k != 1 || (std::isfinite(scale) && scale > 0.0)) {
+            A.topRightCorner(6, 1) = load / s;  // the zero-load LP: alpha fixed at 0
+            good = solver.solve(A, Gi, Ji, load, s, k == 0, a, it);
+          }
+          passes.mutable_data()[K * i + k] = good;
+          alpha.mutable_data()[K * i + k] = a;
+          iterations.mutable_data()[K * i + k] = it;
+          return good;
+        };
+      // The axes first: zero load is held, certified, where an axis LP's answer holds
+      // alpha = 0, or by the combination of two opposite axes' answers that holds zero
+      // (a_- f_+ + a_+ f_-) / (a_+ + a_-); else the zero-load LP says.
+      bool zero = false, last = false;
+      double a_last = 0.0;
+      Vec f_last;
+      for (py::ssize_t k = 2; k < K; ++k) {
+        const bool good = lp(k);
+        const double a = alpha.data()[K * i + k];
+        const Vec f = Eigen::Map<const Vec>(solver.x.data(), nf);
+        if (good && !zero) {
+          const bool opposite = k % 2 == 1 && last && a_last > 0.0 && a > 0.0 &&
+            (Eigen::Map<const Wrench>(axes.data() + 6 * (k - 2)) +
+            Eigen::Map<const Wrench>(axes.data() + 6 * (k - 3))).isZero(0.0);
+          if (a == 0.0) {
+            zero = true;  // certified at 0 times its axis
+          } else if (opposite) {
+            const Vec f0 = (a * f_last + a_last * f) / (a + a_last);
+            const Vec tau = Ji.transpose() * f0;
+            zero = fc.passes(fc.certify(Gi, Ji, Wrench::Zero(), tau_min, tau_max, tau, f0));
+          }
+        }
+        if (k % 2 == 0) {
+          last = good;
+          a_last = a;
+          f_last = f;
+        }
+      }
+      lp(1);
+      if (zero) {
+        passes.mutable_data()[K * i] = true;
+        alpha.mutable_data()[K * i] = 0.0;
+        iterations.mutable_data()[K * i] = 0;
+      } else {
+        lp(0);
+      }
+    }
+  }
+  py::dict d;
+  d["passes"] = passes;
+  d["alpha"] = alpha;
+  d["iterations"] = iterations;
   return d;
 }
 

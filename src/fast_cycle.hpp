@@ -799,7 +799,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 3;
+  mod.attr("API") = 4;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -965,7 +965,13 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     py::arg("loads"), py::arg("scale"), py::arg("A"), py::arg("blower"), py::arg("bupper"),
     py::arg("c"), py::arg("x"), py::arg("lam"), py::arg("ok"), py::arg("kkt_tolerance"),
     py::arg("alpha_max"),
-    "KKT check, alpha and certificate of K capacity-LP answers.");
+    "KKT check, alpha and certificate of K capacity-LP answers.")
+  .def("capacity_batch", &capacity_batch, py::arg("quadprog"), py::arg("defaults"),
+    py::arg("G"), py::arg("J"), py::arg("W"), py::arg("axes"), py::arg("S"), py::arg("bl"),
+    py::arg("bu"), py::arg("sense"), py::arg("bl0"), py::arg("bu0"), py::arg("sense0"),
+    py::arg("primal_tol"), py::arg("iter_limit"), py::arg("eps_prox"),
+    py::arg("kkt_tolerance"), py::arg("alpha_max"),
+    "The capacity LPs of N candidates, each solved by DAQP (its C entry) and checked.");
   mod.def("kinematics_batch", &kinematics_batch, py::arg("Q"), py::arg("parents"),
     py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"),
     py::arg("idx_v"), py::arg("fparent"), py::arg("Rf"), py::arg("tf"), py::arg("nv"),

@@ -45,21 +45,27 @@ from typing import Any
 
 from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
 from grasp_torque_opt.core.certificate import DEFAULT_TOLERANCE
+from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.core.friction import contact_block
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.grasp_setup import GraspSetup, issue_once
 from grasp_torque_opt.core.margin import planned_friction
-from grasp_torque_opt.core.scenario import MAX_CONTACTS, parse_scenario, weight_wrench
+from grasp_torque_opt.core.scenario import MAX_CONTACTS, parse_scenario, SHAPES
+from grasp_torque_opt.core.scenario_contacts import from_geometry
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
 from grasp_torque_opt.core.tree_kinematics import supported, TreeKinematics
 from grasp_torque_opt.methods.batch_capacity import CapacityBatch
-from grasp_torque_opt.methods.score import MAX_LINE, Scorer
+from grasp_torque_opt.methods.score import MAX_LINE, merge, Scorer
 from grasp_torque_opt.native import loader
 import numpy as np
 
 #: Keys a line may hold for the batch stages (anything else: the single path).
-FAST_KEYS = frozenset(('id', 'grasp', 'load', 'gravity'))
+FAST_KEYS = frozenset(('id', 'grasp', 'load', 'gravity', 'object'))
+#: Keys of a line's ``grasp`` the batch stages take.
+GRASP_KEYS = frozenset(('joint_positions', 'contacts', 'object_origin', 'contact_tolerance'))
 _CONTACT_KEYS = frozenset(('link', 'position', 'normal', 'tangent'))
+_OBJECT_KEYS = frozenset(('shape', 'size', 'mass', 'position', 'rpy'))
+_ORIGIN = [0.0, 0.0, 0.0]
 
 
 class _Skip(Exception):
@@ -93,51 +99,105 @@ def _numbers(values: list) -> list:
 
 
 def _vec3(v: Any) -> list[float]:
+    """Return ``v`` if it is a list of 3 finite JSON numbers (:func:`_numbers`, unrolled)."""
     if not isinstance(v, list) or len(v) != 3:
         raise _Skip
-    return _numbers(v)
+    x, y, z = v
+    types = _NUMBER_TYPES
+    # A sum that overflows raises OverflowError (an int of more than 308 digits): the
+    # caller skips the line then too.
+    if (type(x) not in types or type(y) not in types or type(z) not in types
+            or not math.isfinite(x + y + z)):
+        raise _Skip
+    return v
 
 
 def parse_contacts(raw: Any, hand) -> tuple:
     """
     Return the contact arrays of a line's ``grasp.contacts``, read as parse_scenario does.
 
+    Plain lists (points, normals, has_normal, tangents, has_tangent: one entry per
+    contact), made arrays once per group (:meth:`BatchScorer._group`).
+
     Raises:
-        _Skip: anything it does not take.
+        _Skip: anything it does not take, and a contact without a ``position`` (found
+            from geometry by the single path).
     """
     if not isinstance(raw, list) or not 0 < len(raw) <= MAX_CONTACTS:
         raise _Skip
-    model = hand.model
-    p = len(raw)
-    points, normals, tangents = np.zeros((p, 3)), np.zeros((p, 3)), np.zeros((p, 3))
-    has_n, has_t = np.zeros(p, dtype=bool), np.zeros(p, dtype=bool)
-    links, fids = [], []
-    for i, c in enumerate(raw):
+    points, normals, tangents, has_n, has_t, links, fids = [], [], [], [], [], [], []
+    for c in raw:
         if not isinstance(c, dict) or not _CONTACT_KEYS.issuperset(c):
             raise _Skip
         link = c.get('link')
-        if not isinstance(link, str) or not link or not model.existFrame(link):
+        if not isinstance(link, str) or not link:
             raise _Skip
+        try:
+            fids.append(hand.frame_index(link, 'link'))
+        except InputError as e:
+            raise _Skip from e
         links.append(link)
-        fids.append(hand.frame_index(link, 'link'))
-        if c.get('position') is not None:
-            points[i] = _vec3(c['position'])
-        if c.get('normal') is not None:
-            n = np.array(_vec3(c['normal']))
-            norm = np.linalg.norm(n)
-            if norm < 1e-9:
-                raise _Skip
-            normals[i], has_n[i] = n / norm, True
-        if c.get('tangent') is not None:
-            t = np.array(_vec3(c['tangent']))
-            if np.linalg.norm(t) < 1e-9:
-                raise _Skip
-            if has_n[i]:
-                u = t / np.linalg.norm(t)
-                if np.linalg.norm(u - (u @ normals[i]) * normals[i]) < 1e-6:
-                    raise _Skip
-            tangents[i], has_t[i] = t, True
+        if c.get('position') is None:  # found from geometry (or an error): the single path
+            raise _Skip
+        points.append(_vec3(c['position']))
+        normal = _unit(c.get('normal'))
+        normals.append(normal or _ORIGIN)
+        has_n.append(normal is not None)
+        tangents.append(_tangent(c.get('tangent'), normal))
+        has_t.append(c.get('tangent') is not None)
     return tuple(fids), tuple(links), points, normals, has_n, tangents, has_t
+
+
+def _unit(v: Any) -> list[float] | None:
+    """Return a contact's normal divided by its norm, or None if not given (else _Skip)."""
+    if v is None:
+        return None
+    x, y, z = _vec3(v)
+    norm = math.hypot(x, y, z)
+    if not (1e-9 <= norm < math.inf):
+        raise _Skip
+    return [x / norm, y / norm, z / norm]
+
+
+def _tangent(v: Any, normal: list[float] | None) -> list[float]:
+    """Return a contact's tangent as given (zeros if not), checked as parse_scenario does."""
+    if v is None:
+        return _ORIGIN
+    t = _vec3(v)
+    u = _unit(t)
+    if normal is not None:
+        along = sum(a * b for a, b in zip(u, normal))
+        if math.hypot(*(a - along * b for a, b in zip(u, normal))) < 1e-6:
+            raise _Skip
+    return t
+
+
+def object_weight(value: Any) -> tuple[float, list | None]:
+    """
+    Return (mass, position or None) of an ``object`` section, checked as parse_scenario does.
+
+    Raises:
+        _Skip: anything it does not take (the single path then decides).
+    """
+    if not isinstance(value, dict) or not _OBJECT_KEYS.issuperset(value):
+        raise _Skip
+    shape, size, mass = value.get('shape'), value.get('size'), value.get('mass')
+    if not isinstance(shape, str) or shape not in SHAPES:
+        raise _Skip
+    if not isinstance(size, list) or len(size) != len(SHAPES[shape]):
+        raise _Skip
+    if min(_numbers(size)) <= 0 or _numbers([mass])[0] <= 0:
+        raise _Skip
+    for key in ('position', 'rpy'):
+        if value.get(key) is not None:
+            _vec3(value[key])
+    return float(mass), value.get('position')
+
+
+def _tolerance(value: Any) -> None:
+    """Check a line's ``grasp.contact_tolerance`` as parse_scenario does (else _Skip)."""
+    if _numbers([value])[0] <= 0:
+        raise _Skip
 
 
 def why_not(scorer: Scorer) -> str:
@@ -204,8 +264,13 @@ class BatchScorer:
         self.base_extra = np.asarray(sc.extra_wrench, dtype=float)
         self.base_has_extra = (isinstance(scorer.doc.get('load'), dict)
                                and scorer.doc['load'].get('external_wrench') is not None)
-        self.has_gravity = sc.gravity is not None
-        self.weight = weight_wrench(sc.object, sc.gravity, sc.object_origin)
+        self.gravity = None if sc.gravity is None else np.asarray(sc.gravity, dtype=float)
+        raw = scorer.doc.get('object')  # the base's object: (mass, its own position or None)
+        self.base_object = None if sc.object is None else (
+            sc.object.mass, None if raw.get('position') is None else list(sc.object.position))
+        # The base's contacts found from geometry: a line that keeps them has them found
+        # again at its own configuration (the single path).
+        self.base_geometry = from_geometry(sc)
         self.module = loader.fast_cycle
         self.kinematics = TreeKinematics(model, self.module)
         self.kinematics.check(np.array([self.q0]), self.contacts[0])
@@ -232,16 +297,47 @@ class BatchScorer:
     # -- the cheap parse ---------------------------------------------------------------
     def parse(self, lineno: int, text: Any) -> tuple:
         """
-        Return (id, joints, contacts, extra, gravity) of a line the batch stages take.
+        Return (id, joints, contacts, extra, gravity, origin, object) of a line the stages take.
 
         ``joints``: (indices in q, positions) or None for the base's; ``contacts``: the
-        contact arrays (the base's object when not given); ``extra``: the load besides
-        the weight (6 numbers); ``gravity``: whether the object's weight is added.
-        :meth:`inputs` makes the configurations and loads of many.
+        contact arrays (the base's when not given); ``extra``: the load besides the
+        weight (6 numbers, None: the base's); ``gravity``: whether the object's weight is
+        added; ``origin``: the line's ``grasp.object_origin`` (None: the base's);
+        ``object``: (mass, position or None: at the origin) or None (no object).
+        :meth:`inputs` makes the configurations, loads and origins of many.
 
         Raises:
             _Skip: the single path scores this line.
         """
+        data = self._data(text)
+        gravity = self.gravity is not None
+        if 'gravity' in data:
+            if data['gravity'] is not None:
+                raise _Skip
+            gravity = False
+        obj = self.base_object
+        if 'object' in data:
+            obj = (None if data['object'] is None
+                   else object_weight(merge(self.scorer.doc.get('object'), data['object'])))
+        joints, contacts, origin = self._grasp(data.get('grasp', {}))
+        extra = None if self.base_has_extra else _NO_LOAD
+        if 'load' in data:
+            load = data['load']
+            if not isinstance(load, dict) or set(load) != {'external_wrench'}:
+                raise _Skip
+            w = load['external_wrench']
+            if not isinstance(w, list) or len(w) != 6:
+                raise _Skip
+            extra = _numbers(w)
+        if extra is _NO_LOAD:
+            if not (gravity and obj is not None):
+                raise _Skip  # the single path says the load is missing
+            extra = _ZERO_LOAD
+        return data.get('id', lineno), joints, contacts, extra, gravity, origin, obj
+
+    @staticmethod
+    def _data(text: Any) -> dict:
+        """Return a line's JSON object if its keys are all :data:`FAST_KEYS` (else _Skip)."""
         if isinstance(text, str):
             if len(text) > MAX_LINE:
                 raise _Skip
@@ -255,15 +351,13 @@ class BatchScorer:
             raise _Skip
         if not isinstance(data, dict) or not FAST_KEYS.issuperset(data):
             raise _Skip
-        gravity = self.has_gravity
-        if 'gravity' in data:
-            if data['gravity'] is not None:
-                raise _Skip
-            gravity = False
-        joints, contacts = None, self.contacts
-        grasp = data.get('grasp', {})
-        if not isinstance(grasp, dict) or not {'joint_positions', 'contacts'}.issuperset(grasp):
+        return data
+
+    def _grasp(self, grasp: Any) -> tuple:
+        """Return (joints, contacts, origin) of a line's ``grasp`` (see :meth:`parse`)."""
+        if not isinstance(grasp, dict) or not GRASP_KEYS.issuperset(grasp):
             raise _Skip
+        joints, contacts, origin = None, self.contacts, None
         if 'joint_positions' in grasp:
             positions = grasp['joint_positions']
             if not isinstance(positions, dict):
@@ -273,31 +367,25 @@ class BatchScorer:
             except (KeyError, TypeError) as e:
                 raise _Skip from e
             joints = (index, _numbers(list(positions.values())))
+        if 'object_origin' in grasp:
+            origin = _vec3(grasp['object_origin'])
+        if 'contact_tolerance' in grasp:  # only used to find contacts from geometry
+            _tolerance(grasp['contact_tolerance'])
         if 'contacts' in grasp:
             contacts = parse_contacts(grasp['contacts'], self.scorer.base.hand)
+        elif self.base_geometry:
+            raise _Skip
         else:
             issue_once(self.scorer.base_warnings)  # the line keeps the base's contacts
-        extra = None if self.base_has_extra else _NO_LOAD
-        if 'load' in data:
-            load = data['load']
-            if not isinstance(load, dict) or set(load) != {'external_wrench'}:
-                raise _Skip
-            w = load['external_wrench']
-            if not isinstance(w, list) or len(w) != 6:
-                raise _Skip
-            extra = _numbers(w)
-        if extra is _NO_LOAD:
-            if not (gravity and self.scenario.object is not None):
-                raise _Skip  # the single path says the load is missing
-            extra = _ZERO_LOAD
-        return data.get('id', lineno), joints, contacts, extra, gravity
+        return joints, contacts, origin
 
-    def inputs(self, parsed: list[tuple]) -> tuple[np.ndarray, np.ndarray]:
+    def inputs(self, parsed: list[tuple]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """
-        Return the configurations and loads of parsed lines (:meth:`parse`).
+        Return the configurations, loads and object origins of parsed lines (:meth:`parse`).
 
         Returns:
-            (Q, shape (N, nq); W, w_ext = extra + the weight where gravity, shape (N, 6)).
+            (Q, shape (N, nq); W, w_ext = extra + the object's weight about its origin
+            where gravity, shape (N, 6); C, the object origins, shape (N, 3)).
         """
         n = len(parsed)
         Q = np.repeat(self.q0[None], n, axis=0)
@@ -313,9 +401,16 @@ class BatchScorer:
                 Q[np.ix_(rs, index)] = values
         W = np.array([self.base_extra if item[3] is None else item[3] for item in parsed],
                      dtype=float)
-        gravity = np.array([item[4] for item in parsed], dtype=bool)
-        W[gravity] += self.weight
-        return Q, W
+        C = np.array([self.origin if item[5] is None else item[5] for item in parsed],
+                     dtype=float)
+        weighed = [r for r, item in enumerate(parsed) if item[4] and item[6] is not None]
+        if weighed:  # as core.scenario.weight_wrench, row by row
+            mass = np.array([parsed[r][6][0] for r in weighed], dtype=float)
+            at = np.array([C[r] if parsed[r][6][1] is None else parsed[r][6][1]
+                           for r in weighed], dtype=float)
+            force = mass[:, None] * self.gravity
+            W[weighed] += np.concatenate((force, np.cross(at - C[weighed], force)), axis=1)
+        return Q, W, C
 
     # -- the stages ----------------------------------------------------------------------
     def score_lines(self, lines: Iterable[tuple[int, Any]]) -> list[dict[str, Any]]:
@@ -347,14 +442,14 @@ class BatchScorer:
         n = len(members)
         parsed = [m[2] for m in members]
         fids = parsed[0][2][0]
-        Q, W = self.inputs(parsed)
+        Q, W, C = self.inputs(parsed)
         if all(item[2] is self.contacts for item in parsed):
             arrays = [np.repeat(a[None], n, axis=0) for a in self.contacts[2:]]
         else:
             arrays = [np.array([item[2][j] for item in parsed]) for j in range(2, 7)]
         oMf, J6 = self.kinematics.frames(Q, fids)
         b = self.cycle.build_batch(oMf, J6, arrays[0], arrays[1], arrays[2], arrays[3],
-                                   arrays[4], self.origin, W)
+                                   arrays[4], C, W)
         ok = b['ok']
         m = self.scorer.base.hand.m
         A, bu, bl = b['A'], b['bupper'], b['blower']
@@ -367,7 +462,7 @@ class BatchScorer:
                                       solved, KKT_TOLERANCE)
         self._cold_redo(model, b, W, sense, fin, times, X, LAM, solved)
         share = parse_s + (stage_s + time.perf_counter() - t1) / n
-        self._records(members, records, b, Q, W, X, fin, times, share)
+        self._records(members, records, b, (Q, W, C), X, fin, times, share)
 
     def _warm_solves(self, model, b: dict, n: int, m: int) -> tuple:
         """Solve the group's built QPs warm, in turn: (times, X, LAM, solved, its end)."""
@@ -404,9 +499,10 @@ class BatchScorer:
             for key in ('passes', 'f', 'usage', 'ratio'):
                 fin[key][redo] = again[key]
 
-    def _records(self, members, records, b, Q, W, X, fin, times, share) -> None:
+    def _records(self, members, records, b, inputs, X, fin, times, share) -> None:
         """Write the certified candidates' records (the capacity metrics too when asked)."""
         clock = time.perf_counter
+        Q, W, C = inputs
         job = self.scorer.job
         passes = fin['passes'].tolist()
         usage, ratio = fin['usage'], fin['ratio'].tolist()
@@ -419,10 +515,10 @@ class BatchScorer:
             good = [i for i in range(len(members)) if passes[i]]
             full = dict(zip(good, self.capacity.metrics(
                 b['G'][good], b['J'][good], W[good],
-                lambda j: self._bound(Q[good[j]], members[good[j]][2][2], W[good[j]], b,
-                                      good[j]))))
+                lambda j: self._bound(Q[good[j]], members[good[j]][2][2], W[good[j]],
+                                      C[good[j]], b, good[j]))))
             share += (clock() - t2) / max(1, len(good))
-        for i, (k, lineno, (ident, _, contacts, _, _)) in enumerate(members):
+        for i, (k, lineno, (ident, *_)) in enumerate(members):
             if not passes[i]:
                 continue  # the single path answers (and confirms an infeasible load)
             ts = clock()
@@ -459,19 +555,21 @@ class BatchScorer:
         x, _, flag, info = model.solve()
         return x, info['lam'], int(flag)
 
-    def _bound(self, q, contacts, wrench, b, i) -> tuple[GraspSetup, GraspMaps]:
+    def _bound(self, q, contacts, wrench, origin, b, i) -> tuple[GraspSetup, GraspMaps]:
         """Return the candidate as the single path binds it, with the batch stages' maps."""
         base = self.scorer.base
         fids, links, points, normals, has_n, tangents, has_t = contacts
         specs = base.contacts if contacts is self.contacts else [
-            type(base.contacts[0])(link=link, position=points[j],
-                                   normal=normals[j] if has_n[j] else None,
-                                   tangent=tangents[j] if has_t[j] else None)
+            type(base.contacts[0])(link=link, position=np.array(points[j], dtype=float),
+                                   normal=np.array(normals[j], dtype=float) if has_n[j]
+                                   else None,
+                                   tangent=np.array(tangents[j], dtype=float) if has_t[j]
+                                   else None)
             for j, link in enumerate(links)]
-        setup = GraspSetup(hand=base.hand, q=q, contacts=specs, object_origin=self.origin,
+        setup = GraspSetup(hand=base.hand, q=q, contacts=specs, object_origin=origin,
                            friction=base.friction, external_wrench=wrench,
                            weights=base.weights, objective='sum-of-squares')
         maps = GraspMaps(G=b['G'][i], J=b['J'][i], links=links, frame_ids=fids,
                          positions=b['positions'][i], rotations=b['rotations'][i],
-                         object_origin=self.origin)
+                         object_origin=origin)
         return setup, maps

@@ -7,25 +7,35 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-Full metrics of many candidates: their 13 capacity LPs, the checks in one compiled call.
+Full metrics of many candidates: their 14 capacity LPs solved and checked in one compiled call.
 
-For each candidate the batch stages (:mod:`.batch`) certified: the load capacity and
-the 12 axis capacities of :mod:`.capacity`, the same LPs solved the same way (DAQP,
-as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the rows and bounds of
-:class:`~grasp_torque_opt.methods.capacity.CapacityLP`). What the single path does
-after each DAQP call in Python (the KKT check, alpha, the certificate of the answer
-at alpha times the load) runs for all the LPs of a few candidates in one compiled
-call (``lp_finish_batch``), and so do each candidate's zero-load LP's (a capacity is
-that of the load range from zero, :mod:`.capacity`). An LP whose answer does not pass,
-or that DAQP does not call optimal, is solved again by the single path's
-:meth:`CapacityLP.solve` (HiGHS behind DAQP, the unbounded and infeasible verdicts),
-whose answer is then the value; so are all of a candidate's LPs when its zero-load LP
-does not pass.
+For each candidate the batch stages (:mod:`.batch`) certified: its zero-load LP, the
+load capacity and the 12 axis capacities of :mod:`.capacity`, the same LPs solved the
+same way: DAQP as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the rows and
+bounds of :class:`~grasp_torque_opt.methods.capacity.CapacityLP`. The compiled batch
+(``capacity_batch``, src/fast_batch.hpp) runs them all: it writes each LP's rows in
+place, calls DAQP's C entry (``daqp_quadprog``, the function ``daqp.solve`` runs, found
+in the daqp module's own extension: :func:`daqp_entry`), and checks each answer as the
+single path does in Python (the KKT check with DAQP's multipliers, alpha, the
+certificate of the answer at alpha times the load, and the zero-load LP's wrenches
+certified at zero load). The axes go first: where an axis's answer holds alpha = 0, or
+two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e)) combine into (alpha- f+ +
+alpha+ f-) / (alpha+ + alpha-), which holds zero load (the cones and limits are convex)
+and is certified there, zero load is held and its LP is not solved. Where the installed
+daqp is not a release whose C structs the compiled batch declares
+(:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one ``daqp.solve`` each, their
+checks in one compiled call per few candidates (``lp_finish_batch``). Either way an LP
+whose answer does not pass, or that DAQP does not call optimal, is solved again by the
+single path's :meth:`CapacityLP.solve` (HiGHS behind DAQP, the unbounded and infeasible
+verdicts), whose answer is then the value; so are all of a candidate's LPs when its
+zero-load LP does not pass.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+import ctypes
+from importlib import metadata
 import math
 
 from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
@@ -36,8 +46,34 @@ import numpy as np
 #: The 13 loads: the candidate's own (None here), then the 12 axis directions.
 LOADS = (('load', None, '-'),) + tuple(
     (name, (i, sign), 'N' if i < 3 else 'N m') for name, (i, sign) in DIRECTIONS.items())
+#: The 12 axis loads, in :data:`LOADS`' order, shape (12, 6).
+AXES = np.array([[sign if j == i else 0.0 for j in range(6)]
+                 for i, sign in DIRECTIONS.values()])
 #: Candidates whose LPs are checked in one compiled call (bounded memory).
 PER_CALL = 16
+#: The daqp releases whose C structs src/fast_batch.hpp declares (``capacity_batch``).
+DAQP_C_VERSIONS = ('0.11.0',)
+
+
+def daqp_entry() -> tuple[int, int] | None:
+    """
+    Return the addresses of DAQP's ``daqp_quadprog`` and ``daqp_default_settings``.
+
+    The daqp Python module's extension is DAQP's C library compiled in, its functions
+    exported: the compiled batch calls them there, the same code ``daqp.solve`` runs.
+    None when the installed daqp is not a release whose structs the compiled batch
+    declares (:data:`DAQP_C_VERSIONS`), or the functions are not found.
+    """
+    try:
+        import daqp
+
+        if metadata.version('daqp') not in DAQP_C_VERSIONS:
+            return None
+        lib = ctypes.CDLL(daqp.__file__)
+        return (ctypes.cast(lib.daqp_quadprog, ctypes.c_void_p).value,
+                ctypes.cast(lib.daqp_default_settings, ctypes.c_void_p).value)
+    except (ImportError, OSError, AttributeError, metadata.PackageNotFoundError):
+        return None
 
 
 class CapacityBatch:
@@ -54,6 +90,10 @@ class CapacityBatch:
         self._solve = daqp.solve
         self.cycle = cycle
         self._forms: dict[int, CapacityLP] = {}
+        #: DAQP's C entry points for the compiled LPs (None: solved from Python).
+        self.entry = daqp_entry() if hasattr(cycle, 'capacity_batch') else None
+        #: LPs solved again by the single path (their answer here did not pass).
+        self.redone = 0
 
     def metrics(self, G: np.ndarray, J: np.ndarray, W: np.ndarray,
                 bound: Callable[[int], tuple]) -> list[dict]:
@@ -68,6 +108,8 @@ class CapacityBatch:
                 :class:`CapacityLP`, the template and the LPs that do not pass).
         """
         n = G.shape[0]
+        if self.entry is not None and n:
+            return self._compiled(G, J, W, bound)
         out = []
         for start in range(0, n, PER_CALL):
             stop = min(n, start + PER_CALL)
@@ -79,6 +121,47 @@ class CapacityBatch:
         if lp is None:
             lp = self._forms[p] = CapacityLP(*bound(0))
         return lp
+
+    def _compiled(self, G, J, W, bound) -> list[dict]:
+        """Solve and check every LP in one compiled call (DAQP's C entry, :func:`daqp_entry`)."""
+        nf, m = G.shape[2], J.shape[2]
+        t = self._template(bound, nf // 4)
+        form, zero = t.form, t.zero_form
+        out = self.cycle.capacity_batch(
+            *self.entry, G, J, W, AXES, np.ascontiguousarray(t.A[6 + m:, :nf]), form.bl,
+            form.bu, form.sense, zero.bl, zero.bu, zero.sense, PRIMAL_TOL, MAX_ITER,
+            EPS_PROX, KKT_TOLERANCE, ALPHA_MAX)
+        passes, alpha = out['passes'].tolist(), out['alpha'].tolist()
+        return [self._candidate(i, passes[i][0], passes[i][1:], alpha[i][1:], W, bound)
+                for i in range(G.shape[0])]
+
+    def _candidate(self, i: int, zero: bool, passes: list, alpha: list, W, bound) -> dict:
+        """
+        Return candidate i's full metrics from its LPs' answers (:data:`LOADS`' order).
+
+        An LP that did not pass, or every LP when the zero-load LP did not, is the single
+        path's (:meth:`CapacityLP.solve`).
+        """
+        lp = None
+        values, statuses, reasons = {}, {}, {}
+        for j, (name, axis, unit) in enumerate(LOADS):
+            if passes[j] and zero:
+                values[name], statuses[name], reasons[name] = alpha[j], 'optimal', None
+                continue
+            if lp is None:  # the single path's LP of this candidate, and its verdict
+                lp = CapacityLP(*bound(i))
+            self.redone += 1
+            if axis is None:
+                load = W[i]
+            else:
+                load = np.zeros(6)
+                load[axis[0]] = axis[1]
+            cap = lp.solve(load, unit, binding=False)
+            values[name], statuses[name] = cap.value, cap.status
+            reasons[name] = None if cap.status == 'optimal' else cap.message
+        return {'capacity': values['load'], 'capacity_status': statuses['load'],
+                'capacity_reason': reasons['load'], 'holdable_fraction': None,
+                'capacities': {name: values[name] for name in DIRECTIONS}}
 
     def _some(self, G, J, W, bound, start: int, stop: int) -> list[dict]:
         nf = G.shape[2]
@@ -124,29 +207,12 @@ class CapacityBatch:
                                          KKT_TOLERANCE, ALPHA_MAX)
         passes, alpha = fin['passes'].tolist(), fin['alpha'].tolist()
         zero = self._zero_holds(G, J, np.ascontiguousarray(A[::len(LOADS)]), t, start, stop)
-        out = []
-        for i in range(stop - start):
-            lp = None
-            values, statuses, reasons = {}, {}, {}
-            for j, (name, axis, unit) in enumerate(LOADS):
-                k = i * len(LOADS) + j
-                if passes[k] and usable[k] and zero[i]:
-                    values[name], statuses[name], reasons[name] = alpha[k], 'optimal', None
-                    continue
-                if lp is None:  # the single path's LP of this candidate, and its verdict
-                    lp = CapacityLP(*bound(start + i))
-                if axis is None:
-                    load = W[start + i]
-                else:
-                    load = np.zeros(6)
-                    load[axis[0]] = axis[1]
-                cap = lp.solve(load, unit, binding=False)
-                values[name], statuses[name] = cap.value, cap.status
-                reasons[name] = None if cap.status == 'optimal' else cap.message
-            out.append({'capacity': values['load'], 'capacity_status': statuses['load'],
-                        'capacity_reason': reasons['load'], 'holdable_fraction': None,
-                        'capacities': {name: values[name] for name in DIRECTIONS}})
-        return out
+        k = len(LOADS)
+        return [self._candidate(start + i, zero[i],
+                                [p and u for p, u in zip(passes[k * i:k * (i + 1)],
+                                                         usable[k * i:k * (i + 1)].tolist())],
+                                alpha[k * i:k * (i + 1)], W, bound)
+                for i in range(stop - start)]
 
     def _zero_holds(self, G, J, A, t: CapacityLP, start: int, stop: int) -> list[bool]:
         """
