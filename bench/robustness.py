@@ -14,7 +14,8 @@ Usage: .venv/bin/python bench/robustness.py [--duration 3] [--gains 0.3,1] [--ra
        [--params FILE] [--object-loop on|off] [--controllers node preset impedance] [--smoke]
 
 Not in CI. Every episode is grasp_torque_opt.sim.episode.run_episode() on the bundled
-Allegro grasp, in simulated time (the rig of grasp-torque-sim, without ROS): the
+Allegro grasp (with --params, that file's scenario: config/g1_right_node.yaml runs the
+G1's), in simulated time (the rig of grasp-torque-sim, without ROS): the
 controller is asked at --rate (250 Hz) with the encoder's reading, the fingers press on the
 pinned ball for 0.3 s, the ball is released and watched for --duration seconds. The
 controllers:
@@ -56,6 +57,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cycle import machine, report  # noqa: E402, I100
 from grasp_torque_opt.core.resources import find_config  # noqa: E402
 from grasp_torque_opt.core.scenario import load_scenario, Scenario  # noqa: E402
+from grasp_torque_opt.ros.node_process import scenario_of  # noqa: E402
 from grasp_torque_opt.ros.sim_compare import node_controller  # noqa: E402
 from grasp_torque_opt.sim.base_motion import BaseMotion, STANDARD_GRAVITY  # noqa: E402
 from grasp_torque_opt.sim.baselines import Preset, Squeeze, tune_preset  # noqa: E402
@@ -134,10 +136,11 @@ def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 25
         controllers: tuple[str, ...] = CONTROLLERS,
         imu: tuple[float | None, float] = (None, 0.0), effort_report: str = 'applied',
         node: dict | None = None) -> dict:
-    scenario = load_scenario(find_config('allegro_right.yaml'))
     node = node or {}
-    out = {'duration_s': duration, 'gains': list(gains), 'rate_hz': rate, 'rows': [],
-           'presets': {}, 'node_inputs': inputs, 'margin': margin,
+    name = scenario_of(node['params']) if node.get('params') else 'allegro_right.yaml'
+    scenario = load_scenario(find_config(name))
+    out = {'scenario': name, 'duration_s': duration, 'gains': list(gains), 'rate_hz': rate,
+           'rows': [], 'presets': {}, 'node_inputs': inputs, 'margin': margin,
            'effort_report': effort_report,
            'controllers': list(controllers), 'imu_rate_hz': imu[0], 'imu_latency_s': imu[1],
            'params': str(node.get('params') or ''), 'node_config': node.get('config') or {}}
@@ -155,7 +158,8 @@ def run(duration: float, gains: tuple[float, ...], smoke: bool, rate: float = 25
 
 def tables(r: dict) -> str:
     shown = r.get('controllers', CONTROLLERS)
-    lines = ['Held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
+    lines = [f"{r.get('scenario', 'allegro_right.yaml')}: "
+             'held (drift < 2 mm and rotation < 2 deg at the end) and mean effort (RMS '
              f"joint torque after release) over {r['duration_s']:g} s, controllers asked at "
              f"{r['rate_hz']:g} Hz; node inputs (IMU, efforts) "
              f"{r.get('node_inputs')}, friction margin {r.get('margin', 0.0):g}"

@@ -38,6 +38,13 @@ from grasp_torque_opt.ros.node.parameters import scenario_defaults
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
 import yaml
 
+#: The cycle's budget and joint state timeout as lockstep sets them (the schema's largest,
+#: ros/sim_driver.LOCKSTEP_PARAMETERS): simulated time is not timed, so no solver is cut
+#: by the wall clock, and a cycle slowed by a loaded machine does not age its joint state
+#: (the budget is the smaller of the two: a joint_state_timeout of 0.05 s cut the G1's
+#: solves on a busy 2-core machine and dropped its ball).
+UNTIMED = {'cycle_budget': 1.0, 'joint_state_timeout': 10.0}
+
 
 def params_file(path: str | Path, scenario: Scenario, setup) -> Params:
     """
@@ -75,7 +82,7 @@ def _controller(setup, scenario: Scenario, rig, inputs: bool, margin: float,
         ctrl = configure(None, setup, p, obj=scenario.object)
         if effort_report is not None or report != 'applied':
             over = {**told, **over}
-        ctrl.config = dataclasses.replace(ctrl.config, cycle_budget=1.0, **over)
+        ctrl.config = dataclasses.replace(ctrl.config, **UNTIMED, **over)
         inputs, efforts = inputs and p.imu.enabled, ctrl.config.effort_estimation
     else:
         efforts = inputs if efforts is None else efforts
@@ -83,7 +90,7 @@ def _controller(setup, scenario: Scenario, rig, inputs: bool, margin: float,
                                                                         margin=margin))
         ctrl = TorqueController(setup, CycleConfig(
             gravity_compensation=True, gravity=tuple(float(x) for x in scenario.gravity),
-            cycle_budget=1.0, effort_estimation=efforts, **{**told, **over}), fallback='daqp')
+            effort_estimation=efforts, **{**UNTIMED, **told, **over}), fallback='daqp')
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
     if scenario.object is not None:
@@ -103,7 +110,7 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
 
     Configured as config/allegro_right_node.yaml configures the node: gravity
     compensation with the scenario's gravity (the parameter's default from the
-    scenario), DAQP as the fallback; the budget generous, as the node's tests set it.
+    scenario), DAQP as the fallback; the budget generous (:data:`UNTIMED`).
     With ``inputs`` (issue 24's inputs on, as the bundled params turn them on): the rig's
     palm IMU and its measured efforts (effort_estimation) are given to the cycle at each
     joint state. ``efforts``: the effort estimation alone on or off (None: as ``inputs``).
@@ -125,8 +132,9 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     is the node's own, made from the file as the node makes it (:func:`params_file`,
     :func:`~grasp_torque_opt.ros.node.controllers.configure`): ``margin`` and
     ``efforts`` are the file's, the IMU is given if ``inputs`` and the file's
-    ``imu.enabled``; only the cycle's budget stays generous (simulated time is not
-    timed), and ``config`` still goes over the file's.
+    ``imu.enabled``; only the cycle's budget and joint state timeout are lockstep's
+    (:data:`UNTIMED`: simulated time is not timed), and ``config`` still goes over the
+    file's.
     """
     ctrl, inputs, efforts = _controller(setup, scenario, rig, inputs, margin, efforts,
                                         effort_report, {**(commands or {}), **(config or {})},

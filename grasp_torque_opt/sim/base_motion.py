@@ -92,12 +92,14 @@ def imu_reading(model: mujoco.MjModel, data: mujoco.MjData, body: int
     """
     Read an IMU at a body's origin: specific force [m/s^2] and angular velocity [rad/s].
 
-    Both in the body's own axes, from MuJoCo's kinematics at the current state and
-    gravity (MuJoCo counts gravity as the world accelerating up, so a body at rest
-    reads -gravity, as an accelerometer does).
+    Both in the body's own axes (its link frame, MuJoCo's mjOBJ_XBODY: not the frame of
+    its principal axes of inertia, mjOBJ_BODY, which a palm inside a robot turns away
+    from its link's), from MuJoCo's kinematics at the current state and gravity
+    (MuJoCo counts gravity as the world accelerating up, so a body at rest reads
+    -gravity, as an accelerometer does).
     """
     mujoco.mj_rnePostConstraint(model, data)
     acc, vel = np.zeros(6), np.zeros(6)
-    mujoco.mj_objectAcceleration(model, data, mujoco.mjtObj.mjOBJ_BODY, body, acc, 1)
-    mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, body, vel, 1)
+    mujoco.mj_objectAcceleration(model, data, mujoco.mjtObj.mjOBJ_XBODY, body, acc, 1)
+    mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_XBODY, body, vel, 1)
     return acc[3:].copy(), vel[:3].copy()

@@ -7,7 +7,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 """The base's motion as apparent gravity: the palm IMU reads it, the ball moves with it."""
 
-from conftest import ALLEGRO
+from conftest import ALLEGRO, CONFIG
 from grasp_torque_opt.core.scenario import load_scenario
 from grasp_torque_opt.sim.base_motion import BaseMotion, STANDARD_GRAVITY
 from grasp_torque_opt.sim.episode import EpisodeSettings, run_episode, simulated
@@ -61,6 +61,23 @@ def test_the_imu_reads_minus_gravity_at_rest_and_a_minus_g_moving(scenario, acce
     force, omega = rig.imu()
     np.testing.assert_allclose(force, a - scenario.gravity, atol=1e-9)
     np.testing.assert_allclose(omega, 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize('name', ['g1_right.yaml', 'ability_right.yaml'])
+def test_a_hand_inside_a_robot_reads_its_imu_in_its_own_palm_frame(name):
+    # hand.base_link's axes, not its body's principal axes of inertia (MuJoCo's
+    # mjOBJ_BODY frame, which turned the G1's reading of 9.81 along x into 9.79 along z).
+    scenario = load_scenario(CONFIG / name)
+    a = STANDARD_GRAVITY * np.array([0.3, -0.5, 0.7])
+    settings = EpisodeSettings(disturbances=Disturbances(motion=BaseMotion(accel=a)))
+    _, rig = simulated(scenario, settings)
+    rig.step(5)
+    np.testing.assert_allclose(rig.imu()[0], -np.asarray(scenario.gravity), atol=1e-6)
+    rig.release()
+    rig.step(5)
+    force, omega = rig.imu()
+    np.testing.assert_allclose(force, a - scenario.gravity, atol=1e-6)
+    np.testing.assert_allclose(omega, 0.0, atol=1e-9)
 
 
 @pytest.mark.parametrize('axis', [0, 2])
