@@ -86,6 +86,7 @@ def _controller(setup, scenario: Scenario, rig, inputs: bool, margin: float,
         ctrl = TorqueController(setup, CycleConfig(
             gravity_compensation=True, gravity=tuple(float(x) for x in scenario.gravity),
             cycle_budget=1.0, effort_estimation=efforts, **{**told, **over}), fallback='daqp')
+    ctrl.untimed = True  # simulated time: the outcome depends on no wall clock
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
     if scenario.object is not None:
@@ -121,7 +122,11 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     stiffness the rig's Kp and its reference the scenario's grasp (the default).
     The fingertips' estimate of the object is placed as the node places it (the gate).
     ``config``: further CycleConfig fields by name (the object loop's, e.g.
-    ``{'object_loop': True}``), over those.
+    ``{'object_loop': True}``), over those. The cycle is ``untimed``
+    (:class:`~grasp_torque_opt.control.controller.TorqueController`): its solvers get no
+    deadline and its wall time decides nothing, so that an episode's outcome is the same
+    on any machine load (a deadline made ProxSuite stop by its own timing, in chunks that
+    moved a falling ball's end by 0.01 mm between two runs).
 
     With ``params`` (a node's params file, config/allegro_right_node.yaml), the controller
     is the node's own, made from the file as the node makes it (:func:`params_file`,
