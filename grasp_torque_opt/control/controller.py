@@ -237,17 +237,16 @@ class TorqueController:
         elapsed = time.perf_counter() - t0
         counters.max_cycle_time = max(counters.max_cycle_time, elapsed)
         budget = self.config.cycle_budget
-        if self.untimed:  # simulated time: the wall clock decides nothing
-            elapsed = 0.0
-        if elapsed > budget:
+        judged = 0.0 if self.untimed else elapsed  # simulated time: the wall decides nothing
+        if judged > budget:
             counters.overruns += 1
             if result.kind == 'solution':
                 result = policy.faulted(now, f'cycle overrun ({1e3 * elapsed:.1f} ms > '
                                         f'cycle_budget {1e3 * budget:.1f} ms)',
                                         result.solution, result.maps, result.gravity_torque)
-        late = self.stale(now + elapsed) if result.kind == 'solution' else ''
+        late = self.stale(now + judged) if result.kind == 'solution' else ''
         if late:
-            result = policy.faulted(now + elapsed, f'inputs went stale during the cycle: {late}',
+            result = policy.faulted(now + judged, f'inputs went stale during the cycle: {late}',
                                     result.solution, result.maps, result.gravity_torque)
         if result.kind == 'solution':
             self._slew(result, now)
