@@ -325,9 +325,10 @@ def main() -> int:
     duration = 0.5 if a.smoke else a.duration
     node = {'params': a.params, 'config': None if a.object_loop is None
             else {'object_loop': a.object_loop == 'on'}}
+    started = commit()  # the code that runs is the one at the start
     r = run(duration, gains, a.smoke, a.rate, a.node_inputs, a.margin, tuple(a.controllers),
             (a.imu_rate, a.imu_latency), a.effort_report, node, a.grid, a.jobs)
-    r['machine'], r['commit'], r['smoke'] = machine(), commit(), a.smoke
+    r['machine'], r['commit'], r['smoke'] = machine(), started, a.smoke
     report(r, tables(r), None if a.smoke else a.out,
            f"commit {r['commit']}, {len(r['rows']) * len(a.controllers)} episodes"
            + (' (smoke run)' if a.smoke else ''))
