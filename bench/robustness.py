@@ -51,7 +51,9 @@ and by how much, and its effort against the bundled node's where both hold.
 --smoke runs one case per family, Kp 1, 0.5 s: a check that it runs.
 
 Reproducible: no ROS, no wall clock; the controllers are asked in simulated time and
-the node's cycle runs in-process, so a case's outcome is the same on any load.
+the node's cycle runs in-process, untimed (no solver deadline), so a case's outcome is
+the same on any load and with any --jobs (the figures to about 1e-6: floating point;
+docs/simulation.md, "The grid of issue 32").
 """
 
 from __future__ import annotations
