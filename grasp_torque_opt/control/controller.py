@@ -28,7 +28,10 @@ is a cycle that overruns ``cycle_budget``: its command is late and is dropped.
 The solvers are given the cycle's budget (:meth:`TorqueController.budget`) as
 a deadline that they keep themselves, so a cycle ends within about its budget
 whatever the parameters; and the inputs are checked fresh again when the
-command leaves, not only when the cycle starts.
+command leaves, not only when the cycle starts. A controller run in simulated time
+(``untimed``, the simulation's in-process node) gives its solvers no deadline (their
+iteration caps only) and lets its wall time decide nothing: its commands then depend
+on its inputs alone, not on the machine's load.
 
 Input rules (docs/node.md, "Faults" and "Input checks"): every message is checked
 whole before it is kept (sizes, names, finite values, unit quaternions, known
@@ -121,6 +124,9 @@ class TorqueController:
         policy: the fault policy (:class:`~grasp_torque_opt.control.fault_policy.FaultPolicy`).
     """
 
+    #: Simulated time (the simulation's in-process node, ros/sim_compare): no deadline for
+    #: the solvers and no decision by the cycle's wall time (module docstring).
+    untimed = False
     #: The grasp, the settings and the running totals: every part's, set on all at once.
     setup = _Shared()
     config = _Shared()
@@ -170,6 +176,7 @@ class TorqueController:
         new = object.__new__(type(self))
         new.store, new.solving, new.policy = (copy.copy(part) for part in (
             self.store, self.solving, self.policy))
+        new.untimed = self.untimed
         return new
 
     # -- inputs: the store's ---------------------------------------------------------------
@@ -226,19 +233,20 @@ class TorqueController:
         t0 = time.perf_counter()
         counters, policy = self.counters, self.policy
         counters.cycles += 1
-        result = self._attempt(now, t0 + self.budget())
+        result = self._attempt(now, None if self.untimed else t0 + self.budget())
         elapsed = time.perf_counter() - t0
         counters.max_cycle_time = max(counters.max_cycle_time, elapsed)
         budget = self.config.cycle_budget
-        if elapsed > budget:
+        judged = 0.0 if self.untimed else elapsed  # simulated time: the wall decides nothing
+        if judged > budget:
             counters.overruns += 1
             if result.kind == 'solution':
                 result = policy.faulted(now, f'cycle overrun ({1e3 * elapsed:.1f} ms > '
                                         f'cycle_budget {1e3 * budget:.1f} ms)',
                                         result.solution, result.maps, result.gravity_torque)
-        late = self.stale(now + elapsed) if result.kind == 'solution' else ''
+        late = self.stale(now + judged) if result.kind == 'solution' else ''
         if late:
-            result = policy.faulted(now + elapsed, f'inputs went stale during the cycle: {late}',
+            result = policy.faulted(now + judged, f'inputs went stale during the cycle: {late}',
                                     result.solution, result.maps, result.gravity_torque)
         if result.kind == 'solution':
             self._slew(result, now)
@@ -332,7 +340,7 @@ class TorqueController:
         result.faded = blend[1], blend[2]
         self.counters.slew_limited += 1
 
-    def _attempt(self, now: float, deadline: float) -> CycleResult:
+    def _attempt(self, now: float, deadline: float | None) -> CycleResult:
         """Solve and gate; a certified command is returned, not yet committed."""
         reason = self.stale(now)
         if reason:

@@ -415,7 +415,7 @@ class Cycle:
             return CycleResult(None, 'none', sol, None, g, why)
         return CycleResult(cmd, 'solution', sol, None, g, q=inputs.q)
 
-    def attempt(self, inputs: Inputs, deadline: float) -> CycleResult:
+    def attempt(self, inputs: Inputs, deadline: float | None) -> CycleResult:
         """
         Solve and gate; never raises.
 
@@ -431,7 +431,7 @@ class Cycle:
                                    self.setup.hand.torque_limits)
         return result
 
-    def _attempt(self, inputs: Inputs, deadline: float) -> CycleResult:
+    def _attempt(self, inputs: Inputs, deadline: float | None) -> CycleResult:
         """Solve and gate (:meth:`attempt`)."""
         try:
             if not self.config.hold_object:

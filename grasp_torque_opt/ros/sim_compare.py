@@ -9,9 +9,11 @@
 """
 The node's cycle on the rig without ROS: the baseline beside a run, and the benchmark's node.
 
-``grasp-torque-sim`` runs the node over ROS in real time; beside it, for the plot, the
-same disturbances on a fresh rig in simulated time with the node's own cycle told only
-the scenario (no IMU, no efforts): what the node was before issue 24.
+``grasp-torque-sim`` runs the node over ROS; beside it, for the plot, the same
+disturbances on a fresh rig in simulated time with the node's own cycle as a baseline:
+by default made from the same params file with the object loop off (the feedforward-only
+node, what the node was before issue 32), or told only the scenario (no IMU, no efforts:
+what the node was before issue 24).
 bench/robustness.py drives every episode of its grid through :func:`node_controller`.
 """
 
@@ -91,6 +93,7 @@ def _controller(setup, scenario: Scenario, rig, inputs: bool, margin: float,
         ctrl = TorqueController(setup, CycleConfig(
             gravity_compensation=True, gravity=tuple(float(x) for x in scenario.gravity),
             effort_estimation=efforts, **{**UNTIMED, **told, **over}), fallback='daqp')
+    ctrl.untimed = True  # simulated time: the outcome depends on no wall clock
     ctrl.load_of_gravity = load_of_gravity(scenario)
     ctrl.solving.weight = weight_of(scenario)
     if scenario.object is not None:
@@ -126,7 +129,11 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     stiffness the rig's Kp and its reference the scenario's grasp (the default).
     The fingertips' estimate of the object is placed as the node places it (the gate).
     ``config``: further CycleConfig fields by name (the object loop's, e.g.
-    ``{'object_loop': True}``), over those.
+    ``{'object_loop': True}``), over those. The cycle is ``untimed``
+    (:class:`~grasp_torque_opt.control.controller.TorqueController`): its solvers get no
+    deadline and its wall time decides nothing, so that an episode's outcome is the same
+    on any machine load (a deadline made ProxSuite stop by its own timing, in chunks that
+    moved a falling ball's end by 0.01 mm between two runs).
 
     With ``params`` (a node's params file, config/allegro_right_node.yaml), the controller
     is the node's own, made from the file as the node makes it (:func:`params_file`,
@@ -166,18 +173,37 @@ def node_controller(setup, scenario: Scenario, rig=None, inputs: bool = False,
     return command
 
 
-def baseline_trace(scenario: Scenario, settings: EpisodeSettings, sim=None) -> list:
-    """
-    Run the node told only the scenario on a fresh rig; return its trace.
+#: The plot's baselines (``grasp-torque-sim --plot-baseline``): the node on its params
+#: file with the object loop off (the feedforward-only node: the scenario's load, the
+#: IMU's, no feedback from the object's motion), or the node told only the scenario.
+BASELINES = ('loop-off', 'scenario')
 
-    Rows of (time since release [s], drift [m], RMS applied joint torque [N m]), as
-    :func:`~grasp_torque_opt.sim.episode.run_episode` records them.
+
+def baseline_trace(scenario: Scenario, settings: EpisodeSettings, sim=None,
+                   kind: str = 'scenario', params: str | Path | None = None) -> list:
     """
+    Run a baseline node on a fresh rig with the same disturbances; return its trace.
+
+    ``kind``: ``scenario``, the node told only the scenario (no IMU, no efforts, friction
+    margin 0); ``loop-off``, the node made from ``params`` as the node makes it (its
+    margin, the IMU when the file enables it, effort estimation as the file says) with
+    ``object_loop.enabled`` false. Rows of (time since release [s], drift [m], RMS
+    applied joint torque [N m]), as :func:`~grasp_torque_opt.sim.episode.run_episode`
+    records them.
+    """
+    if kind not in BASELINES:
+        raise ValueError(f'baseline must be one of {", ".join(BASELINES)}, got {kind!r}')
+    if kind == 'loop-off' and params is None:
+        raise ValueError('baseline loop-off: needs the params file')
     kw = {} if sim is None else {'sim': sim}
     setup, rig = simulated(scenario, settings, **kw)
     trace: list = []
-    run_episode(rig, node_controller(setup, scenario, rig, inputs=False), settings,
-                trace=trace)
+    if kind == 'scenario':
+        command = node_controller(setup, scenario, rig, inputs=False)
+    else:
+        command = node_controller(setup, scenario, rig, inputs=True, params=params,
+                                  config={'object_loop': False})
+    run_episode(rig, command, settings, trace=trace)
     return trace
 
 

@@ -495,12 +495,16 @@ class _Track:
         self.errors: list[float] = []
         self.usage: list[float] = []
         self.trace: list[tuple[float, float, float]] = []
+        self.printed_at: float | None = None
 
     def every_second(self) -> None:
         """Print the line of the second: drift, rotation, forces against the prediction."""
         from grasp_torque_opt.sim.simulator import friction_usage
 
         hsim = self.hsim
+        if self.printed_at == hsim.time:  # lockstep's last second, already printed
+            return
+        self.printed_at = hsim.time
         t = hsim.time - self.sim_release
         drift, rotation = hsim.motion()
         readings, unplanned = hsim.readings()
@@ -602,14 +606,17 @@ def _mujoco_version() -> str:
 
 def _plot(args: argparse.Namespace, scenario, trace: list, node: bool) -> str:
     """Run the baseline on the same disturbances, plot both runs; return the line to print."""
+    from grasp_torque_opt.core.resources import find_config
     from grasp_torque_opt.ros.sim_compare import baseline_trace
     from grasp_torque_opt.sim.model import SimSettings
     from grasp_torque_opt.sim.plot import PLOT_CAPTION, plot_runs
 
     mu_tangential, mu_torsional = friction(args, scenario)
     sim = SimSettings(mu_tangential=mu_tangential, mu_torsional=mu_torsional)
-    base = baseline_trace(scenario, rig_settings(args), sim)
-    label = 'this run: the node over ROS, on its params file' if node else \
+    base = baseline_trace(scenario, rig_settings(args), sim, args.plot_baseline,
+                          find_config(args.params, '--params'))
+    label = (f'this run: the node over ROS on {Path(args.params).name}'
+             + (' (lockstep)' if args.lockstep else '')) if node else \
         f'this run: {args.controller}'
     if not base:
         outcome = 'did not run'
@@ -619,14 +626,17 @@ def _plot(args: argparse.Namespace, scenario, trace: list, node: bool) -> str:
         outcome = f'drifted {1e3 * base[-1][1]:.3f} mm'
     title = f"{describe(args) or 'no disturbance'}, Kp {args.kp:g} N m/rad"
     try:
-        written = plot_runs(args.plot, {
-            label: trace,
-            f'baseline: the node told only the scenario (no IMU, no measured efforts, '
-            f'friction margin k = 0, i.e. the full cone), {outcome}': base},
+        written = plot_runs(args.plot, {label: trace, (
+            'baseline: the same node with the object loop off (object_loop.enabled false: '
+            "the scenario's load and the IMU's, no feedback from the ball's motion), "
+            if args.plot_baseline == 'loop-off' else
+            'baseline: the node told only the scenario (no IMU, no measured efforts, '
+            'friction margin k = 0, i.e. the full cone), ') + outcome: base},
             title, args.drift_limit)
     except OSError as e:
         return f'plot: not written, cannot write {args.plot}: {e.strerror}'
-    return f'plot: {written.resolve()} ({PLOT_CAPTION}; the baseline {outcome})'
+    which = 'object loop off' if args.plot_baseline == 'loop-off' else 'scenario only'
+    return f'plot: {written.resolve()} ({PLOT_CAPTION}; the baseline ({which}) {outcome})'
 
 
 def _picture(hsim, path: str, predicted) -> str:

@@ -27,6 +27,9 @@ CONTROLLERS = ('node', 'preset', 'impedance')
 #: What joint_states' effort may be (grasp_torque_opt.sim.rig.EFFORT_REPORTS).
 EFFORT_REPORTS = ('applied', 'commanded')
 AXES = {'x': (1, 0, 0), 'y': (0, 1, 0), 'z': (0, 0, 1)}
+#: The plot's baselines (grasp_torque_opt.ros.sim_compare.BASELINES; that module needs
+#: MuJoCo, this one must not).
+PLOT_BASELINES = ('loop-off', 'scenario')
 
 
 def _disturbances(p: argparse.ArgumentParser) -> None:
@@ -108,8 +111,13 @@ def parser(description: str) -> argparse.ArgumentParser:
                         'path')
     p.add_argument('--plot', default='grasp_sim_plot.png',
                    help="PNG of the object's drift and the hand's effort over time, this "
-                        'run beside the node told only the scenario (no IMU, no efforts) '
-                        'on the same disturbances; in the current folder unless a path')
+                        'run beside a baseline (--plot-baseline) on the same disturbances, '
+                        'simulated without ROS; in the current folder unless a path')
+    p.add_argument('--plot-baseline', choices=PLOT_BASELINES, default='loop-off',
+                   help="the plot's baseline: loop-off, the node on the same params file "
+                        'with the object loop off (object_loop.enabled false: feedforward '
+                        'only); scenario, the node told only the scenario (no IMU, no '
+                        'efforts, friction margin 0)')
     p.add_argument('--no-picture', action='store_true', help='write no picture and no plot')
     p.add_argument('--with-node', action='store_true',
                    help='start grasp_torque_node in a child process')

@@ -394,6 +394,27 @@ def test_a_command_computed_from_inputs_that_went_stale_is_not_published(planar)
     assert ctrl.cycle(1.0).kind == 'solution'
 
 
+def test_an_untimed_cycle_is_neither_cut_nor_dropped_by_its_wall_time(planar):
+    """
+    Simulated time (``untimed``): the same over-budget, stale-by-the-wall-clock cycles.
+
+    The overrun and the staleness of the two tests above, each published when the
+    controller is untimed (the simulation's in-process node), refused when it is not.
+    """
+    for untimed in (False, True):
+        ctrl = fresh(planar, cycle_budget=1e-4, hold_time=1.0)
+        ctrl.untimed = untimed
+        ctrl.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
+        r = ctrl.cycle(0.0)
+        assert (r.kind == 'solution') == untimed, r.fault
+        slow = fresh(planar, cycle_budget=10.0, joint_state_timeout=0.05, hold_time=1.0)
+        slow.untimed, slow.solver = untimed, Slow(0.08)
+        slow.take('joint_states', JointStateReading(*joint_state(planar)), 0.0)
+        r = slow.cycle(0.0)
+        assert (r.kind == 'solution') == untimed and r.cycle_time > 0.05, r.fault
+        assert copy.copy(slow).untimed == untimed
+
+
 def with_limits(ctrl, limit):
     """Apply a torque_limits change to the controller, as the node applies one."""
     hand = dataclasses.replace(ctrl.setup.hand,
