@@ -878,7 +878,7 @@ def report(r: dict) -> str:
         f"| overruns / solver failures | {during('overruns')} / {during('solver_failures')} |",
         f"| latency p50 / p99 / max [ms] | {_f(r['latency_ms']['p50_ms'])} / "
         f"{_f(r['latency_ms']['p99_ms'])} / {_f(r['latency_ms']['max_ms'])} |",
-        f"| commands answered over 20 ms after their joint state | "
+        f'| commands answered over 20 ms after their joint state | '
         f"{r.get('latency_over_20ms', 'n/a')} |",
         f'| commands received over joint_state_timeout + {DELIVERY_MARGIN_S:g} s after their '
         f"stamp | {r['late_receipts']} |",
