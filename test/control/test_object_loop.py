@@ -74,6 +74,15 @@ def step(loop, q, t, certified=True, command=None):
     return loop.update(HAND, SETUP.contacts, q, t, ORIGIN, WEIGHT, GAINS, 0.05)
 
 
+def wound_up(loop, n):
+    """Settle, then hold the object 0.5 mm along -x for n cycles; return (q, the time)."""
+    t = settled(loop, SETUP.q)
+    q = carried(np.array([-0.5e-3, 0.0, 0.0, 0.0, 0.0, 0.0]))
+    for k in range(n):
+        step(loop, q, t + k * DT)
+    return q, t + n * DT
+
+
 def test_wrench_is_stiffness_and_integral_against_the_displacement():
     loop = ObjectLoop()
     t = settled(loop, SETUP.q)
@@ -110,11 +119,7 @@ def test_integral_is_bounded_by_its_ratio_of_the_weight():
 @pytest.mark.parametrize('outcome', ['limit', 'uncertified'])
 def test_integral_unwinds_at_a_limit_and_without_a_certified_command(outcome):
     loop = ObjectLoop()
-    t = settled(loop, SETUP.q)
-    q = carried(np.array([-0.5e-3, 0.0, 0.0, 0.0, 0.0, 0.0]))
-    for k in range(50):
-        step(loop, q, t + k * DT)
-    t += 50 * DT
+    q, t = wound_up(loop, 50)
     wound = loop.integral.copy()
     assert np.linalg.norm(wound[:3]) > 0
     at_limit = np.zeros_like(LIMITS)
@@ -134,11 +139,7 @@ def test_integral_unwinds_at_a_limit_and_without_a_certified_command(outcome):
 
 def test_integral_frozen_while_a_contact_slips():
     loop = ObjectLoop()
-    t = settled(loop, SETUP.q)
-    q = carried(np.array([-0.5e-3, 0.0, 0.0, 0.0, 0.0, 0.0]))
-    for k in range(20):
-        step(loop, q, t + k * DT)
-    t += 20 * DT
+    q, t = wound_up(loop, 20)
     before = loop.integral.copy()
     slipped = q.copy()
     slipped[HAND.idx_q[0]] += 0.1  # one finger's joint alone: its tip leaves the rigid motion
