@@ -133,8 +133,12 @@ class _Entities:
         can = executor.can_execute
         self.nodes = tuple(nodes)
         self.stack = ExitStack()
-        #: Per kind, the (handle pointer, entity, node) waited on, in rclpy's order.
+        #: Per kind, the (handle pointer, entity, node) waited on.
         self.by_kind: dict[str, list] = {k: [] for k in self.KINDS}
+        #: The nodes' entities as (kind, pointer, entity, node) in the order rclpy's
+        #: executor looks at them: node by node, timers, subscriptions, guard conditions,
+        #: clients, services, each in the order it was made.
+        self.order: list[tuple[str, int, Any, Any]] = []
         self.guards, self.waitables = [], []
         stack = self.stack
         stack.enter_context(executor._context.handle)
@@ -147,6 +151,7 @@ class _Entities:
                     except InvalidHandle:
                         continue
                     self.by_kind[kind].append((entity.handle.pointer, entity, node))
+                    self.order.append((kind, entity.handle.pointer, entity, node))
             for w in filter(can, node.waitables):
                 try:
                     stack.enter_context(w)
@@ -249,33 +254,33 @@ class WaitSetExecutor(SingleThreadedExecutor):
         return ready, ready_waitables
 
     def _ready(self, e: _Entities, ready: dict, waitables: list):
-        """Yield the ready work in rclpy's order: waitables, timers, subscriptions, the rest."""
+        """Yield the ready work in rclpy's order: waitables, then node by node (``order``)."""
         for wt, node in waitables:
             if wt.callback_group.can_execute(wt):
                 yield self._make_handler(wt, node, self._take_waitable), wt, node
         take = {'guard_condition': self._take_guard_condition, 'client': self._take_client,
                 'service': self._take_service}
-        for kind in _Entities.KINDS:
-            now = ready[kind]
-            for ptr, entity, node in e.by_kind[kind]:
-                if kind == 'guard_condition':
-                    if node is None or not entity._executor_triggered:
-                        continue  # the executor's own guard conditions have no callback
-                elif ptr not in now:
+        any_ready = set().union(*(ready[k] for k in ('timer', 'subscription', 'client',
+                                                     'service')))
+        for kind, ptr, entity, node in e.order:
+            if kind == 'guard_condition':
+                if not entity._executor_triggered:
                     continue
-                if not entity.callback_group.can_execute(entity):
-                    continue
-                if kind == 'timer':
-                    if _plain(entity):
-                        yield _Direct(lambda t=entity: _run_timer(t)), entity, node
-                    elif entity.handle.is_timer_ready():
-                        yield self._make_handler(entity, node, self._take_timer), entity, node
-                elif kind == 'subscription':
-                    yield (_Direct(lambda s=entity: _run_subscription(s)) if _plain(entity)
-                           else self._make_handler(entity, node, self._take_subscription)
-                           ), entity, node
-                else:
-                    yield self._make_handler(entity, node, take[kind]), entity, node
+            elif ptr not in any_ready:
+                continue
+            if not entity.callback_group.can_execute(entity):
+                continue
+            if kind == 'timer':
+                if _plain(entity):
+                    yield _Direct(lambda t=entity: _run_timer(t)), entity, node
+                elif entity.handle.is_timer_ready():
+                    yield self._make_handler(entity, node, self._take_timer), entity, node
+            elif kind == 'subscription':
+                yield (_Direct(lambda s=entity: _run_subscription(s)) if _plain(entity)
+                       else self._make_handler(entity, node, self._take_subscription)
+                       ), entity, node
+            else:
+                yield self._make_handler(entity, node, take[kind]), entity, node
 
     def _wait_for_ready_callbacks(self, timeout_sec: Any = None, nodes: list | None = None,
                                   condition: Callable[[], bool] = lambda: False):
