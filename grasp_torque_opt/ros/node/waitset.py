@@ -139,7 +139,7 @@ class _Entities:
         #: executor looks at them: node by node, timers, subscriptions, guard conditions,
         #: clients, services, each in the order it was made.
         self.order: list[tuple[str, int, Any, Any]] = []
-        self.guards, self.waitables = [], []
+        self.waitables: list[tuple[Any, Any]] = []
         stack = self.stack
         stack.enter_context(executor._context.handle)
         for node in nodes:
@@ -150,6 +150,8 @@ class _Entities:
                         stack.enter_context(entity.handle)
                     except InvalidHandle:
                         continue
+                    if kind == 'guard_condition' and entity._executor_triggered:
+                        entity.trigger()  # triggered but not handled: again (as rclpy)
                     self.by_kind[kind].append((entity.handle.pointer, entity, node))
                     self.order.append((kind, entity.handle.pointer, entity, node))
             for w in filter(can, node.waitables):
