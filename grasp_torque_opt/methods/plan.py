@@ -243,7 +243,8 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
         R = _draw_orientation(shape.kind, shape.size, settings, frame, rng)
         theta0 = np.clip(theta_base + rng.normal(0.0, settings.joint_spread, hand.m),
                          lower, upper)
-        sol = ik.solve(theta0, p0, R, setup.q, (lower, upper), region, settings.clearance)
+        sol = ik.solve(theta0, p0, R, setup.q, (lower, upper), region, settings.clearance,
+                       tolerance=settings.tolerance)
         q = ik.full_q(sol.theta, setup.q)
         pose = pin.SE3(R, sol.position)
         why = _reject(check, ik, q, pose, links, settings)
