@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
-from grasp_torque_opt.core.geometry_contacts import GeometryContacts
+from grasp_torque_opt.core.geometry_contacts import collision_model, GeometryContacts
 from grasp_torque_opt.core.grasp_setup import bind_for_candidates
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
@@ -218,9 +218,10 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     if not links:
         raise InputError('links', 'no contact links: give them (the base scenario has none)')
     urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
+    geom = collision_model(hand, urdf)  # the meshes read once, for the check and the IK
     check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
-                                  max_penetration=1.0, field='links')
-    ik = SurfaceIK(hand, urdf, shape, links, EDGE)
+                                  max_penetration=1.0, field='links', geometry=geom)
+    ik = SurfaceIK(hand, urdf, shape, links, EDGE, geom)
     model = hand.model
     lower = model.lowerPositionLimit[hand.idx_q] + settings.joint_margin
     upper = model.upperPositionLimit[hand.idx_q] - settings.joint_margin
@@ -247,8 +248,7 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
                        tolerance=settings.tolerance)
         q = ik.full_q(sol.theta, setup.q)
         pose = pin.SE3(R, sol.position)
-        why = _reject(check, ik, q, pose, links, settings)
-        found = check.contacts(q, pose) if why is None else None
+        why, found = _reject(check, ik, q, pose, links, settings)
         if why is None and margin is not None:
             why = _not_held(setup, q, found, sol.position, load, margin)
         if why is not None:
@@ -353,24 +353,29 @@ def _not_held(setup, q: np.ndarray, found, position: np.ndarray, load: np.ndarra
 
 
 def _reject(check: GeometryContacts, ik: SurfaceIK, q: np.ndarray, pose: pin.SE3,
-            links: list[str], settings: PlanSettings) -> str | None:
-    """Return why a solution is not a candidate, or None (the independent check)."""
+            links: list[str], settings: PlanSettings) -> tuple[str | None, Any]:
+    """
+    Return why a solution is not a candidate, or None (the independent check).
+
+    And the contacts found (None before they are looked for).
+    """
     model = check.hand.model
     if np.any(q < model.lowerPositionLimit - 1e-12) or np.any(
             q > model.upperPositionLimit + 1e-12):
-        return 'joint limits'
+        return 'joint limits', None
     try:
         found = check.contacts(q, pose)
     except GeometryError:
-        return 'overlap'
+        return 'overlap', None
     if found.links != tuple(links) or np.any(np.abs(found.distances) > settings.tolerance):
-        return 'contact off the surface'
+        return 'contact off the surface', found
     if any(on_edge(check.object, pose.actInv(p), EDGE) for p in found.object_points):
-        return 'contact at an edge'
+        return 'contact at an edge', found
+    # Every shape measured (no bound), as before issue 36: not the IK's broad phase.
     others = {k: d for k, d in ik.distances(q, pose).items() if k not in links}
     if others and min(others.values()) < settings.clearance:
-        return 'another link too close'
-    return None
+        return 'another link too close', found
+    return None, found
 
 
 def on_edge(shape: ObjectShape, x: np.ndarray, margin: float) -> bool:

@@ -85,14 +85,19 @@ class SurfaceIK:
     """Every collision shape of one hand against one object: distances, Jacobians, the IK."""
 
     def __init__(self, hand: Hand, urdf, shape: ObjectShape, contact_links: list[str],
-                 edge: float = 0.0) -> None:
-        """Bind the hand's collision shapes and the object once (``edge``: keep off edges)."""
+                 edge: float = 0.0, geom: pin.GeometryModel | None = None) -> None:
+        """
+        Bind the hand's collision shapes and the object once (``edge``: keep off edges).
+
+        ``geom``: the hand's ``collision_model`` of ``urdf``, built already (its meshes
+        get their convex hulls here); None: built here.
+        """
         self.hand = hand
         self.shape = shape
         self.edge = edge
         self.model = hand.model
         self.data = hand.model.createData()
-        self.geom = collision_model(hand, urdf)
+        self.geom = geom if geom is not None else collision_model(hand, urdf)
         self.gdata = pin.GeometryData(self.geom)
         self._owner = coal_shape(shape)  # ComputeDistance keeps a pointer: keep it alive
         self.request = coal.DistanceRequest()
