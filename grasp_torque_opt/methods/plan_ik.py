@@ -51,6 +51,9 @@ PULL_JOINTS = 2e-3
 PULL_OBJECT = 2e-2
 #: Weight of a contact's distance past the keep-off band of an edge [-].
 EDGE_WEIGHT = 1.0
+#: A contact link's mesh whose convex hull is farther than this is taken at its hull's
+#: distance in the IK (more than the stop test's contact distance) [m].
+APPROACH = 1e-3
 #: Taken off every broad-phase bound, for coal's own tolerance [m].
 BOUND_SLACK = 1e-6
 #: The IK stops at a point with every contact within this share of the tolerance of
@@ -60,12 +63,19 @@ STOP_SHARE = 0.5
 
 @dataclass(frozen=True)
 class IKResult:
-    """One IK's answer: the actuated joint positions, the object's position, its cost."""
+    """
+    One IK's answer: the actuated joint positions, the object's position, its cost.
+
+    ``stopped``: it ended at a point that met the stop test (:meth:`SurfaceIK.solve`);
+    ``evaluations``: the residual evaluations it took.
+    """
 
     theta: np.ndarray
     position: np.ndarray
     cost: float
     success: bool
+    stopped: bool = False
+    evaluations: int = 0
 
 
 def _skew(r: np.ndarray) -> np.ndarray:
@@ -183,14 +193,27 @@ class SurfaceIK:
 
     def _distance(self, i: int, tf, centre: np.ndarray, band: float | None
                   ) -> tuple[float, bool]:
-        """Return shape i's distance (or a bound at least ``band``) and whether exact."""
+        """
+        Return shape i's distance and whether its coal result holds its nearest points.
+
+        With ``band`` (the IK's), a bound stands for the distance where it says enough:
+        another link's shape bounded at least ``band`` away (its row is 0 either way:
+        no nearest points); a contact link's mesh whose convex hull is more than
+        :data:`APPROACH` away (the hull's distance and points: the contact is at least
+        that far, and near the surface the mesh's own are taken).
+        """
         oMg = self.gdata.oMg[i]
         tg = coal.Transform3s(oMg.rotation, oMg.translation)
+        res = self.results[i]
         if band is not None and self._far[i]:
             bound = self._bound(i, oMg, tg, tf, centre)
             if bound >= band:
                 return bound, False
-        res = self.results[i]
+        elif band is not None and self._hull_of(i) is not None:
+            res.clear()
+            hull = float(self._hulls[i](tg, tf, self.request, res))
+            if hull > APPROACH:
+                return hull, True
         res.clear()
         return float(self.computes[i](tg, tf, self.request, res)), True
 
@@ -203,17 +226,17 @@ class SurfaceIK:
         """
         gap = (np.linalg.norm(oMg.act(self._centres[i]) - centre) - self._radii[i]
                - self._object_radius)
-        hull = self._hulls.get(i, False)
-        if hull is False:
-            hull = self._hull(i)
+        hull = self._hull_of(i)
         if hull is None:
             return float(gap) - BOUND_SLACK
         res = self.result
         res.clear()
         return max(float(gap), float(hull(tg, tf, self.request, res))) - BOUND_SLACK
 
-    def _hull(self, i: int):
+    def _hull_of(self, i: int):
         """Return a ComputeDistance of shape i's convex hull and the object (None: no mesh)."""
+        if i in self._hulls:
+            return self._hulls[i]
         geometry = self.geom.geometryObjects[i].geometry
         compute = None
         if isinstance(geometry, coal.BVHModelBase):
@@ -304,9 +327,10 @@ class SurfaceIK:
         m = self.hand.m
         target = 1.25 * clearance  # a little more than asked: the check is strict
         stop = None if tolerance is None else STOP_SHARE * tolerance
-        cache: dict = {}
+        cache: dict = {'n': 0}
 
         def fun(x):
+            cache['n'] += 1
             f, J = self._residuals(x, theta0, p0, rotation, q_base, target)
             cache['x'], cache['J'] = x.copy(), J
             if stop is not None and self._meets(f, stop, clearance):
@@ -325,10 +349,11 @@ class SurfaceIK:
             sol = least_squares(fun, x0, jac=jac, bounds=(lower, upper), method='trf',
                                 max_nfev=max_evaluations, xtol=1e-10, ftol=1e-10,
                                 gtol=1e-10)
-            x, cost, success = sol.x, float(sol.cost), sol.status > 0
+            x, cost, success, stopped = sol.x, float(sol.cost), sol.status > 0, False
         except _Done as done:
-            x, cost, success = done.x, done.cost, True
-        return IKResult(theta=x[:m], position=x[m:], cost=cost, success=success)
+            x, cost, success, stopped = done.x, done.cost, True, True
+        return IKResult(theta=x[:m], position=x[m:], cost=cost, success=success,
+                        stopped=stopped, evaluations=cache['n'])
 
     def _meets(self, f: np.ndarray, stop: float, clearance: float) -> bool:
         """
