@@ -26,7 +26,9 @@ link's point p1 and the object's p2 along the unit normal n (link to object) is
 Cost (issue 36): a shape of another link whose lower bound (the bounding spheres' gap,
 then for a mesh coal's distance from its convex hull, which the mesh lies in) is
 already past the clearance band is not measured: its row is 0 either way, so the
-residuals are those of every distance measured. One evaluation gives the residuals
+residuals are those of every distance measured. With meshes on the contact links, the
+IK runs first on every mesh's convex hull, then, from where that met the stop test, on
+the meshes themselves. One evaluation gives the residuals
 and their Jacobian (the rows that are not 0 only), which least_squares' next Jacobian
 call at that point reuses. The IK stops at the first point that meets the check's
 tolerances with a margin (:meth:`SurfaceIK.solve`'s ``tolerance``) rather than run to
@@ -91,6 +93,16 @@ class _Done(Exception):
         self.x, self.cost = x, cost
 
 
+def _run(fun, jac, x0: np.ndarray, bounds: tuple, evaluations: int) -> tuple:
+    """Run least_squares from x0; return (x, cost, success, whether the stop test ended it)."""
+    try:
+        sol = least_squares(fun, x0, jac=jac, bounds=bounds, method='trf',
+                            max_nfev=evaluations, xtol=1e-10, ftol=1e-10, gtol=1e-10)
+        return sol.x, float(sol.cost), sol.status > 0, False
+    except _Done as done:
+        return done.x, done.cost, True, True
+
+
 class SurfaceIK:
     """Every collision shape of one hand against one object: distances, Jacobians, the IK."""
 
@@ -136,6 +148,9 @@ class SurfaceIK:
         self._object_radius = float(self._owner.aabb_radius)
         self._far = [i in self.other_shapes for i in range(len(frames))]
         self._hulls: dict[int, object] = {}
+        self._hulls_only = False
+        self._contact_hulls = any(self._hull_of(i) is not None
+                                  for shapes in self.contact_shapes for i in shapes)
 
     def full_q(self, theta: np.ndarray, q_base: np.ndarray) -> np.ndarray:
         """Return the full configuration: ``q_base`` with the actuated joints at theta."""
@@ -197,41 +212,33 @@ class SurfaceIK:
         Return shape i's distance and whether its coal result holds its nearest points.
 
         With ``band`` (the IK's), a bound stands for the distance where it says enough:
-        another link's shape bounded at least ``band`` away (its row is 0 either way:
-        no nearest points); a contact link's mesh whose convex hull is more than
-        :data:`APPROACH` away (the hull's distance and points: the contact is at least
-        that far, and near the surface the mesh's own are taken).
+        another link's shape bounded at least ``band`` away (the bounding spheres' gap,
+        then a mesh's convex hull's distance: the mesh lies in its hull) gets the bound
+        and no nearest points (its row is 0 either way); a contact link's mesh whose
+        hull is more than :data:`APPROACH` away, the hull's distance and points (the
+        contact is at least that far). While ``_hulls_only`` (the IK's first phase)
+        every mesh within the band is taken at its hull's distance.
         """
         oMg = self.gdata.oMg[i]
         tg = coal.Transform3s(oMg.rotation, oMg.translation)
         res = self.results[i]
-        if band is not None and self._far[i]:
-            bound = self._bound(i, oMg, tg, tf, centre)
-            if bound >= band:
-                return bound, False
-        elif band is not None and self._hull_of(i) is not None:
-            res.clear()
-            hull = float(self._hulls[i](tg, tf, self.request, res))
-            if hull > APPROACH:
-                return hull, True
+        if band is not None:
+            far = self._far[i]
+            if far:
+                gap = (np.linalg.norm(oMg.act(self._centres[i]) - centre) - self._radii[i]
+                       - self._object_radius - BOUND_SLACK)
+                if gap >= band:
+                    return float(gap), False
+            hull = self._hull_of(i)
+            if hull is not None:
+                res.clear()
+                d = float(hull(tg, tf, self.request, res))
+                if far and d - BOUND_SLACK >= band:
+                    return d - BOUND_SLACK, False
+                if self._hulls_only or (not far and d > APPROACH):
+                    return d, True
         res.clear()
         return float(self.computes[i](tg, tf, self.request, res)), True
-
-    def _bound(self, i: int, oMg: pin.SE3, tg, tf, centre: np.ndarray) -> float:
-        """
-        Return a lower bound of shape i's distance to the object [m] (broad phase).
-
-        The bounding spheres' gap first; then, for a mesh, coal's distance from its
-        convex hull (the mesh lies in its hull, so it is no nearer; built on first use).
-        """
-        gap = (np.linalg.norm(oMg.act(self._centres[i]) - centre) - self._radii[i]
-               - self._object_radius)
-        hull = self._hull_of(i)
-        if hull is None:
-            return float(gap) - BOUND_SLACK
-        res = self.result
-        res.clear()
-        return max(float(gap), float(hull(tg, tf, self.request, res))) - BOUND_SLACK
 
     def _hull_of(self, i: int):
         """Return a ComputeDistance of shape i's convex hull and the object (None: no mesh)."""
@@ -322,9 +329,11 @@ class SurfaceIK:
             max_evaluations: residual evaluations at most (60 before issue 36: with the
                 stop test 9 in 10 kept IKs take at most 14, the IKs that fail took 33
                 to 45).
-            tolerance: stop at the first point with every contact within
-                :data:`STOP_SHARE` of it and every other row 0 (the pulls aside) [m];
-                None: run least_squares to its own tolerances.
+            tolerance: stop at the first point that meets the stop test
+                (:meth:`_meets`: every contact within :data:`STOP_SHARE` of it) [m],
+                every mesh within the band measured first by its convex hull, then,
+                from there, by itself; None: run least_squares to its own tolerances, the
+                contact meshes beyond :data:`APPROACH` by their hulls.
         """
         m = self.hand.m
         target = 1.25 * clearance  # a little more than asked: the check is strict
@@ -346,14 +355,19 @@ class SurfaceIK:
 
         lower = np.concatenate([bounds[0], region[0]])
         upper = np.concatenate([bounds[1], region[1]])
-        x0 = np.clip(np.concatenate([theta0, p0]), lower, upper)
+        x = np.clip(np.concatenate([theta0, p0]), lower, upper)
+        hulls = stop is not None and self._contact_hulls
         try:
-            sol = least_squares(fun, x0, jac=jac, bounds=(lower, upper), method='trf',
-                                max_nfev=max_evaluations, xtol=1e-10, ftol=1e-10,
-                                gtol=1e-10)
-            x, cost, success, stopped = sol.x, float(sol.cost), sol.status > 0, False
-        except _Done as done:
-            x, cost, success, stopped = done.x, done.cost, True, True
+            # With contact meshes: first on the meshes' hulls (cheap), then from where
+            # that stopped on the meshes themselves (most often met at once).
+            for only in ((True, False) if hulls else (False,)):
+                self._hulls_only = only
+                x, cost, success, stopped = _run(fun, jac, x, (lower, upper),
+                                                 max(max_evaluations - cache['n'], 1))
+                if not stopped:
+                    break
+        finally:
+            self._hulls_only = False
         return IKResult(theta=x[:m], position=x[m:], cost=cost, success=success,
                         stopped=stopped, evaluations=cache['n'])
 

@@ -87,6 +87,14 @@ def test_bounded_residuals_are_the_full_evaluations(iks, case):
             assert got <= want + 1e-9
             if got <= plan_ik.APPROACH:
                 assert got == pytest.approx(want, abs=1e-9)
+        # the first phase (meshes at their hulls): no contact farther, no hinge smaller
+        ik._hulls_only = True
+        try:
+            hulls, _ = ik._residuals(x, x[:ik.hand.m], x[ik.hand.m:], R, q_base, TARGET)
+        finally:
+            ik._hulls_only = False
+        assert np.all(hulls[:c] <= contacts + 1e-9)
+        assert np.all(hulls[c:c + n] >= others - 1e-9)
         # every bound is a lower bound of its shape's distance
         m = ik.hand.m
         bounds = ik.evaluate(ik.full_q(x[:m], q_base), pin.SE3(R, x[m:]), band=np.inf)
