@@ -28,11 +28,11 @@ then for a mesh coal's distance from its convex hull, which the mesh lies in) is
 already past the clearance band is not measured: its row is 0 either way, so the
 residuals are those of every distance measured. With meshes on the contact links, the
 IK runs first on every mesh's convex hull, then, from where that met the stop test, on
-the meshes themselves. One evaluation gives the residuals
-and their Jacobian (the rows that are not 0 only), which least_squares' next Jacobian
-call at that point reuses. The IK stops at the first point that meets the check's
-tolerances with a margin (:meth:`SurfaceIK.solve`'s ``tolerance``) rather than run to
-least_squares' own: the independent check of :mod:`.plan` judges it either way.
+the meshes themselves. One evaluation gives the residuals and their Jacobian (the rows
+that are not 0 only), which least_squares' next Jacobian call at that point reuses.
+The IK stops at the first point that meets the check's tolerances with a margin
+(:meth:`SurfaceIK.solve`'s ``tolerance``) rather than run to least_squares' own: the
+independent check of :mod:`.plan` judges it either way.
 """
 
 from __future__ import annotations
@@ -123,7 +123,6 @@ class SurfaceIK:
         self.gdata = pin.GeometryData(self.geom)
         self._owner = coal_shape(shape)  # ComputeDistance keeps a pointer: keep it alive
         self.request = coal.DistanceRequest()
-        self.result = coal.DistanceResult()
         self.results = [coal.DistanceResult() for _ in self.geom.geometryObjects]
         self.computes = [coal.ComputeDistance(g.geometry, self._owner)
                          for g in self.geom.geometryObjects]
