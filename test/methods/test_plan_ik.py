@@ -24,6 +24,7 @@ from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import load_scenario
 from grasp_torque_opt.methods import plan_ik
+from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
 from grasp_torque_opt.methods.plan_ik import SurfaceIK
 import numpy as np
 import pinocchio as pin
@@ -134,6 +135,26 @@ def test_the_jacobian_is_the_residuals_derivative(iks, case):
     assert checked >= 4 * len(ik.contact_links)
 
 
+def by_coal(ik, geom, target, q, pose_in_base) -> dict[str, float]:
+    """Return every link's least distance to the object, coal on ``geom`` directly."""
+    model = ik.model
+    data, gdata = model.createData(), pin.GeometryData(geom)
+    pin.framesForwardKinematics(model, data, q)
+    pin.updateGeometryPlacements(model, data, geom, gdata)
+    base = (data.oMf[model.getFrameId(ik.hand.base_link)] if ik.hand.base_link
+            else pin.SE3.Identity())
+    pose = base * pose_in_base
+    least: dict[str, float] = {}
+    for i, g in enumerate(geom.geometryObjects):
+        oMg = gdata.oMg[i]
+        d = coal.distance(g.geometry, coal.Transform3s(oMg.rotation, oMg.translation),
+                          target, coal.Transform3s(pose.rotation, pose.translation),
+                          coal.DistanceRequest(), coal.DistanceResult())
+        link = model.frames[g.parentFrame].name
+        least[link] = min(d, least.get(link, np.inf))
+    return least
+
+
 @pytest.mark.parametrize('case', ['allegro sphere', 'g1 sphere'])
 def test_the_ik_stops_where_every_shape_measured_by_coal_meets_its_test(iks, case):
     """Each stop point: contacts within half the tolerance, every other shape clear."""
@@ -143,34 +164,40 @@ def test_the_ik_stops_where_every_shape_measured_by_coal_meets_its_test(iks, cas
     lower, upper = model.lowerPositionLimit[ik.hand.idx_q], model.upperPositionLimit[
         ik.hand.idx_q]
     geom = collision_model(ik.hand, urdf)  # its own shapes, not the IK's
-    target = {'sphere': lambda s: coal.Sphere(s[0]), 'box': lambda s: coal.Box(*s)}[
-        shape.kind](shape.size)
+    target = coal.Sphere(shape.size[0])
     stopped = 0
     for x, R in draws(ik, q_base, origin, 6, seed=3):
         region = (x[m:] - 0.02, x[m:] + 0.02)
         sol = ik.solve(np.clip(x[:m], lower, upper), x[m:], R, q_base, (lower, upper),
                        region, CLEARANCE, tolerance=tolerance)
-        q = ik.full_q(sol.theta, q_base)
-        data, gdata = model.createData(), pin.GeometryData(geom)
-        pin.framesForwardKinematics(model, data, q)
-        pin.updateGeometryPlacements(model, data, geom, gdata)
-        base = data.oMf[model.getFrameId(ik.hand.base_link)] if ik.hand.base_link else \
-            pin.SE3.Identity()
-        pose = base * pin.SE3(R, sol.position)
-        least: dict[str, float] = {}
-        for i, g in enumerate(geom.geometryObjects):
-            oMg = gdata.oMg[i]
-            d = coal.distance(g.geometry, coal.Transform3s(oMg.rotation, oMg.translation),
-                              target, coal.Transform3s(pose.rotation, pose.translation),
-                              coal.DistanceRequest(), coal.DistanceResult())
-            link = model.frames[g.parentFrame].name
-            least[link] = min(d, least.get(link, np.inf))
         if not sol.stopped:
             continue
         stopped += 1
+        least = by_coal(ik, geom, target, ik.full_q(sol.theta, q_base),
+                        pin.SE3(R, sol.position))
         for k in ik.contact_links:
             assert abs(least[k]) <= plan_ik.STOP_SHARE * tolerance + 1e-7, (k, least[k])
         for k, d in least.items():
             if k not in ik.contact_links:
                 assert d >= CLEARANCE, (k, d)
     assert stopped >= 2
+
+
+def test_planned_g1_candidates_touch_with_their_links_and_nothing_else(iks):
+    """The G1's lines (its meshes, the whole robot's shapes), measured by coal directly."""
+    ik, q_base, _, shape, urdf = iks['g1 sphere']
+    settings = PlanSettings(count=3, seed=2)
+    plan = plan_grasps(G1, settings)
+    assert len(plan.candidates) == 3
+    geom = collision_model(ik.hand, urdf)
+    for line in plan.candidates:
+        theta = np.array([line['grasp']['joint_positions'][j] for j in ik.hand.joints])
+        obj = line['object']
+        pose = pin.SE3(pin.rpy.rpyToMatrix(*obj['rpy']), np.array(obj['position']))
+        least = by_coal(ik, geom, coal.Sphere(shape.size[0]), ik.full_q(theta, q_base), pose)
+        assert [c['link'] for c in line['grasp']['contacts']] == ik.contact_links
+        for k, d in least.items():
+            if k in ik.contact_links:
+                assert abs(d) <= settings.tolerance, (k, d)
+            else:
+                assert d >= settings.clearance, (k, d)
