@@ -240,14 +240,17 @@ class SurfaceIK:
         return float(self.computes[i](tg, tf, self.request, res)), True
 
     def _hull_of(self, i: int):
-        """Return a ComputeDistance of shape i's convex hull and the object (None: no mesh)."""
+        """Return a ComputeDistance of shape i's convex hull and the object (None: none)."""
         if i in self._hulls:
             return self._hulls[i]
         geometry = self.geom.geometryObjects[i].geometry
         compute = None
         if isinstance(geometry, coal.BVHModelBase):
-            geometry.buildConvexHull(True, 'Qt')
-            compute = coal.ComputeDistance(geometry.convex, self._owner)
+            try:
+                geometry.buildConvexHull(True, 'Qt')
+                compute = coal.ComputeDistance(geometry.convex, self._owner)
+            except (RuntimeError, ValueError):  # no hull (a flat mesh): measured always
+                compute = None
         self._hulls[i] = compute
         return compute
 
