@@ -202,7 +202,8 @@ class GeometryContacts:
     def bind(cls, hand: Hand, urdf: str | Path, obj: ObjectShape | ObjectSpec,
              tolerance: float = DEFAULT_TOLERANCE, links: list[str] | None = None,
              max_penetration: float = MAX_PENETRATION, urdf_dir: Path | None = None,
-             field: str = 'grasp.contacts', analytic: bool = True) -> GeometryContacts:
+             field: str = 'grasp.contacts', analytic: bool = True,
+             geometry: pin.GeometryModel | None = None) -> GeometryContacts:
         """
         Build the collision shapes, the object's shape and the candidate links once.
 
@@ -218,6 +219,8 @@ class GeometryContacts:
             field: the input named in errors about the links.
             analytic: take the closed form where it applies (False: coal for every pair,
                 the independent formulation the tests compare with).
+            geometry: the hand's :func:`collision_model` of ``urdf``, built already
+                (its shapes are used, not copied); None: built here.
 
         Raises:
             InputError: a bad tolerance, URDF or object; FrameNotFound: an unknown link;
@@ -229,7 +232,7 @@ class GeometryContacts:
         shape = ObjectShape.from_spec(obj) if isinstance(obj, ObjectSpec) else obj
         target = coal_shape(shape)
         model = hand.model
-        geom = collision_model(hand, urdf, urdf_dir)
+        geom = geometry if geometry is not None else collision_model(hand, urdf, urdf_dir)
         by_link: dict[str, list] = {}
         for g in geom.geometryObjects:
             by_link.setdefault(model.frames[g.parentFrame].name, []).append(g)

@@ -159,11 +159,15 @@ class CapacityLP:
 
     Variables x = [f (4p); alpha]; rows: G f + alpha d = 0 (6), J^T f in the torque
     bounds (m), S f <= b (the planned polygons and f_min).
+
+    ``explain``: name the conflict of a grasp that cannot hold zero load (False: the
+    same verdict, certified the same way, without its name; the planner's filter).
     """
 
     def __init__(self, setup: GraspSetup, maps: GraspMaps,
-                 tolerance: float = DEFAULT_TOLERANCE) -> None:
+                 tolerance: float = DEFAULT_TOLERANCE, explain: bool = True) -> None:
         self.setup, self.maps, self.tolerance = setup, maps, tolerance
+        self.explain = explain
         self.friction = fr = planned_friction(setup.friction)
         G, J = maps.G, maps.J
         self.S, b_S = friction_matrix(maps.p, fr.mu1, fr.mu2, fr.sides, fr.min_normal_force)
@@ -220,6 +224,9 @@ class CapacityLP:
         # be held (else the verdict is numerics, not the grasp).
         if linearized_feasible(self.maps, self.friction, np.zeros(6), self.tau_min,
                                self.tau_max) is False:
+            if not self.explain:
+                return Capacity('infeasible', 0.0, '-', solver=res.solver,
+                                message='not even zero load can be held')
             return self._conflict(res)
         return Capacity('failed', None, '-', solver=res.solver, message=(
             f'zero load: {res.message}, and no certified answer (the feasibility LP does '

@@ -38,12 +38,12 @@ from pathlib import Path
 from typing import Any
 
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
-from grasp_torque_opt.core.geometry_contacts import GeometryContacts
+from grasp_torque_opt.core.geometry_contacts import collision_model, GeometryContacts
 from grasp_torque_opt.core.grasp_setup import bind_for_candidates
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import load_scenario, Scenario
-from grasp_torque_opt.methods.capacity import load_capacity
+from grasp_torque_opt.methods.capacity import CapacityLP
 from grasp_torque_opt.methods.plan_ik import SurfaceIK
 import numpy as np
 import pinocchio as pin
@@ -218,9 +218,10 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     if not links:
         raise InputError('links', 'no contact links: give them (the base scenario has none)')
     urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
+    geom = collision_model(hand, urdf)  # the meshes read once, for the check and the IK
     check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
-                                  max_penetration=1.0, field='links')
-    ik = SurfaceIK(hand, urdf, shape, links, EDGE)
+                                  max_penetration=1.0, field='links', geometry=geom)
+    ik = SurfaceIK(hand, urdf, shape, links, EDGE, geom)
     model = hand.model
     lower = model.lowerPositionLimit[hand.idx_q] + settings.joint_margin
     upper = model.upperPositionLimit[hand.idx_q] - settings.joint_margin
@@ -243,11 +244,11 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
         R = _draw_orientation(shape.kind, shape.size, settings, frame, rng)
         theta0 = np.clip(theta_base + rng.normal(0.0, settings.joint_spread, hand.m),
                          lower, upper)
-        sol = ik.solve(theta0, p0, R, setup.q, (lower, upper), region, settings.clearance)
+        sol = ik.solve(theta0, p0, R, setup.q, (lower, upper), region, settings.clearance,
+                       tolerance=settings.tolerance)
         q = ik.full_q(sol.theta, setup.q)
         pose = pin.SE3(R, sol.position)
-        why = _reject(check, ik, q, pose, links, settings)
-        found = check.contacts(q, pose) if why is None else None
+        why, found = _reject(check, ik, q, pose, links, settings)
         if why is None and margin is not None:
             why = _not_held(setup, q, found, sol.position, load, margin)
         if why is not None:
@@ -335,13 +336,16 @@ def _not_held(setup, q: np.ndarray, found, position: np.ndarray, load: np.ndarra
     Return why a touching candidate is not kept for its load, or None (it is held).
 
     Held: its load capacity (the certified LP of :mod:`.capacity`, every load from zero
-    up to it held with friction margin ``margin``) is at least 1.
+    up to it held with friction margin ``margin``) is at least 1 (:func:`.capacity.load_capacity`'s
+    verdict; what binds is not named).
     """
     candidate = dataclasses.replace(
         setup, q=q, contacts=found.specs(), object_origin=np.asarray(position, float),
         external_wrench=load, friction=dataclasses.replace(setup.friction, margin=margin))
     try:
-        cap = load_capacity(candidate)
+        # load_capacity's LP, without naming what binds or conflicts (not written)
+        cap = CapacityLP(candidate, candidate.maps(), explain=False).solve(
+            load, '-', binding=False)
     except (InputError, GeometryError):
         return 'no grasp maps'
     if cap.status == 'unbounded' or (cap.status == 'optimal' and cap.value >= 1.0):
@@ -352,24 +356,29 @@ def _not_held(setup, q: np.ndarray, found, position: np.ndarray, load: np.ndarra
 
 
 def _reject(check: GeometryContacts, ik: SurfaceIK, q: np.ndarray, pose: pin.SE3,
-            links: list[str], settings: PlanSettings) -> str | None:
-    """Return why a solution is not a candidate, or None (the independent check)."""
+            links: list[str], settings: PlanSettings) -> tuple[str | None, Any]:
+    """
+    Return why a solution is not a candidate, or None (the independent check).
+
+    And the contacts found (None before they are looked for).
+    """
     model = check.hand.model
     if np.any(q < model.lowerPositionLimit - 1e-12) or np.any(
             q > model.upperPositionLimit + 1e-12):
-        return 'joint limits'
+        return 'joint limits', None
     try:
         found = check.contacts(q, pose)
     except GeometryError:
-        return 'overlap'
+        return 'overlap', None
     if found.links != tuple(links) or np.any(np.abs(found.distances) > settings.tolerance):
-        return 'contact off the surface'
+        return 'contact off the surface', found
     if any(on_edge(check.object, pose.actInv(p), EDGE) for p in found.object_points):
-        return 'contact at an edge'
+        return 'contact at an edge', found
+    # Every shape measured (no bound), as before issue 36: not the IK's broad phase.
     others = {k: d for k, d in ik.distances(q, pose).items() if k not in links}
     if others and min(others.values()) < settings.clearance:
-        return 'another link too close'
-    return None
+        return 'another link too close', found
+    return None, found
 
 
 def on_edge(shape: ObjectShape, x: np.ndarray, margin: float) -> bool:

@@ -22,6 +22,17 @@ The distances are coal's (signed: GJK, EPA when they overlap) between each of th
 URDF's collision shapes and the object. The derivative of a distance d between a
 link's point p1 and the object's p2 along the unit normal n (link to object) is
 -n . v(p1) for the link's motion and +n . v_object for the object's.
+
+Cost (issue 36): a shape of another link whose lower bound (the bounding spheres' gap,
+then for a mesh coal's distance from its convex hull, which the mesh lies in) is
+already past the clearance band is not measured: its row is 0 either way, so the
+residuals are those of every distance measured. With meshes on the contact links, the
+IK runs first on every mesh's convex hull, then, from where that met the stop test, on
+the meshes themselves. One evaluation gives the residuals and their Jacobian (the rows
+that are not 0 only), which least_squares' next Jacobian call at that point reuses.
+The IK stops at the first point that meets the check's tolerances with a margin
+(:meth:`SurfaceIK.solve`'s ``tolerance``) rather than run to least_squares' own: the
+independent check of :mod:`.plan` judges it either way.
 """
 
 from __future__ import annotations
@@ -42,34 +53,77 @@ PULL_JOINTS = 2e-3
 PULL_OBJECT = 2e-2
 #: Weight of a contact's distance past the keep-off band of an edge [-].
 EDGE_WEIGHT = 1.0
+#: A contact link's mesh whose convex hull is farther than this is taken at its hull's
+#: distance in the IK (more than the stop test's contact distance) [m].
+APPROACH = 1e-3
+#: Taken off every broad-phase bound, for coal's own tolerance [m].
+BOUND_SLACK = 1e-6
+#: The IK stops at a point with every contact within this share of the tolerance of
+#: the surface, the other rows within this share of their slack (SurfaceIK._meets).
+STOP_SHARE = 0.5
 
 
 @dataclass(frozen=True)
 class IKResult:
-    """One IK's answer: the actuated joint positions, the object's position, its cost."""
+    """
+    One IK's answer: the actuated joint positions, the object's position, its cost.
+
+    ``stopped``: it ended at a point that met the stop test (:meth:`SurfaceIK.solve`);
+    ``evaluations``: the residual evaluations it took.
+    """
 
     theta: np.ndarray
     position: np.ndarray
     cost: float
     success: bool
+    stopped: bool = False
+    evaluations: int = 0
+
+
+def _skew(r: np.ndarray) -> np.ndarray:
+    """Return the matrix of r x ."""
+    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+
+
+class _Done(Exception):
+    """Raised by the residuals at a point that already meets the stop test."""
+
+    def __init__(self, x: np.ndarray, cost: float) -> None:
+        super().__init__()
+        self.x, self.cost = x, cost
+
+
+def _run(fun, jac, x0: np.ndarray, bounds: tuple, evaluations: int) -> tuple:
+    """Run least_squares from x0; return (x, cost, success, whether the stop test ended it)."""
+    try:
+        sol = least_squares(fun, x0, jac=jac, bounds=bounds, method='trf',
+                            max_nfev=evaluations, xtol=1e-10, ftol=1e-10, gtol=1e-10)
+        return sol.x, float(sol.cost), sol.status > 0, False
+    except _Done as done:
+        return done.x, done.cost, True, True
 
 
 class SurfaceIK:
     """Every collision shape of one hand against one object: distances, Jacobians, the IK."""
 
     def __init__(self, hand: Hand, urdf, shape: ObjectShape, contact_links: list[str],
-                 edge: float = 0.0) -> None:
-        """Bind the hand's collision shapes and the object once (``edge``: keep off edges)."""
+                 edge: float = 0.0, geom: pin.GeometryModel | None = None) -> None:
+        """
+        Bind the hand's collision shapes and the object once (``edge``: keep off edges).
+
+        ``geom``: the hand's ``collision_model`` of ``urdf``, built already (its meshes
+        get their convex hulls here); None: built here.
+        """
         self.hand = hand
         self.shape = shape
         self.edge = edge
         self.model = hand.model
         self.data = hand.model.createData()
-        self.geom = collision_model(hand, urdf)
+        self.geom = geom if geom is not None else collision_model(hand, urdf)
         self.gdata = pin.GeometryData(self.geom)
         self._owner = coal_shape(shape)  # ComputeDistance keeps a pointer: keep it alive
         self.request = coal.DistanceRequest()
-        self.result = coal.DistanceResult()
+        self.results = [coal.DistanceResult() for _ in self.geom.geometryObjects]
         self.computes = [coal.ComputeDistance(g.geometry, self._owner)
                          for g in self.geom.geometryObjects]
         frames = [self.model.frames[g.parentFrame].name for g in self.geom.geometryObjects]
@@ -82,6 +136,20 @@ class SurfaceIK:
         base = hand.base_link
         self.base = None if base is None else self.model.getFrameId(base)
         self.C = hand.velocity_map
+        # The broad phase: each shape's bounding sphere (its frame), the object's.
+        self._centres, self._radii = [], []
+        for g in self.geom.geometryObjects:
+            g.geometry.computeLocalAABB()
+            self._centres.append(np.array(g.geometry.aabb_center, dtype=float))
+            self._radii.append(float(g.geometry.aabb_radius))
+        self._owner.computeLocalAABB()
+        self._object_centre = np.array(self._owner.aabb_center, dtype=float)
+        self._object_radius = float(self._owner.aabb_radius)
+        self._far = [i in self.other_shapes for i in range(len(frames))]
+        self._hulls: dict[int, object] = {}
+        self._hulls_only = False
+        self._contact_hulls = any(self._hull_of(i) is not None
+                                  for shapes in self.contact_shapes for i in shapes)
 
     def full_q(self, theta: np.ndarray, q_base: np.ndarray) -> np.ndarray:
         """Return the full configuration: ``q_base`` with the actuated joints at theta."""
@@ -95,7 +163,8 @@ class SurfaceIK:
         pin.updateFramePlacement(self.model, self.data, self.base)
         return self.data.oMf[self.base]
 
-    def evaluate(self, q: np.ndarray, pose: pin.SE3, jacobians: bool = False) -> list[tuple]:
+    def evaluate(self, q: np.ndarray, pose: pin.SE3, jacobians: bool = False,
+                 band: float | None = None) -> list[tuple]:
         """
         Return per collision shape its distance, derivatives and nearest point.
 
@@ -103,45 +172,106 @@ class SurfaceIK:
         nearest point in its frame, that point's velocity columns there).
 
         All but the distance are None unless ``jacobians``; p is the object's position
-        in the base frame; the point is taken as moving with the link.
+        in the base frame; the point is taken as moving with the link. With ``band``,
+        a shape of :attr:`other_shapes` whose bound (its bounding sphere's, then its
+        convex hull's distance: neither exceeds its own) is at least ``band`` gets that
+        bound as its distance, no derivatives (its planner row is 0 either way).
         """
-        model, data = self.model, self.data
-        pin.forwardKinematics(model, data, q)
-        pin.updateGeometryPlacements(model, data, self.geom, self.gdata)
+        oMb, oMo, tf, centre = self._place(q, pose)
+        Jb = self._jacobians() if jacobians else None
+        out = []
+        for i in range(len(self.computes)):
+            d, exact = self._distance(i, tf, centre, band)
+            if jacobians and exact:
+                out.append(self._derivatives(i, d, oMb, oMo, Jb))
+            else:
+                out.append((d, None, None, None, None))
+        return out
+
+    def _place(self, q: np.ndarray, pose: pin.SE3) -> tuple:
+        """Place the shapes at q: return the base's and the object's poses, coal's, centre."""
+        pin.forwardKinematics(self.model, self.data, q)
+        pin.updateGeometryPlacements(self.model, self.data, self.geom, self.gdata)
         oMb = self._base()
         oMo = oMb * pose
-        tf = coal.Transform3s(oMo.rotation, oMo.translation)
-        Jb = None
-        if jacobians:
-            pin.computeJointJacobians(model, data, q)
-            if self.base is not None:  # the base moves with q too (a hand in a robot)
-                Jb = pin.getFrameJacobian(model, data, self.base, pin.LOCAL_WORLD_ALIGNED)
-        out = []
-        for i, g in enumerate(self.geom.geometryObjects):
-            oMg = self.gdata.oMg[i]
-            res = self.result
-            res.clear()
-            d = self.computes[i](coal.Transform3s(oMg.rotation, oMg.translation), tf,
-                                 self.request, res)
-            if not jacobians:
-                out.append((float(d), None, None, None, None))
-                continue
-            n = np.asarray(res.normal, dtype=float)
-            n = n / max(np.linalg.norm(n), 1e-12)
-            p1 = np.asarray(res.getNearestPoint1(), dtype=float)
-            J = pin.getJointJacobian(model, data, g.parentJoint, pin.LOCAL_WORLD_ALIGNED)
-            r = p1 - data.oMi[g.parentJoint].translation
-            v = J[:3] - np.cross(r, J[3:].T).T  # the point's velocity columns
-            dq = -n @ v
-            if Jb is not None:  # the object's point moves with the base
-                rb = np.asarray(res.getNearestPoint2(), dtype=float) - oMb.translation
-                dq = dq + n @ (Jb[:3] - np.cross(rb, Jb[3:].T).T)
-            dtheta = dq[self.hand.idx_v] if self.C is None else dq @ self.C
-            vtheta = v[:, self.hand.idx_v] if self.C is None else v @ self.C
-            local = oMo.actInv(np.asarray(res.getNearestPoint2(), dtype=float))
-            out.append((float(d), dtheta, oMb.rotation.T @ n, local,
-                        oMo.rotation.T @ vtheta))
-        return out
+        return (oMb, oMo, coal.Transform3s(oMo.rotation, oMo.translation),
+                oMo.act(self._object_centre))
+
+    def _jacobians(self):
+        """Compute the joint Jacobians at the placed q; return the base's (None: fixed)."""
+        pin.computeJointJacobians(self.model, self.data)
+        if self.base is None:
+            return None
+        # the base moves with q too (a hand in a robot)
+        return pin.getFrameJacobian(self.model, self.data, self.base, pin.LOCAL_WORLD_ALIGNED)
+
+    def _distance(self, i: int, tf, centre: np.ndarray, band: float | None
+                  ) -> tuple[float, bool]:
+        """
+        Return shape i's distance and whether its coal result holds its nearest points.
+
+        With ``band`` (the IK's), a bound stands for the distance where it says enough:
+        another link's shape bounded at least ``band`` away (the bounding spheres' gap,
+        then a mesh's convex hull's distance: the mesh lies in its hull) gets the bound
+        and no nearest points (its row is 0 either way); a contact link's mesh whose
+        hull is more than :data:`APPROACH` away, the hull's distance and points (the
+        contact is at least that far). While ``_hulls_only`` (the IK's first phase)
+        every mesh within the band is taken at its hull's distance.
+        """
+        oMg = self.gdata.oMg[i]
+        tg = coal.Transform3s(oMg.rotation, oMg.translation)
+        res = self.results[i]
+        if band is not None:
+            far = self._far[i]
+            if far:
+                gap = (np.linalg.norm(oMg.act(self._centres[i]) - centre) - self._radii[i]
+                       - self._object_radius - BOUND_SLACK)
+                if gap >= band:
+                    return float(gap), False
+            hull = self._hull_of(i)
+            if hull is not None:
+                res.clear()
+                d = float(hull(tg, tf, self.request, res))
+                if far and d - BOUND_SLACK >= band:
+                    return d - BOUND_SLACK, False
+                if self._hulls_only or (not far and d > APPROACH):
+                    return d, True
+        res.clear()
+        return float(self.computes[i](tg, tf, self.request, res)), True
+
+    def _hull_of(self, i: int):
+        """Return a ComputeDistance of shape i's convex hull and the object (None: none)."""
+        if i in self._hulls:
+            return self._hulls[i]
+        geometry = self.geom.geometryObjects[i].geometry
+        compute = None
+        if isinstance(geometry, coal.BVHModelBase):
+            try:
+                geometry.buildConvexHull(True, 'Qt')
+                compute = coal.ComputeDistance(geometry.convex, self._owner)
+            except (RuntimeError, ValueError):  # no hull (a flat mesh): measured always
+                compute = None
+        self._hulls[i] = compute
+        return compute
+
+    def _derivatives(self, i: int, d: float, oMb: pin.SE3, oMo: pin.SE3, Jb) -> tuple:
+        """Return shape i's row from its last coal result (see :meth:`evaluate`)."""
+        model, data, res = self.model, self.data, self.results[i]
+        joint = self.geom.geometryObjects[i].parentJoint
+        n = np.asarray(res.normal, dtype=float)
+        n = n / max(np.linalg.norm(n), 1e-12)
+        p1 = np.asarray(res.getNearestPoint1(), dtype=float)
+        p2 = np.asarray(res.getNearestPoint2(), dtype=float)
+        J = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
+        r = p1 - data.oMi[joint].translation
+        v = J[:3] - _skew(r) @ J[3:]  # the point's velocity columns: v - r x w
+        dq = -n @ v
+        if Jb is not None:  # the object's point moves with the base
+            dq = dq + n @ (Jb[:3] - _skew(p2 - oMb.translation) @ Jb[3:])
+        dtheta = dq[self.hand.idx_v] if self.C is None else dq @ self.C
+        vtheta = v[:, self.hand.idx_v] if self.C is None else v @ self.C
+        local = oMo.actInv(p2)
+        return (d, dtheta, oMb.rotation.T @ n, local, oMo.rotation.T @ vtheta)
 
     def distances(self, q: np.ndarray, pose: pin.SE3) -> dict[str, float]:
         """Return every link's least signed distance to the object [m] (palm included)."""
@@ -186,7 +316,7 @@ class SurfaceIK:
     def solve(self, theta0: np.ndarray, p0: np.ndarray, rotation: np.ndarray,
               q_base: np.ndarray, bounds: tuple[np.ndarray, np.ndarray],
               region: tuple[np.ndarray, np.ndarray], clearance: float,
-              max_evaluations: int = 60) -> IKResult:
+              max_evaluations: int = 30, tolerance: float | None = None) -> IKResult:
         """
         Solve one IK from a sampled start (theta0, p0), the object's rotation fixed.
 
@@ -198,49 +328,98 @@ class SurfaceIK:
             bounds: lower and upper bounds of theta.
             region: lower and upper corners of the object's position.
             clearance: the distance every other shape keeps from the object [m].
-            max_evaluations: residual evaluations at most.
+            max_evaluations: residual evaluations at most (60 before issue 36: with the
+                stop test 9 in 10 kept IKs take at most 14, the IKs that fail took 33
+                to 45).
+            tolerance: stop at the first point that meets the stop test
+                (:meth:`_meets`: every contact within :data:`STOP_SHARE` of it) [m],
+                every mesh within the band measured first by its convex hull, then,
+                from there, by itself; None: run least_squares to its own tolerances, the
+                contact meshes beyond :data:`APPROACH` by their hulls.
         """
         m = self.hand.m
-        c = len(self.contact_links)
         target = 1.25 * clearance  # a little more than asked: the check is strict
+        stop = None if tolerance is None else STOP_SHARE * tolerance
+        cache: dict = {'n': 0}
 
-        def split(x):
-            return x[:m], x[m:]
+        def fun(x):
+            cache['n'] += 1
+            f, J = self._residuals(x, theta0, p0, rotation, q_base, target)
+            cache['x'], cache['J'] = x.copy(), J
+            if stop is not None and self._meets(f, stop, clearance):
+                raise _Done(x.copy(), 0.5 * float(f @ f))
+            return f
 
-        edges = self.edge > 0.0 and self.shape.kind in ('box', 'cylinder')
-
-        def residuals(x, want_jac=False):
-            want_jac = want_jac or edges  # the edge rows need the object point
-            theta, p = split(x)
-            rows = self.evaluate(self.full_q(theta, q_base), pin.SE3(rotation, p), want_jac)
-            f = np.zeros(c + len(self.other_shapes) + m + 3 + 2 * c)
-            J = np.zeros((f.size, m + 3)) if want_jac else None
-            e = f.size - 2 * c
-            for k, shapes in enumerate(self.contact_shapes):
-                i = min(shapes, key=lambda s: rows[s][0])
-                f[k] = rows[i][0]
-                if want_jac:
-                    J[k, :m], J[k, m:] = rows[i][1], rows[i][2]
-                if edges:
-                    self._edge_rows(rows[i][3], rows[i][4], rotation, f, J, e + 2 * k)
-            for k, i in enumerate(self.other_shapes, c):
-                gap = target - rows[i][0]
-                f[k] = max(gap, 0.0)
-                if want_jac and gap > 0.0:
-                    J[k, :m], J[k, m:] = -rows[i][1], -rows[i][2]
-            k = c + len(self.other_shapes)
-            f[k:k + m] = PULL_JOINTS * (theta - theta0)
-            f[k + m:k + m + 3] = PULL_OBJECT * (p - p0)
-            if want_jac:
-                J[k:k + m, :m] = PULL_JOINTS * np.eye(m)
-                J[k + m:k + m + 3, m:] = PULL_OBJECT * np.eye(3)
-            return f, J
+        def jac(x):  # least_squares asks at a point whose residuals it has: reuse them
+            if 'x' not in cache or not np.array_equal(cache['x'], x):
+                fun(x)
+            return cache['J']
 
         lower = np.concatenate([bounds[0], region[0]])
         upper = np.concatenate([bounds[1], region[1]])
-        x0 = np.clip(np.concatenate([theta0, p0]), lower, upper)
-        sol = least_squares(lambda x: residuals(x)[0], x0, jac=lambda x: residuals(x, True)[1],
-                            bounds=(lower, upper), method='trf', max_nfev=max_evaluations,
-                            xtol=1e-10, ftol=1e-10, gtol=1e-10)
-        theta, p = split(sol.x)
-        return IKResult(theta=theta, position=p, cost=float(sol.cost), success=sol.status > 0)
+        x = np.clip(np.concatenate([theta0, p0]), lower, upper)
+        hulls = stop is not None and self._contact_hulls
+        try:
+            # With contact meshes: first on the meshes' hulls (cheap), then from where
+            # that stopped on the meshes themselves (most often met at once).
+            for only in ((True, False) if hulls else (False,)):
+                self._hulls_only = only
+                x, cost, success, stopped = _run(fun, jac, x, (lower, upper),
+                                                 max(max_evaluations - cache['n'], 1))
+                if not stopped:
+                    break
+        finally:
+            self._hulls_only = False
+        return IKResult(theta=x[:m], position=x[m:], cost=cost, success=success,
+                        stopped=stopped, evaluations=cache['n'])
+
+    def _meets(self, f: np.ndarray, stop: float, clearance: float) -> bool:
+        """
+        Tell whether residuals ``f`` meet the stop test (see :meth:`solve`).
+
+        Every contact within ``stop`` of the surface; every other shape's row at most
+        :data:`STOP_SHARE` of the 0.25 ``clearance`` it is asked over the clearance
+        (so at least 1.125 ``clearance`` away); each edge row at most :data:`STOP_SHARE`
+        of the edge (its band is twice the edge).
+        """
+        c = len(self.contact_links)
+        pulls = c + len(self.other_shapes)
+        return bool(np.all(np.abs(f[:c]) <= stop)
+                    and np.all(f[c:pulls] <= STOP_SHARE * 0.25 * clearance)
+                    and np.all(f[pulls + self.hand.m + 3:] <= STOP_SHARE * EDGE_WEIGHT
+                               * self.edge))
+
+    def _residuals(self, x: np.ndarray, theta0: np.ndarray, p0: np.ndarray,
+                   rotation: np.ndarray, q_base: np.ndarray, target: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """
+        Return the residuals and their Jacobian at x = (theta, p) (see the module).
+
+        Far shapes are bounded, not measured (:meth:`evaluate`'s ``band``: their rows
+        are 0 either way); derivatives are taken for the rows that are not 0 only.
+        """
+        m, c = self.hand.m, len(self.contact_links)
+        theta, p = x[:m], x[m:]
+        oMb, oMo, tf, centre = self._place(self.full_q(theta, q_base), pin.SE3(rotation, p))
+        d = [self._distance(i, tf, centre, target)[0] for i in range(len(self.computes))]
+        Jb = self._jacobians()
+        f = np.zeros(c + len(self.other_shapes) + m + 3 + 2 * c)
+        J = np.zeros((f.size, m + 3))
+        e = f.size - 2 * c
+        edges = self.edge > 0.0 and self.shape.kind in ('box', 'cylinder')
+        for k, shapes in enumerate(self.contact_shapes):
+            i = min(shapes, key=d.__getitem__)
+            row = self._derivatives(i, d[i], oMb, oMo, Jb)
+            f[k], J[k, :m], J[k, m:] = d[i], row[1], row[2]
+            if edges:
+                self._edge_rows(row[3], row[4], rotation, f, J, e + 2 * k)
+        for k, i in enumerate(self.other_shapes, c):
+            if target - d[i] > 0.0:
+                row = self._derivatives(i, d[i], oMb, oMo, Jb)
+                f[k], J[k, :m], J[k, m:] = target - d[i], -row[1], -row[2]
+        k = c + len(self.other_shapes)
+        f[k:k + m] = PULL_JOINTS * (theta - theta0)
+        f[k + m:k + m + 3] = PULL_OBJECT * (p - p0)
+        J[k:k + m, :m] = PULL_JOINTS * np.eye(m)
+        J[k + m:k + m + 3, m:] = PULL_OBJECT * np.eye(3)
+        return f, J

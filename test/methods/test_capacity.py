@@ -14,7 +14,8 @@ import dataclasses
 import box_grasp
 from conftest import setup_from_doc
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.methods.capacity import direction_capacities, DIRECTIONS, load_capacity
+from grasp_torque_opt.methods.capacity import (CapacityLP, direction_capacities, DIRECTIONS,
+                                               load_capacity)
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.methods.explain import explain
 from independent import assert_holds, lp_alpha_range, lp_capacity, lp_feasible
@@ -141,6 +142,27 @@ def test_capacity_equals_an_independent_lp_on_random_grasps(allegro):
         alpha, _ = lp_capacity(setup, maps, setup.external_wrench)
         assert cap.status == 'optimal' and cap.certificate.ok
         assert cap.value == pytest.approx(alpha, rel=1e-6)
+
+
+def test_the_unexplained_capacity_is_the_same_verdict_against_an_independent_lp(allegro_doc):
+    """The planner's filter (explain=False, no binding): the same status and value."""
+    doc = copy.deepcopy(allegro_doc)
+    doc['friction']['min_normal_force'] = 50.0
+    setups = [*random_grasps(setup_from_doc(allegro_doc), 6, seed=12), setup_from_doc(doc)]
+    for setup in setups:
+        maps = setup.maps()
+        cap = CapacityLP(setup, maps, explain=False).solve(setup.external_wrench,
+                                                           binding=False)
+        full = load_capacity(setup, maps)
+        assert (cap.status, cap.value) == (full.status, full.value)
+        assert cap.conflict is None and cap.binding is None
+        if cap.status == 'optimal':
+            assert cap.value == pytest.approx(lp_capacity(setup, maps,
+                                                          setup.external_wrench)[0], rel=1e-6)
+        else:
+            assert cap.status == 'infeasible'
+            assert not lp_feasible(dataclasses.replace(setup, external_wrench=np.zeros(6)),
+                                   maps)
 
 
 def box_setup(tmp_path, mz: float) -> GraspSetup:

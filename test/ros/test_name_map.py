@@ -85,8 +85,10 @@ def test_a_renamed_urdf_commands_the_original_torques_in_its_own_names_and_order
     # The command order in the URDF's names, thumb first (not the scenario's order).
     thumb_first = (12, 13, 14, 15, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11)
     order = [renamed(f'joint_{i}.0') for i in thumb_first]
+    # gravity_timeout 0: the gravity sent below must not go stale while a loaded machine
+    # runs this test (a stale input stops commands; that rule has its own tests).
     h = Harness(ALLEGRO, robot_description=str(urdf), name_map=NAME_MAP, joints=order,
-                gravity_compensation=True, publish_stamped_command=True)
+                gravity_compensation=True, publish_stamped_command=True, gravity_timeout=0.0)
     try:
         stamped = []
         h.tester.create_subscription(JointState, 'grasp_torque_node/effort_commands_stamped',
