@@ -14,18 +14,22 @@ Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000]
 
 Each case starts one answering process exactly as a user would, with nothing
 added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
-(the default executor; the default backend, ProxSuite with its verified warm
+(the default executor, the node's own wait-set loop; the default backend, ProxSuite
+with its verified warm
 start, in the compiled cycle; normal scheduling), then with ``-p
 thread_priority:=50`` (the spinning thread SCHED_FIFO 50, as ros2_control's
 controller_manager asks for its loop), with ``-p solver.compiled:=false``
 (the Python cycle, the default before the compiled one), with that and
 ``-p solver.warm_start:=false`` as well (the cold ProxSuite default before the
-warm start), with ``-p solver.backend:=daqp``, and the trivial
+warm start), with ``-p solver.backend:=daqp``, with ``-p object_loop.enabled:=false``
+(the params file's object loop off: its share of the cost), and the trivial
 echo node of ``bench/node_load.py`` (one zero command per joint state), taking
 joint states with sensor-data QoS (keep last 5) and, as ``echo, joint_states depth
 1``, with the node's own QoS (keep last 1), and as ``echo, SCHED_FIFO 50`` with the
 thread priority the node asks; and the node with ``--executor events``
-(rclpy's experimental events executor, its main's flag, not a parameter). A
+(rclpy's experimental events executor, its main's flag, not a parameter), with
+``--executor single`` (rclpy's SingleThreadedExecutor, the default before issue 36)
+and ``--executor waitset`` (the default, named). A
 separate process publishes Allegro joint states at the rate with sensor-data
 QoS for ``--duration`` seconds once the answering node is discovered and has
 answered once, and counts the ``effort_commands`` that arrive (a plain
@@ -69,10 +73,13 @@ TARGETS = {'echo': None, 'echo, joint_states depth 1': None, 'echo, SCHED_FIFO 5
            'grasp_torque_node (default)': [],
            'grasp_torque_node thread_priority:=50': ['-p', 'thread_priority:=50'],
            'grasp_torque_node --executor events': ['--executor', 'events'],
+           'grasp_torque_node --executor single': ['--executor', 'single'],
+           'grasp_torque_node --executor waitset': ['--executor', 'waitset'],
            'grasp_torque_node compiled:=false': ['-p', 'solver.compiled:=false'],
            'grasp_torque_node warm_start:=false compiled:=false':
                ['-p', 'solver.warm_start:=false', '-p', 'solver.compiled:=false'],
-           'grasp_torque_node backend:=daqp': ['-p', 'solver.backend:=daqp']}
+           'grasp_torque_node backend:=daqp': ['-p', 'solver.backend:=daqp'],
+           'grasp_torque_node object_loop:=false': ['-p', 'object_loop.enabled:=false']}
 DRAIN_S = 0.5
 READY_TIMEOUT_S = 15.0
 

@@ -10,7 +10,7 @@
 The node under load: latency and dropped cycles of grasp_torque_node beside a trivial echo node.
 
 Usage: .venv/bin/python bench/node_load.py [--duration 10] [--rates 500 1000]
-       [--hands allegro planar] [--executors single events] [--load-priority 0]
+       [--hands allegro planar] [--executors waitset single events] [--load-priority 0]
        [--out FILE]
 
 For each hand, joint-state rate and rclpy executor, these answering processes
@@ -26,7 +26,9 @@ are measured in turn with the same load process:
 - an echo node written here, named ``grasp_torque_node`` too, that answers each
   joint state with zero torques on ``effort_commands`` and the stamped copy on
   ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
-  its executor as the node's main does (``events``: a ``spin_once`` loop), with
+  its executor as the node's main does (``events``: a ``spin_once`` loop; for
+  ``waitset``, the node's own loop and its default, the echo stays on rclpy's
+  SingleThreadedExecutor: the floor the node is held to), with
   normal scheduling (target ``echo``) and with SCHED_FIFO 50, the priority the
   node asks (target ``echo/fifo``).
 
@@ -94,15 +96,22 @@ DRAIN_S = 0.5
 READY_TIMEOUT_S = 10.0
 #: Executors of the answering node. ``events`` is rclpy's EventsExecutor served by a
 #: spin_once loop, as the node's main does (its spin() delivered no callback here).
-EXECUTORS = ('single', 'events')
+EXECUTORS = ('waitset', 'single', 'events')
 #: Amplitude of the joint motion around the scenario's grasp [rad].
 AMPLITUDE = 1e-3
 
 
 def _executor(name: str):
+    """
+    Give the echo's (or the load process's) executor for the node's ``--executor name``.
+
+    ``waitset`` is the node's own loop: its echo stays on rclpy's SingleThreadedExecutor,
+    rclpy's floor, the baseline issue 36 item 4 compares the node's default with.
+    """
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.experimental import EventsExecutor
-    return {'single': SingleThreadedExecutor, 'events': EventsExecutor}[name]()
+    return {'single': SingleThreadedExecutor, 'waitset': SingleThreadedExecutor,
+            'events': EventsExecutor}[name]()
 
 
 # -- the echo node ---------------------------------------------------------------------------

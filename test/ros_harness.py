@@ -18,6 +18,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import Pose, PoseArray, Vector3Stamped, WrenchStamped
 from grasp_torque_opt.ros.lifecycle_node import GraspTorqueLifecycleNode
 from grasp_torque_opt.ros.node import COMMAND_QOS, GraspTorqueNode, SERVICE_QOS
+from grasp_torque_opt.ros.node.waitset import WaitSetExecutor
 from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState, GetState
 import numpy as np
@@ -61,7 +62,8 @@ class Harness:
         overrides += [Parameter(k.replace('__', '.'), value=v) for k, v in params.items()]
         self.node = self.make_node(overrides)
         self.tester = rclpy.create_node('tester', context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
+        # The executor the node's main spins by default (the node's own wait-set loop).
+        self.executor = WaitSetExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.executor.add_node(self.tester)
         t = self.tester

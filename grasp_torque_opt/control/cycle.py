@@ -91,6 +91,7 @@ class Cycle:
         #: The object loop (:mod:`.object_loop`): the restoring wrench and the squeeze,
         #: moved by the loop's cycles (``estimating``), read by the service's.
         self.object_loop = ObjectLoop()
+        self._gains: tuple[CycleConfig, LoopGains] | None = None  # the loop's, of a config
         self._gravity_in_use = np.zeros(3)  # base axes, of the last grasp_at
         #: Why the IMU is not used, at the last cycle ('' while it is, or none came).
         self.imu_state = ''
@@ -190,7 +191,10 @@ class Cycle:
         """Return the object loop's restoring wrench and the squeezed friction."""
         loop, friction = self.object_loop, self.setup.friction
         if self.estimating:
-            gains = loop_gains(self.config)
+            made = self._gains
+            if made is None or made[0] is not self.config:  # a parameter change: new config
+                self._gains = made = (self.config, loop_gains(self.config))
+            gains = made[1]
             gap = self.config.joint_state_timeout
             loop.update(self.setup.hand, contacts, q, now, origin, self.weight, gains, gap)
             if gains.squeeze:

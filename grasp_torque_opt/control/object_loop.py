@@ -69,6 +69,8 @@ moves in steps of ``STEP`` (the compiled cycle is built again for each).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
+import math
 
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.object_from_hand import ObjectFromHand
@@ -130,14 +132,21 @@ class LoopGains:
     max_normal_force: float = 1.0
     usage_timeout: float = 0.05
 
+    @cached_property
+    def per_axis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """K, D and Ki for each axis of the error [x, y, z, rotation x, y, z] (made once)."""
+        return (np.repeat([self.stiffness, self.rotational_stiffness], 3),
+                np.repeat([self.damping, self.rotational_damping], 3),
+                np.repeat([self.integral, self.rotational_integral], 3))
+
 
 def bounded(w: np.ndarray, force: float, lever: float) -> np.ndarray:
     """Scale a wrench's force to at most ``force`` and its moment to ``force * lever``."""
     out = np.array(w, dtype=float)
-    for part, limit in ((slice(0, 3), force), (slice(3, 6), force * lever)):
-        norm = float(np.linalg.norm(out[part]))
+    for part, limit in ((out[:3], force), (out[3:], force * lever)):
+        norm = math.sqrt(float(part @ part))
         if norm > limit:
-            out[part] *= limit / norm
+            part *= limit / norm
     return out
 
 
@@ -213,9 +222,7 @@ class ObjectLoop:
             self.residual = self.slip = self._slow = np.zeros(len(contacts))
             return self.wrench
         est = self.tracker.estimate(q)
-        moved = est.pose * self.tracker.pose0.inverse()
-        carried = np.array([moved.act(p) for p in self.tracker.points0])
-        residual = np.linalg.norm(self.tracker.points(q) - carried, axis=1)
+        residual = est.residuals  # each point's distance from the rigid motion carried
         if self._slow.shape != residual.shape:
             self._slow = residual.copy()
         self.residual = residual
@@ -227,9 +234,7 @@ class ObjectLoop:
         self.error = error
         lever = float(np.max(np.linalg.norm(self.tracker.points0 - origin, axis=1)))
         self._integrate(error, dt, gains, weight, lever)
-        k = np.repeat([gains.stiffness, gains.rotational_stiffness], 3)
-        d = np.repeat([gains.damping, gains.rotational_damping], 3)
-        ki = np.repeat([gains.integral, gains.rotational_integral], 3)
+        k, d, ki = gains.per_axis
         w = -(k * error + d * self.rate + self._integral_wrench(ki, gains, weight, lever))
         self.wrench = bounded(w, gains.max_force_ratio * weight, lever)
         return self.wrench
@@ -257,7 +262,7 @@ class ObjectLoop:
             return
         self.why_frozen = ''
         self.integral = self.integral + error * dt
-        ki = np.repeat([gains.integral, gains.rotational_integral], 3)
+        ki = gains.per_axis[2]
         # Clamp the integral itself where its wrench is at its bound (no hidden windup).
         w = ki * self.integral
         capped = bounded(w, gains.max_integral_ratio * weight, lever)

@@ -17,13 +17,14 @@ squares over the contacts:
 
 - the displacement, finite, from a reference (the grasp's start: a joint configuration
   q0 and the object's pose there): the rigid motion that best carries the contact
-  points at q0 to the same material points at q (Kabsch's solution,
-  ``scipy.spatial.transform.Rotation.align_vectors``; for small motions it is the least
-  squares solution of G^T dx = J dq); the object's pose is that motion applied to the
-  reference pose;
+  points at q0 to the same material points at q (Kabsch's solution, :func:`kabsch`: the
+  rotation of ``scipy.spatial.transform.Rotation.align_vectors``, without its 60 us of
+  array dispatch on every joint state; for small motions it is the least squares
+  solution of G^T dx = J dq); the object's pose is that motion applied to the reference
+  pose;
 - the twist, from joint velocities: ``numpy.linalg.lstsq`` of G^T [v, w] = J qdot;
-- the residual: how far the worst contact point is from the rigid motion [m] (a slip, a
-  finger off the object, or a lie of the joint states).
+- the residuals: how far each contact point is from the rigid motion [m] (a slip, a
+  finger off the object, or a lie of the joint states), and the worst of them.
 
 With fewer than three contacts the rotation is not observed: the displacement is the
 contact points' mean translation, the rotation none. ROS-free.
@@ -31,13 +32,12 @@ contact points' mean translation, the rotation none. ROS-free.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.scenario_fields import ContactSpec
 import numpy as np
 import pinocchio as pin
-from scipy.spatial.transform import Rotation
 
 
 @dataclass(frozen=True)
@@ -52,6 +52,7 @@ class ObjectEstimate:
         twist: [v, w] of the object at its origin, base axes [m/s, rad/s], shape (6,),
             or None (no joint velocities given).
         residual: the largest distance of a contact point from the rigid motion [m].
+        residuals: each contact point's distance from the rigid motion [m], shape (p,).
     """
 
     pose: pin.SE3
@@ -59,6 +60,26 @@ class ObjectEstimate:
     rotation: np.ndarray
     twist: np.ndarray | None
     residual: float
+    residuals: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+def kabsch(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """
+    Return the rotation R that minimises sum ||a_i - R b_i||^2 (Kabsch's solution).
+
+    ``a`` and ``b``, shape (n, 3), centred. The SVD of B = a^T b, its last singular
+    direction turned where det(U V^T) < 0 (a reflection is never returned), as
+    ``scipy.spatial.transform.Rotation.align_vectors(a, b)`` computes it unweighted.
+    """
+    u, _, vh = np.linalg.svd(a.T @ b)
+    r = u @ vh
+    det = (r[0, 0] * (r[1, 1] * r[2, 2] - r[1, 2] * r[2, 1])
+           - r[0, 1] * (r[1, 0] * r[2, 2] - r[1, 2] * r[2, 0])
+           + r[0, 2] * (r[1, 0] * r[2, 1] - r[1, 1] * r[2, 0]))
+    if det < 0.0:
+        u[:, 2] = -u[:, 2]
+        r = u @ vh
+    return r
 
 
 class ObjectFromHand:
@@ -114,15 +135,14 @@ class ObjectFromHand:
         """
         p0, p = self.points0, self.points(q)
         m0, m = p0.mean(axis=0), p.mean(axis=0)
-        R = np.eye(3)
-        if len(p) >= 3:
-            R = Rotation.align_vectors(p - m, p0 - m0)[0].as_matrix()
+        R = kabsch(p - m, p0 - m0) if len(p) >= 3 else np.eye(3)
         t = m - R @ m0
-        residual = float(np.linalg.norm(p - (p0 @ R.T + t), axis=1).max())
+        d = p - (p0 @ R.T + t)
+        residuals = np.sqrt((d * d).sum(axis=1))
         pose = pin.SE3(R, t) * self.pose0
         twist = None if v is None else self._twist(q, v, p, pose.translation)
         return ObjectEstimate(pose, pose.translation - self.pose0.translation, pin.log3(R),
-                              twist, residual)
+                              twist, float(residuals.max()), residuals)
 
     def _twist(self, q: np.ndarray, v: np.ndarray, points: np.ndarray, c: np.ndarray
                ) -> np.ndarray:

@@ -17,7 +17,7 @@ the twist against a finite difference of the displacement.
 
 from conftest import ALLEGRO
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.core.object_from_hand import ObjectFromHand
+from grasp_torque_opt.core.object_from_hand import kabsch, ObjectFromHand
 from grasp_torque_opt.core.object_geometry import object_pose
 import numpy as np
 import pinocchio as pin
@@ -92,3 +92,32 @@ def test_one_finger_off_the_rigid_motion_shows_in_the_residual(est):
     q = SETUP.q.copy()
     q[MODEL.joints[MODEL.getJointId('joint_1.0')].idx_q] -= 0.05  # the index lifts
     assert est.estimate(q).residual > 1e-3
+
+
+def test_kabsch_is_scipys_align_vectors_rotation():
+    """The closed form against scipy's Rotation.align_vectors, reflections included."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(5)
+    for n, noise in ((3, 0.0), (4, 1e-3), (4, 0.5), (8, 2.0)):
+        for _ in range(20):
+            b = rng.standard_normal((n, 3))
+            R = Rotation.random(random_state=rng).as_matrix()
+            a = b @ R.T + noise * rng.standard_normal((n, 3))
+            a, b = a - a.mean(axis=0), b - b.mean(axis=0)
+            got = kabsch(a, b)
+            np.testing.assert_allclose(got, Rotation.align_vectors(a, b)[0].as_matrix(),
+                                       atol=1e-9)
+            assert abs(np.linalg.det(got) - 1.0) < 1e-12  # a rotation, never a reflection
+
+
+def test_the_residuals_are_each_points_distance_from_the_rigid_motion(est):
+    """Each contact's residual: its point at q against the reference point carried."""
+    q = SETUP.q.copy()
+    q[MODEL.joints[MODEL.getJointId('joint_1.0')].idx_q] -= 0.05  # the index lifts
+    e = est.estimate(q)
+    moved = e.pose * POSE.inverse()
+    carried = np.array([moved.act(p) for p in est.points0])
+    np.testing.assert_allclose(e.residuals, np.linalg.norm(est.points(q) - carried, axis=1),
+                               atol=1e-15)
+    assert e.residual == e.residuals.max() > 1e-3

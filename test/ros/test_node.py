@@ -343,13 +343,15 @@ def test_stopping_applies_the_policy_in_process(planar):
             h.close()
 
 
-@pytest.mark.parametrize('sig,executor', [(signal.SIGINT, 'single'), (signal.SIGTERM, 'single'),
+@pytest.mark.parametrize('sig,executor', [(signal.SIGINT, 'waitset'),
+                                          (signal.SIGTERM, 'waitset'),
+                                          (signal.SIGINT, 'single'), (signal.SIGTERM, 'single'),
                                           (signal.SIGINT, 'events')])
 def test_the_process_publishes_zero_when_stopped_with_the_zero_policy(planar, sig, executor):
     """
     Stop the process with a signal: with fault_policy zero, zero torques are left.
 
-    grasp_torque_node as users run it (either executor): it answers joint states, a signal
+    grasp_torque_node as users run it (any executor): it answers joint states, a signal
     stops it, and with fault_policy zero the effort controller is left with zero torques.
     """
     p = NodeProcess('grasp_torque_opt.ros.node',

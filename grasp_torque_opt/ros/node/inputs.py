@@ -41,6 +41,7 @@ from grasp_torque_opt.control.inputs.tactile import TactileArrayReading, Tactile
 from grasp_torque_opt.control.parameters.snapshot import value_of
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
+from grasp_torque_opt.ros.node.throttle import Throttle
 from grasp_torque_opt.ros.peers import quiet_subscription
 import numpy as np
 from rclpy.qos import qos_profile_sensor_data
@@ -79,6 +80,7 @@ class Inputs:
         self.joint_states_topic = ''  # remapped and resolved, once subscribed
         # use_sim_time is fixed after start (DeclaredParameters): read once.
         self.sim_time = bool(root.node.get_parameter('use_sim_time').value)
+        self._rejections = Throttle(1.0)
 
     def start(self) -> list[Any]:
         """Make a subscription per input of the table (an input's ``enabled`` parameter on)."""
@@ -109,7 +111,8 @@ class Inputs:
         return lambda data: self.on_serialized(topic, msg_type, data, take, None)
 
     def _rejected(self, e: InputError) -> None:
-        self.node.get_logger().warn(f'rejected: {e}', throttle_duration_sec=1.0)
+        if self._rejections.due():
+            self.node.get_logger().warn(f'rejected: {e}')
 
     def clock_now(self) -> float:
         """

@@ -32,6 +32,7 @@ from grasp_torque_opt.control.commands.registry import REGISTRY
 from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.ros.node.qos import COMMAND_QOS
+from grasp_torque_opt.ros.node.throttle import Throttle
 from grasp_torque_opt.ros.peers import quiet_publisher
 import numpy as np
 from rclpy.duration import Duration
@@ -54,6 +55,10 @@ class Outputs:
         self.stamped_pub: Any = None
         self.marker_pub: Any = None
         self.wrench_pub: Any = None
+        #: The one Float64MultiArray every command leaves in (its data set each time:
+        #: rclpy converts a message when it is published, so none is kept half-written).
+        self._array = Float64MultiArray()
+        self._no_command = Throttle(1.0)
 
     def start(self) -> list[tuple[str, Any]]:
         """Make the publishers; give them as (kind, publisher) for :meth:`stop`."""
@@ -104,8 +109,8 @@ class Outputs:
             result: the controller's decision.
             stamp: the header stamp of the joint state it answers (None: now).
         """
-        if result.fault:
-            self.node.get_logger().warn(f'no command: {result.fault}', throttle_duration_sec=1.0)
+        if result.fault and self._no_command.due():
+            self.node.get_logger().warn(f'no command: {result.fault}')
         cmd = result.command
         if cmd is None:
             return
@@ -137,7 +142,9 @@ class Outputs:
         if out.position is None:  # Float64MultiArray
             values = data if out.interface == 'effort' and data is not None else \
                 array('d', np.ascontiguousarray(out.values, dtype=float).tobytes())
-            self.command_pub.publish(Float64MultiArray(data=values))
+            msg = self._array
+            msg.data = values
+            self.command_pub.publish(msg)
             return
         hand = self.root.controller.setup.hand
         msg = JointState(name=list(hand.joints), position=out.position.tolist(),

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
+import ctypes
 import sys
 
 from grasp_torque_opt.backends import single_threaded_math
@@ -26,6 +27,7 @@ from grasp_torque_opt.core.exceptions import GraspTorqueError
 from grasp_torque_opt.ros import realtime
 from grasp_torque_opt.ros.node import signals
 from grasp_torque_opt.ros.node.qos import NODE_NAME
+from grasp_torque_opt.ros.node.waitset import WaitSetExecutor
 from grasp_torque_opt.ros.node_help import node_parser
 import rclpy
 from rclpy.exceptions import NameValidationException, ParameterException
@@ -38,18 +40,51 @@ from rclpy.utilities import remove_ros_args
 #: Longest wait of the spin loop without any callback [s]: how late a stop signal may be
 #: seen when nothing else wakes the executor.
 STOP_POLL_S = 0.1
-#: Executors the runner can spin: rclpy's default and its experimental events executor.
-EXECUTORS = {'single': SingleThreadedExecutor, 'events': EventsExecutor}
+#: Executors the runner can spin: the node's own wait-set loop (rclpy's single-threaded
+#: executor, lighter per message: :mod:`~grasp_torque_opt.ros.node.waitset`), rclpy's own
+#: and its experimental events executor.
+EXECUTORS = {'waitset': WaitSetExecutor, 'single': SingleThreadedExecutor,
+             'events': EventsExecutor}
+
+
+#: glibc's mallopt parameters: the size from which malloc maps memory of its own, and
+#: the free memory at the heap's top from which it is given back.
+M_MMAP_THRESHOLD, M_TRIM_THRESHOLD = -3, -1
+#: Buffers at least this large are mapped, and given back to the system when freed [B].
+LARGE_BUFFER = 128 * 1024
+
+
+def large_buffers_returned() -> bool:
+    """
+    Have glibc map every buffer of at least LARGE_BUFFER and give it back when freed.
+
+    glibc raises both thresholds by itself after a large buffer is freed (the imports
+    free some), and later ones of that size then stay in the heap: an oversized message
+    (refused by ``max_message_bytes``) left one more such buffer resident with the
+    node's own wait-set loop (test_node_memory). Fixed at glibc's defaults, the node's
+    memory after oversized messages is what it was before them, whatever the executor.
+    The node's per-message allocations are far smaller. False where the C library has
+    no ``mallopt`` (musl).
+    """
+    try:
+        libc = ctypes.CDLL(None)
+        return bool(libc.mallopt(M_MMAP_THRESHOLD, LARGE_BUFFER)) and \
+            bool(libc.mallopt(M_TRIM_THRESHOLD, LARGE_BUFFER))
+    except (OSError, AttributeError):
+        return False
 
 
 def _init(prog: str, argv: list[str]) -> argparse.Namespace | None:
     """Parse the arguments and start rclpy; None (and one line on stderr) if refused."""
     parser = node_parser(prog)  # what it does, the --ros-args it takes, --version
-    parser.add_argument('--executor', choices=sorted(EXECUTORS), default='single',
-                        help='rclpy executor to spin')
+    parser.add_argument('--executor', choices=sorted(EXECUTORS), default='waitset',
+                        help="executor to spin: the node's own wait-set loop (waitset), "
+                        "rclpy's SingleThreadedExecutor (single) or its EventsExecutor "
+                        '(events)')
     try:
         opts = parser.parse_args(remove_ros_args(argv)[1:])
         single_threaded_math()
+        large_buffers_returned()
         # rclpy's own handlers would shut the context down on SIGINT/SIGTERM, before the
         # safe action could publish; here both end the spin loop and the context stays
         # valid.
@@ -80,7 +115,8 @@ def run(make_node: Callable[..., Node], prog: str, args: list[str] | None = None
     """
     Run a node: spin until a stop signal, then destroy it and shut down.
 
-    Besides the ROS arguments, ``--executor single|events`` picks the executor.
+    Besides the ROS arguments, ``--executor waitset|single|events`` picks the executor
+    (default: the node's own wait-set loop, :mod:`~grasp_torque_opt.ros.node.waitset`).
 
     Args:
         make_node: the node's class (or a factory taking ``message_info``).
