@@ -55,9 +55,12 @@ def test_oversized_messages_do_not_grow_memory_with_their_number(planar):
 
         start = rss_mb(p.child.pid)
         first = burst(2)
-        after = burst(8)
+        after = [burst(8) for _ in range(3)]
         assert first - start < 4 * size, (start, first)  # a buffer or two of the largest
-        assert after - first < 0.25 * size, (first, after)  # not one more per message
+        # Not one more per message: 24 more would hold 480 MiB more. On a loaded machine
+        # one or two more buffers of the largest size can stay (a message taken while
+        # the next arrives; seen with rclpy's executor and the node's own loop alike).
+        assert max(after) - first < 4 * size, (first, after)
         n = len(p.commands)
         for _ in range(20):
             p.pub.publish(JointState(name=names, position=pos))
