@@ -37,6 +37,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+import coal
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
 from grasp_torque_opt.core.geometry_contacts import collision_model, GeometryContacts
 from grasp_torque_opt.core.grasp_setup import bind_for_candidates
@@ -219,6 +220,7 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
         raise InputError('links', 'no contact links: give them (the base scenario has none)')
     urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
     geom = collision_model(hand, urdf)  # the meshes read once, for the check and the IK
+    _refuse_mesh_on_mesh(hand, geom, shape, links)
     check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
                                   max_penetration=1.0, field='links', geometry=geom)
     ik = SurfaceIK(hand, urdf, shape, links, EDGE, geom)
@@ -258,6 +260,26 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
                               sol.position, R, shape, mass, found, settings,
                               scenario.gravity))
     return PlanResult(out, tries, settings, rejected)
+
+
+def _refuse_mesh_on_mesh(hand, geom: pin.GeometryModel, shape: ObjectShape,
+                         links: list[str]) -> None:
+    """
+    Refuse a mesh object when a contact link's collision shape is a mesh too.
+
+    coal's distance between two triangle meshes gives no normal, so the check could
+    place no contact: without this every IK was refused as an overlap (the G1's
+    fingers are meshes).
+    """
+    if shape.kind != 'mesh':
+        return
+    meshed = [link for link in links if any(
+        isinstance(g.geometry, coal.BVHModelBase)
+        and hand.model.frames[g.parentFrame].name == link for g in geom.geometryObjects)]
+    if meshed:
+        raise InputError('mesh', f"contact links {', '.join(meshed)} are meshes: between two "
+                         'meshes coal gives no contact normal; plan this hand with an '
+                         'object shape (--object sphere|box|cylinder)')
 
 
 def _load(mass: float, gravity, extra) -> np.ndarray:

@@ -219,6 +219,26 @@ def test_bad_options_are_named(argv, message, capsys):
     assert len(err.strip().splitlines()) == 1
 
 
+def test_a_mesh_object_on_a_hand_of_meshes_is_refused_by_name(tmp_path, capsys):
+    """The G1's contact links are meshes: a mesh object is refused at once, named."""
+    mesh = tmp_path / 'box.obj'
+    corners = [(x, y, z) for x in (-0.015, 0.015) for y in (-0.02, 0.02) for z in (-0.025, 0.025)]
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7),
+             (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    mesh.write_text(''.join(f'v {x} {y} {z}\n' for x, y, z in corners)
+                    + ''.join(f'f {a + 1} {b + 1} {c + 1}\n' for a, b, c in faces))
+    g1 = ROOT / 'config' / 'g1_right.yaml'
+    code = main(['plan', str(g1), '--count', '1', '--mesh', str(mesh)])
+    err = capsys.readouterr().err
+    assert code == 2 and 'Traceback' not in err, err
+    assert 'right_hand_thumb_2_link' in err and 'are meshes' in err, err
+    # The Allegro's fingertips are spheres: the same mesh is planned on.
+    code = main(['plan', str(ALLEGRO), '--count', '1', '--mesh', str(mesh), '--out',
+                 str(tmp_path / 'plan.jsonl')])
+    err = capsys.readouterr().err
+    assert code == 0 and 'planned 1 of 1 candidates' in err, err
+
+
 def test_the_summary_names_what_was_asked_without_being_told_again():
     """A PlanResult keeps its settings: summary() takes no arguments (issue 35)."""
     result = plan_grasps(ALLEGRO, PlanSettings(count=1, seed=3, attempts=2, region=0.001),
