@@ -332,7 +332,8 @@ class CapacityLP:
 
 
 def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
-                  load: np.ndarray | None = None, highs_only: bool = False) -> Capacity:
+                  load: np.ndarray | None = None, highs_only: bool = False,
+                  explain: bool = True) -> Capacity:
     """
     How many times over the grasp holds its load (alpha [-], certified).
 
@@ -341,9 +342,13 @@ def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
         maps: G and J if already computed.
         load: w_ext instead of the setup's load [N, N m].
         highs_only: HiGHS alone, no DAQP.
+        explain: name what binds, or the conflict when not even zero load is held
+            (False: the same verdict, certified the same way, unnamed; the planner's
+            filter).
     """
-    lp = CapacityLP(setup, maps if maps is not None else setup.maps())
-    return lp.solve(setup.external_wrench if load is None else load, '-', highs_only)
+    lp = CapacityLP(setup, maps if maps is not None else setup.maps(), explain=explain)
+    return lp.solve(setup.external_wrench if load is None else load, '-', highs_only,
+                    binding=explain)
 
 
 def direction_capacities(setup: GraspSetup, maps: GraspMaps | None = None,

@@ -44,7 +44,7 @@ from grasp_torque_opt.core.grasp_setup import bind_for_candidates
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.scenario import load_scenario, Scenario
-from grasp_torque_opt.methods.capacity import CapacityLP
+from grasp_torque_opt.methods.capacity import load_capacity
 from grasp_torque_opt.methods.plan_ik import SurfaceIK
 import numpy as np
 import pinocchio as pin
@@ -365,9 +365,7 @@ def _not_held(setup, q: np.ndarray, found, position: np.ndarray, load: np.ndarra
         setup, q=q, contacts=found.specs(), object_origin=np.asarray(position, float),
         external_wrench=load, friction=dataclasses.replace(setup.friction, margin=margin))
     try:
-        # load_capacity's LP, without naming what binds or conflicts (not written)
-        cap = CapacityLP(candidate, candidate.maps(), explain=False).solve(
-            load, '-', binding=False)
+        cap = load_capacity(candidate, explain=False)  # what binds is not written
     except (InputError, GeometryError):
         return 'no grasp maps'
     if cap.status == 'unbounded' or (cap.status == 'optimal' and cap.value >= 1.0):

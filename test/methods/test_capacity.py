@@ -14,8 +14,7 @@ import dataclasses
 import box_grasp
 from conftest import setup_from_doc
 from grasp_torque_opt.core.grasp_setup import GraspSetup
-from grasp_torque_opt.methods.capacity import (CapacityLP, direction_capacities, DIRECTIONS,
-                                               load_capacity)
+from grasp_torque_opt.methods.capacity import direction_capacities, DIRECTIONS, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.methods.explain import explain
 from independent import assert_holds, lp_alpha_range, lp_capacity, lp_feasible
@@ -151,8 +150,7 @@ def test_the_unexplained_capacity_is_the_same_verdict_against_an_independent_lp(
     setups = [*random_grasps(setup_from_doc(allegro_doc), 6, seed=12), setup_from_doc(doc)]
     for setup in setups:
         maps = setup.maps()
-        cap = CapacityLP(setup, maps, explain=False).solve(setup.external_wrench,
-                                                           binding=False)
+        cap = load_capacity(setup, maps, explain=False)
         full = load_capacity(setup, maps)
         assert (cap.status, cap.value) == (full.status, full.value)
         assert cap.conflict is None and cap.binding is None
