@@ -87,7 +87,8 @@ def fast_cycle_extensions() -> list[Extension]:
     # libraries' headers as system headers (their own warnings are theirs).
     common = ['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden', '-g0',
               '-isystem', eigen, '-isystem', proxsuite]
-    header = [_source('src/fast_cycle.hpp'), _source('src/fast_batch.hpp')]
+    header = [_source('src/fast_cycle.hpp'), _source('src/fast_batch.hpp'),
+              _source('src/vertex_lp.hpp')]
     out = [Extension('grasp_torque_opt.native._fast_cycle', [_source('src/fast_cycle.cpp')],
                      include_dirs=[pybind11.get_include()], language='c++',
                      extra_compile_args=common, depends=header, optional=True)]

@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "vertex_lp.hpp"
+
 namespace
 {
 
@@ -501,8 +503,9 @@ using DaqpDefaults = void (*)(DaqpSettings *);
 
 // One capacity LP (methods/capacity.CapacityLP) solved by DAQP as methods/lp.solve_lp
 // calls it (daqp.solve: daqp_quadprog, the default settings but primal_tol, iter_limit and
-// eps_prox), then checked as lp_finish_batch checks it. A holds the LP's rows; its alpha
-// column (the first 6 rows' last entry) is the load direction. Returns passes; alpha.
+// eps_prox), or by the vertex method (vertex_lp.hpp) from the zero-load wrenches, then
+// checked as lp_finish_batch checks it. A holds the LP's rows; its alpha column (the
+// first 6 rows' last entry) is the load direction. Returns passes; alpha.
 struct CapacitySolver
 {
   const FastCycle & fc;
@@ -512,6 +515,13 @@ struct CapacitySolver
   std::vector<double> H, x, lam, bu, bl, bu0, bl0, c;
   std::vector<int> sense, sense0, sense_copy;
   double kkt_tolerance, alpha_max;
+  // The vertex method's LPs: the capacity LP's rows in "<=" form (row k is sign[k] times
+  // row origin[k] of [I; A], DAQP's indexing), and the zero-load phase 1 (below).
+  VertexLP lp, phase1;
+  std::vector<int> origin, eq_origin;
+  std::vector<double> sign;
+  Vec f0;
+  VertexLP::State from;
 
   bool solve(
     RowMat & A, const RowMat & G, const RowMat & J, const Wrench & load, double scale,
@@ -530,6 +540,16 @@ struct CapacitySolver
     if (res.exitflag != 1 && res.exitflag != 2) {
       return false;
     }
+    return check(A, G, J, load, scale, up, lo, alpha);
+  }
+
+  // The answer in x and lam: finite, KKT-checked, alpha below alpha_max, certified at
+  // alpha times the load.
+  bool check(
+    const RowMat & A, const RowMat & G, const RowMat & J, const Wrench & load, double scale,
+    const std::vector<double> & up, const std::vector<double> & lo, double & alpha)
+  {
+    const int n = nf + 1;
     for (int i = 0; i < n; ++i) {
       if (!std::isfinite(x[i])) {
         return false;
@@ -547,6 +567,149 @@ struct CapacitySolver
     const Vec tau_max = fc.limits(), tau_min = -fc.limits();
     return fc.passes(fc.certify(G, J, alpha * load, tau_min, tau_max, tau, f));
   }
+
+  // The rows' structure in "<=" form from DAQP's bounds (the same for every candidate):
+  // a finite upper bound gives +row, a finite lower one -row, equal bounds an equality.
+  void layout()
+  {
+    const int n = nf + 1;
+    for (int i = 0; i < n + rows; ++i) {
+      if (bl[i] == bu[i]) {
+        eq_origin.push_back(i);
+        continue;
+      }
+      for (const double s : {1.0, -1.0}) {
+        const double bound = s > 0.0 ? bu[i] : -bl[i];
+        if (bound < DAQP_INF) {
+          origin.push_back(i);
+          sign.push_back(s);
+        }
+      }
+    }
+  }
+
+  // Copy row i of [I; A] (DAQP's indexing), times s, into out.
+  void row(const RowMat & A, int i, double s, Eigen::Ref<Vec> out) const
+  {
+    const int n = nf + 1;
+    if (i < n) {
+      out.setZero();
+      out(i) = s;
+    } else {
+      out = s * A.row(i - n).transpose();
+    }
+  }
+
+  // The vertex method's rows of this candidate (A: its G and J; the alpha column is set
+  // per LP), then phase 1: zero load's wrenches f0 from the LP min t over (f, t) subject
+  // to G f = 0, every inequality of f relaxed by t and t >= 0, from f = 0 (t = the
+  // largest violation there). True where t reaches 0 (to 1e-12): f0 then holds zero load
+  // on the linearized problem (the caller certifies it on the exact one).
+  bool zero_load(const RowMat & A, int & iterations)
+  {
+    const int n = nf + 1, ne = static_cast<int>(eq_origin.size());
+    const int nr = static_cast<int>(origin.size());
+    lp.R.resize(nr, n);
+    lp.r.resize(nr);
+    lp.E.resize(ne, n);
+    lp.e.resize(ne);
+    Vec a(n);
+    for (int k = 0; k < nr; ++k) {
+      const int i = origin[k];
+      row(A, i, sign[k], a);
+      lp.R.row(k) = a.transpose();
+      lp.r(k) = sign[k] > 0.0 ? bu[i] : -bl[i];
+    }
+    for (int k = 0; k < ne; ++k) {
+      row(A, eq_origin[k], 1.0, a);
+      lp.E.row(k) = a.transpose();
+      lp.e(k) = bu[eq_origin[k]];
+    }
+    phase1.E = lp.E;
+    phase1.E.col(nf).setZero();
+    phase1.e = lp.e;
+    phase1.R.resize(nr + 1, n);
+    phase1.r.resize(nr + 1);
+    int k1 = 0;
+    double t0 = 0.0;
+    for (int k = 0; k < nr; ++k) {
+      if (origin[k] == nf) {
+        continue;  // alpha's bounds (alpha is 0 at zero load)
+      }
+      phase1.R.row(k1) = lp.R.row(k);
+      phase1.R(k1, nf) = -1.0;
+      phase1.r(k1) = lp.r(k);
+      t0 = std::max(t0, -lp.r(k));
+      ++k1;
+    }
+    phase1.R.row(k1) = -Vec::Unit(n, nf).transpose();
+    phase1.r(k1) = 0.0;
+    phase1.R.conservativeResize(k1 + 1, n);
+    phase1.r.conservativeResize(k1 + 1);
+    Vec start = Vec::Zero(n), cost = Vec::Unit(n, nf);
+    start(nf) = t0;
+    const auto status = phase1.solve(cost, start, 20 * n + 200, 1e-12);
+    iterations = phase1.iterations;
+    if (status != VertexLP::OPTIMAL || !(std::abs(phase1.s.x(nf)) <= 1e-12)) {
+      return false;
+    }
+    f0 = phase1.s.x.head(nf);
+    return base();
+  }
+
+  // The state the capacity LPs start from: (f0, 0), its working set the equalities (with
+  // no load), alpha >= 0 and the rows f0 meets. False if it cannot be made.
+  bool base()
+  {
+    const int n = nf + 1;
+    lp.E.col(nf).setZero();
+    Vec start = Vec::Zero(n);
+    start.head(nf) = f0;
+    if (!lp.start(start, 1e-12)) {
+      return false;
+    }
+    for (int q = 0; q < n; ++q) {
+      if (lp.s.kind[q] == VertexLP::INEQUALITY && origin[lp.s.index[q]] == nf) {
+        from = lp.s;
+        return true;
+      }
+    }
+    return false;  // alpha >= 0 not in it: the load's column would make B singular
+  }
+
+  // The capacity LP whose alpha column A holds, by the vertex method from base(); its
+  // answer in x and lam (DAQP's form), then checked.
+  bool vertex(
+    const RowMat & A, const RowMat & G, const RowMat & J, const Wrench & load, double scale,
+    double & alpha, int & iterations)
+  {
+    const int n = nf + 1, ne = static_cast<int>(eq_origin.size());
+    alpha = std::numeric_limits<double>::quiet_NaN();
+    lp.s = from;
+    lp.E.col(nf).setZero();
+    Vec delta(ne);
+    for (int k = 0; k < ne; ++k) {
+      const int i = eq_origin[k];
+      delta(k) = i < n ? 0.0 : A(i - n, nf);  // the load's direction
+    }
+    lp.change_column(nf, delta);
+    const auto status = lp.iterate(Eigen::Map<const Vec>(c.data(), n), 20 * n + 200);
+    iterations = lp.iterations;
+    if (status != VertexLP::OPTIMAL) {
+      return false;
+    }
+    std::fill(lam.begin(), lam.end(), 0.0);
+    for (int j = 0; j < n; ++j) {
+      x[j] = lp.s.x(j);
+      const int k = lp.s.index[j];
+      if (lp.s.kind[j] == VertexLP::EQUALITY) {
+        lam[eq_origin[k]] = lp.mu(j);
+      } else if (lp.s.kind[j] == VertexLP::INEQUALITY) {
+        lam[origin[k]] = sign[k] * std::max(0.0, lp.mu(j));  // -1e-12 read as 0
+      }
+    }
+    return check(A, G, J, load, scale, bu, bl, alpha);
+  }
 };
 
 // The capacity LPs of N candidates (methods/batch_capacity.CapacityBatch): for each, its
@@ -554,15 +717,21 @@ struct CapacitySolver
 // |W[i]|) and one per row of axes (L, 6), over x = [f; alpha] with the rows [G; J^T; S]
 // (S, the friction rows of the planned polygons and f_min, shape (rows_S, nf)), the bounds
 // bl, bu and sense (DAQP's form, nf + 1 + rows) and bl0, bu0, sense0 for the zero-load LP.
+// With vertex, each candidate's zero-load wrenches come from the vertex method's phase 1
+// (certified at zero load) and its LPs by the vertex method from them, DAQP solving any
+// LP that does not pass; where phase 1 does not give certified wrenches, and without
+// vertex, DAQP solves them all, the axes first.
 // Returns a dict: passes (N, 2 + L: KKT-checked, below alpha_max, certified; the zero-load
-// LP first, then the load's, then the axes'), alpha (N, 2 + L; NaN where DAQP gave none),
-// iterations (N, 2 + L). The zero-load LP is solved only where the axes' answers do not
-// already certify wrenches that hold zero load (its entry then says passes, 0 iterations).
+// LP first, then the load's, then the axes'), alpha (N, 2 + L; NaN where none was found),
+// iterations (N, 2 + L: pivots or DAQP's iterations), vertex (N, 2 + L: answered by the
+// vertex method). Without phase 1, the zero-load LP is solved only where the axes'
+// answers do not already certify wrenches that hold zero load (its entry then says
+// passes, 0 iterations).
 py::dict capacity_batch(
   const FastCycle & fc, int64_t quadprog, int64_t defaults, Array G, Array J, Array W,
   Array axes, Array S, Array bl, Array bu, py::array_t<int32_t> sense, Array bl0, Array bu0,
   py::array_t<int32_t> sense0, double primal_tol, int iter_limit, double eps_prox,
-  double kkt_tolerance, double alpha_max)
+  double kkt_tolerance, double alpha_max, bool vertex)
 {
   const int m = fc.m();
   expect(quadprog != 0 && defaults != 0, "no DAQP");
@@ -583,7 +752,9 @@ py::dict capacity_batch(
     std::vector<double>(bu0.data(), bu0.data() + nb),
     std::vector<double>(bl0.data(), bl0.data() + nb), std::vector<double>(n, 0.0),
     std::vector<int>(sense.data(), sense.data() + nb),
-    std::vector<int>(sense0.data(), sense0.data() + nb), {}, kkt_tolerance, alpha_max};
+    std::vector<int>(sense0.data(), sense0.data() + nb), {}, kkt_tolerance, alpha_max,
+    {}, {}, {}, {}, {}, Vec(), {}};
+  solver.layout();
   reinterpret_cast<DaqpDefaults>(defaults)(&solver.settings);
   solver.settings.primal_tol = primal_tol;
   solver.settings.iter_limit = iter_limit;
@@ -593,6 +764,8 @@ py::dict capacity_batch(
   py::array_t<bool> passes({N, K});
   auto alpha = zeros({N, K});
   py::array_t<int32_t> iterations({N, K});
+  py::array_t<bool> by_vertex({N, K});
+  std::fill(by_vertex.mutable_data(), by_vertex.mutable_data() + N * K, false);
   const Vec tau_max = fc.limits(), tau_min = -fc.limits();
   {
     py::gil_scoped_release release;
@@ -605,6 +778,7 @@ py::dict capacity_batch(
       A.block(6, 0, m, nf) = Ji.transpose();
       const Wrench w = Eigen::Map<const Wrench>(W.data() + 6 * i);
       const double scale = w.cwiseAbs().maxCoeff();
+      bool from_zero = false;
       auto lp = [&](py::ssize_t k) {
           Wrench load = Wrench::Zero();
           double s = 1.0;
@@ -619,14 +793,37 @@ py::dict capacity_batch(
           int it = 0;
           if (k != 1 || (std::isfinite(scale) && scale > 0.0)) {
             A.topRightCorner(6, 1) = load / s;  // the zero-load LP: alpha fixed at 0
-            good = solver.solve(A, Gi, Ji, load, s, k == 0, a, it);
+            if (k > 0 && from_zero) {
+              good = solver.vertex(A, Gi, Ji, load, s, a, it);
+              by_vertex.mutable_data()[K * i + k] = good;
+            }
+            if (!good) {
+              good = solver.solve(A, Gi, Ji, load, s, k == 0, a, it);
+            }
           }
           passes.mutable_data()[K * i + k] = good;
           alpha.mutable_data()[K * i + k] = a;
           iterations.mutable_data()[K * i + k] = it;
           return good;
         };
-      // The axes first: zero load is held, certified, where an axis LP's answer holds
+      // Phase 1's wrenches, certified at zero load: every LP from them.
+      int it0 = 0;
+      if (vertex && solver.zero_load(A, it0)) {
+        const Vec tau0 = Ji.transpose() * solver.f0;
+        from_zero = fc.passes(
+          fc.certify(Gi, Ji, Wrench::Zero(), tau_min, tau_max, tau0, solver.f0));
+      }
+      if (from_zero) {
+        passes.mutable_data()[K * i] = true;
+        alpha.mutable_data()[K * i] = 0.0;
+        iterations.mutable_data()[K * i] = it0;
+        by_vertex.mutable_data()[K * i] = true;
+        for (py::ssize_t k = 1; k < K; ++k) {
+          lp(k);
+        }
+        continue;
+      }
+      // Else DAQP, the axes first: zero load is held, certified, where an axis LP's answer holds
       // alpha = 0, or by the combination of two opposite axes' answers that holds zero
       // (a_- f_+ + a_+ f_-) / (a_+ + a_-); else the zero-load LP says.
       bool zero = false, last = false;
@@ -668,6 +865,7 @@ py::dict capacity_batch(
   d["passes"] = passes;
   d["alpha"] = alpha;
   d["iterations"] = iterations;
+  d["vertex"] = by_vertex;
   return d;
 }
 

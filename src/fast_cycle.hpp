@@ -799,7 +799,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 4;
+  mod.attr("API") = 5;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -970,8 +970,8 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     py::arg("G"), py::arg("J"), py::arg("W"), py::arg("axes"), py::arg("S"), py::arg("bl"),
     py::arg("bu"), py::arg("sense"), py::arg("bl0"), py::arg("bu0"), py::arg("sense0"),
     py::arg("primal_tol"), py::arg("iter_limit"), py::arg("eps_prox"),
-    py::arg("kkt_tolerance"), py::arg("alpha_max"),
-    "The capacity LPs of N candidates, each solved by DAQP (its C entry) and checked.");
+    py::arg("kkt_tolerance"), py::arg("alpha_max"), py::arg("vertex") = true,
+    "The capacity LPs of N candidates, solved by the vertex method or DAQP and checked.");
   mod.def("kinematics_batch", &kinematics_batch, py::arg("Q"), py::arg("parents"),
     py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"),
     py::arg("idx_v"), py::arg("fparent"), py::arg("Rf"), py::arg("tf"), py::arg("nv"),
