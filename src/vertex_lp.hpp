@@ -35,7 +35,8 @@ namespace
 // as soon as their multiplier is not zero (either sign). Each pivot drops the row with
 // the most negative multiplier (Bland's rule after a run of degenerate pivots), moves
 // along the edge it frees to the first row it meets (the ratio test) and updates B's
-// inverse by Sherman-Morrison; the answer is solved again from B at the end.
+// inverse and the multipliers by Sherman-Morrison; the answer and its multipliers are
+// solved again from B at the end.
 struct VertexLP
 {
   enum Kind { EQUALITY, INEQUALITY, ARTIFICIAL };
@@ -56,6 +57,7 @@ struct VertexLP
 
   RowMat E;
   Eigen::MatrixXd R;  // column-major: R d as axpys
+  Eigen::MatrixXd Rt;  // R's transpose, made by start(): each row of R contiguous
   Vec e, r;
   State s;
   Vec mu, Rd, d, ratio, u, v, w;
@@ -112,10 +114,11 @@ struct VertexLP
         return FAILED;  // dependent equalities: not these LPs
       }
     }
+    Rt = R.transpose();
     s.slack = r - R * s.x;
     for (int i = 0; i < nr; ++i) {
       const double scale = std::max(1.0, std::abs(r(i)));
-      if (s.slack(i) <= tight * scale && enter(R.row(i).transpose(), r(i), INEQUALITY, i)) {
+      if (s.slack(i) <= tight * scale && enter(Rt.col(i), r(i), INEQUALITY, i)) {
         s.slack(i) = std::numeric_limits<double>::infinity();
       }
     }
@@ -149,8 +152,8 @@ struct VertexLP
     iterations = 0;
     const double dual_tol = 1e-12, pivot_tol = 1e-9;
     int degenerate = 0;
+    mu.noalias() = -(s.Binv.transpose() * c);
     for (; iterations < iter_limit; ++iterations) {
-      mu.noalias() = -(s.Binv.transpose() * c);
       const bool bland = degenerate > 2 * n;
       int q = -1;
       double best = 0.0;
@@ -177,7 +180,8 @@ struct VertexLP
       Rd.noalias() = R * d;
       // The ratio test over the rows not in the working set that d moves towards; of
       // rows tied at the smallest step, the one d meets most squarely (Bland: the first).
-      // Written as loops the compiler vectorizes (no division where it could trap).
+      // A loop without branches, which the compiler vectorizes (setup.py's
+      // -fno-trapping-math): a row d does not move towards is read as +inf.
       const double * sl = s.slack.data(), * rd = Rd.data();
       double * ra = ratio.data();
       for (int i = 0; i < nr; ++i) {
@@ -206,8 +210,11 @@ struct VertexLP
       }
       s.x.noalias() += step * d;
       s.slack.noalias() -= step * Rd;
-      w.noalias() = s.Binv.transpose() * R.row(p).transpose();
-      replace(q, R.row(p).transpose(), r(p));
+      // Row p in for row q; the multipliers follow B's inverse: mu' = mu - v mu_q / w_q.
+      w.noalias() = s.Binv.transpose() * Rt.col(p);
+      const double dual = mu(q) / w(q);
+      replace(q, Rt.col(p), r(p));
+      mu.noalias() -= dual * v;
       s.kind[q] = INEQUALITY;
       s.index[q] = p;
       s.slack(p) = std::numeric_limits<double>::infinity();

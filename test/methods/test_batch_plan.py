@@ -127,9 +127,45 @@ def test_full_metrics_of_plan_lines_match_the_single_path_and_highs(planned):
             assert rec['capacities'][name] == pytest.approx(value, rel=1e-6, abs=1e-9)
 
 
+class Recorded:
+    """The batch's compiled cycle, passed through, keeping each capacity_batch's arguments."""
+
+    def __init__(self, cycle) -> None:
+        self.cycle, self.calls = cycle, []
+
+    def __getattr__(self, name: str):
+        return getattr(self.cycle, name)
+
+    def capacity_batch(self, *args):
+        self.calls.append(args)
+        return self.cycle.capacity_batch(*args)
+
+
+def test_the_vertex_method_answers_the_compiled_lps_as_daqp_does(planned):
+    # The compiled batch's LPs by the vertex method (the default) and, on the same
+    # arguments, by DAQP alone (vertex=False): every LP answered by the vertex method
+    # and passed, each alpha DAQP's to 1e-7.
+    lines = moved(planned)
+    job = ScoreJob.from_file(ALLEGRO, metrics='full')
+    batch = BatchScorer(Scorer(job))
+    if batch.capacity.entry is None:
+        pytest.skip(f'daqp {metadata.version("daqp")} is not one of {DAQP_C_VERSIONS}')
+    batch.capacity.cycle = recorded = Recorded(batch.capacity.cycle)
+    batch.score_lines(lines)
+    assert recorded.calls and batch.capacity.redone == 0
+    for args in recorded.calls:
+        by_vertex = recorded.cycle.capacity_batch(*args, vertex=True)
+        by_daqp = recorded.cycle.capacity_batch(*args, vertex=False)
+        assert by_vertex['vertex'].all() and by_vertex['passes'].all()
+        assert by_daqp['passes'].all() and not by_daqp['vertex'].any()
+        np.testing.assert_allclose(by_vertex['alpha'], by_daqp['alpha'],
+                                   rtol=1e-7, atol=1e-12)
+
+
 def test_the_compiled_lps_give_the_python_loops_answers(planned):
-    # The 14 LPs per candidate solved in the compiled batch (DAQP's C entry) and from
-    # Python (one daqp.solve each): the same DAQP code on the same rows, the same answers.
+    # The 14 LPs per candidate solved in the compiled batch (the vertex method, DAQP's
+    # C entry behind it) and from Python (one daqp.solve each): the same rows, the same
+    # answers.
     lines = moved(planned)
     job = ScoreJob.from_file(ALLEGRO, metrics='full')
     compiled_lps, python_lps = BatchScorer(Scorer(job)), BatchScorer(Scorer(job))
