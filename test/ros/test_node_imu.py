@@ -121,8 +121,11 @@ def test_a_bad_imu_is_rejected_and_the_scenarios_gravity_used(allegro):
 @pytest.mark.parametrize('lie', ['1.9 g sideways', 'rate chatter'])
 def test_an_imu_lie_is_refused_and_every_joint_state_gets_the_nominal_command(allegro, lie):
     # Issue 33: a still hand told 1.9 g sideways (every command pulled at the true grasp),
-    # or +-29 rad/s alternating (every other grasp infeasible: commands lost).
-    h = ImuHarness()
+    # or +-29 rad/s alternating (every other grasp infeasible: commands lost). The upper
+    # freshness bound long: the rate rule compares no two readings further apart than it
+    # (a reading after such a pause may be true), and a loaded machine once paused 50 ms
+    # (the default) between two of these readings, waiting for a command.
+    h = ImuHarness(**{'imu.timeout_bounds': [0.005, 5.0]})
     try:
         nominal = reference(G, allegro.q)
         # Each reading taken before the next is sent, as a node spinning at 1 kHz takes
