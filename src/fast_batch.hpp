@@ -16,6 +16,7 @@
 #define FAST_BATCH_HPP_
 
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
@@ -522,6 +523,14 @@ struct CapacitySolver
   std::vector<double> sign;
   Vec f0;
   VertexLP::State from;
+  // The same LPs with the equalities E_f f + E_alpha alpha = e eliminated (zero_load):
+  // f = fe + Z y + g alpha, Z an orthonormal basis of E_f's null space, fe = pinv e and
+  // g = -pinv E_alpha (pinv = E_f's pseudo-inverse), so that each LP is over z = (y,
+  // alpha) with inequalities only: Rf f + Ra alpha <= r becomes (Rf Z) y + (Ra - P
+  // E_alpha) alpha <= r - Rf fe (P = Rf pinv). Each LP's load changes only the alpha
+  // column; nz + 1 unknowns where the full LP has nf + 1 and six more rows.
+  Eigen::MatrixXd Rf, Z, pinv, P;
+  Vec Ra, fe;
 
   bool solve(
     RowMat & A, const RowMat & G, const RowMat & J, const Wrench & load, double scale,
@@ -601,34 +610,55 @@ struct CapacitySolver
   }
 
   // The vertex method's rows of this candidate (A: its G and J; the alpha column is set
-  // per LP), then phase 1: zero load's wrenches f0 from the LP min t over (f, t) subject
-  // to G f = 0, every inequality of f relaxed by t and t >= 0, from f = 0 (t = the
-  // largest violation there). True where t reaches 0 (to 1e-12): f0 then holds zero load
-  // on the linearized problem (the caller certifies it on the exact one).
+  // per LP), with its equalities eliminated (above), then phase 1: zero load's wrenches
+  // f0 from the LP min t over (y, t) subject to every inequality of f relaxed by t and
+  // t >= 0, from y = 0 (t = the largest violation there). True where t reaches 0 (to
+  // 1e-12): f0 then holds zero load on the linearized problem (the caller certifies it
+  // on the exact one). False also where the equalities are dependent (DAQP then).
   bool zero_load(const RowMat & A, int & iterations)
   {
     const int n = nf + 1, ne = static_cast<int>(eq_origin.size());
-    const int nr = static_cast<int>(origin.size());
-    lp.R.resize(nr, n);
-    lp.r.resize(nr);
-    lp.E.resize(ne, n);
-    lp.e.resize(ne);
-    Vec a(n);
+    const int nr = static_cast<int>(origin.size()), nz = nf - ne;
+    iterations = 0;
+    if (nz < 1) {
+      return false;
+    }
+    Rf.resize(nr, nf);
+    Ra.resize(nr);
+    Vec r(nr), a(n), e(ne);
     for (int k = 0; k < nr; ++k) {
       const int i = origin[k];
       row(A, i, sign[k], a);
-      lp.R.row(k) = a.transpose();
-      lp.r(k) = sign[k] > 0.0 ? bu[i] : -bl[i];
+      Rf.row(k) = a.head(nf).transpose();
+      Ra(k) = a(nf);
+      r(k) = sign[k] > 0.0 ? bu[i] : -bl[i];
     }
+    Eigen::MatrixXd EfT(nf, ne);
     for (int k = 0; k < ne; ++k) {
       row(A, eq_origin[k], 1.0, a);
-      lp.E.row(k) = a.transpose();
-      lp.e(k) = bu[eq_origin[k]];
+      EfT.col(k) = a.head(nf);
+      e(k) = bu[eq_origin[k]];
     }
-    phase1.E = lp.E;
-    phase1.E.col(nf).setZero();
-    phase1.e = lp.e;
-    phase1.R.resize(nr + 1, n);
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(EfT);
+    const auto R1 = qr.matrixQR().topRows(ne).triangularView<Eigen::Upper>();
+    const Vec diag = qr.matrixQR().diagonal().cwiseAbs();
+    if (!(diag.minCoeff() > 1e-10 * std::max(1.0, diag.maxCoeff()))) {
+      return false;  // dependent equalities (a grasp matrix of rank < 6)
+    }
+    const Eigen::MatrixXd Q = qr.householderQ();
+    Z = Q.rightCols(nz);
+    pinv = R1.solve(Q.leftCols(ne).transpose()).transpose();  // E_f pinv = I
+    fe.noalias() = pinv * e;
+    P.noalias() = Rf * pinv;
+    lp.R.resize(nr, nz + 1);
+    lp.R.leftCols(nz).noalias() = Rf * Z;
+    lp.R.col(nz) = Ra;  // zero load: E_alpha = 0
+    lp.r = r - Rf * fe;
+    lp.E.resize(0, nz + 1);
+    lp.e.resize(0);
+    phase1.E.resize(0, nz + 1);
+    phase1.e.resize(0);
+    phase1.R.resize(nr + 1, nz + 1);
     phase1.r.resize(nr + 1);
     int k1 = 0;
     double t0 = 0.0;
@@ -636,39 +666,38 @@ struct CapacitySolver
       if (origin[k] == nf) {
         continue;  // alpha's bounds (alpha is 0 at zero load)
       }
-      phase1.R.row(k1) = lp.R.row(k);
-      phase1.R(k1, nf) = -1.0;
+      phase1.R.row(k1).head(nz) = lp.R.row(k).head(nz);
+      phase1.R(k1, nz) = -1.0;
       phase1.r(k1) = lp.r(k);
       t0 = std::max(t0, -lp.r(k));
       ++k1;
     }
-    phase1.R.row(k1) = -Vec::Unit(n, nf).transpose();
+    phase1.R.row(k1) = -Vec::Unit(nz + 1, nz).transpose();
     phase1.r(k1) = 0.0;
-    phase1.R.conservativeResize(k1 + 1, n);
+    phase1.R.conservativeResize(k1 + 1, nz + 1);
     phase1.r.conservativeResize(k1 + 1);
-    Vec start = Vec::Zero(n), cost = Vec::Unit(n, nf);
-    start(nf) = t0;
+    Vec start = Vec::Zero(nz + 1), cost = Vec::Unit(nz + 1, nz);
+    start(nz) = t0;
     const auto status = phase1.solve(cost, start, 20 * n + 200, 1e-12);
     iterations = phase1.iterations;
-    if (status != VertexLP::OPTIMAL || !(std::abs(phase1.s.x(nf)) <= 1e-12)) {
+    if (status != VertexLP::OPTIMAL || !(std::abs(phase1.s.x(nz)) <= 1e-12)) {
       return false;
     }
-    f0 = phase1.s.x.head(nf);
-    return base();
+    start(nz) = 0.0;
+    start.head(nz) = phase1.s.x.head(nz);
+    f0 = fe + Z * start.head(nz);
+    return base(start);
   }
 
-  // The state the capacity LPs start from: (f0, 0), its working set the equalities (with
-  // no load), alpha >= 0 and the rows f0 meets. False if it cannot be made.
-  bool base()
+  // The state the capacity LPs start from: (y0, alpha = 0), its working set alpha >= 0
+  // and the rows f0 meets. False if it cannot be made.
+  bool base(const Vec & start)
   {
-    const int n = nf + 1;
-    lp.E.col(nf).setZero();
-    Vec start = Vec::Zero(n);
-    start.head(nf) = f0;
+    const int nz = static_cast<int>(start.size()) - 1;
     if (!lp.start(start, 1e-12)) {
       return false;
     }
-    for (int q = 0; q < n; ++q) {
+    for (int q = 0; q <= nz; ++q) {
       if (lp.s.kind[q] == VertexLP::INEQUALITY && origin[lp.s.index[q]] == nf) {
         from = lp.s;
         return true;
@@ -678,36 +707,50 @@ struct CapacitySolver
   }
 
   // The capacity LP whose alpha column A holds, by the vertex method from base(); its
-  // answer in x and lam (DAQP's form), then checked.
+  // answer in x and lam (DAQP's form: the equalities' multipliers from stationarity in
+  // f, Rf' lam + E_f' nu = 0), then checked.
   bool vertex(
     const RowMat & A, const RowMat & G, const RowMat & J, const Wrench & load, double scale,
     double & alpha, int & iterations)
   {
     const int n = nf + 1, ne = static_cast<int>(eq_origin.size());
+    const int nr = static_cast<int>(origin.size()), nz = nf - ne;
     alpha = std::numeric_limits<double>::quiet_NaN();
-    lp.s = from;
-    lp.E.col(nf).setZero();
-    Vec delta(ne);
+    Vec ea(ne);
     for (int k = 0; k < ne; ++k) {
       const int i = eq_origin[k];
-      delta(k) = i < n ? 0.0 : A(i - n, nf);  // the load's direction
+      ea(k) = i < n ? 0.0 : A(i - n, nf);  // the load's direction
     }
-    lp.change_column(nf, delta);
-    const auto status = lp.iterate(Eigen::Map<const Vec>(c.data(), n), 20 * n + 200);
+    lp.R.col(nz) = Ra;  // the base's column, then this LP's
+    lp.Rt.row(nz) = Ra.transpose();
+    lp.s = from;
+    lp.set_column(nz, Ra - P * ea, Vec());
+    Vec cost = Vec::Zero(nz + 1);
+    cost(nz) = -1.0;
+    const auto status = lp.iterate(cost, 20 * n + 200);
     iterations = lp.iterations;
     if (status != VertexLP::OPTIMAL) {
       return false;
     }
+    const Vec & z = lp.s.x;
+    const Vec f = fe + Z * z.head(nz) - pinv * (ea * z(nz));
+    Vec mu = Vec::Zero(nr);
     std::fill(lam.begin(), lam.end(), 0.0);
-    for (int j = 0; j < n; ++j) {
-      x[j] = lp.s.x(j);
+    for (int j = 0; j <= nz; ++j) {
       const int k = lp.s.index[j];
-      if (lp.s.kind[j] == VertexLP::EQUALITY) {
-        lam[eq_origin[k]] = lp.mu(j);
-      } else if (lp.s.kind[j] == VertexLP::INEQUALITY) {
-        lam[origin[k]] = sign[k] * std::max(0.0, lp.mu(j));  // -1e-12 read as 0
+      if (lp.s.kind[j] == VertexLP::INEQUALITY) {
+        mu(k) = std::max(0.0, lp.mu(j));  // -1e-12 read as 0
+        lam[origin[k]] = sign[k] * mu(k);
       }
     }
+    const Vec nu = -(pinv.transpose() * (Rf.transpose() * mu));
+    for (int k = 0; k < ne; ++k) {
+      lam[eq_origin[k]] = nu(k);
+    }
+    for (int j = 0; j < nf; ++j) {
+      x[j] = f(j);
+    }
+    x[nf] = z(nz);
     return check(A, G, J, load, scale, bu, bl, alpha);
   }
 };
@@ -753,7 +796,7 @@ py::dict capacity_batch(
     std::vector<double>(bl0.data(), bl0.data() + nb), std::vector<double>(n, 0.0),
     std::vector<int>(sense.data(), sense.data() + nb),
     std::vector<int>(sense0.data(), sense0.data() + nb), {}, kkt_tolerance, alpha_max,
-    {}, {}, {}, {}, {}, Vec(), {}};
+    {}, {}, {}, {}, {}, Vec(), {}, {}, {}, {}, {}, Vec(), Vec()};
   solver.layout();
   reinterpret_cast<DaqpDefaults>(defaults)(&solver.settings);
   solver.settings.primal_tol = primal_tol;

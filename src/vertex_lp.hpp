@@ -9,12 +9,12 @@
 // A small dense LP solved from a feasible point by a primal active-set (vertex) method:
 // the capacity LPs of the batch (fast_batch.hpp, capacity_batch), which share their rows
 // and a feasible point (the certified zero-load wrenches at alpha = 0) and differ in one
-// column of their equalities. Written here, not taken from a library, because what makes
-// it fast is that shared start: each LP starts at the zero-load vertex and needs a few
-// pivots of an n x n working set (n = 17 on the Allegro) where DAQP, from scratch, takes
-// about fifty proximal-point iterations. No answer is trusted alone: the caller checks
-// the KKT conditions with these multipliers and certifies the primal answer, and DAQP
-// solves any LP this does not answer.
+// column, alpha's. Written here, not taken from a library, because what makes it fast
+// is that shared start: each LP starts at the zero-load vertex and needs a few pivots of
+// an n x n working set (n = 11 on the Allegro, its equalities eliminated) where DAQP,
+// from scratch, takes about fifty proximal-point iterations. No answer is trusted
+// alone: the caller checks the KKT conditions with these multipliers and certifies the
+// primal answer, and DAQP solves any LP this does not answer.
 
 #ifndef VERTEX_LP_HPP_
 #define VERTEX_LP_HPP_
@@ -111,7 +111,7 @@ struct VertexLP
     s.index.assign(n, -1);
     for (int i = 0; i < E.rows(); ++i) {
       if (!enter(E.row(i).transpose(), e(i), EQUALITY, i)) {
-        return FAILED;  // dependent equalities: not these LPs
+        return false;  // dependent equalities: not these LPs
       }
     }
     Rt = R.transpose();
@@ -125,18 +125,23 @@ struct VertexLP
     return true;
   }
 
-  // Column j of E changed by delta (one entry per row of E) at a point where x_j = 0 (x
-  // still feasible): the working set's B follows, its inverse by Sherman-Morrison.
-  void change_column(int j, const Vec & delta)
+  // Column j of R and of E set to rc and ec at a point where x_j = 0 (x and the slacks
+  // stay as they are): the working set's B follows, its inverse by Sherman-Morrison.
+  void set_column(int j, const Vec & rc, const Vec & ec)
   {
     const int n = static_cast<int>(s.x.size());
-    E.col(j) += delta;
     u = Vec::Zero(n);
     for (int q = 0; q < n; ++q) {
+      const int i = s.index[q];
       if (s.kind[q] == EQUALITY) {
-        u(q) = delta(s.index[q]);
+        u(q) = ec(i) - E(i, j);
+      } else if (s.kind[q] == INEQUALITY) {
+        u(q) = rc(i) - R(i, j);
       }
     }
+    R.col(j) = rc;
+    Rt.row(j) = rc.transpose();
+    E.col(j) = ec;
     s.B.col(j) += u;
     w.noalias() = s.Binv * u;
     v = s.Binv.row(j).transpose();

@@ -33,9 +33,10 @@ zero-load LP does not pass.
 Since API 5 the compiled batch first tries the vertex method of src/vertex_lp.hpp (a
 primal active-set LP solver, written for these LPs because they share a start: phase 1
 finds each candidate's zero-load wrenches, certified at zero load, and every LP of the
-candidate starts from that vertex at alpha = 0, about 16 pivots where DAQP takes about
-fifty iterations from scratch). Its answers go through the same KKT check and
-certificate; an LP it does not answer is DAQP's as above.
+candidate starts from that vertex at alpha = 0, over the null space of its wrench
+balance: about 16 pivots where DAQP takes about fifty iterations from scratch). Its
+answers go through the same KKT check and certificate (the equalities' multipliers
+recovered for it); an LP it does not answer is DAQP's as above.
 """
 
 from __future__ import annotations
