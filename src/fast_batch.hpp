@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "vertex_lp.hpp"
@@ -506,9 +507,14 @@ using DaqpDefaults = void (*)(DaqpSettings *);
 // calls it (daqp.solve: daqp_quadprog, the default settings but primal_tol, iter_limit and
 // eps_prox), or by the vertex method (vertex_lp.hpp) from the zero-load wrenches, then
 // checked as lp_finish_batch checks it. A holds the LP's rows; its alpha column (the
-// first 6 rows' last entry) is the load direction. Returns passes; alpha.
+// first 6 rows' last entry) is the load direction. Returns passes; alpha. N: the vertex
+// method's unknowns (VertexLPT).
+template<int N>
 struct CapacitySolver
 {
+  using LP = VertexLPT<N>;
+  using VecN = typename LP::VecN;
+
   const FastCycle & fc;
   DaqpQuadprog quadprog;
   DaqpSettings settings;
@@ -518,11 +524,11 @@ struct CapacitySolver
   double kkt_tolerance, alpha_max;
   // The vertex method's LPs: the capacity LP's rows in "<=" form (row k is sign[k] times
   // row origin[k] of [I; A], DAQP's indexing), and the zero-load phase 1 (below).
-  VertexLP lp, phase1;
+  LP lp, phase1;
   std::vector<int> origin, eq_origin;
   std::vector<double> sign;
   Vec f0;
-  VertexLP::State from;
+  typename LP::State from;
   // The same LPs with the equalities E_f f + E_alpha alpha = e eliminated (zero_load):
   // f = fe + Z y + g alpha, Z an orthonormal basis of E_f's null space, fe = pinv e and
   // g = -pinv E_alpha (pinv = E_f's pseudo-inverse), so that each LP is over z = (y,
@@ -620,8 +626,8 @@ struct CapacitySolver
     const int n = nf + 1, ne = static_cast<int>(eq_origin.size());
     const int nr = static_cast<int>(origin.size()), nz = nf - ne;
     iterations = 0;
-    if (nz < 1) {
-      return false;
+    if (nz < 1 || (N != Eigen::Dynamic && nz + 1 != N)) {
+      return false;  // (the second: not the size this was compiled for)
     }
     Rf.resize(nr, nf);
     Ra.resize(nr);
@@ -676,11 +682,11 @@ struct CapacitySolver
     phase1.r(k1) = 0.0;
     phase1.R.conservativeResize(k1 + 1, nz + 1);
     phase1.r.conservativeResize(k1 + 1);
-    Vec start = Vec::Zero(nz + 1), cost = Vec::Unit(nz + 1, nz);
+    VecN start = VecN::Zero(nz + 1), cost = VecN::Unit(nz + 1, nz);
     start(nz) = t0;
     const auto status = phase1.solve(cost, start, 20 * n + 200, 1e-12);
     iterations = phase1.iterations;
-    if (status != VertexLP::OPTIMAL || !(std::abs(phase1.s.x(nz)) <= 1e-12)) {
+    if (status != LP::OPTIMAL || !(std::abs(phase1.s.x(nz)) <= 1e-12)) {
       return false;
     }
     start(nz) = 0.0;
@@ -691,14 +697,14 @@ struct CapacitySolver
 
   // The state the capacity LPs start from: (y0, alpha = 0), its working set alpha >= 0
   // and the rows f0 meets. False if it cannot be made.
-  bool base(const Vec & start)
+  bool base(const VecN & start)
   {
     const int nz = static_cast<int>(start.size()) - 1;
     if (!lp.start(start, 1e-12)) {
       return false;
     }
     for (int q = 0; q <= nz; ++q) {
-      if (lp.s.kind[q] == VertexLP::INEQUALITY && origin[lp.s.index[q]] == nf) {
+      if (lp.s.kind[q] == LP::INEQUALITY && origin[lp.s.index[q]] == nf) {
         from = lp.s;
         return true;
       }
@@ -725,20 +731,20 @@ struct CapacitySolver
     lp.Rt.row(nz) = Ra.transpose();
     lp.s = from;
     lp.set_column(nz, Ra - P * ea, Vec());
-    Vec cost = Vec::Zero(nz + 1);
+    VecN cost = VecN::Zero(nz + 1);
     cost(nz) = -1.0;
     const auto status = lp.iterate(cost, 20 * n + 200);
     iterations = lp.iterations;
-    if (status != VertexLP::OPTIMAL) {
+    if (status != LP::OPTIMAL) {
       return false;
     }
-    const Vec & z = lp.s.x;
+    const VecN & z = lp.s.x;
     const Vec f = fe + Z * z.head(nz) - pinv * (ea * z(nz));
     Vec mu = Vec::Zero(nr);
     std::fill(lam.begin(), lam.end(), 0.0);
     for (int j = 0; j <= nz; ++j) {
       const int k = lp.s.index[j];
-      if (lp.s.kind[j] == VertexLP::INEQUALITY) {
+      if (lp.s.kind[j] == LP::INEQUALITY) {
         mu(k) = std::max(0.0, lp.mu(j));  // -1e-12 read as 0
         lam[origin[k]] = sign[k] * mu(k);
       }
@@ -770,7 +776,8 @@ struct CapacitySolver
 // vertex method). Without phase 1, the zero-load LP is solved only where the axes'
 // answers do not already certify wrenches that hold zero load (its entry then says
 // passes, 0 iterations).
-py::dict capacity_batch(
+template<int Size>
+py::dict capacity_batch_n(
   const FastCycle & fc, int64_t quadprog, int64_t defaults, Array G, Array J, Array W,
   Array axes, Array S, Array bl, Array bu, py::array_t<int32_t> sense, Array bl0, Array bu0,
   py::array_t<int32_t> sense0, double primal_tol, int iter_limit, double eps_prox,
@@ -788,7 +795,7 @@ py::dict capacity_batch(
     expect(a->size() == nb, "bounds of the wrong shape");
   }
   expect(sense.size() == nb && sense0.size() == nb, "sense of the wrong shape");
-  CapacitySolver solver{fc, reinterpret_cast<DaqpQuadprog>(quadprog), DaqpSettings{},
+  CapacitySolver<Size> solver{fc, reinterpret_cast<DaqpQuadprog>(quadprog), DaqpSettings{},
     static_cast<int>(nf), m, static_cast<int>(rows),
     std::vector<double>(n * n, 0.0), std::vector<double>(n), std::vector<double>(nb),
     std::vector<double>(bu.data(), bu.data() + nb), std::vector<double>(bl.data(), bl.data() + nb),
@@ -910,6 +917,33 @@ py::dict capacity_batch(
   d["iterations"] = iterations;
   d["vertex"] = by_vertex;
   return d;
+}
+
+// capacity_batch_n with the vertex method's size fixed where it is a common one: 3, 4 or 5
+// contacts give 7, 11 or 15 unknowns once the six equalities are eliminated (nf + 1 - the
+// bounds that are equal).
+py::dict capacity_batch(
+  const FastCycle & fc, int64_t quadprog, int64_t defaults, Array G, Array J, Array W,
+  Array axes, Array S, Array bl, Array bu, py::array_t<int32_t> sense, Array bl0, Array bu0,
+  py::array_t<int32_t> sense0, double primal_tol, int iter_limit, double eps_prox,
+  double kkt_tolerance, double alpha_max, bool vertex)
+{
+  int equal = 0;
+  for (py::ssize_t i = 0; i < std::min(bl.size(), bu.size()); ++i) {
+    equal += bl.data()[i] == bu.data()[i];
+  }
+  const int size = G.ndim() == 3 ? static_cast<int>(G.shape(2)) + 1 - equal : 0;
+  auto run = [&](auto tag) {
+      return capacity_batch_n<decltype(tag)::value>(
+        fc, quadprog, defaults, G, J, W, axes, S, bl, bu, sense, bl0, bu0, sense0, primal_tol,
+        iter_limit, eps_prox, kkt_tolerance, alpha_max, vertex);
+    };
+  switch (size) {
+      case 7: return run(std::integral_constant<int, 7>());
+      case 11: return run(std::integral_constant<int, 11>());
+      case 15: return run(std::integral_constant<int, 15>());
+      default: return run(std::integral_constant<int, Eigen::Dynamic>());
+  }
 }
 
 }  // namespace

@@ -162,6 +162,30 @@ def test_the_vertex_method_answers_the_compiled_lps_as_daqp_does(planned):
                                    rtol=1e-7, atol=1e-12)
 
 
+def test_fewer_contacts_take_the_vertex_method_at_their_own_size():
+    # The vertex method is compiled for 7, 11 and 15 unknowns (3, 4, 5 contacts) and for
+    # any size: two and three of the bundled grasp's contacts take the 3-unknown (any
+    # size) and 7-unknown builds, every LP answered there and the single path's records.
+    base = GraspSetup.from_file(ALLEGRO)
+    picks = [[1, 3], [2, 3], [0, 1, 3], [0, 2, 3]]  # the thumb (3) against the fingers
+    lines = [(k + 1, json.dumps({'grasp': {'contacts': [
+        {'link': base.contacts[i].link, 'position': base.contacts[i].position.tolist()}
+        for i in pick]}})) for k, pick in enumerate(picks)]
+    job = ScoreJob.from_file(ALLEGRO, metrics='full')
+    batch = BatchScorer(Scorer(job))
+    if batch.capacity.entry is None:
+        pytest.skip(f'daqp {metadata.version("daqp")} is not one of {DAQP_C_VERSIONS}')
+    batch.capacity.cycle = recorded = Recorded(batch.capacity.cycle)
+    fast = batch.score_lines(lines)
+    assert batch.staged == len(lines) and batch.capacity.redone == 0
+    assert_same(fast, Scorer(job).score_lines(lines), tol=1e-6)
+    assert {args[2].shape[2] for args in recorded.calls} == {8, 12}  # 4 per contact
+    for args in recorded.calls:
+        out = recorded.cycle.capacity_batch(*args)
+        assert out['vertex'].all() and out['passes'].all()
+    assert all(rec['capacity_status'] == 'optimal' for rec in fast)
+
+
 def test_the_compiled_lps_give_the_python_loops_answers(planned):
     # The 14 LPs per candidate solved in the compiled batch (the vertex method, DAQP's
     # C entry behind it) and from Python (one daqp.solve each): the same rows, the same
