@@ -577,10 +577,14 @@ struct CapacitySolver
     if (!(kkt <= kkt_tolerance) || !(x[nf] < (1.0 - 1e-9) * alpha_max)) {
       return false;
     }
-    const Vec f = Eigen::Map<const Vec>(x.data(), nf);
+    return holds(G, J, alpha * load, Eigen::Map<const Vec>(x.data(), nf));
+  }
+
+  // Whether wrenches f hold load on the exact cones within the torque limits (certified).
+  bool holds(const RowMat & G, const RowMat & J, const Wrench & load, const Vec & f) const
+  {
     const Vec tau = J.transpose() * f;
-    const Vec tau_max = fc.limits(), tau_min = -fc.limits();
-    return fc.passes(fc.certify(G, J, alpha * load, tau_min, tau_max, tau, f));
+    return fc.passes(fc.certify(G, J, load, -fc.limits(), fc.limits(), tau, f));
   }
 
   // The rows' structure in "<=" form from DAQP's bounds (the same for every candidate):
@@ -660,10 +664,6 @@ struct CapacitySolver
     lp.R.leftCols(nz).noalias() = Rf * Z;
     lp.R.col(nz) = Ra;  // zero load: E_alpha = 0
     lp.r = r - Rf * fe;
-    lp.E.resize(0, nz + 1);
-    lp.e.resize(0);
-    phase1.E.resize(0, nz + 1);
-    phase1.e.resize(0);
     phase1.R.resize(nr + 1, nz + 1);
     phase1.r.resize(nr + 1);
     int k1 = 0;
@@ -684,7 +684,8 @@ struct CapacitySolver
     phase1.r.conservativeResize(k1 + 1);
     VecN start = VecN::Zero(nz + 1), cost = VecN::Unit(nz + 1, nz);
     start(nz) = t0;
-    const auto status = phase1.solve(cost, start, 20 * n + 200, 1e-12);
+    phase1.start(start, 1e-12);
+    const auto status = phase1.iterate(cost, 20 * n + 200);
     iterations = phase1.iterations;
     if (status != LP::OPTIMAL || !(std::abs(phase1.s.x(nz)) <= 1e-12)) {
       return false;
@@ -700,9 +701,7 @@ struct CapacitySolver
   bool base(const VecN & start)
   {
     const int nz = static_cast<int>(start.size()) - 1;
-    if (!lp.start(start, 1e-12)) {
-      return false;
-    }
+    lp.start(start, 1e-12);
     for (int q = 0; q <= nz; ++q) {
       if (lp.s.kind[q] == LP::INEQUALITY && origin[lp.s.index[q]] == nf) {
         from = lp.s;
@@ -727,10 +726,9 @@ struct CapacitySolver
       const int i = eq_origin[k];
       ea(k) = i < n ? 0.0 : A(i - n, nf);  // the load's direction
     }
-    lp.R.col(nz) = Ra;  // the base's column, then this LP's
-    lp.Rt.row(nz) = Ra.transpose();
+    lp.reset_column(nz, Ra);  // the base's column, then this LP's
     lp.s = from;
-    lp.set_column(nz, Ra - P * ea, Vec());
+    lp.set_column(nz, Ra - P * ea);
     VecN cost = VecN::Zero(nz + 1);
     cost(nz) = -1.0;
     const auto status = lp.iterate(cost, 20 * n + 200);
@@ -816,7 +814,6 @@ py::dict capacity_batch_n(
   py::array_t<int32_t> iterations({N, K});
   py::array_t<bool> by_vertex({N, K});
   std::fill(by_vertex.mutable_data(), by_vertex.mutable_data() + N * K, false);
-  const Vec tau_max = fc.limits(), tau_min = -fc.limits();
   {
     py::gil_scoped_release release;
     RowMat A = RowMat::Zero(rows, n);
@@ -859,9 +856,7 @@ py::dict capacity_batch_n(
       // Phase 1's wrenches, certified at zero load: every LP from them.
       int it0 = 0;
       if (vertex && solver.zero_load(A, it0)) {
-        const Vec tau0 = Ji.transpose() * solver.f0;
-        from_zero = fc.passes(
-          fc.certify(Gi, Ji, Wrench::Zero(), tau_min, tau_max, tau0, solver.f0));
+        from_zero = solver.holds(Gi, Ji, Wrench::Zero(), solver.f0);
       }
       if (from_zero) {
         passes.mutable_data()[K * i] = true;
@@ -890,9 +885,7 @@ py::dict capacity_batch_n(
           if (a == 0.0) {
             zero = true;  // certified at 0 times its axis
           } else if (opposite) {
-            const Vec f0 = (a * f_last + a_last * f) / (a + a_last);
-            const Vec tau = Ji.transpose() * f0;
-            zero = fc.passes(fc.certify(Gi, Ji, Wrench::Zero(), tau_min, tau_max, tau, f0));
+            zero = solver.holds(Gi, Ji, Wrench::Zero(), (a * f_last + a_last * f) / (a + a_last));
           }
         }
         if (k % 2 == 0) {

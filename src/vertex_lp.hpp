@@ -29,9 +29,10 @@
 namespace
 {
 
-// minimize c'x subject to E x = e and R x <= r, from a feasible x0. The working set
-// always holds n rows, B x = b_W: the equalities, inequalities at equality and, where
-// these do not make n independent rows, artificial rows x_j = x0_j, which are dropped
+// minimize c'x subject to R x <= r, from a feasible x0 (the capacity LPs have their
+// equalities eliminated first). The working set always holds n rows, B x = b_W:
+// inequalities at equality and, where these do not make n independent rows, artificial
+// rows x_j = x0_j, which are dropped
 // as soon as their multiplier is not zero (either sign). Each pivot drops the row with
 // the most negative multiplier (Bland's rule after a run of degenerate pivots), moves
 // along the edge it frees to the first row it meets (the ratio test) and updates B's
@@ -43,7 +44,7 @@ namespace
 template<int N>
 struct VertexLPT
 {
-  enum Kind { EQUALITY, INEQUALITY, ARTIFICIAL };
+  enum Kind { INEQUALITY, ARTIFICIAL };
   enum Status { OPTIMAL, UNBOUNDED, FAILED };
   using VecN = Eigen::Matrix<double, N, 1>;
   using MatN = Eigen::Matrix<double, N, N>;
@@ -63,10 +64,9 @@ struct VertexLPT
     std::vector<int> index;
   };
 
-  Eigen::Matrix<double, Eigen::Dynamic, N, Eigen::RowMajor> E;
   Eigen::Matrix<double, Eigen::Dynamic, N> R;  // column-major: R d as axpys
   Eigen::Matrix<double, N, Eigen::Dynamic> Rt;  // R's transpose (start()): rows contiguous
-  Vec e, r;
+  Vec r;
   State s;
   VecN mu, d, u, v, w;
   Vec Rd, ratio;
@@ -84,9 +84,9 @@ struct VertexLPT
     s.b(q) = rhs;
   }
 
-  // Bring row a into the working set in place of the artificial row it depends on most;
-  // false when it depends on none enough (then it stays out).
-  bool enter(const Eigen::Ref<const VecN> & a, double rhs, Kind k, int i)
+  // Bring inequality i (row a) into the working set in place of the artificial row it
+  // depends on most; false when it depends on none enough (then it stays out).
+  bool enter(const Eigen::Ref<const VecN> & a, double rhs, int i)
   {
     w.noalias() = s.Binv.transpose() * a;
     int q = -1;
@@ -101,15 +101,14 @@ struct VertexLPT
       return false;
     }
     replace(q, a, rhs);
-    s.kind[q] = k;
+    s.kind[q] = INEQUALITY;
     s.index[q] = i;
     return true;
   }
 
-  // The working set at x0: the equalities, then the inequalities within tight (relative)
-  // of equality, each in order where it is independent of those before. False where the
-  // equalities are dependent.
-  bool start(const VecN & x0, double tight)
+  // The working set at x0: the inequalities within tight (relative) of equality, each in
+  // order where it is independent of those before.
+  void start(const VecN & x0, double tight)
   {
     const int n = static_cast<int>(x0.size()), nr = static_cast<int>(R.rows());
     s.B = RowMatN::Identity(n, n);
@@ -118,39 +117,36 @@ struct VertexLPT
     s.x = x0;
     s.kind.assign(n, ARTIFICIAL);
     s.index.assign(n, -1);
-    for (int i = 0; i < E.rows(); ++i) {
-      if (!enter(E.row(i).transpose(), e(i), EQUALITY, i)) {
-        return false;  // dependent equalities: not these LPs
-      }
-    }
     Rt = R.transpose();
     s.slack = r - R * s.x;
     for (int i = 0; i < nr; ++i) {
       const double scale = std::max(1.0, std::abs(r(i)));
-      if (s.slack(i) <= tight * scale && enter(Rt.col(i), r(i), INEQUALITY, i)) {
+      if (s.slack(i) <= tight * scale && enter(Rt.col(i), r(i), i)) {
         s.slack(i) = std::numeric_limits<double>::infinity();
       }
     }
-    return true;
   }
 
-  // Column j of R and of E set to rc and ec at a point where x_j = 0 (x and the slacks
-  // stay as they are): the working set's B follows, its inverse by Sherman-Morrison.
-  void set_column(int j, const Vec & rc, const Vec & ec)
+  // Column j of R set to rc as it was when a saved State was made (the working set is
+  // not touched: assign that State after this).
+  void reset_column(int j, const Vec & rc)
+  {
+    R.col(j) = rc;
+    Rt.row(j) = rc.transpose();
+  }
+
+  // Column j of R set to rc at a point where x_j = 0 (x and the slacks stay as they are):
+  // the working set's B follows, its inverse by Sherman-Morrison.
+  void set_column(int j, const Vec & rc)
   {
     const int n = static_cast<int>(s.x.size());
     u = VecN::Zero(n);
     for (int q = 0; q < n; ++q) {
-      const int i = s.index[q];
-      if (s.kind[q] == EQUALITY) {
-        u(q) = ec(i) - E(i, j);
-      } else if (s.kind[q] == INEQUALITY) {
-        u(q) = rc(i) - R(i, j);
+      if (s.kind[q] == INEQUALITY) {
+        u(q) = rc(s.index[q]) - R(s.index[q], j);
       }
     }
-    R.col(j) = rc;
-    Rt.row(j) = rc.transpose();
-    E.col(j) = ec;
+    reset_column(j, rc);
     s.B.col(j) += u;
     w.noalias() = s.Binv * u;
     v = s.Binv.row(j).transpose();
@@ -172,8 +168,7 @@ struct VertexLPT
       int q = -1;
       double best = 0.0;
       for (int j = 0; j < n; ++j) {
-        const double gain = s.kind[j] == INEQUALITY ? -mu(j) :
-          s.kind[j] == ARTIFICIAL ? std::abs(mu(j)) : 0.0;
+        const double gain = s.kind[j] == INEQUALITY ? -mu(j) : std::abs(mu(j));
         if (!(gain > dual_tol)) {
           continue;
         }
@@ -248,13 +243,6 @@ struct VertexLPT
     u.noalias() = -c - s.B.transpose() * mu;
     mu.noalias() += s.Binv.transpose() * u;
     return s.x.allFinite() && mu.allFinite();
-  }
-
-  // start, then iterate.
-  Status solve(const VecN & c, const VecN & x0, int iter_limit, double tight)
-  {
-    iterations = 0;
-    return start(x0, tight) ? iterate(c, iter_limit) : FAILED;
   }
 };
 
