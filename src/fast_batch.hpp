@@ -31,9 +31,6 @@
 namespace
 {
 
-//: DAQP's "infinite" bound (backends/daqp.DAQP_INF).
-constexpr double DAQP_INF = 1e30;
-
 py::array_t<double> zeros(std::vector<py::ssize_t> shape)
 {
   py::array_t<double> out(shape);
@@ -225,33 +222,6 @@ py::dict build_batch(
   d["blower"] = blower;
   d["n_eq"] = n_eq;
   return d;
-}
-
-// backends/daqp.kkt_violation of min 1/2 x'Hx + g'x, H = diag(hdiag), blower <= [x; A x]
-// <= bupper, with DAQP's multipliers lam (bounds on x first).
-double daqp_kkt(
-  const Vec & hdiag, const double * g, const double * A, const double * up,
-  const double * lo, const double * x, const double * lam, int n, int rows)
-{
-  Eigen::Map<const RowMat> Am(A, rows, n);
-  Eigen::Map<const Vec> xv(x, n), lv(lam, n + rows);
-  Vec grad = hdiag.cwiseProduct(xv);
-  if (g != nullptr) {
-    grad += Eigen::Map<const Vec>(g, n);
-  }
-  Vec residual = Am.transpose() * lv.tail(rows) + lv.head(n) + grad;
-  const Vec Ax = Am * xv;
-  double infeasible = -std::numeric_limits<double>::infinity();
-  double complementarity = -std::numeric_limits<double>::infinity();
-  for (int i = 0; i < n + rows; ++i) {
-    const double v = i < n ? xv(i) : Ax(i - n);
-    const double to_upper = up[i] - v, to_lower = v - lo[i];
-    infeasible = std::max(infeasible, -std::min(to_upper, to_lower));
-    complementarity = std::max(
-      complementarity, std::max(lam[i] * to_upper, -lam[i] * to_lower));
-  }
-  return std::max(
-    {max_abs(residual) / std::max(1.0, max_abs(grad)), infeasible, complementarity});
 }
 
 // After the DAQP solves: for each candidate with solved[i] (DAQP's exit flag 1), the KKT
@@ -473,35 +443,6 @@ py::dict lp_finish_batch(
   d["passes"] = passes;
   return d;
 }
-
-// DAQP's C interface (version 0.11.0: include/types.h and include/api.h), as the daqp
-// Python module's extension exports it: the three structs daqp_quadprog reads and writes.
-// grasp_torque_opt.methods.batch_capacity passes the functions' addresses only where the
-// installed daqp is that version, so that these layouts are its own.
-struct DaqpProblem
-{
-  int n, m, ms;
-  double * H, * f, * A, * bupper, * blower;
-  int * sense, * break_points;
-  int nh, problem_type;
-};
-struct DaqpSettings
-{
-  double primal_tol, dual_tol, zero_tol, pivot_tol, progress_tol;
-  int cycle_tol, iter_limit;
-  double fval_bound, eps_prox, eta_prox, rho_soft, rel_subopt, abs_subopt, sing_tol;
-  double refactor_tol, time_limit, w_soft;
-  int eq_reduction, presolve;
-};
-struct DaqpResult
-{
-  double * x, * lam;
-  double fval, soft_slack;
-  int exitflag, iter, nodes;
-  double solve_time, setup_time;
-};
-using DaqpQuadprog = void (*)(DaqpResult *, DaqpProblem *, DaqpSettings *);
-using DaqpDefaults = void (*)(DaqpSettings *);
 
 // One capacity LP (methods/capacity.CapacityLP) solved by DAQP as methods/lp.solve_lp
 // calls it (daqp.solve: daqp_quadprog, the default settings but primal_tol, iter_limit and

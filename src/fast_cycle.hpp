@@ -128,6 +128,65 @@ struct Settings
 
 using Wrench = Eigen::Matrix<double, 6, 1>;
 
+// DAQP's "infinite" bound (backends/daqp.DAQP_INF).
+constexpr double DAQP_INF = 1e30;
+
+// DAQP's C interface (version 0.11.0: include/types.h and include/api.h), as the daqp
+// Python module's extension exports it: the three structs daqp_quadprog reads and writes.
+// grasp_torque_opt.backends.daqp.daqp_entry gives the functions' addresses only
+// where the installed daqp is that version, so that these layouts are its own.
+struct DaqpProblem
+{
+  int n, m, ms;
+  double * H, * f, * A, * bupper, * blower;
+  int * sense, * break_points;
+  int nh, problem_type;
+};
+struct DaqpSettings
+{
+  double primal_tol, dual_tol, zero_tol, pivot_tol, progress_tol;
+  int cycle_tol, iter_limit;
+  double fval_bound, eps_prox, eta_prox, rho_soft, rel_subopt, abs_subopt, sing_tol;
+  double refactor_tol, time_limit, w_soft;
+  int eq_reduction, presolve;
+};
+struct DaqpResult
+{
+  double * x, * lam;
+  double fval, soft_slack;
+  int exitflag, iter, nodes;
+  double solve_time, setup_time;
+};
+using DaqpQuadprog = void (*)(DaqpResult *, DaqpProblem *, DaqpSettings *);
+using DaqpDefaults = void (*)(DaqpSettings *);
+
+// backends/daqp.kkt_violation of min 1/2 x'Hx + g'x, H = diag(hdiag), blower <= [x; A x]
+// <= bupper, with DAQP's multipliers lam (bounds on x first).
+double daqp_kkt(
+  const Vec & hdiag, const double * g, const double * A, const double * up,
+  const double * lo, const double * x, const double * lam, int n, int rows)
+{
+  Eigen::Map<const RowMat> Am(A, rows, n);
+  Eigen::Map<const Vec> xv(x, n), lv(lam, n + rows);
+  Vec grad = hdiag.cwiseProduct(xv);
+  if (g != nullptr) {
+    grad += Eigen::Map<const Vec>(g, n);
+  }
+  Vec residual = Am.transpose() * lv.tail(rows) + lv.head(n) + grad;
+  const Vec Ax = Am * xv;
+  double infeasible = -std::numeric_limits<double>::infinity();
+  double complementarity = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n + rows; ++i) {
+    const double v = i < n ? xv(i) : Ax(i - n);
+    const double to_upper = up[i] - v, to_lower = v - lo[i];
+    infeasible = std::max(infeasible, -std::min(to_upper, to_lower));
+    complementarity = std::max(
+      complementarity, std::max(lam[i] * to_upper, -lam[i] * to_lower));
+  }
+  return std::max(
+    {max_abs(residual) / std::max(1.0, max_abs(grad)), infeasible, complementarity});
+}
+
 // The maps stage's inputs: one cycle's kinematics as Pinocchio gave them (borrowed).
 struct Kinematics
 {
@@ -224,6 +283,27 @@ public:
     weights_ = Eigen::Map<const Vec>(weights.data(), m_);
     limits_ = Eigen::Map<const Vec>(limits.data(), m_);
   }
+
+  // Solve with DAQP (backends/daqp.DaqpSolver) instead of ProxSuite: its C entry
+  // daqp_quadprog at address quadprog, daqp_default_settings at defaults (as
+  // backends/daqp.daqp_entry finds them), with its primal_tol and iter_limit, and
+  // iteration_s the time per iteration assumed before one is measured (daqp.ITERATION_S).
+  void use_daqp(
+    int64_t quadprog, int64_t defaults, double primal_tol, int iter_limit, double iteration_s)
+  {
+    if (quadprog == 0 || defaults == 0 || iter_limit < 1) {
+      throw std::invalid_argument("use_daqp: no DAQP entry, or an iteration cap below 1");
+    }
+    quadprog_ = reinterpret_cast<DaqpQuadprog>(quadprog);
+    reinterpret_cast<DaqpDefaults>(defaults)(&daqp_settings_);
+    daqp_settings_.primal_tol = primal_tol;
+    daqp_settings_.iter_limit = iter_limit;
+    daqp_settings_.eps_prox = 0.0;  // H = 2 diag(w) is positive definite: no z here
+    daqp_iteration_s_ = iteration_s;
+    dims_ = {-1, -1, -1};
+  }
+
+  bool uses_daqp() const {return quadprog_ != nullptr;}
 
   // One cycle. oMf: (p, 4, 4) link placements; J6: (p, 6, nv) LOCAL_WORLD_ALIGNED
   // link Jacobians; points: (p, 3) contact points in their link frames; normals and
@@ -425,6 +505,9 @@ public:
       a.message = "QP bounds NaN or inverted (lower > upper)";
       return false;
     }
+    if (quadprog_ != nullptr) {
+      return solve_daqp(qp, cold, has_deadline, deadline, a);
+    }
     const int m = m_, n_eq = qp.n_eq(), n_in = static_cast<int>(qp.C.rows());
     bool stopped = false, warm = false;
     try {
@@ -472,6 +555,103 @@ public:
     }
     a.warm = warm;
     a.tau = r.x.head(m);
+    a.f = qp.M1() * qp.w + qp.M2() * a.tau;
+    return true;
+  }
+
+  // -- solve with DAQP (backends/daqp.DaqpSolver.solve) --------------------------------
+  // The tau-QP in DAQP's form: bounds on tau first, then the equalities, then the cone
+  // rows. Cold on a new size or when cold, else warm if enabled: started from the active
+  // set of the last solved QP (the signs of its multipliers; DaqpSolver's workspace keeps
+  // its working set). A warm answer that is not optimal by DAQP's flag and the KKT check
+  // is redone cold from the same data, the two sharing a cap fitted to the deadline.
+  bool solve_daqp(
+    const QPData & qp, bool cold, bool has_deadline, Clock::time_point deadline,
+    Answer & a)
+  {
+    const int m = m_, n_eq = qp.n_eq(), n_in = static_cast<int>(qp.C.rows());
+    const int rows = n_eq + n_in;
+    if (has_deadline && Clock::now() >= deadline) {
+      a.code = TIMED_OUT;
+      a.message = "time budget spent before DAQP started";
+      return false;
+    }
+    const std::tuple<int, int, int> dims(m, n_eq, n_in);
+    if (dims != dims_) {
+      ++inits_;
+      dims_ = dims;
+      // daqp.size_factor: a new size, a guess scaled from the Allegro's tau-QP.
+      iter_s_ = daqp_iteration_s_ *
+        std::max(1.0, static_cast<double>(m) * (m + rows) / (16.0 * 144.0));
+      have_active_ = false;
+      sense0_.assign(m + rows, 0);
+      std::fill(sense0_.begin() + m, sense0_.begin() + m + n_eq, 5);  // equality
+    }
+    daqp_A_.resize(rows, m);
+    daqp_A_.topRows(n_eq) = qp.A;
+    daqp_A_.bottomRows(n_in) = qp.C;
+    up_.resize(m + rows);
+    lo_.resize(m + rows);
+    for (int j = 0; j < m; ++j) {
+      up_(j) = std::min(qp.u_box(j), DAQP_INF);
+      lo_(j) = std::max(qp.l_box(j), -DAQP_INF);
+    }
+    up_.segment(m, n_eq) = qp.b;
+    lo_.segment(m, n_eq) = qp.b;
+    up_.tail(n_in) = qp.u;
+    lo_.tail(n_in).setConstant(-DAQP_INF);
+    H_ = qp.H;
+    g_ = qp.g;
+    x_.resize(m);
+    lam_.resize(m + rows);
+    int limit = daqp_settings_.iter_limit;
+    if (has_deadline) {
+      const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+      limit = std::min(limit, std::max(1, static_cast<int>(left / iter_s_)));
+    }
+    const bool warm = warm_start_ && !cold && have_active_;
+    const auto t0 = Clock::now();
+    int iterations = 0;
+    int flag = daqp_run(warm, limit, iterations);
+    double kkt = daqp_answer_kkt(flag, rows);
+    a.warm = false;
+    if (warm) {
+      a.warm_solves += 1;
+      a.warm = kkt <= s_.kkt_tolerance;
+      if (!a.warm) {
+        a.redone_cold += 1;
+        const int rest = limit < daqp_settings_.iter_limit ?
+          std::max(1, limit - iterations) : limit;
+        int more = 0;
+        flag = daqp_run(false, rest, more);
+        iterations += more;
+        kkt = daqp_answer_kkt(flag, rows);
+      }
+    }
+    if (iterations) {
+      iter_s_ = std::max(seconds_since(t0) / iterations, s_.estimate_decay * iter_s_);
+    }
+    a.iterations += iterations;
+    a.message = "DAQP exit flag " + std::to_string(flag);
+    if (flag != 1 || !(kkt <= s_.kkt_tolerance)) {
+      have_active_ = false;
+      a.warm = false;
+      a.code = NOT_SOLVED;
+      if (flag == 1) {
+        a.message += ", but KKT violated by " + std::to_string(kkt);
+      }
+      return false;
+    }
+    // The next warm start: the rows this answer holds at a bound, on that bound.
+    active_ = sense0_;
+    for (int i = 0; i < m + rows; ++i) {
+      if (i >= m && i < m + n_eq) {
+        continue;
+      }
+      active_[i] = lam_(i) > 0.0 ? 1 : lam_(i) < 0.0 ? 3 : 0;  // ACTIVE, ACTIVE + LOWER
+    }
+    have_active_ = true;
+    a.tau = x_;
     a.f = qp.M1() * qp.w + qp.M2() * a.tau;
     return true;
   }
@@ -602,6 +782,33 @@ private:
     return "PROXQP_UNKNOWN";
   }
 
+  // One daqp_quadprog call on the QP in daqp_A_, up_, lo_, H_, g_ (from the last
+  // solved QP's active set when warm); DAQP's exit flag, its iterations in iterations.
+  int daqp_run(bool warm, int limit, int & iterations)
+  {
+    const int n = m_, total = static_cast<int>(up_.size());
+    sense_ = warm ? active_ : sense0_;  // DAQP may write to the array it is given
+    DaqpProblem p{n, total, n, H_.data(), g_.data(), daqp_A_.data(), up_.data(), lo_.data(),
+      sense_.data(), nullptr, 0, 0};
+    DaqpResult res{x_.data(), lam_.data(), 0.0, 0.0, 0, 0, 0, 0.0, 0.0};
+    DaqpSettings st = daqp_settings_;
+    st.iter_limit = limit;
+    quadprog_(&res, &p, &st);
+    iterations = res.iter;
+    return res.exitflag;
+  }
+
+  // daqp.DaqpSolver._kkt: the KKT violation of an answer DAQP calls optimal, else inf.
+  double daqp_answer_kkt(int flag, int rows) const
+  {
+    if (flag != 1 || !x_.allFinite() || !lam_.allFinite()) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return daqp_kkt(
+      H_.diagonal(), g_.data(), daqp_A_.data(), up_.data(), lo_.data(), x_.data(),
+      lam_.data(), m_, rows);
+  }
+
   // backends/proxsuite.kkt_violation
   double kkt_violation(const QPData & qp, const Vec & x, const Vec & y, const Vec & z) const
   {
@@ -730,6 +937,15 @@ private:
   std::tuple<int, int, int> dims_{-1, -1, -1};
   double inner_s_ = 0.0;
   int inits_ = 0;
+  // DAQP (use_daqp): its entry and settings, the QP in its form, the active sets.
+  DaqpQuadprog quadprog_ = nullptr;
+  DaqpSettings daqp_settings_{};
+  double daqp_iteration_s_ = 0.0, iter_s_ = 0.0;
+  RowMat daqp_A_;
+  Mat H_;
+  Vec g_, up_, lo_, x_, lam_;
+  std::vector<int> sense0_, active_, sense_;
+  bool have_active_ = false;
 };
 
 py::array_t<double> to_array(const Vec & v)
@@ -799,7 +1015,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 5;
+  mod.attr("API") = 6;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -858,6 +1074,10 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
          py::arg("normals"), py::arg("has_normal"), py::arg("tangents"),
          py::arg("has_tangent"), py::arg("c"), py::arg("w_ext"), py::arg("offset"),
          py::arg("time_left"))
+  .def("use_daqp", &FastCycle::use_daqp, py::arg("quadprog"), py::arg("defaults"),
+    py::arg("primal_tol"), py::arg("iter_limit"), py::arg("iteration_s"),
+    "Solve with DAQP's C entry (its addresses) instead of ProxSuite.")
+  .def_property_readonly("uses_daqp", &FastCycle::uses_daqp)
   .def_property_readonly("inits", &FastCycle::dims_changes)
   // The four stages of solve() one by one, on given inputs (the parity tests).
   .def("maps", [](const FastCycle & fc, Array oMf, Array J6, Array points, Array normals,
@@ -940,7 +1160,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     }, py::arg("H"), py::arg("g"), py::arg("A"), py::arg("b"), py::arg("C"), py::arg("u"),
     py::arg("l_box"), py::arg("u_box"), py::arg("M1"), py::arg("M2"), py::arg("w"),
     py::arg("cold") = false, py::arg("time_left") = -1.0,
-    "The solve stage on this cycle's ProxSuite QP (warm from its last solve).")
+    "The solve stage on this cycle's QP, ProxSuite or DAQP (warm from its last solve).")
   .def("certify", [](const FastCycle & fc, Array G, Array J, Array w_ext, Array tau_min,
     Array tau_max, Array tau, Array f) {
       const int m = fc.m();

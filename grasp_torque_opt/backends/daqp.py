@@ -16,7 +16,9 @@ proximal-point iterations.
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
+from importlib import metadata
 import math
 import time
 
@@ -66,6 +68,32 @@ def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray
     complementarity = np.maximum(lam * to_upper, -lam * to_lower)
     return max(float(np.abs(residual).max()) / max(1.0, float(np.abs(grad).max())),
                -float(np.minimum(to_upper, to_lower).min()), float(complementarity.max()))
+
+
+#: The daqp releases whose C structs src/fast_cycle.hpp declares (for ``capacity_batch``
+#: and the compiled cycle's DAQP solve).
+DAQP_C_VERSIONS = ('0.11.0',)
+
+
+def daqp_entry() -> tuple[int, int] | None:
+    """
+    Return the addresses of DAQP's ``daqp_quadprog`` and ``daqp_default_settings``.
+
+    The daqp Python module's extension is DAQP's C library compiled in, its functions
+    exported: the compiled batch and cycle call them there, the same code ``daqp.solve`` runs.
+    None when the installed daqp is not a release whose structs the compiled batch
+    declares (:data:`DAQP_C_VERSIONS`), or the functions are not found.
+    """
+    try:
+        import daqp
+
+        if metadata.version('daqp') not in DAQP_C_VERSIONS:
+            return None
+        lib = ctypes.CDLL(daqp.__file__)
+        return (ctypes.cast(lib.daqp_quadprog, ctypes.c_void_p).value,
+                ctypes.cast(lib.daqp_default_settings, ctypes.c_void_p).value)
+    except (ImportError, OSError, AttributeError, metadata.PackageNotFoundError):
+        return None
 
 
 @dataclass(frozen=True)

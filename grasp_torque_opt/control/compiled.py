@@ -7,7 +7,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 
 """
-The node's cycle compiled: maps, build, warm ProxSuite solve and certificate in C++.
+The node's cycle compiled: maps, build, warm ProxSuite or DAQP solve and certificate in C++.
 
 ``grasp_torque_opt.native._fast_cycle`` (``src/fast_cycle.hpp``, built by ``setup.py`` with
 pybind11, Eigen and ProxSuite's C++ headers; on x86-64 also ``_fast_cycle_avx2``, used
@@ -16,12 +16,15 @@ the case the node runs on every joint state (docs/design.md section 2.6):
 
 - the ``tau-qp`` method and the ``sum-of-squares`` objective;
 - the ProxSuite backend with the package's settings (Diagonal Hessian,
-  PrimalDualLDLT, the preconditioner of the first problem kept);
+  PrimalDualLDLT, the preconditioner of the first problem kept), or the DAQP backend
+  (DAQP's C entry in the daqp module's extension, called as
+  :class:`~grasp_torque_opt.backends.daqp.DaqpSolver` calls it: the same settings, the
+  KKT check, a warm start from the last solved QP's active set);
 - A = [G; J^T] of full column rank (the QR branch of
   :func:`~grasp_torque_opt.core.tau_qp.decompose`: no internal-force variables, as
   for the Allegro's four fingertips).
 
-Pinocchio's kinematics stay in Python (about 10 us). A warm answer that ProxSuite does
+Pinocchio's kinematics stay in Python (about 10 us). A warm answer that the solver does
 not call solved, or that fails the KKT check or the certificate, is redone cold in the
 same call, as the Python solver does. What the compiled cycle cannot certify, it hands
 back: :meth:`CompiledCycle.solve` returns None with the reason, and the controller runs
@@ -33,10 +36,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from grasp_torque_opt.backends import daqp as daqp_backend
 from grasp_torque_opt.backends.proxsuite import (
     ESTIMATE_DECAY,
     INNER_ITERATION_S,
     KKT_TOLERANCE,
+    ProxSuiteSettings,
     TauQPSolver,
 )
 from grasp_torque_opt.core.certificate import Certificate
@@ -51,11 +56,11 @@ from grasp_torque_opt.native.loader import fast_cycle, IMPORT_ERROR
 import numpy as np
 import pinocchio as pin
 
-#: Share of the time left that the compiled ProxSuite solve may use; the fallback gets
+#: Share of the time left that the compiled solve (ProxSuite or DAQP) may use; the fallback gets
 #: the rest (as :data:`grasp_torque_opt.methods.dispatch.PRIMARY_SHARE`).
 PRIMARY_SHARE = 0.8
-#: Outcome codes after which ProxSuite was tried (warm, and cold if the warm answer
-#: failed): the controller asks its fallback backend next, not ProxSuite again.
+#: Outcome codes after which the solver was tried (warm, and cold if the warm answer
+#: failed): the controller asks its fallback backend next, not the same solver again.
 SOLVER_CODES = () if fast_cycle is None else (
     fast_cycle.NOT_SOLVED, fast_cycle.NOT_CERTIFIED, fast_cycle.TIMED_OUT)
 #: After this many cycles in a row handed back as not of full column rank (a grasp
@@ -85,9 +90,14 @@ def unsupported(setup: GraspSetup, method: str, solver) -> str:
         return f'method {method} (the compiled cycle solves tau-qp)'
     if setup.objective != 'sum-of-squares':
         return f'objective {setup.objective} (the compiled cycle solves sum-of-squares)'
+    if isinstance(solver, daqp_backend.DaqpSolver):
+        if daqp_backend.daqp_entry() is None:
+            return ("backend daqp (the compiled cycle calls DAQP's C entry of daqp "
+                    f"{', '.join(daqp_backend.DAQP_C_VERSIONS)} only)")
+        return ''
     if not isinstance(solver, TauQPSolver):
         return f"backend {getattr(solver, 'name', type(solver).__name__)} (the compiled " \
-               'cycle solves with ProxSuite)'
+               'cycle solves with ProxSuite or DAQP)'
     s = solver.settings
     if (s.hessian_type, s.dense_backend, s.preconditioner) != \
             ('Diagonal', 'PrimalDualLDLT', 'first'):
@@ -117,7 +127,7 @@ class CompiledCycle:
 
     Args:
         setup: the grasp (its friction, weights and limits are taken here).
-        solver: the Python ProxSuite solver it stands in for: its settings are used,
+        solver: the Python solver it stands in for (ProxSuite or DAQP): its settings are used,
             and its counters (``warm_solves``, ``fallbacks``, ``timeouts``) count the
             compiled solves too.
         tolerance: certificate tolerance.
@@ -136,11 +146,14 @@ class CompiledCycle:
         friction = planned_friction(setup.friction)
         S_i, b_i = contact_block(friction.mu1, friction.mu2, friction.sides,
                                  friction.min_normal_force)
-        st = solver.settings
+        daqp = isinstance(solver, daqp_backend.DaqpSolver)
+        # DAQP's solve reads only the tolerances past max_iter_in here.
+        st = ProxSuiteSettings() if daqp else solver.settings
         s = (module or fast_cycle).Settings()
         s.eps_abs, s.eps_rel, s.eps_primal_inf = st.eps_abs, st.eps_rel, st.eps_primal_inf
         s.max_iter, s.max_iter_in = st.max_iter, st.max_iter_in
-        s.kkt_tolerance, s.certificate_tolerance = KKT_TOLERANCE, tolerance
+        s.kkt_tolerance = daqp_backend.KKT_TOLERANCE if daqp else KKT_TOLERANCE
+        s.certificate_tolerance = tolerance
         s.qr_rtol, s.box_margin = QR_RTOL, BOX_MARGIN
         s.inner_iteration_s, s.estimate_decay = INNER_ITERATION_S, ESTIMATE_DECAY
         s.primary_share = PRIMARY_SHARE
@@ -151,6 +164,9 @@ class CompiledCycle:
             np.asarray(setup.weights, dtype=float), np.asarray(hand.torque_limits, dtype=float),
             friction.mu1, friction.mu2, setup.friction.mu1, setup.friction.mu2,
             friction.min_normal_force, solver.warm_start, s)
+        if daqp:
+            self._cycle.use_daqp(*daqp_backend.daqp_entry(), solver.settings.primal_tol,
+                                 solver.settings.iter_limit, daqp_backend.ITERATION_S)
         self._joints = list(hand.joints)
         self._contacts: _Contacts | None = None
         self._no_offset = np.zeros(0)
@@ -242,7 +258,8 @@ class CompiledCycle:
         solver.last_warm = a.warm
         self.last_code = a.code
         if a.code != self.module.CERTIFIED:
-            solver.timeouts += a.code == self.module.TIMED_OUT
+            if isinstance(solver, TauQPSolver):  # DaqpSolver counts no timeouts
+                solver.timeouts += a.code == self.module.TIMED_OUT
             self.handed_back += 1
             self.last_reason = f'compiled cycle: {a.message}'
             self._rank_misses = self._rank_misses + 1 if a.message.startswith('A = ') else 0

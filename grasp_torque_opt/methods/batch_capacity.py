@@ -15,20 +15,21 @@ same way: DAQP as :func:`grasp_torque_opt.methods.lp.solve_lp` calls it, on the 
 bounds of :class:`~grasp_torque_opt.methods.capacity.CapacityLP`. The compiled batch
 (``capacity_batch``, src/fast_batch.hpp) runs them all: it writes each LP's rows in
 place, calls DAQP's C entry (``daqp_quadprog``, the function ``daqp.solve`` runs, found
-in the daqp module's own extension: :func:`daqp_entry`), and checks each answer as the
-single path does in Python (the KKT check with DAQP's multipliers, alpha, the
-certificate of the answer at alpha times the load, and the zero-load LP's wrenches
-certified at zero load). The axes go first: where an axis's answer holds alpha = 0, or
-two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e)) combine into (alpha- f+ +
-alpha+ f-) / (alpha+ + alpha-), which holds zero load (the cones and limits are convex)
-and is certified there, zero load is held and its LP is not solved. Where the installed
-daqp is not a release whose C structs the compiled batch declares
-(:data:`DAQP_C_VERSIONS`), the LPs are solved from Python one ``daqp.solve`` each, their
-checks in one compiled call per few candidates (``lp_finish_batch``). Either way an LP
-whose answer does not pass, or that DAQP does not call optimal, is solved again by the
-single path's :meth:`CapacityLP.solve` (HiGHS behind DAQP, the unbounded and infeasible
-verdicts), whose answer is then the value; so are all of a candidate's LPs when its
-zero-load LP does not pass.
+in the daqp module's own extension: :func:`~grasp_torque_opt.backends.daqp.daqp_entry`),
+and checks each answer as the single path does in Python (the KKT check with DAQP's
+multipliers, alpha, the certificate of the answer at alpha times the load, and the
+zero-load LP's wrenches certified at zero load). The axes go first: where an axis's
+answer holds alpha = 0, or two opposite axes' answers f+ (alpha+ e) and f- (alpha- (-e))
+combine into (alpha- f+ + alpha+ f-) / (alpha+ + alpha-), which holds zero load (the
+cones and limits are convex) and is certified there, zero load is held and its LP is not
+solved. Where the installed daqp is not a release whose C structs the compiled batch
+declares (:data:`~grasp_torque_opt.backends.daqp.DAQP_C_VERSIONS`), the LPs are solved
+from Python one ``daqp.solve`` each, their checks in one compiled call per few
+candidates (``lp_finish_batch``). Either way an LP whose answer does not pass, or that
+DAQP does not call optimal, is solved again by the single path's
+:meth:`CapacityLP.solve` (HiGHS behind DAQP, the unbounded and infeasible verdicts),
+whose answer is then the value; so are all of a candidate's LPs when its zero-load LP
+does not pass.
 
 Since API 5 the compiled batch first tries the vertex method of src/vertex_lp.hpp (a
 primal active-set LP solver, written for these LPs because they share a start: phase 1
@@ -42,11 +43,9 @@ recovered for it); an LP it does not answer is DAQP's as above.
 from __future__ import annotations
 
 from collections.abc import Callable
-import ctypes
-from importlib import metadata
 import math
 
-from grasp_torque_opt.backends.daqp import KKT_TOLERANCE
+from grasp_torque_opt.backends.daqp import daqp_entry, KKT_TOLERANCE
 from grasp_torque_opt.methods.capacity import ALPHA_MAX, CapacityLP, DIRECTIONS
 from grasp_torque_opt.methods.lp import EPS_PROX, MAX_ITER, PRIMAL_TOL
 import numpy as np
@@ -59,29 +58,6 @@ AXES = np.array([[sign if j == i else 0.0 for j in range(6)]
                  for i, sign in DIRECTIONS.values()])
 #: Candidates whose LPs are checked in one compiled call (bounded memory).
 PER_CALL = 16
-#: The daqp releases whose C structs src/fast_batch.hpp declares (``capacity_batch``).
-DAQP_C_VERSIONS = ('0.11.0',)
-
-
-def daqp_entry() -> tuple[int, int] | None:
-    """
-    Return the addresses of DAQP's ``daqp_quadprog`` and ``daqp_default_settings``.
-
-    The daqp Python module's extension is DAQP's C library compiled in, its functions
-    exported: the compiled batch calls them there, the same code ``daqp.solve`` runs.
-    None when the installed daqp is not a release whose structs the compiled batch
-    declares (:data:`DAQP_C_VERSIONS`), or the functions are not found.
-    """
-    try:
-        import daqp
-
-        if metadata.version('daqp') not in DAQP_C_VERSIONS:
-            return None
-        lib = ctypes.CDLL(daqp.__file__)
-        return (ctypes.cast(lib.daqp_quadprog, ctypes.c_void_p).value,
-                ctypes.cast(lib.daqp_default_settings, ctypes.c_void_p).value)
-    except (ImportError, OSError, AttributeError, metadata.PackageNotFoundError):
-        return None
 
 
 class CapacityBatch:
@@ -131,7 +107,7 @@ class CapacityBatch:
         return lp
 
     def _compiled(self, G, J, W, bound) -> list[dict]:
-        """Solve and check every LP in one compiled call (DAQP's C entry, :func:`daqp_entry`)."""
+        """Solve and check every LP in one compiled call (DAQP's C entry: ``daqp_entry``)."""
         nf, m = G.shape[2], J.shape[2]
         t = self._template(bound, nf // 4)
         form, zero = t.form, t.zero_form

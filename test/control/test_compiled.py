@@ -10,8 +10,9 @@
 The compiled cycle (src/fast_cycle.hpp) against the Python cycle and independent solvers.
 
 The Python cycle is the reference; the optimum of each compiled command is checked
-against DAQP (a dual active-set method, not ProxSuite) on the QP the Python builder
-makes, and its certificate against the Python certificate of the same (tau, f).
+against another method (DAQP, a dual active-set method, for ProxSuite's; quadprog for
+DAQP's) on the QP the Python builder makes, and its certificate against the Python
+certificate of the same (tau, f).
 """
 
 import dataclasses
@@ -61,14 +62,24 @@ def run(ctrl, setup, qs):
     return out
 
 
-def reference(setup, q, g):
-    """Solve by DAQP (cold) the Python-built QP at q, with the offset g."""
+def reference(setup, q, g, backend='daqp'):
+    """Solve cold the Python-built QP at q, with the offset g (DAQP, or the backend named)."""
     full = setup.q.copy()
     full[setup.hand.idx_q] = q
     at = dataclasses.replace(setup, q=full, torque_offset=g)
-    sol = solve(at, solver=make_solver('daqp'))
+    sol = solve(at, solver=make_solver(backend))
     assert sol.optimal, sol.message
     return sol, at
+
+
+#: Each backend the compiled cycle solves with: its warm solver, the independent solver
+#: its commands are held to (another method: DAQP's dual active set for ProxSuite's
+#: augmented Lagrangian, Goldfarb-Idnani's quadprog for DAQP), and the message of a
+#: certified answer.
+BACKENDS = {'proxsuite': (lambda: TauQPSolver(warm_start=True), 'daqp',
+                          'certified (solver: PROXQP_SOLVED)'),
+            'daqp': (lambda: make_solver('daqp', warm_start=True), 'quadprog',
+                     'certified (solver: DAQP exit flag 1)')}
 
 
 def test_the_compiled_cycle_is_built():
@@ -79,12 +90,14 @@ def test_the_compiled_cycle_is_built():
     assert loader.fast_cycle.__name__.endswith(loader.MODULES[0])
 
 
+@pytest.mark.parametrize('backend', BACKENDS)
 @pytest.mark.parametrize('gravity', [False, True])
-def test_commands_are_the_optimum_of_independent_solvers(allegro, gravity):
+def test_commands_are_the_optimum_of_independent_solvers(allegro, gravity, backend):
+    warm, independent, message = BACKENDS[backend]
     fast = fresh(allegro, gravity_compensation=gravity)
-    fast.solver = TauQPSolver(warm_start=True)
+    fast.solver = warm()
     slow = fresh(allegro, gravity_compensation=gravity, compiled=False)
-    slow.solver = TauQPSolver(warm_start=True)
+    slow.solver = warm()
     qs = moving_states(allegro, 300)
     got, ref = run(fast, allegro, qs), run(slow, allegro, qs)
     assert fast.compiled_cycle is not None and slow.compiled_cycle is None
@@ -95,8 +108,8 @@ def test_commands_are_the_optimum_of_independent_solvers(allegro, gravity):
         a, b = got[i], ref[i]
         assert a.kind == b.kind == 'solution'
         np.testing.assert_allclose(a.command, b.command, atol=1e-6)
-        daqp, at = reference(allegro, qs[i], a.gravity_torque)
-        np.testing.assert_allclose(a.solution.tau, daqp.tau, atol=1e-6)
+        other, at = reference(allegro, qs[i], a.gravity_torque, independent)
+        np.testing.assert_allclose(a.solution.tau, other.tau, atol=1e-6)
         # The compiled certificate is the Python one of the same (tau, f).
         lo, hi = at.tau_bounds
         f = a.solution.wrenches.reshape(-1)
@@ -117,7 +130,7 @@ def test_commands_are_the_optimum_of_independent_solvers(allegro, gravity):
         np.testing.assert_allclose(a.solution.friction_usage, b.solution.friction_usage,
                                    atol=1e-6)
         assert abs(a.solution.max_torque_ratio - b.solution.max_torque_ratio) <= 1e-6
-        assert a.solution.message == 'certified (solver: PROXQP_SOLVED)'
+        assert a.solution.message == message
     values = dict(report(fast, 2.0).values)
     assert values['solver.compiled'] == 'true'
     assert values['solver.compiled_solves'] == '300'
@@ -189,6 +202,33 @@ def test_no_time_left_is_a_timeout_and_bad_data_is_refused(allegro):
     assert sol.optimal and maps.G.shape == (6, 16)
 
 
+def test_daqp_hands_back_no_time_left_and_an_infeasible_load(allegro):
+    cycle = compiled.CompiledCycle(allegro, make_solver('daqp', warm_start=True), 1e-6)
+    sol, why = cycle.solve(allegro, 0.0)
+    assert sol is None and why == 'compiled cycle: time budget spent before DAQP started'
+    assert cycle.last_code == loader.fast_cycle.TIMED_OUT
+    sol, maps = cycle.solve(allegro, None)
+    assert sol.optimal and sol.message == 'certified (solver: DAQP exit flag 1)'
+    # Too heavy: DAQP says infeasible (exit flag -1), handed back to the fallback and LP.
+    heavy = dataclasses.replace(allegro, external_wrench=np.array([0, 0, -500.0, 0, 0, 0]))
+    sol, why = cycle.solve(heavy, None)
+    assert sol is None and why == 'compiled cycle: DAQP exit flag -1'
+    assert cycle.last_code in compiled.SOLVER_CODES
+    fast = fresh(heavy)
+    fast.solver = make_solver('daqp', warm_start=True)
+    fast.fallback = make_solver('proxsuite')
+    fast.take('joint_states', JointStateReading(*joint_state(heavy)), 1.0)
+    a = fast.cycle(1.0)
+    assert a.kind != 'solution' and a.solution.status == 'infeasible'
+    assert 'after the compiled cycle: DAQP exit flag -1' in a.solution.message
+    # A warm start from the heavy load's last solved active set (the good grasp's, as the
+    # heavy one was not solved) gives the optimum again.
+    sol, maps = cycle.solve(allegro, None)
+    ref = solve(allegro, solver=make_solver('quadprog'))
+    np.testing.assert_allclose(sol.tau, ref.tau, atol=1e-6)
+    assert cycle.solver.warm_solves >= 1
+
+
 def test_inputs_of_the_wrong_shape_are_handed_back_not_a_crash(allegro):
     cycle = compiled.CompiledCycle(allegro, TauQPSolver(), 1e-6)
     raw = cycle._cycle
@@ -217,16 +257,19 @@ def test_what_the_compiled_cycle_does_not_solve_is_said(allegro_doc, allegro):
     cases = {'tau-qp-adaptive': 'method tau-qp-adaptive'}
     for method, why in cases.items():
         assert compiled.unsupported(allegro, method, TauQPSolver()).startswith(why)
-    assert compiled.unsupported(allegro, 'tau-qp', make_solver('daqp')).startswith('backend daqp')
+    assert compiled.unsupported(allegro, 'tau-qp',
+                                make_solver('quadprog')).startswith('backend quadprog')
     minmax = dataclasses.replace(allegro, objective='min-max')
     assert compiled.unsupported(minmax, 'tau-qp', TauQPSolver()).startswith('objective min-max')
     assert compiled.unsupported(allegro, 'tau-qp', TauQPSolver()) == ''
-    # A DAQP controller runs the Python cycle and says why.
+    assert compiled.unsupported(allegro, 'tau-qp', make_solver('daqp')) == ''
+    # A quadprog controller runs the Python cycle and says why.
     ctrl = fresh(allegro)
-    ctrl.solver = make_solver('daqp')
+    ctrl.solver = make_solver('quadprog')
     ctrl.take('joint_states', JointStateReading(*joint_state(allegro)), 1.0)
     assert ctrl.cycle(1.0).kind == 'solution' and ctrl.compiled_cycle is None
-    assert dict(report(ctrl, 2.0).values)['solver.compiled'].startswith('false: backend daqp')
+    assert dict(report(ctrl, 2.0).values)['solver.compiled'].startswith(
+        'false: backend quadprog')
 
 
 def test_a_new_friction_or_weights_make_a_new_compiled_cycle(allegro):
@@ -275,14 +318,15 @@ def test_a_contact_list_of_another_size_is_taken_cold(allegro_doc, allegro):
     assert fast.compiled_cycle.solves == certified and fast.compiled_cycle._cycle.inits == 3
 
 
+@pytest.mark.parametrize('backend', BACKENDS)
 @pytest.mark.parametrize('name', loader.MODULES)
-def test_every_module_built_for_this_cpu_gives_the_python_optimum(allegro, name):
+def test_every_module_built_for_this_cpu_gives_the_python_optimum(allegro, name, backend):
     # The node loads the best of them; the other must be right as well (another CPU).
     module, why = loader.load(name)
     assert module is not None, why
-    cycle = compiled.CompiledCycle(allegro, TauQPSolver(warm_start=True), 1e-6, module=module)
-    assert cycle.module is module
-    python = TauQPSolver()
+    cycle = compiled.CompiledCycle(allegro, BACKENDS[backend][0](), 1e-6, module=module)
+    assert cycle.module is module and cycle._cycle.uses_daqp == (backend == 'daqp')
+    python = make_solver(backend)
     for q in moving_states(allegro, 60, seed=5):
         full = allegro.q.copy()
         full[allegro.hand.idx_q] = q

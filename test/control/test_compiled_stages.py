@@ -11,14 +11,16 @@ The compiled cycle's four stages, each held to its Python twin on the same input
 
 src/fast_cycle.hpp's ``run()`` is maps, build, solve_qp and certify in order; each is
 exposed on ``FastCycle`` and compared here with the Python stage it was written from:
-core/grasp_maps.py, core/tau_qp.build_tau_qp, backends/proxsuite.TauQPSolver and
-core/certificate.certify, on the bundled Allegro grasp and perturbed joint states.
+core/grasp_maps.py, core/tau_qp.build_tau_qp, backends/proxsuite.TauQPSolver (and
+backends/daqp.DaqpSolver) and core/certificate.certify, on the bundled Allegro grasp and
+perturbed joint states.
 """
 
 import dataclasses
 import os
 import time
 
+from grasp_torque_opt.backends import make_solver
 from grasp_torque_opt.backends.proxsuite import TauQPSolver
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.core.certificate import certify
@@ -186,6 +188,28 @@ def test_solve_is_the_python_proxsuite_solve(allegro, module):
         assert_near(got['f'], qp.wrenches(tau), 'f')
         assert got['warm'] == python.last_warm == (k > 0)
     assert python.warm_solves == 7
+
+
+def test_solve_is_the_python_daqp_solve(allegro, module):
+    # DaqpSolver.solve's rules on the same QPs in the same order: cold first, then warm
+    # (the compiled one from the last answer's active set, DaqpSolver from its workspace's).
+    cycle = compiled.CompiledCycle(allegro, make_solver('daqp', warm_start=True), 1e-6,
+                                   module=module)
+    python = make_solver('daqp', warm_start=True)
+    for k, at in enumerate(states(allegro, count=8, scale=2e-3)):
+        qp = python_qp(at)
+        got, ref = solve_stage(cycle, qp), python.solve(qp)
+        assert ref.status == 'solved' and got['solved'], (ref.message, got['message'])
+        assert got['message'] == ref.message == 'DAQP exit flag 1'
+        assert_near(got['tau'], ref.x, 'tau', rel=SOLVER_ATOL)
+        assert_near(got['f'], qp.wrenches(got['tau']), 'f')
+        assert got['warm'] == python.last_warm == (k > 0)
+        assert got['warm_solves'] == (k > 0) and got['redone_cold'] == 0
+    # No time left: both stop before solving, with the same words.
+    got = solve_stage(cycle, qp, time_left=0.0)
+    ref = python.solve(qp, deadline=time.perf_counter())
+    assert got['code'] == loader.fast_cycle.TIMED_OUT and ref.status == 'error'
+    assert got['message'] == ref.message == 'time budget spent before DAQP started'
 
 
 def test_solve_refuses_what_the_python_solver_refuses(allegro):

@@ -25,11 +25,11 @@ import json
 import warnings
 
 from conftest import ALLEGRO, scenario_doc, setup_from_doc
+from grasp_torque_opt.backends.daqp import DAQP_C_VERSIONS
 from grasp_torque_opt.control import compiled
 from grasp_torque_opt.core.exceptions import GeometryWarning
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.methods.batch import BatchScorer
-from grasp_torque_opt.methods.batch_capacity import DAQP_C_VERSIONS
 from grasp_torque_opt.methods.capacity import DIRECTIONS
 from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
 from grasp_torque_opt.methods.score import ScoreJob, Scorer
