@@ -14,14 +14,14 @@ Usage: .venv/bin/python bench/node_blackbox.py [--duration 8] [--rates 500 1000]
 
 Each case starts one answering process exactly as a user would, with nothing
 added: ``grasp_torque_node --ros-args --params-file config/allegro_right_node.yaml``
-(the default executor, the node's own wait-set loop; the default backend, ProxSuite
-with its verified warm
-start, in the compiled cycle; normal scheduling), then with ``-p
+(the default executor, the node's own wait-set loop; the default backend, DAQP
+with its verified warm start, in the compiled cycle; normal scheduling), then with ``-p
 thread_priority:=50`` (the spinning thread SCHED_FIFO 50, as ros2_control's
 controller_manager asks for its loop), with ``-p solver.compiled:=false``
 (the Python cycle, the default before the compiled one), with that and
 ``-p solver.warm_start:=false`` as well (the cold ProxSuite default before the
-warm start), with ``-p solver.backend:=daqp``, with ``-p object_loop.enabled:=false``
+warm start), with ``-p solver.backend:=proxsuite -p solver.fallback:=daqp`` (the
+default before DAQP's compiled cycle), with ``-p object_loop.enabled:=false``
 (the params file's object loop off: its share of the cost), and the trivial
 echo node of ``bench/node_load.py`` (one zero command per joint state), taking
 joint states with sensor-data QoS (keep last 5) and, as ``echo, joint_states depth
@@ -78,7 +78,8 @@ TARGETS = {'echo': None, 'echo, joint_states depth 1': None, 'echo, SCHED_FIFO 5
            'grasp_torque_node compiled:=false': ['-p', 'solver.compiled:=false'],
            'grasp_torque_node warm_start:=false compiled:=false':
                ['-p', 'solver.warm_start:=false', '-p', 'solver.compiled:=false'],
-           'grasp_torque_node backend:=daqp': ['-p', 'solver.backend:=daqp'],
+           'grasp_torque_node backend:=proxsuite':
+               ['-p', 'solver.backend:=proxsuite', '-p', 'solver.fallback:=daqp'],
            'grasp_torque_node object_loop:=false': ['-p', 'object_loop.enabled:=false']}
 DRAIN_S = 0.5
 READY_TIMEOUT_S = 15.0

@@ -17,12 +17,13 @@ For each hand, joint-state rate and rclpy executor, these answering processes
 are measured in turn with the same load process:
 
 - ``grasp_torque_node`` (``--executor E``, the hand's ``config/*_node.yaml``,
-  ``publish_stamped_command:=true``), as configured (ProxSuite, the compiled cycle
+  ``publish_stamped_command:=true``), as configured (DAQP, the compiled cycle
   where it applies, normal scheduling), with ``thread_priority:=50`` (the spinning
   thread SCHED_FIFO 50 where the system allows; target ``grasp_torque_node/fifo``),
   with ``solver.compiled:=false`` (the Python cycle,
-  target ``grasp_torque_node/python``) and with ``solver.backend:=daqp`` (target
-  ``grasp_torque_node/daqp``);
+  target ``grasp_torque_node/python``) and with ``solver.backend:=proxsuite``
+  ``solver.fallback:=daqp`` (target ``grasp_torque_node/proxsuite``, the default
+  before DAQP's compiled cycle);
 - an echo node written here, named ``grasp_torque_node`` too, that answers each
   joint state with zero torques on ``effort_commands`` and the stamped copy on
   ``~/effort_commands_stamped``: rclpy's own floor on this machine. It spins
@@ -82,13 +83,14 @@ from ros_load import (  # noqa: E402
 
 HANDS = {'allegro': ('allegro_right.yaml', 'allegro_right_node.yaml'),
          'planar': ('planar_two_finger.yaml', 'planar_two_finger_node.yaml')}
-#: Answering nodes: the echo node, the node as configured (ProxSuite), and with DAQP.
+#: Answering nodes: the echo node, the node as configured (DAQP), and with ProxSuite.
 TARGETS = ('echo', 'echo/fifo', 'grasp_torque_node', 'grasp_torque_node/fifo',
-           'grasp_torque_node/python', 'grasp_torque_node/daqp')
+           'grasp_torque_node/python', 'grasp_torque_node/proxsuite')
 #: The node's arguments added per target (the default: none).
 TARGET_ARGS = {'grasp_torque_node/fifo': ['-p', 'thread_priority:=50'],
                'grasp_torque_node/python': ['-p', 'solver.compiled:=false'],
-               'grasp_torque_node/daqp': ['-p', 'solver.backend:=daqp']}
+               'grasp_torque_node/proxsuite': ['-p', 'solver.backend:=proxsuite',
+                                               '-p', 'solver.fallback:=daqp']}
 WARMUP_S = 1.0
 #: After the last joint state, how long commands in flight are still awaited [s].
 DRAIN_S = 0.5
