@@ -32,6 +32,11 @@ The paths:
   "compiled answered" counts its certified cycles) and with ``compiled=False``
   (the Python cycle everywhere).
 
+With ``--params FILE`` it times only the cycle as the node makes it from a params file
+(the bundled ``config/allegro_right_node.yaml``: its backend, its object loop and
+margins), as the file says and with ``solver.backend`` ProxSuite, and the compiled
+call's stages from its own timings.
+
 With ``--geometry`` it also times the contacts from geometry per call
 (``bench/geometry.py``: the Allegro's tips against the ball by the closed form and by
 coal, ``contacts: auto``, a mesh object), what the node would add to each cycle.
@@ -63,6 +68,7 @@ from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.scenario import load_scenario
 from grasp_torque_opt.methods.dispatch import solve
 import numpy as np
+import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ['planar_two_finger.yaml', 'allegro_right.yaml']
@@ -264,6 +270,85 @@ def node_geometry_table(results: dict) -> str:
     return '\n'.join(lines) + '\n\n(times in us)'
 
 
+#: The params-file cycle's variants: name -> parameters over the file's (none: as is).
+PARAMS_VARIANTS = {'as the file says': {},
+                   'backend proxsuite, fallback daqp': {'backend': 'proxsuite',
+                                                        'fallback': 'daqp'}}
+
+
+def bench_params(params: Path, repeats: int, motion: str) -> dict:
+    """
+    Time the cycle as the node makes it from a params file, per :data:`PARAMS_VARIANTS`.
+
+    The controller is the node's own (``sim_compare.params_file`` and the node's
+    ``configure``), the object's estimate from the fingertips placed as the node places
+    it; joint states only (no IMU, contacts or wrench messages, as
+    ``bench/node_blackbox.py`` sends them), one every millisecond of the monotonic clock.
+    Per variant: the cycle (take and cycle) median and p99, and the compiled call's
+    stages (its own timings) with the solver's iterations, medians.
+    """
+    from grasp_torque_opt.core.object_from_hand import ObjectFromHand
+    from grasp_torque_opt.ros.node.controllers import configure
+    from grasp_torque_opt.ros.sim_compare import params_file
+
+    doc = yaml.safe_load(params.read_text())
+    name = next(iter(doc.values()))['ros__parameters']['scenario']
+    path = ROOT / 'config' / name
+    scenario, setup = load_scenario(path), GraspSetup.from_file(path)
+    out = {'params': str(params.relative_to(ROOT)) if params.is_relative_to(ROOT) else
+           str(params), 'motion': motion, 'variants': {}}
+    for variant, over in PARAMS_VARIANTS.items():
+        p = params_file(params, scenario, setup)
+        if over:
+            p = dataclasses.replace(p, solver=dataclasses.replace(p.solver, **over))
+        ctrl = configure(None, setup, p, obj=scenario.object)
+        obj = scenario.object
+        ctrl.solving.hand_object = ObjectFromHand(setup.hand, setup.contacts, setup.q,
+                                                  object_pose(obj.position, obj.rpy))
+        names = list(setup.hand.joints)
+        q0 = setup.q[setup.hand.idx_q]
+        samples, stages, published = [], {k: [] for k in (*STAGES, 'iterations')}, 0
+        for i, dq in enumerate(offsets(q0.size, repeats + 50, motion)):
+            positions = (q0 + dq).tolist()
+            now = time.monotonic()
+            t0 = time.perf_counter()
+            ctrl.take('joint_states', JointStateReading(names, positions), now)
+            result = ctrl.cycle(now)
+            elapsed = time.perf_counter() - t0
+            if i >= 50:
+                samples.append(elapsed)
+                published += result.kind == 'solution'
+                sol = result.solution
+                if sol is not None and sol.timings:
+                    for k in STAGES:
+                        stages[k].append(sol.timings[k])
+                    stages['iterations'].append(sol.iterations)
+            while time.monotonic() < now + 1e-3:  # the next joint state a millisecond on
+                pass
+        fast = ctrl.compiled_cycle
+        out['variants'][variant] = {
+            'backend': ctrl.solver.name, 'total': summary(samples), 'certified': published,
+            'cycles': repeats, 'compiled_solves': fast.solves if fast is not None else 0,
+            'stages_median': {k: float(np.median(v)) if v else None for k, v in stages.items()}}
+    return out
+
+
+def params_table(r: dict) -> str:
+    """Format the params-file cycle's table [us]."""
+    lines = [f"the cycle as the node makes it from {r['params']} ({r['motion']} motion, joint "
+             'states only):', '',
+             '| variant | backend | cycle median | cycle p99 | certified | compiled answered '
+             '| compiled maps | build | solve | certify | solver iterations (median) |',
+             '|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|']
+    for name, v in r['variants'].items():
+        st = v['stages_median']
+        us = ' | '.join('-' if st[k] is None else f'{1e6 * st[k]:.1f}' for k in STAGES)
+        lines.append(f"| {name} | {v['backend']} | {1e6 * v['total']['median_s']:.0f} | "
+                     f"{1e6 * v['total']['p99_s']:.0f} | {v['certified']} of {v['cycles']} | "
+                     f"{v['compiled_solves']} | {us} | {st['iterations'] or '-'} |")
+    return '\n'.join(lines)
+
+
 def table(results: dict) -> str:
     """Format a markdown table: per scenario and backend, stage medians [us], totals."""
     head = ('| scenario | backend, motion | maps | build | solve | certify | core median '
@@ -302,8 +387,18 @@ def main() -> None:
     parser.add_argument('--out', type=Path, help='also write the results here (JSON)')
     parser.add_argument('--geometry', action='store_true',
                         help='also time the contacts from geometry (bench/geometry.py)')
+    parser.add_argument('--params', type=Path, metavar='FILE',
+                        help="only the cycle as the node makes it from this params file "
+                        "(e.g. config/allegro_right_node.yaml), as the file says and with "
+                        "ProxSuite; the first of --motions")
     args = parser.parse_args()
     single_threaded_math()
+    if args.params is not None:
+        results = {'machine': machine(), 'repeats': args.repeats,
+                   'params': bench_params(args.params.resolve(), args.repeats,
+                                          args.motions.split(',')[0])}
+        report(results, params_table(results['params']), args.out)
+        return
     results = run(args.repeats, tuple(args.backends.split(',')),
                   tuple(args.motions.split(',')))
     text = table(results)
