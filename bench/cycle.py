@@ -388,9 +388,9 @@ def main() -> None:
     parser.add_argument('--geometry', action='store_true',
                         help='also time the contacts from geometry (bench/geometry.py)')
     parser.add_argument('--params', type=Path, metavar='FILE',
-                        help="only the cycle as the node makes it from this params file "
-                        "(e.g. config/allegro_right_node.yaml), as the file says and with "
-                        "ProxSuite; the first of --motions")
+                        help='only the cycle as the node makes it from this params file '
+                        '(e.g. config/allegro_right_node.yaml), as the file says and with '
+                        'ProxSuite; the first of --motions')
     args = parser.parse_args()
     single_threaded_math()
     if args.params is not None:
