@@ -266,11 +266,11 @@ class CycleConfig:
             optimum from QPs with a certified gap to it, docs/adaptive.md; needs DAQP; warm across
             cycles when solver.warm_start; solver.backend is then its fallback polygon's solver;
             slower than tau-qp, docs/adaptive.md); the ~/solve JSON carries its bounds.
-        compiled: (``solver.compiled``) Run the cycle compiled (maps, build, ProxSuite solve and
-            certificate in C++, src/fast_cycle.hpp, docs/design.md section 2.6) where it applies:
-            tau-qp, sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on
-            any answer it cannot certify, the Python cycle answers (diagnostics solver.compiled
-            says which and why); false, the Python cycle always.
+        compiled: (``solver.compiled``) Run the cycle compiled (maps, build, DAQP or ProxSuite
+            solve and certificate in C++, src/fast_cycle.hpp, docs/design.md section 2.6) where it
+            applies: tau-qp, sum-of-squares, DAQP or ProxSuite, A = [G; J^T] of full column rank.
+            Elsewhere, and on any answer it cannot certify, the Python cycle answers (diagnostics
+            solver.compiled says which and why); false, the Python cycle always.
         certificate_tolerance: Tolerance of the certificate on every residual. [SI]
         command_interface: What the node publishes, in its driver's units (docs/node.md, Command
             interfaces): effort (joint torques [N m], std_msgs/Float64MultiArray on
@@ -700,11 +700,11 @@ class ParamsSolver:
             check or is not certified is redone cold in the same cycle and counted (diagnostics
             solver.warm_start_fallbacks); no effect on quadprog; the ~/solve service always solves
             cold.
-        compiled: Run the cycle compiled (maps, build, ProxSuite solve and certificate in C++,
-            src/fast_cycle.hpp, docs/design.md section 2.6) where it applies: tau-qp,
-            sum-of-squares, ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on any
-            answer it cannot certify, the Python cycle answers (diagnostics solver.compiled says
-            which and why); false, the Python cycle always.
+        compiled: Run the cycle compiled (maps, build, DAQP or ProxSuite solve and certificate in
+            C++, src/fast_cycle.hpp, docs/design.md section 2.6) where it applies: tau-qp,
+            sum-of-squares, DAQP or ProxSuite, A = [G; J^T] of full column rank. Elsewhere, and on
+            any answer it cannot certify, the Python cycle answers (diagnostics solver.compiled
+            says which and why); false, the Python cycle always.
         eps_abs: Solver absolute tolerance (ProxSuite eps_abs, DAQP primal_tol).
         max_iter: Solver iteration cap (ProxSuite outer, DAQP).
         max_iter_in: ProxSuite inner iteration cap; one outer iteration, up to this many inner
