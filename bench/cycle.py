@@ -181,6 +181,29 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jit
     return out
 
 
+def timed_cycles(ctrl: TorqueController, setup: GraspSetup, repeats: int, motion: str,
+                 paced: bool = False):
+    """
+    Yield (seconds, result) of ``repeats`` cycles after 50 of warm-up: take a state, cycle.
+
+    ``paced``: one joint state a millisecond of the monotonic clock (as at 1 kHz), else
+    back to back.
+    """
+    names = list(setup.hand.joints)
+    q0 = setup.q[setup.hand.idx_q]
+    for i, dq in enumerate(offsets(q0.size, repeats + 50, motion)):
+        positions = (q0 + dq).tolist()
+        now = time.monotonic()
+        t0 = time.perf_counter()
+        ctrl.take('joint_states', JointStateReading(names, positions), now)
+        result = ctrl.cycle(now)
+        elapsed = time.perf_counter() - t0
+        if i >= 50:
+            yield elapsed, result
+        while paced and time.monotonic() < now + 1e-3:
+            pass
+
+
 def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jitter',
                      compiled: bool = True, scenario=None) -> dict:
     """
@@ -201,19 +224,10 @@ def bench_controller(setup: GraspSetup, variant: str, repeats: int, motion: str 
         ctrl.solving.tracker = ContactTracker(GeometryContacts.bind(
             setup.hand, resolve_urdf(scenario.urdf, scenario.base_dir), obj, 1e-3,
             [c.link for c in scenario.contacts]), obj)
-    names = list(setup.hand.joints)
-    q0 = setup.q[setup.hand.idx_q]
     samples, published = [], 0
-    for i, dq in enumerate(offsets(q0.size, repeats + 50, motion)):
-        positions = (q0 + dq).tolist()
-        now = time.monotonic()
-        t0 = time.perf_counter()
-        ctrl.take('joint_states', JointStateReading(names, positions), now)
-        result = ctrl.cycle(now)
-        elapsed = time.perf_counter() - t0
-        if i >= 50:
-            samples.append(elapsed)
-            published += result.kind == 'solution'
+    for elapsed, result in timed_cycles(ctrl, setup, repeats, motion):
+        samples.append(elapsed)
+        published += result.kind == 'solution'
     solver = ctrl.solver
     fast = ctrl.compiled_cycle
     return {'total': summary(samples), 'certified_commands': published, 'cycles': repeats,
@@ -305,26 +319,15 @@ def bench_params(params: Path, repeats: int, motion: str) -> dict:
         obj = scenario.object
         ctrl.solving.hand_object = ObjectFromHand(setup.hand, setup.contacts, setup.q,
                                                   object_pose(obj.position, obj.rpy))
-        names = list(setup.hand.joints)
-        q0 = setup.q[setup.hand.idx_q]
         samples, stages, published = [], {k: [] for k in (*STAGES, 'iterations')}, 0
-        for i, dq in enumerate(offsets(q0.size, repeats + 50, motion)):
-            positions = (q0 + dq).tolist()
-            now = time.monotonic()
-            t0 = time.perf_counter()
-            ctrl.take('joint_states', JointStateReading(names, positions), now)
-            result = ctrl.cycle(now)
-            elapsed = time.perf_counter() - t0
-            if i >= 50:
-                samples.append(elapsed)
-                published += result.kind == 'solution'
-                sol = result.solution
-                if sol is not None and sol.timings:
-                    for k in STAGES:
-                        stages[k].append(sol.timings[k])
-                    stages['iterations'].append(sol.iterations)
-            while time.monotonic() < now + 1e-3:  # the next joint state a millisecond on
-                pass
+        for elapsed, result in timed_cycles(ctrl, setup, repeats, motion, paced=True):
+            samples.append(elapsed)
+            published += result.kind == 'solution'
+            sol = result.solution
+            if sol is not None and sol.timings:
+                for k in STAGES:
+                    stages[k].append(sol.timings[k])
+                stages['iterations'].append(sol.iterations)
         fast = ctrl.compiled_cycle
         out['variants'][variant] = {
             'backend': ctrl.solver.name, 'total': summary(samples), 'certified': published,
