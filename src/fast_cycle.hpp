@@ -614,7 +614,6 @@ public:
     int iterations = 0;
     int flag = daqp_run(warm, limit, iterations);
     double kkt = daqp_answer_kkt(flag, rows);
-    a.warm = false;
     if (warm) {
       a.warm_solves += 1;
       a.warm = kkt <= s_.kkt_tolerance;
@@ -635,7 +634,6 @@ public:
     a.message = "DAQP exit flag " + std::to_string(flag);
     if (flag != 1 || !(kkt <= s_.kkt_tolerance)) {
       have_active_ = false;
-      a.warm = false;
       a.code = NOT_SOLVED;
       if (flag == 1) {
         a.message += ", but KKT violated by " + std::to_string(kkt);

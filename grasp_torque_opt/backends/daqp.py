@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import ctypes
 from dataclasses import dataclass
+from functools import cache
 from importlib import metadata
 import math
 import time
@@ -75,6 +76,7 @@ def kkt_violation(H: np.ndarray, g: np.ndarray, A: np.ndarray, lower: np.ndarray
 DAQP_C_VERSIONS = ('0.11.0',)
 
 
+@cache
 def daqp_entry() -> tuple[int, int] | None:
     """
     Return the addresses of DAQP's ``daqp_quadprog`` and ``daqp_default_settings``.
@@ -82,7 +84,8 @@ def daqp_entry() -> tuple[int, int] | None:
     The daqp Python module's extension is DAQP's C library compiled in, its functions
     exported: the compiled batch and cycle call them there, the same code ``daqp.solve`` runs.
     None when the installed daqp is not a release whose structs the compiled batch
-    declares (:data:`DAQP_C_VERSIONS`), or the functions are not found.
+    declares (:data:`DAQP_C_VERSIONS`), or the functions are not found. Looked up once a
+    process (the cycle asks whenever it decides whether its compiled twin applies).
     """
     try:
         import daqp
