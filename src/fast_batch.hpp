@@ -300,13 +300,10 @@ py::dict finish_batch(
   return d;
 }
 
-// The kinematics of N configurations Q (N, nq) of a tree of 1-DoF joints
-// (core/tree_kinematics.TreeKinematics, whose numpy twin this is): joint j (1..nj-1)
-// has parent parents[j] (< j), revolute (kinds[j] = 0) or prismatic (1) along axes[j]
-// (joint frame), placement (Rp[j], tp[j]) in its parent, position Q[:, idx_q[j]] and
-// velocity column idx_v[j]. Frame i is placed at (Rf[i], tf[i]) in joint fparent[i].
-// Returns (oMf (N, p, 4, 4), J6 (N, p, 6, nv)): LOCAL_WORLD_ALIGNED at each frame's
-// origin, as Pinocchio's getFrameJacobian.
+// The kinematics of N configurations Q (N, nq) of a tree (tree_kinematics.hpp: the
+// joint tables as Tree takes them). Frame i is placed at (Rf[i], tf[i]) in joint
+// fparent[i]. Returns (oMf (N, p, 4, 4), J6 (N, p, 6, nv)): LOCAL_WORLD_ALIGNED at each
+// frame's origin, as Pinocchio's getFrameJacobian.
 py::tuple kinematics_batch(
   Array Q, py::array_t<int64_t> parents, py::array_t<int64_t> kinds, Array axes, Array Rp,
   Array tp, py::array_t<int64_t> idx_q, py::array_t<int64_t> idx_v,
@@ -319,62 +316,22 @@ py::tuple kinematics_batch(
     kinds.size() == nj && axes.size() == 3 * nj && Rp.size() == 9 * nj &&
     tp.size() == 3 * nj && idx_q.size() == nj && idx_v.size() == nj &&
     Rf.size() == 9 * p && tf.size() == 3 * p && nv > 0, "joint or frame tables of the wrong shape");
-  const int64_t * par = parents.data(), * kind = kinds.data(), * iq = idx_q.data();
-  const int64_t * iv = idx_v.data(), * fp = fparent.data();
-  for (py::ssize_t j = 1; j < nj; ++j) {
-    expect(
-      par[j] >= 0 && par[j] < j && iq[j] >= 0 && iq[j] < nq && iv[j] >= 0 && iv[j] < nv,
-      "joint table out of range");
-  }
+  Tree tree(
+    nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
+    idx_v.data(), nq, nv);
+  const int64_t * fp = fparent.data();
   for (py::ssize_t i = 0; i < p; ++i) {
     expect(fp[i] >= 0 && fp[i] < nj, "frame table out of range");
   }
-  using M3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-  using V3 = Eigen::Vector3d;
   auto oMf = zeros({N, p, 4, 4}), J6 = zeros({N, p, 6, nv});
   {
     py::gil_scoped_release release;
-    std::vector<M3> R(nj);
-    std::vector<V3> t(nj), axis(nj);
-    std::vector<std::vector<int64_t>> support(nj);
-    for (py::ssize_t j = 1; j < nj; ++j) {
-      support[j] = support[par[j]];
-      support[j].push_back(j);
-    }
     for (py::ssize_t n = 0; n < N; ++n) {
-      const double * q = Q.data() + nq * n;
-      R[0].setIdentity();
-      t[0].setZero();
-      for (py::ssize_t j = 1; j < nj; ++j) {
-        const M3 base = R[par[j]] * Eigen::Map<const M3>(Rp.data() + 9 * j);
-        const V3 a = Eigen::Map<const V3>(axes.data() + 3 * j);
-        t[j] = t[par[j]] + R[par[j]] * Eigen::Map<const V3>(tp.data() + 3 * j);
-        if (kind[j] == 0) {
-          R[j] = base * Eigen::AngleAxisd(q[iq[j]], a).toRotationMatrix();
-        } else {
-          R[j] = base;
-          t[j] += q[iq[j]] * (base * a);
-        }
-        axis[j] = R[j] * a;
-      }
+      tree.place(Q.data() + nq * n);
       for (py::ssize_t i = 0; i < p; ++i) {
-        const int64_t j = fp[i];
-        const M3 Rw = R[j] * Eigen::Map<const M3>(Rf.data() + 9 * i);
-        const V3 o = t[j] + R[j] * Eigen::Map<const V3>(tf.data() + 3 * i);
-        Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(
-          oMf.mutable_data() + 16 * (p * n + i));
-        M.topLeftCorner<3, 3>() = Rw;
-        M.topRightCorner<3, 1>() = o;
-        M(3, 3) = 1.0;
-        Eigen::Map<RowMat> Jm(J6.mutable_data() + 6 * nv * (p * n + i), 6, nv);
-        for (int64_t s : support[j]) {
-          if (kind[s] == 0) {
-            Jm.block<3, 1>(0, iv[s]) = axis[s].cross(o - t[s]);
-            Jm.block<3, 1>(3, iv[s]) = axis[s];
-          } else {
-            Jm.block<3, 1>(0, iv[s]) = axis[s];
-          }
-        }
+        tree.frame(
+          fp[i], Rf.data() + 9 * i, tf.data() + 3 * i, oMf.mutable_data() + 16 * (p * n + i),
+          J6.mutable_data() + 6 * nv * (p * n + i));
       }
     }
   }

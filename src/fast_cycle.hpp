@@ -39,6 +39,8 @@
 
 #include <proxsuite/proxqp/dense/dense.hpp>
 
+#include "tree_kinematics.hpp"
+
 namespace py = pybind11;
 namespace dense = proxsuite::proxqp::dense;
 
@@ -337,6 +339,100 @@ public:
     return a;
   }
 
+  // Compute the contact links' kinematics here, from the hand's tree (Tree's tables,
+  // as kinematics_batch takes them), for solve_q.
+  void use_tree(
+    py::array_t<int64_t> parents, py::array_t<int64_t> kinds, Array axes, Array Rp,
+    Array tp, py::array_t<int64_t> idx_q, py::array_t<int64_t> idx_v, int64_t nq, int64_t nv)
+  {
+    const py::ssize_t nj = parents.size();
+    if (kinds.size() != nj || axes.size() != 3 * nj || Rp.size() != 9 * nj ||
+      tp.size() != 3 * nj || idx_q.size() != nj || idx_v.size() != nj)
+    {
+      throw std::invalid_argument("joint or frame tables of the wrong shape");
+    }
+    for (int64_t j : idx_v_) {
+      if (j < 0 || j >= nv) {
+        throw std::invalid_argument("joint index out of range");
+      }
+    }
+    tree_ = std::make_unique<Tree>(
+      nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
+      idx_v.data(), nq, nv);
+  }
+
+  bool uses_tree() const {return tree_ != nullptr;}
+
+  // One cycle at configuration q (nq) with the kinematics of use_tree(): contact i on the
+  // link frame placed at (Rf[i], tf[i]) in joint fparent[i]; the rest as solve().
+  Answer solve_q(
+    Array q, py::array_t<int64_t> fparent, Array Rf, Array tf, Array points, Array normals,
+    py::array_t<bool> has_normal, Array tangents, py::array_t<bool> has_tangent, Array c,
+    Array w_ext, Array offset, double time_left)
+  {
+    Answer a;
+    const auto t0 = Clock::now();
+    const int p = static_cast<int>(fparent.size());
+    Kinematics k;
+    if (tree_ == nullptr) {
+      a.message = "no tree kinematics (use_tree)";
+      return a;
+    }
+    const int64_t nv = tree_->nv();
+    bool fits = q.size() == tree_->nq() && Rf.size() == 9 * p && tf.size() == 3 * p &&
+      w_ext.size() == 6 && (offset.size() == 0 || offset.size() == m_) && p > 0;
+    for (int i = 0; fits && i < p; ++i) {
+      fits = fparent.data()[i] >= 0 && fparent.data()[i] < tree_->joints();
+    }
+    if (!fits || !borrow_contacts(p, points, normals, has_normal, tangents, has_tangent, c, k)) {
+      a.message = "inputs of the wrong shape";
+      return a;
+    }
+    oMf_.resize(16 * p);
+    J6_.resize(6 * nv * p);
+    tree_->place(q.data());
+    for (int i = 0; i < p; ++i) {
+      tree_->frame(
+        fparent.data()[i], Rf.data() + 9 * i, tf.data() + 3 * i, oMf_.data() + 16 * i,
+        J6_.data() + 6 * nv * i);
+    }
+    k.p = p;
+    k.nv = static_cast<int>(nv);
+    k.oMf = oMf_.data();
+    k.J6 = J6_.data();
+    Eigen::Map<const Wrench> w_ext_v(w_ext.data());
+    Vec off = offset.size() ? Vec(Eigen::Map<const Vec>(offset.data(), m_)) :
+      Vec::Zero(m_);
+    {
+      py::gil_scoped_release release;
+      run(a, k, w_ext_v, off, time_left, t0);
+    }
+    return a;
+  }
+
+  // The contact arrays of p contacts as the maps stage takes them; false where they do
+  // not fit.
+  bool borrow_contacts(
+    int p, const Array & points, const Array & normals, const py::array_t<bool> & has_normal,
+    const Array & tangents, const py::array_t<bool> & has_tangent, const Array & c,
+    Kinematics & k) const
+  {
+    if (points.ndim() != 2 || points.shape(0) != p || points.shape(1) != 3 ||
+      normals.ndim() != 2 || normals.shape(0) != p || normals.shape(1) != 3 ||
+      tangents.ndim() != 2 || tangents.shape(0) != p || tangents.shape(1) != 3 ||
+      has_normal.size() != p || has_tangent.size() != p || c.size() != 3 || p == 0)
+    {
+      return false;
+    }
+    k.points = points.data();
+    k.normals = normals.data();
+    k.has_normal = has_normal.data();
+    k.tangents = tangents.data();
+    k.has_tangent = has_tangent.data();
+    k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
+    return true;
+  }
+
   // The arrays of one cycle's kinematics as the maps stage takes them; false and why
   // where they do not fit.
   bool borrow(
@@ -347,9 +443,8 @@ public:
   {
     const int p = static_cast<int>(oMf.shape(0));
     if (oMf.ndim() != 3 || oMf.shape(1) != 4 || oMf.shape(2) != 4 || J6.ndim() != 3 ||
-      J6.shape(0) != p || J6.shape(1) != 6 || points.shape(0) != p ||
-      normals.shape(0) != p || tangents.shape(0) != p || has_normal.size() != p ||
-      has_tangent.size() != p || c.size() != 3 || p == 0)
+      J6.shape(0) != p || J6.shape(1) != 6 ||
+      !borrow_contacts(p, points, normals, has_normal, tangents, has_tangent, c, k))
     {
       why = "inputs of the wrong shape";
       return false;
@@ -365,12 +460,6 @@ public:
     k.nv = nv;
     k.oMf = oMf.data();
     k.J6 = J6.data();
-    k.points = points.data();
-    k.normals = normals.data();
-    k.has_normal = has_normal.data();
-    k.tangents = tangents.data();
-    k.has_tangent = has_tangent.data();
-    k.c = Eigen::Map<const Eigen::Vector3d>(c.data());
     return true;
   }
 
@@ -944,6 +1033,8 @@ private:
   Vec g_, up_, lo_, x_, lam_;
   std::vector<int> sense0_, active_, sense_;
   bool have_active_ = false;
+  std::unique_ptr<Tree> tree_;  // use_tree's; solve_q's kinematics
+  std::vector<double> oMf_, J6_;
 };
 
 py::array_t<double> to_array(const Vec & v)
@@ -1013,7 +1104,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 6;
+  mod.attr("API") = 7;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -1075,6 +1166,15 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
   .def("use_daqp", &FastCycle::use_daqp, py::arg("quadprog"), py::arg("defaults"),
     py::arg("primal_tol"), py::arg("iter_limit"), py::arg("iteration_s"),
     "Solve with DAQP's C entry (its addresses) instead of ProxSuite.")
+  .def("use_tree", &FastCycle::use_tree, py::arg("parents"), py::arg("kinds"),
+    py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"), py::arg("idx_v"),
+    py::arg("nq"), py::arg("nv"),
+    "Compute the contact links' kinematics from the hand's tree (for solve_q).")
+  .def("solve_q", &FastCycle::solve_q, py::arg("q"), py::arg("fparent"), py::arg("Rf"),
+    py::arg("tf"), py::arg("points"), py::arg("normals"), py::arg("has_normal"),
+    py::arg("tangents"), py::arg("has_tangent"), py::arg("c"), py::arg("w_ext"),
+    py::arg("offset"), py::arg("time_left"))
+  .def_property_readonly("uses_tree", &FastCycle::uses_tree)
   .def_property_readonly("uses_daqp", &FastCycle::uses_daqp)
   .def_property_readonly("inits", &FastCycle::dims_changes)
   // The four stages of solve() one by one, on given inputs (the parity tests).

@@ -24,12 +24,16 @@ the case the node runs on every joint state (docs/design.md section 2.6):
   :func:`~grasp_torque_opt.core.tau_qp.decompose`: no internal-force variables, as
   for the Allegro's four fingertips).
 
-Pinocchio's kinematics stay in Python (about 10 us). A warm answer that the solver does
-not call solved, or that fails the KKT check or the certificate, is redone cold in the
-same call, as the Python solver does. What the compiled cycle cannot certify, it hands
-back: :meth:`CompiledCycle.solve` returns None with the reason, and the controller runs
-the Python cycle, which stays the reference and is what the tests hold the compiled
-one to.
+The contact links' placements and Jacobians are computed in the same call where the
+hand is a tree of 1-DoF revolute and prismatic joints
+(:class:`~grasp_torque_opt.core.tree_kinematics.TreeKinematics`'s rules, held to
+Pinocchio's at the first configuration of each contact link), else asked of Pinocchio
+in Python (about 15 us a cycle: two calls a contact into its binding). A warm answer
+that the solver does not call solved, or that fails the KKT check or the certificate,
+is redone cold in the same call, as the Python solver does. What the compiled cycle
+cannot certify, it hands back: :meth:`CompiledCycle.solve` returns None with the
+reason, and the controller runs the Python cycle, which stays the reference and is
+what the tests hold the compiled one to.
 """
 
 from __future__ import annotations
@@ -51,6 +55,7 @@ from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
+from grasp_torque_opt.core.tree_kinematics import supported as tree_supported, TreeKinematics
 from grasp_torque_opt.methods.batch import contact_arrays
 from grasp_torque_opt.native.loader import fast_cycle, IMPORT_ERROR
 import numpy as np
@@ -119,6 +124,9 @@ class _Contacts:
     has_normal: np.ndarray
     tangents: np.ndarray
     has_tangent: np.ndarray
+    #: The links' frames as the compiled kinematics takes them (parent joints, placement
+    #: rotations and translations), or None: Pinocchio's kinematics in Python.
+    frames: tuple[np.ndarray, np.ndarray, np.ndarray] | None
 
 
 class CompiledCycle:
@@ -132,10 +140,13 @@ class CompiledCycle:
             compiled solves too.
         tolerance: certificate tolerance.
         module: the compiled module to use (default: the best one built for this CPU).
+        previous: the compiled cycle this one replaces (a squeeze or a parameter moved
+            the grasp's constants): its hand's tree and checked links are kept when the
+            hand is the same.
     """
 
     def __init__(self, setup: GraspSetup, solver: TauQPSolver, tolerance: float,
-                 module=None) -> None:
+                 module=None, previous: CompiledCycle | None = None) -> None:
         self.solver = solver
         self.tolerance = tolerance
         #: What it was made for (held, so that an identity check cannot meet a new
@@ -169,6 +180,17 @@ class CompiledCycle:
                                  solver.settings.iter_limit, daqp_backend.ITERATION_S)
         self._joints = list(hand.joints)
         self._contacts: _Contacts | None = None
+        #: The hand's tree for the kinematics in the compiled call (None: Pinocchio's, in
+        #: Python), and the contact links already held to Pinocchio's.
+        self.tree: TreeKinematics | None = None
+        self._tree_checked: set[int] = set()
+        if previous is not None and previous._made_for[0] is hand \
+                and previous.module is self.module:
+            self.tree, self._tree_checked = previous.tree, previous._tree_checked
+        elif not tree_supported(hand.model):
+            self.tree = TreeKinematics(hand.model, self.module)
+        if self.tree is not None:
+            self._cycle.use_tree(*self.tree.tables, hand.model.nq, hand.model.nv)
         self._no_offset = np.zeros(0)
         #: Cycles answered here, and handed back to the Python cycle (by reason code).
         self.solves = 0
@@ -203,8 +225,25 @@ class CompiledCycle:
             setup.hand, setup.contacts)
         self._contacts = c = _Contacts(
             specs=setup.contacts, frame_ids=fids, links=links, points=points,
-            normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t)
+            normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t,
+            frames=self._frames(setup, fids))
         return c
+
+    def _frames(self, setup: GraspSetup, fids: tuple[int, ...]
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Return the links' frame tables for the compiled kinematics, each link checked once."""
+        tree = self.tree
+        if tree is None:
+            return None
+        new = tuple(f for f in dict.fromkeys(fids) if f not in self._tree_checked)
+        if new:
+            try:  # at this configuration, against Pinocchio's own (the first time only)
+                tree.check(np.array([setup.q]), new)
+            except ValueError:
+                self.tree = None  # never expected for a supported tree: Pinocchio's then
+                return None
+            self._tree_checked.update(new)
+        return tree.frame_tables(fids)
 
     def kinematics(self, setup: GraspSetup, compute: bool = True
                    ) -> tuple[np.ndarray, np.ndarray]:
@@ -241,17 +280,24 @@ class CompiledCycle:
             time_left: seconds the solver may still take (None: only its caps).
             kinematics: compute the joint Jacobians and frame placements at
                 ``setup.q`` here; False: the hand's data already holds them
-                (``grasp_at(..., jacobians=True)``).
+                (``grasp_at(..., jacobians=True)``). Unused where the compiled call
+                computes them (:attr:`tree`).
 
         Returns:
             (certified solution, maps), or (None, why) when the Python cycle must answer.
         """
         c = self._arrays(setup)
-        oMf, J6 = self.kinematics(setup, kinematics)
         offset = self._no_offset if setup.torque_offset is None else setup.torque_offset
-        a = self._cycle.solve(oMf, J6, c.points, c.normals, c.has_normal, c.tangents,
-                              c.has_tangent, setup.object_origin, setup.external_wrench,
-                              offset, -1.0 if time_left is None else time_left)
+        budget = -1.0 if time_left is None else time_left
+        if c.frames is not None:
+            a = self._cycle.solve_q(setup.q, *c.frames, c.points, c.normals, c.has_normal,
+                                    c.tangents, c.has_tangent, setup.object_origin,
+                                    setup.external_wrench, offset, budget)
+        else:
+            oMf, J6 = self.kinematics(setup, kinematics)
+            a = self._cycle.solve(oMf, J6, c.points, c.normals, c.has_normal, c.tangents,
+                                  c.has_tangent, setup.object_origin, setup.external_wrench,
+                                  offset, budget)
         solver = self.solver
         solver.warm_solves += a.warm_solves
         solver.fallbacks += a.redone_cold

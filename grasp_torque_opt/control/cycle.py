@@ -307,13 +307,15 @@ class Cycle:
         # The compiled cycle is made for the squeeze's friction (:meth:`squeezed`); made
         # again when this cycle's grasp moved it.
         fast = self._compiled(replaced(self.setup, friction=self.squeezed()))
-        setup, g = self.grasp_at(inputs, jacobians=fast is not None)
+        # The joint Jacobians for the compiled call, unless it computes its kinematics.
+        jacobians = fast is not None and fast.tree is None
+        setup, g = self.grasp_at(inputs, jacobians=jacobians)
         if fast is not None and setup.friction is not self.setup.friction:
             fast = self._compiled(setup)
         solver, fallback, handed_back = self.solver, self.fallback, ''
         if fast is not None:
             sol, maps = fast.solve(setup, None if deadline is None else
-                                   deadline - time.perf_counter(), kinematics=False)
+                                   deadline - time.perf_counter(), kinematics=not jacobians)
             if sol is not None:
                 return sol, maps, g
             handed_back = maps
@@ -343,7 +345,8 @@ class Cycle:
             return fast
         why = compiled.unsupported(setup, self.config.method, self.solver)
         self.compiled_reason = why
-        self.compiled_cycle = None if why else compiled.CompiledCycle(setup, self.solver, tol)
+        self.compiled_cycle = None if why else compiled.CompiledCycle(
+            setup, self.solver, tol, previous=fast)
         return self.compiled_cycle
 
     def _refiner(self) -> Refiner | None:

@@ -92,6 +92,25 @@ class TreeKinematics:
         self._support = {j: [s for s in model.supports[j] if s > 0]
                          for j in range(model.njoints)}
 
+    @property
+    def tables(self) -> tuple[np.ndarray, ...]:
+        """
+        Return the joint tables as the compiled module takes them (src/tree_kinematics.hpp).
+
+        (parents, kinds: 0 revolute, 1 prismatic; axes, shape (njoints, 3); the
+        placements in the parent, Rp (njoints, 3, 3) and tp (njoints, 3); idx_q, idx_v),
+        joint 0 the root.
+        """
+        return self._tables
+
+    def frame_tables(self, frame_ids: tuple[int, ...]
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Return (parent joints, placement rotations (p, 3, 3), translations (p, 3)) of frames."""
+        frames = [self.model.frames[f] for f in frame_ids]
+        return (np.array([f.parentJoint for f in frames], dtype=np.int64),
+                np.array([f.placement.rotation for f in frames]).reshape(-1, 3, 3),
+                np.array([f.placement.translation for f in frames]).reshape(-1, 3))
+
     def joints(self, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """
         World placements of every joint frame at configurations Q, shape (N, nq).
@@ -130,11 +149,8 @@ class TreeKinematics:
         """
         Q = np.asarray(Q, dtype=float)
         if self.module is not None:
-            frames = [self.model.frames[f] for f in frame_ids]
-            return self.module.kinematics_batch(
-                Q, *self._tables, np.array([f.parentJoint for f in frames], dtype=np.int64),
-                np.array([f.placement.rotation for f in frames]).reshape(-1, 3, 3),
-                np.array([f.placement.translation for f in frames]).reshape(-1, 3), self.nv)
+            return self.module.kinematics_batch(Q, *self._tables,
+                                                *self.frame_tables(frame_ids), self.nv)
         N, p = Q.shape[0], len(frame_ids)
         R, t = self.joints(Q)
         oMf = np.zeros((N, p, 4, 4))

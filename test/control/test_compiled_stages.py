@@ -73,10 +73,13 @@ def cycle_for(setup, module=None):
     return compiled.CompiledCycle(setup, TauQPSolver(warm_start=True), 1e-6, module=module)
 
 
-def compiled_maps(cycle, at):
-    """Run the compiled maps stage on Pinocchio's kinematics of ``at``."""
+def compiled_maps(cycle, at, tree=False):
+    """Run the compiled maps stage on Pinocchio's kinematics of ``at`` (or the tree's)."""
     c = cycle._arrays(at)
-    oMf, J6 = cycle.kinematics(at)
+    if tree:
+        oMf, J6 = (k[0] for k in cycle.tree.frames(np.array([at.q]), c.frame_ids))
+    else:
+        oMf, J6 = cycle.kinematics(at)
     return cycle._cycle.maps(oMf, J6, c.points, c.normals, c.has_normal, c.tangents,
                              c.has_tangent, at.object_origin)
 
@@ -282,7 +285,7 @@ def test_the_cycle_is_its_four_stages_in_order(allegro, module):
             at = with_offset(at, k)
         sol, maps = whole.solve(at, None)
         assert sol is not None, maps
-        m = compiled_maps(staged, at)
+        m = compiled_maps(staged, at, tree=True)  # as solve() computes them
         offset = np.zeros(0) if at.torque_offset is None else at.torque_offset
         qp = staged._cycle.build(m['G'], m['J'], at.external_wrench, offset)
         s = staged._cycle.solve_qp(qp['H'], qp['g'], qp['A'], qp['b'], qp['C'], qp['u'],
@@ -296,3 +299,36 @@ def test_the_cycle_is_its_four_stages_in_order(allegro, module):
         assert whole.solver.last_warm == s['warm'] == (k > 0)
         for name, value in zip(RESIDUALS, cert[:5]):
             assert_near(getattr(sol.certificate, name), value, name)
+
+
+def test_the_compiled_kinematics_are_pinocchios(allegro, module):
+    # The same cycles with the contact links' kinematics computed in the compiled call
+    # (the hand's tree) and asked of Pinocchio in Python: the same maps and answers.
+    inside, outside = cycle_for(allegro, module), cycle_for(allegro, module)
+    assert inside.tree is not None and inside._cycle.uses_tree
+    outside.tree = None  # before its first contacts: Pinocchio's kinematics in Python
+    for at in states(allegro, count=6, scale=0.2):
+        (a, maps_a), (b, maps_b) = inside.solve(at, None), outside.solve(at, None)
+        assert a is not None and b is not None, (maps_a, maps_b)
+        for name in ('G', 'J', 'positions', 'rotations'):
+            assert_near(getattr(maps_a, name), getattr(maps_b, name), name)
+        assert_near(a.tau, b.tau, 'tau', rel=SOLVER_ATOL)
+    assert inside._contacts.frames is not None and outside._contacts.frames is None
+
+
+def test_the_compiled_kinematics_refuse_tables_that_do_not_fit(allegro):
+    cycle = cycle_for(allegro)
+    tables = cycle.tree.tables
+    model = allegro.hand.model
+    with pytest.raises(ValueError, match='wrong shape'):
+        cycle._cycle.use_tree(*tables[:-1], tables[-1][:-1], model.nq, model.nv)
+    with pytest.raises(ValueError, match='out of range'):
+        cycle._cycle.use_tree(*tables, model.nq, 1)
+    c = cycle._arrays(allegro)
+    fparent, Rf, tf = c.frames
+    at = allegro
+    for q, parents in ((at.q[:-1], fparent), (at.q, fparent + model.njoints)):
+        a = cycle._cycle.solve_q(q, parents, Rf, tf, c.points, c.normals, c.has_normal,
+                                 c.tangents, c.has_tangent, at.object_origin,
+                                 at.external_wrench, np.zeros(0), -1.0)
+        assert a.code == loader.fast_cycle.NOT_HANDLED and 'wrong shape' in a.message
