@@ -296,13 +296,15 @@ def bench_params(params: Path, repeats: int, motion: str) -> dict:
 
     The controller is the node's own (``sim_compare.params_file`` and the node's
     ``configure``), the object's estimate from the fingertips placed as the node places
-    it; joint states only (no IMU, contacts or wrench messages, as
+    it, with the scenario's load, object and weight bound as the node binds them
+    (``grasp_source.bind_scenario``: the object loop and the effort estimation run as
+    in the node); joint states only (no IMU, contacts or wrench messages, as
     ``bench/node_blackbox.py`` sends them), one every millisecond of the monotonic clock.
     Per variant: the cycle (take and cycle) median and p99, and the compiled call's
     stages (its own timings) with the solver's iterations, medians.
     """
-    from grasp_torque_opt.core.object_from_hand import ObjectFromHand
     from grasp_torque_opt.ros.node.controllers import configure
+    from grasp_torque_opt.ros.node.grasp_source import bind_scenario
     from grasp_torque_opt.ros.sim_compare import params_file
 
     doc = yaml.safe_load(params.read_text())
@@ -316,9 +318,7 @@ def bench_params(params: Path, repeats: int, motion: str) -> dict:
         if over:
             p = dataclasses.replace(p, solver=dataclasses.replace(p.solver, **over))
         ctrl = configure(None, setup, p, obj=scenario.object)
-        obj = scenario.object
-        ctrl.solving.hand_object = ObjectFromHand(setup.hand, setup.contacts, setup.q,
-                                                  object_pose(obj.position, obj.rpy))
+        bind_scenario((ctrl,), scenario, p, '')
         samples, stages, published = [], {k: [] for k in (*STAGES, 'iterations')}, 0
         for elapsed, result in timed_cycles(ctrl, setup, repeats, motion, paced=True):
             samples.append(elapsed)

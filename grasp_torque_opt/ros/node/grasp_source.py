@@ -275,6 +275,33 @@ def place_object(ctrl: TorqueController, scenario: Scenario, p: Any, urdf: str) 
     ctrl.solving.tracker = ContactTracker(model, obj)
 
 
+def bind_scenario(ctrls: tuple[TorqueController, ...], scenario: Scenario, p: Any,
+                  urdf: str) -> str:
+    """
+    Give controllers what the node's cycle takes from the scenario beyond the grasp.
+
+    Its load as a function of gravity, its object (pose, the fingertips' estimate,
+    contacts from geometry: :func:`place_object`), the links' collision shapes
+    (:func:`bind_surfaces`) and its weight (the effort estimation's bound and the object
+    loop's). The node does this for its loop's and its service's controllers;
+    ``bench/cycle.py --params`` for its own.
+
+    Returns:
+        :func:`bind_surfaces`' warning ('' for none).
+
+    Raises:
+        InputError: as :func:`place_object`.
+    """
+    for c in ctrls:
+        c.load_of_gravity = load_of_gravity(scenario)
+        c.store.object = scenario.object
+        place_object(c, scenario, p, urdf)
+    bare = bind_surfaces(ctrls, scenario, urdf)
+    for c in ctrls:
+        c.solving.weight = weight_of(scenario)
+    return bare
+
+
 def bind_surfaces(ctrls: tuple[TorqueController, ...], scenario: Scenario, urdf: str) -> str:
     """
     Give controllers the links' collision shapes their contact checks use; say what lacks them.

@@ -30,12 +30,9 @@ from grasp_torque_opt.ros.node import controllers
 from grasp_torque_opt.ros.node.declared import DeclaredParameters
 from grasp_torque_opt.ros.node.grasp_source import (
     bind,
-    bind_surfaces,
+    bind_scenario,
     Grasp,
-    load_of_gravity,
-    place_object,
     urdf_document,
-    weight_of,
 )
 from grasp_torque_opt.ros.node.inputs import Inputs
 from grasp_torque_opt.ros.node.outputs import Outputs
@@ -140,14 +137,9 @@ class GraspTorque:
         self._warn_missing_fallback(p)
         ctrl = controllers.configure(None, setup, p, obj=grasp.scenario.object)
         service = controllers.configure(None, setup, p, service=True, obj=grasp.scenario.object)
-        ctrl.load_of_gravity = service.load_of_gravity = load_of_gravity(grasp.scenario)
-        ctrl.store.object = service.store.object = grasp.scenario.object
-        for c in (ctrl, service):
-            place_object(c, grasp.scenario, p, self._urdf)
-        bare = bind_surfaces((ctrl, service), grasp.scenario, self._urdf)
+        bare = bind_scenario((ctrl, service), grasp.scenario, p, self._urdf)
         if bare:
             self.node.get_logger().warning(bare)
-        ctrl.solving.weight = service.solving.weight = weight_of(grasp.scenario)
         # The service plans for the model's load (the scenario's, the IMU's): it does not
         # estimate, and a transient correction of the loop's is not its prediction.
         service.solving.estimating = False
