@@ -1290,6 +1290,58 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     py::arg("primal_tol"), py::arg("iter_limit"), py::arg("eps_prox"),
     py::arg("kkt_tolerance"), py::arg("alpha_max"), py::arg("vertex") = true,
     "The capacity LPs of N candidates, solved by the vertex method or DAQP and checked.");
+  py::class_<TreePoints>(mod, "TreePoints")
+  .def(py::init([](py::array_t<int64_t> parents, py::array_t<int64_t> kinds, Array axes,
+    Array Rp, Array tp, py::array_t<int64_t> idx_q, py::array_t<int64_t> idx_v, int64_t nq,
+    int64_t nv, py::array_t<int64_t> fparent, Array Rf, Array tf, Array local, int64_t base,
+    Array Rb, Array tb) {
+      const py::ssize_t nj = parents.size(), p = fparent.size();
+      expect(
+        kinds.size() == nj && axes.size() == 3 * nj && Rp.size() == 9 * nj &&
+        tp.size() == 3 * nj && idx_q.size() == nj && idx_v.size() == nj &&
+        Rf.size() == 9 * p && tf.size() == 3 * p && local.size() == 3 * p &&
+        Rb.size() == 9 && tb.size() == 3, "joint or frame tables of the wrong shape");
+      return TreePoints(
+        Tree(
+          nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
+          idx_v.data(), nq, nv), p, fparent.data(), Rf.data(), tf.data(), local.data(), base,
+        Rb.data(), tb.data());
+    }), py::arg("parents"), py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"),
+    py::arg("idx_q"), py::arg("idx_v"), py::arg("nq"), py::arg("nv"), py::arg("fparent"),
+    py::arg("Rf"), py::arg("tf"), py::arg("local"), py::arg("base"), py::arg("Rb"),
+    py::arg("tb"))
+  .def("points", [](TreePoints & tp, Array q) {
+      expect(q.size() == tp.nq(), "q of the wrong shape");
+      TreePoints::Points out;
+      tp.points(q.data(), out);
+      return to_array(RowMat(out));
+    }, py::arg("q"), "The points at configuration q, (p, 3).")
+  .def("estimate", [](TreePoints & tp, Array q, Array p0) {
+      expect(q.size() == tp.nq(), "q of the wrong shape");
+      expect(p0.ndim() == 2 && p0.shape(0) == tp.size() && p0.shape(1) == 3,
+        "p0 of the wrong shape");
+      TreePoints::Points p;
+      tp.points(q.data(), p);
+      TreePoints::M3 R;
+      TreePoints::V3 t;
+      Vec residuals;
+      TreePoints::fit(Eigen::Map<const TreePoints::Points>(p0.data(), tp.size(), 3), p, R, t,
+        residuals);
+      return py::make_tuple(to_array(RowMat(R)), to_array(Vec(t)), to_array(RowMat(p)),
+        to_array(residuals));
+    }, py::arg("q"), py::arg("p0"),
+    "(R, t, points, residuals): the rigid motion carrying p0 to the points at q.");
+  mod.def("rigid_fit", [](Array p0, Array p) {
+      expect(p0.ndim() == 2 && p0.shape(1) == 3 && p.ndim() == 2 && p.shape(1) == 3 &&
+        p.shape(0) == p0.shape(0) && p.shape(0) > 0, "p0 or p of the wrong shape");
+      TreePoints::M3 R;
+      TreePoints::V3 t;
+      Vec residuals;
+      TreePoints::fit(Eigen::Map<const TreePoints::Points>(p0.data(), p0.shape(0), 3),
+        Eigen::Map<const TreePoints::Points>(p.data(), p.shape(0), 3), R, t, residuals);
+      return py::make_tuple(to_array(RowMat(R)), to_array(Vec(t)), to_array(residuals));
+    }, py::arg("p0"), py::arg("p"),
+    "(R, t, residuals): Kabsch's rigid motion carrying points p0 (n, 3) to p.");
   mod.def("kinematics_batch", &kinematics_batch, py::arg("Q"), py::arg("parents"),
     py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"),
     py::arg("idx_v"), py::arg("fparent"), py::arg("Rf"), py::arg("tf"), py::arg("nv"),

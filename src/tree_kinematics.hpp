@@ -20,9 +20,11 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include <cstdint>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace
@@ -121,6 +123,91 @@ private:
   std::vector<std::vector<int64_t>> support_;
   std::vector<M3> R_;
   std::vector<V3> t_, axis_;
+};
+
+// Material points of a tree's links in the base frame, and the rigid motion that best
+// carries reference points to them (core/object_from_hand.ObjectFromHand's points and
+// estimate, whose numpy twin this is): point i is local[i] in the frame placed at
+// (Rf[i], tf[i]) in joint fparent[i]; with a base frame (base >= 0, placed at (Rb, tb)
+// in joint base) the points are in its axes about its origin, else in the root's.
+class TreePoints
+{
+public:
+  using M3 = Tree::M3;
+  using V3 = Tree::V3;
+  using Points = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+  TreePoints(
+    Tree tree, int64_t p, const int64_t * fparent, const double * Rf, const double * tf,
+    const double * local, int64_t base, const double * Rb, const double * tb)
+  : tree_(std::move(tree)), fparent_(fparent, fparent + p), Rf_(Rf, Rf + 9 * p),
+    tf_(tf, tf + 3 * p), local_(Eigen::Map<const Points>(local, p, 3)), base_(base),
+    Rb_(Rb, Rb + 9), tb_(tb, tb + 3), oMf_(16), J6_(6 * tree_.nv())
+  {
+    for (int64_t j : fparent_) {
+      if (j < 0 || j >= tree_.joints()) {
+        throw std::invalid_argument("frame table out of range");
+      }
+    }
+    if (base_ >= tree_.joints()) {
+      throw std::invalid_argument("frame table out of range");
+    }
+  }
+
+  int64_t size() const {return static_cast<int64_t>(fparent_.size());}
+  int64_t nq() const {return tree_.nq();}
+
+  // The points at configuration q (nq values), (p, 3) into out.
+  void points(const double * q, Points & out)
+  {
+    tree_.place(q);
+    const int64_t p = size();
+    out.resize(p, 3);
+    for (int64_t i = 0; i < p; ++i) {
+      tree_.frame(fparent_[i], Rf_.data() + 9 * i, tf_.data() + 3 * i, oMf_.data(), J6_.data());
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf_.data());
+      out.row(i) = (M.topLeftCorner<3, 3>() * local_.row(i).transpose() +
+        M.topRightCorner<3, 1>()).transpose();
+    }
+    if (base_ >= 0) {
+      tree_.frame(base_, Rb_.data(), tb_.data(), oMf_.data(), J6_.data());
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf_.data());
+      const M3 R = M.topLeftCorner<3, 3>();
+      const V3 o = M.topRightCorner<3, 1>();
+      for (int64_t i = 0; i < p; ++i) {
+        out.row(i) = ((out.row(i).transpose() - o).transpose() * R);
+      }
+    }
+  }
+
+  // Kabsch's rotation R minimising sum |p_i - m - R (p0_i - m0)|^2 (identity with fewer
+  // than three points), t = m - R m0, and each point's distance from the motion.
+  static void fit(const Points & p0, const Points & p, M3 & R, V3 & t, Eigen::VectorXd & residuals)
+  {
+    const V3 m0 = p0.colwise().mean().transpose(), m = p.colwise().mean().transpose();
+    R.setIdentity();
+    if (p.rows() >= 3) {
+      const Eigen::Matrix3d B = (p.rowwise() - m.transpose()).transpose() *
+        (p0.rowwise() - m0.transpose());
+      Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      Eigen::Matrix3d U = svd.matrixU();
+      const Eigen::Matrix3d V = svd.matrixV();
+      if ((U * V.transpose()).determinant() < 0.0) {
+        U.col(2) = -U.col(2);
+      }
+      R = U * V.transpose();
+    }
+    t = m - R * m0;
+    residuals = ((p0 * R.transpose()).rowwise() + t.transpose() - p).rowwise().norm();
+  }
+
+private:
+  Tree tree_;
+  std::vector<int64_t> fparent_;
+  std::vector<double> Rf_, tf_;
+  Points local_;
+  int64_t base_;
+  std::vector<double> Rb_, tb_, oMf_, J6_;
 };
 
 }  // namespace

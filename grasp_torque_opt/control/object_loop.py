@@ -140,13 +140,28 @@ class LoopGains:
                 np.repeat([self.integral, self.rotational_integral], 3))
 
 
+def scales(w: np.ndarray, force: float, lever: float) -> tuple[float, float]:
+    """
+    Return the factors :func:`bounded` scales a wrench (an array, (6,)) by (1.0: within).
+
+    In floats, not numpy: the loop bounds three wrenches a cycle, and numpy's dispatch
+    on 3-vectors cost more than the arithmetic.
+    """
+    x, y, z, a, b, c = w.tolist()
+    norm_f, norm_m = math.sqrt(x * x + y * y + z * z), math.sqrt(a * a + b * b + c * c)
+    limit = force * lever
+    return (force / norm_f if norm_f > force else 1.0,
+            limit / norm_m if norm_m > limit else 1.0)
+
+
 def bounded(w: np.ndarray, force: float, lever: float) -> np.ndarray:
     """Scale a wrench's force to at most ``force`` and its moment to ``force * lever``."""
     out = np.array(w, dtype=float)
-    for part, limit in ((out[:3], force), (out[3:], force * lever)):
-        norm = math.sqrt(float(part @ part))
-        if norm > limit:
-            part *= limit / norm
+    s_f, s_m = scales(out, force, lever)
+    if s_f != 1.0:
+        out[:3] *= s_f
+    if s_m != 1.0:
+        out[3:] *= s_m
     return out
 
 
@@ -183,6 +198,7 @@ class ObjectLoop:
         self._start = self._last = None
         self._links: tuple[str, ...] | None = None
         self._previous: tuple[bool, bool] = (True, False)  # (certified, at a limit)
+        self._lever: tuple | None = None  # (reference points, origin, lever): _lever_of's
 
     def after(self, certified: bool, command: np.ndarray | None, limits: np.ndarray) -> None:
         """Note the cycle's outcome: a certified command, and whether it was at a limit."""
@@ -232,12 +248,21 @@ class ObjectLoop:
         a = dt / (gains.velocity_filter + dt)
         self.rate = self.rate + a * ((error - self.error) / dt - self.rate)
         self.error = error
-        lever = float(np.max(np.linalg.norm(self.tracker.points0 - origin, axis=1)))
+        lever = self._lever_of(origin)
         self._integrate(error, dt, gains, weight, lever)
         k, d, ki = gains.per_axis
         w = -(k * error + d * self.rate + self._integral_wrench(ki, gains, weight, lever))
         self.wrench = bounded(w, gains.max_force_ratio * weight, lever)
         return self.wrench
+
+    def _lever_of(self, origin: np.ndarray) -> float:
+        """Return the reference points' farthest distance from ``origin`` (kept per origin)."""
+        points0, key = self.tracker.points0, np.asarray(origin, dtype=float).tobytes()
+        kept = self._lever
+        if kept is None or kept[0] is not points0 or kept[1] != key:
+            kept = self._lever = (points0, key,
+                                  float(np.max(np.linalg.norm(points0 - origin, axis=1))))
+        return kept[2]
 
     def _settle(self, hand: Hand, contacts: list[ContactSpec], q: np.ndarray,
                 origin: np.ndarray, now: float, links: tuple[str, ...]) -> None:
@@ -263,11 +288,13 @@ class ObjectLoop:
         self.why_frozen = ''
         self.integral = self.integral + error * dt
         ki = gains.per_axis[2]
-        # Clamp the integral itself where its wrench is at its bound (no hidden windup).
+        # Clamp the integral itself where its wrench is at its bound (no hidden windup);
+        # a row whose Ki is zero keeps its integral (its wrench is zero whatever it is).
         w = ki * self.integral
-        capped = bounded(w, gains.max_integral_ratio * weight, lever)
-        scale = np.divide(capped, w, out=np.ones(6), where=np.abs(w) > 0)
-        self.integral = self.integral * scale
+        s_f, s_m = scales(w, gains.max_integral_ratio * weight, lever)
+        if s_f != 1.0 or s_m != 1.0:
+            scale = np.where(w != 0.0, np.repeat((s_f, s_m), 3), 1.0)
+            self.integral = self.integral * scale
 
     def _integral_wrench(self, ki: np.ndarray, gains: LoopGains, weight: float,
                          lever: float) -> np.ndarray:

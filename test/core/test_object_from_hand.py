@@ -15,7 +15,7 @@ linearized least squares G^T dx = J dq built from Pinocchio's frame Jacobians he
 the twist against a finite difference of the displacement.
 """
 
-from conftest import ALLEGRO
+from conftest import ALLEGRO, CONFIG, setup_from_doc
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.object_from_hand import kabsch, ObjectFromHand
 from grasp_torque_opt.core.object_geometry import object_pose
@@ -28,9 +28,9 @@ MODEL = SETUP.hand.model
 POSE = object_pose(SETUP.object_origin, np.zeros(3))
 
 
-@pytest.fixture()
-def est():
-    return ObjectFromHand(SETUP.hand, SETUP.contacts, SETUP.q, POSE)
+@pytest.fixture(params=[True, False], ids=['compiled', 'numpy'])
+def est(request):
+    return ObjectFromHand(SETUP.hand, SETUP.contacts, SETUP.q, POSE, compiled=request.param)
 
 
 def linearized(dq):
@@ -83,6 +83,7 @@ def test_a_rigid_motion_of_the_points_is_found_whole(est):
     est.points0 = est.points0.copy()
     moved = est.points0 @ motion.rotation.T + motion.translation
     est.points = lambda q: moved  # the fingers exactly where the motion puts the points
+    est.compiled = None  # (the compiled estimate computes its own points)
     e = est.estimate(SETUP.q)
     np.testing.assert_allclose(e.pose.homogeneous, (motion * POSE).homogeneous, atol=1e-12)
     assert e.residual < 1e-12
@@ -121,3 +122,50 @@ def test_the_residuals_are_each_points_distance_from_the_rigid_motion(est):
     np.testing.assert_allclose(e.residuals, np.linalg.norm(est.points(q) - carried, axis=1),
                                atol=1e-15)
     assert e.residual == e.residuals.max() > 1e-3
+
+
+def test_the_compiled_fit_is_scipys_align_vectors():
+    """The compiled Kabsch fit against scipy's Rotation.align_vectors, and t, residuals."""
+    from grasp_torque_opt.native import loader
+    from scipy.spatial.transform import Rotation
+
+    if loader.fast_cycle is None:
+        pytest.skip(loader.IMPORT_ERROR)
+    rng = np.random.default_rng(6)
+    for n, noise in ((3, 0.0), (4, 1e-3), (4, 0.5), (8, 2.0)):
+        for _ in range(20):
+            p0 = rng.standard_normal((n, 3))
+            R = Rotation.random(random_state=rng).as_matrix()
+            p = p0 @ R.T + rng.standard_normal(3) + noise * rng.standard_normal((n, 3))
+            got_R, got_t, got_res = loader.fast_cycle.rigid_fit(p0, p)
+            a, b = p - p.mean(axis=0), p0 - p0.mean(axis=0)
+            ref = Rotation.align_vectors(a, b)[0].as_matrix()
+            np.testing.assert_allclose(got_R, ref, atol=1e-9)
+            t = p.mean(axis=0) - ref @ p0.mean(axis=0)
+            np.testing.assert_allclose(got_t, t, atol=1e-9)
+            np.testing.assert_allclose(got_res, np.linalg.norm(p - (p0 @ ref.T + t), axis=1),
+                                       atol=1e-9)
+            assert abs(np.linalg.det(got_R) - 1.0) < 1e-12
+
+
+@pytest.mark.parametrize('hand', ['allegro', 'g1'])
+def test_the_compiled_estimate_is_the_numpy_one(hand):
+    """The same estimates with the points and the fit compiled and in numpy."""
+    from g1_grasp import ARM_Q, g1_doc
+
+    # The G1's in its palm's frame (base_link), the arm posed: points moved into it.
+    setup = SETUP if hand == 'allegro' else setup_from_doc(g1_doc(posture=ARM_Q), CONFIG)
+    pose = object_pose(setup.object_origin, np.zeros(3))
+    fast = ObjectFromHand(setup.hand, setup.contacts, setup.q, pose)
+    slow = ObjectFromHand(setup.hand, setup.contacts, setup.q, pose, compiled=False)
+    from grasp_torque_opt.native import loader
+    assert (fast.compiled is not None) == (loader.fast_cycle is not None)
+    assert slow.compiled is None
+    rng = np.random.default_rng(9)
+    model = setup.hand.model
+    for _ in range(10):
+        q = setup.q + rng.uniform(-0.1, 0.1, model.nq)
+        a, b = fast.estimate(q), slow.estimate(q)
+        np.testing.assert_allclose(a.pose.homogeneous, b.pose.homogeneous, atol=1e-12)
+        np.testing.assert_allclose(a.residuals, b.residuals, atol=1e-12)
+        np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-12)
