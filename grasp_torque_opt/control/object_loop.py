@@ -75,6 +75,7 @@ import math
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.object_from_hand import ObjectFromHand
 from grasp_torque_opt.core.scenario_fields import ContactSpec
+from grasp_torque_opt.native.loader import fast_cycle
 import numpy as np
 import pinocchio as pin
 
@@ -271,7 +272,7 @@ class ObjectLoop:
         self._last, self._start, self._links = now, now, links
         self.changes += 1
         pose0 = pin.SE3(np.eye(3), np.asarray(origin, dtype=float))
-        self.tracker = ObjectFromHand(hand, contacts, q, pose0)
+        self.tracker = ObjectFromHand(hand, contacts, q, pose0, module=fast_cycle)
 
     def _integrate(self, error: np.ndarray, dt: float, gains: LoopGains, weight: float,
                    lever: float) -> None:

@@ -31,7 +31,8 @@ contact points' mean translation, the rotation none. ROS-free.
 
 The node's object loop asks for an estimate on every joint state, where the numpy
 above costs about 80 us (the SVD of a 3 x 3 matrix alone 13 us of numpy's dispatch).
-Where the compiled module is built and the hand is a tree of 1-DoF joints, the points
+Given the compiled module (``grasp_torque_opt.native.loader.fast_cycle``, handed down:
+core imports nothing above it) and a hand that is a tree of 1-DoF joints, the points
 and the fit are computed there (``TreePoints`` in src/tree_kinematics.hpp, the same
 rules in Eigen), held to Pinocchio's points at the reference before use; the numpy path
 stays the reference the tests hold it to.
@@ -104,14 +105,15 @@ class ObjectFromHand:
             link's frame).
         q0: the reference configuration, shape (model.nq,) (coupled joints completed).
         pose0: the object's frame in the base frame at ``q0``.
-        compiled: compute the points and the fit in the compiled module where it is
-            built and takes the hand (:attr:`compiled` says whether it does).
+        module: the compiled module whose ``TreePoints`` computes the points and the
+            fit where it takes the hand (:attr:`compiled` says whether it does), or
+            None: numpy's and Pinocchio's.
 
     Keeps its own Pinocchio data: not shared across threads.
     """
 
     def __init__(self, hand: Hand, contacts: list[ContactSpec], q0: np.ndarray,
-                 pose0: pin.SE3, compiled: bool = True) -> None:
+                 pose0: pin.SE3, module=None) -> None:
         self.hand = hand
         model = hand.model
         self._data = model.createData()
@@ -120,22 +122,19 @@ class ObjectFromHand:
         self._local = self._local.reshape(-1, 3)
         self._base = None if hand.base_link is None else model.getFrameId(hand.base_link)
         #: The compiled points and fit (None: numpy's and Pinocchio's).
-        self.compiled = self._compiled(q0) if compiled else None
+        self.compiled = None if module is None else self._compiled(module, q0)
         self.reset(q0, pose0)
 
-    def _compiled(self, q0: np.ndarray):
-        """Return the compiled points of this hand's contacts, if it takes them (else None)."""
-        from grasp_torque_opt.native.loader import fast_cycle
-
+    def _compiled(self, module, q0: np.ndarray):
+        """Return the module's points of this hand's contacts, if it takes them (else None)."""
         model = self.hand.model
-        if fast_cycle is None or not self._frames or supported(model):
+        if not self._frames or supported(model):
             return None
         tree = TreeKinematics(model)
         base = (-1, np.eye(3), np.zeros(3)) if self._base is None else \
             (b[0] for b in tree.frame_tables((self._base,)))
-        points = fast_cycle.TreePoints(*tree.tables, model.nq, model.nv,
-                                       *tree.frame_tables(tuple(self._frames)), self._local,
-                                       *base)
+        points = module.TreePoints(*tree.tables, model.nq, model.nv,
+                                   *tree.frame_tables(tuple(self._frames)), self._local, *base)
         q0 = np.asarray(q0, dtype=float)
         if not np.abs(points.points(q0) - self.points(q0)).max() <= POINTS_TOLERANCE:
             return None  # never expected for a tree the module takes: numpy's then

@@ -34,6 +34,7 @@ from grasp_torque_opt.core.bounded_yaml import BoundedLoader
 from grasp_torque_opt.core.object_from_hand import ObjectFromHand
 from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.scenario import Scenario
+from grasp_torque_opt.native.loader import fast_cycle
 from grasp_torque_opt.ros.node.controllers import configure
 from grasp_torque_opt.ros.node.grasp_source import load_of_gravity, weight_of
 from grasp_torque_opt.ros.node.parameters import scenario_defaults
@@ -99,7 +100,7 @@ def _controller(setup, scenario: Scenario, rig, inputs: bool, margin: float,
     if scenario.object is not None:
         ctrl.solving.hand_object = ObjectFromHand(
             setup.hand, setup.contacts, setup.q,
-            object_pose(scenario.object.position, scenario.object.rpy))
+            object_pose(scenario.object.position, scenario.object.rpy), module=fast_cycle)
     return ctrl, inputs, efforts
 
 

@@ -37,6 +37,7 @@ from grasp_torque_opt.core.object_from_hand import ObjectFromHand
 from grasp_torque_opt.core.object_geometry import object_pose
 from grasp_torque_opt.core.resources import decode_utf8, find_config, read_bounded
 from grasp_torque_opt.core.scenario import load_scenario, Scenario, weight_wrench
+from grasp_torque_opt.native.loader import fast_cycle
 from grasp_torque_opt.ros.node.parameters import PARAMETERS
 from grasp_torque_opt.ros.node.qos import URDF_QOS
 import numpy as np
@@ -261,7 +262,8 @@ def place_object(ctrl: TorqueController, scenario: Scenario, p: Any, urdf: str) 
     if pose is not None:  # where the fingertips place it, from the scenario's grasp (its start)
         setup = ctrl.setup
         ctrl.store.hand_object, ctrl.solving.hand_object = (
-            ObjectFromHand(setup.hand, setup.contacts, setup.q, pose) for _ in range(2))
+            ObjectFromHand(setup.hand, setup.contacts, setup.q, pose, module=fast_cycle)
+            for _ in range(2))
     if not p.contact_geometry.enabled:
         return
     if obj is None:
