@@ -57,7 +57,7 @@ from grasp_torque_opt.control.fault_policy import CycleResult, FaultPolicy
 from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, InputStore
 from grasp_torque_opt.control.parameters.generated import CycleConfig
-from grasp_torque_opt.control.rates import slewed, step_wrenches
+from grasp_torque_opt.control.rates import slewed, step_wrenches, within_step
 from grasp_torque_opt.control.tactile import tactile_report, TactileReport
 from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -313,11 +313,15 @@ class TorqueController:
         gap = min(max(now - policy.in_force_time, 0.0), config.command_period)
         known, start, shift = policy.in_force_wrenches, policy.in_force, None
         g, g_in_force = result.gravity_torque, policy.in_force_gravity
-        if known is not None and known.size == 0 and g is not None:
+        from_zero = known is not None and known.size == 0 and g is not None
+        if from_zero:
             start = g  # zero torques: g(q) whole, the wrenches stepped
-        elif g is not None and g_in_force is not None and g_in_force.shape == start.shape:
-            shift = g - g_in_force  # the contact torques in force under today's g(q)
         most = config.max_torque_rate * gap
+        if within_step(start, result.command, most):
+            return  # the usual cycle: no joint moves more than a step (slewed gives None)
+        if not from_zero and g is not None and g_in_force is not None \
+                and g_in_force.shape == start.shape:
+            shift = g - g_in_force  # the contact torques in force under today's g(q)
         if shift is not None and float(np.abs(shift).max()) > most:
             shift = None  # g(q) moved more than a step: the whole commands are blended
         limits = self.setup.hand.torque_limits

@@ -204,7 +204,7 @@ class ObjectLoop:
     def after(self, certified: bool, command: np.ndarray | None, limits: np.ndarray) -> None:
         """Note the cycle's outcome: a certified command, and whether it was at a limit."""
         at_limit = command is not None and bool(
-            np.any(np.abs(command) >= LIMIT_FRACTION * limits))
+            (np.abs(command) >= LIMIT_FRACTION * limits).any())
         self._previous = (certified and command is not None, at_limit)
 
     def update(self, hand: Hand, contacts: list[ContactSpec], q: np.ndarray, now: float,

@@ -67,6 +67,18 @@ def turned_towards(old: np.ndarray, new: np.ndarray, step: float) -> np.ndarray:
     return v * (n_old + float(np.clip(n_new - n_old, -step, step)))
 
 
+def within_step(in_force: np.ndarray, target: np.ndarray, step: float) -> bool:
+    """
+    Tell whether no joint of ``target`` is farther than ``step`` from ``in_force``.
+
+    Then :func:`slewed` gives None whatever the shift (``shift + delta`` is this change).
+    False for NaN, and for arrays of two shapes (:func:`slewed` refuses those).
+    """
+    if in_force.shape != target.shape:
+        return False
+    return not target.size or bool(np.abs(target - in_force).max() <= step)
+
+
 def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
            limits: np.ndarray, shift: np.ndarray | None = None
            ) -> tuple[np.ndarray, float] | None:
@@ -94,7 +106,8 @@ def slewed(in_force: np.ndarray, target: np.ndarray, step: float,
         ``step`` already or ``in_force`` is not within ``limits`` (lowered since): then
         the certified command is published whole.
     """
-    if in_force.shape != target.shape or not (np.abs(in_force) <= limits).all():
+    if in_force.shape != target.shape or within_step(in_force, target, step) \
+            or not (np.abs(in_force) <= limits).all():
         return None
     if shift is not None:
         return _shifted(in_force + shift, shift, target, step, limits)

@@ -23,7 +23,7 @@ from conftest import ALLEGRO_URDF
 from cycle_inputs import base_poses, fresh, joint_state, tilted
 from grasp_torque_opt.control.inputs.contacts import ContactsReading
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
-from grasp_torque_opt.control.rates import slewed, step_wrenches
+from grasp_torque_opt.control.rates import slewed, step_wrenches, within_step
 from grasp_torque_opt.core.friction import cone_margin
 from grasp_torque_opt.core.hand import resolve_urdf
 import numpy as np
@@ -39,6 +39,30 @@ def test_a_step_is_on_the_segment_and_no_joint_moves_faster():
     assert s == 0.1 / 0.4
     assert slewed(in_force, target, 0.4, np.full(3, 1.0)) is None  # within the step: whole
     assert slewed(in_force, target, 0.1, np.full(3, 0.2)) is None  # in force over a limit
+
+
+def test_within_a_step_no_step_is_made_with_or_without_a_shift():
+    # The controller's shortcut: within_step(in_force, target, step) means slewed gives
+    # None (the certified command whole), whatever the shift of g(q); the converse
+    # holds without a shift. Checked on random commands around the step's size.
+    rng = np.random.default_rng(3)
+    limits = np.full(6, 1.0)
+    seen = {True: 0, False: 0}
+    for _ in range(2000):
+        in_force = rng.uniform(-0.9, 0.9, 6)
+        step = rng.uniform(0.0, 0.05)
+        target = in_force + rng.uniform(-1.0, 1.0, 6) * rng.choice([0.5, 1.0, 2.0]) * step
+        shift = rng.uniform(-1.0, 1.0, 6) * step
+        within = within_step(in_force, target, step)
+        seen[within] += 1
+        if within:
+            assert slewed(in_force, target, step, limits) is None
+            assert slewed(in_force, target, step, limits, shift) is None
+        else:
+            assert slewed(in_force, target, step, limits) is not None
+    assert min(seen.values()) > 200  # both sides drawn
+    assert not within_step(in_force, np.full(6, np.nan), 1.0)
+    assert not within_step(in_force, np.zeros(5), 1.0)
 
 
 def test_step_wrenches_combine_both_ends_and_zero_torques_have_none():
