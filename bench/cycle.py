@@ -34,8 +34,9 @@ The paths:
 
 With ``--params FILE`` it times only the cycle as the node makes it from a params file
 (the bundled ``config/allegro_right_node.yaml``: its backend, its object loop and
-margins), as the file says and with ``solver.backend`` ProxSuite, and the compiled
-call's stages from its own timings.
+margins), as the file says and with ``solver.backend`` ProxSuite, the compiled
+call's stages from its own timings, and the object loop's estimate from the
+fingertips per call, compiled and in numpy.
 
 With ``--geometry`` it also times the contacts from geometry per call
 (``bench/geometry.py``: the Allegro's tips against the ball by the closed form and by
@@ -333,7 +334,37 @@ def bench_params(params: Path, repeats: int, motion: str) -> dict:
             'backend': ctrl.solver.name, 'total': summary(samples), 'certified': published,
             'cycles': repeats, 'compiled_solves': fast.solves if fast is not None else 0,
             'stages_median': {k: float(np.median(v)) if v else None for k, v in stages.items()}}
+        if not over:
+            out['estimate'] = estimate_times(ctrl, setup, repeats, motion)
     return out
+
+
+def estimate_times(ctrl: TorqueController, setup: GraspSetup, repeats: int, motion: str
+                   ) -> dict | None:
+    """
+    Time the object loop's estimate from the fingertips per call, compiled and in numpy.
+
+    The loop's own tracker (the compiled points and fit, as the node runs it) and its
+    numpy twin on the same reference, alternating call by call on the run's joint
+    states; medians and p99 [s]. None when the loop has no tracker.
+    """
+    from grasp_torque_opt.core.object_from_hand import ObjectFromHand
+
+    tracker = ctrl.solving.object_loop.tracker
+    if tracker is None:
+        return None
+    # (joint states only: the loop's contacts are the scenario's)
+    twin = ObjectFromHand(setup.hand, setup.contacts, tracker.q0, tracker.pose0)
+    q = setup.q.copy()
+    times = {'compiled': [], 'numpy': []}
+    for dq in offsets(setup.hand.m, repeats, motion):
+        q[setup.hand.idx_q] = setup.q[setup.hand.idx_q] + dq
+        for name, est in (('compiled', tracker), ('numpy', twin)):
+            t0 = time.perf_counter()
+            est.estimate(q)
+            times[name].append(time.perf_counter() - t0)
+    return {'module': tracker.compiled is not None,
+            **{k: summary(v) for k, v in times.items()}}
 
 
 def params_table(r: dict) -> str:
@@ -349,6 +380,15 @@ def params_table(r: dict) -> str:
         lines.append(f"| {name} | {v['backend']} | {1e6 * v['total']['median_s']:.0f} | "
                      f"{1e6 * v['total']['p99_s']:.0f} | {v['certified']} of {v['cycles']} | "
                      f"{v['compiled_solves']} | {us} | {st['iterations'] or '-'} |")
+    e = r.get('estimate')
+    if e is not None:
+        lines += ['', "the object loop's estimate from the fingertips, per call (the same "
+                  'joint states, alternating): compiled '
+                  f"{1e6 * e['compiled']['median_s']:.1f} us median, "
+                  f"{1e6 * e['compiled']['p99_s']:.1f} p99"
+                  + ('' if e['module'] else ' (the module did not take the hand: numpy)')
+                  + f"; numpy {1e6 * e['numpy']['median_s']:.1f} us median, "
+                  f"{1e6 * e['numpy']['p99_s']:.1f} p99"]
     return '\n'.join(lines)
 
 
