@@ -328,14 +328,7 @@ public:
       }
       return a;
     }
-    Eigen::Map<const Wrench> w_ext_v(w_ext.data());
-    Vec off = offset.size() ? Vec(Eigen::Map<const Vec>(offset.data(), m_)) :
-      Vec::Zero(m_);
-    {
-      // The GIL is released from here on: nothing below touches a Python object.
-      py::gil_scoped_release release;
-      run(a, k, w_ext_v, off, time_left, t0);
-    }
+    run_released(a, k, w_ext, offset, time_left, t0);
     return a;
   }
 
@@ -400,14 +393,21 @@ public:
     k.nv = static_cast<int>(nv);
     k.oMf = oMf_.data();
     k.J6 = J6_.data();
+    run_released(a, k, w_ext, offset, time_left, t0);
+    return a;
+  }
+
+  // run() on checked inputs (w_ext of 6, offset of m or none), the GIL released.
+  void run_released(
+    Answer & a, const Kinematics & k, const Array & w_ext, const Array & offset,
+    double time_left, Clock::time_point t0)
+  {
     Eigen::Map<const Wrench> w_ext_v(w_ext.data());
     Vec off = offset.size() ? Vec(Eigen::Map<const Vec>(offset.data(), m_)) :
       Vec::Zero(m_);
-    {
-      py::gil_scoped_release release;
-      run(a, k, w_ext_v, off, time_left, t0);
-    }
-    return a;
+    // The GIL is released from here on: nothing below touches a Python object.
+    py::gil_scoped_release release;
+    run(a, k, w_ext_v, off, time_left, t0);
   }
 
   // The contact arrays of p contacts as the maps stage takes them; false where they do
