@@ -312,13 +312,8 @@ py::tuple kinematics_batch(
   expect(Q.ndim() == 2, "Q of the wrong shape");
   const py::ssize_t N = Q.shape(0), nq = Q.shape(1), nj = parents.size();
   const py::ssize_t p = fparent.size();
-  expect(
-    kinds.size() == nj && axes.size() == 3 * nj && Rp.size() == 9 * nj &&
-    tp.size() == 3 * nj && idx_q.size() == nj && idx_v.size() == nj &&
-    Rf.size() == 9 * p && tf.size() == 3 * p && nv > 0, "joint or frame tables of the wrong shape");
-  Tree tree(
-    nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
-    idx_v.data(), nq, nv);
+  expect(Rf.size() == 9 * p && tf.size() == 3 * p, "joint or frame tables of the wrong shape");
+  Tree tree = tree_of(parents, kinds, axes, Rp, tp, idx_q, idx_v, nq, nv);
   const int64_t * fp = fparent.data();
   for (py::ssize_t i = 0; i < p; ++i) {
     expect(fp[i] >= 0 && fp[i] < nj, "frame table out of range");

@@ -248,6 +248,24 @@ struct Answer
   double t_maps = 0.0, t_build = 0.0, t_solve = 0.0, t_certify = 0.0;
 };
 
+// A Tree from the joint tables as Python passes them (TreeKinematics.tables); a
+// ValueError where their shapes do not agree (Tree checks their values).
+Tree tree_of(
+  const py::array_t<int64_t> & parents, const py::array_t<int64_t> & kinds, const Array & axes,
+  const Array & Rp, const Array & tp, const py::array_t<int64_t> & idx_q,
+  const py::array_t<int64_t> & idx_v, int64_t nq, int64_t nv)
+{
+  const py::ssize_t nj = parents.size();
+  if (kinds.size() != nj || axes.size() != 3 * nj || Rp.size() != 9 * nj ||
+    tp.size() != 3 * nj || idx_q.size() != nj || idx_v.size() != nj)
+  {
+    throw std::invalid_argument("joint or frame tables of the wrong shape");
+  }
+  return Tree(
+    nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
+    idx_v.data(), nq, nv);
+}
+
 // The compiled cycle bound to one grasp's friction, weights, limits and settings.
 //
 // solve() runs one cycle: run() calls the four stages in order, each the twin of a
@@ -338,20 +356,12 @@ public:
     py::array_t<int64_t> parents, py::array_t<int64_t> kinds, Array axes, Array Rp,
     Array tp, py::array_t<int64_t> idx_q, py::array_t<int64_t> idx_v, int64_t nq, int64_t nv)
   {
-    const py::ssize_t nj = parents.size();
-    if (kinds.size() != nj || axes.size() != 3 * nj || Rp.size() != 9 * nj ||
-      tp.size() != 3 * nj || idx_q.size() != nj || idx_v.size() != nj)
-    {
-      throw std::invalid_argument("joint or frame tables of the wrong shape");
-    }
     for (int64_t j : idx_v_) {
       if (j < 0 || j >= nv) {
         throw std::invalid_argument("joint index out of range");
       }
     }
-    tree_ = std::make_unique<Tree>(
-      nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
-      idx_v.data(), nq, nv);
+    tree_ = std::make_unique<Tree>(tree_of(parents, kinds, axes, Rp, tp, idx_q, idx_v, nq, nv));
   }
 
   bool uses_tree() const {return tree_ != nullptr;}
@@ -1295,17 +1305,13 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     Array Rp, Array tp, py::array_t<int64_t> idx_q, py::array_t<int64_t> idx_v, int64_t nq,
     int64_t nv, py::array_t<int64_t> fparent, Array Rf, Array tf, Array local, int64_t base,
     Array Rb, Array tb) {
-      const py::ssize_t nj = parents.size(), p = fparent.size();
+      const py::ssize_t p = fparent.size();
       expect(
-        kinds.size() == nj && axes.size() == 3 * nj && Rp.size() == 9 * nj &&
-        tp.size() == 3 * nj && idx_q.size() == nj && idx_v.size() == nj &&
         Rf.size() == 9 * p && tf.size() == 3 * p && local.size() == 3 * p &&
         Rb.size() == 9 && tb.size() == 3, "joint or frame tables of the wrong shape");
       return TreePoints(
-        Tree(
-          nj, parents.data(), kinds.data(), axes.data(), Rp.data(), tp.data(), idx_q.data(),
-          idx_v.data(), nq, nv), p, fparent.data(), Rf.data(), tf.data(), local.data(), base,
-        Rb.data(), tb.data());
+        tree_of(parents, kinds, axes, Rp, tp, idx_q, idx_v, nq, nv), p, fparent.data(),
+        Rf.data(), tf.data(), local.data(), base, Rb.data(), tb.data());
     }), py::arg("parents"), py::arg("kinds"), py::arg("axes"), py::arg("Rp"), py::arg("tp"),
     py::arg("idx_q"), py::arg("idx_v"), py::arg("nq"), py::arg("nv"), py::arg("fparent"),
     py::arg("Rf"), py::arg("tf"), py::arg("local"), py::arg("base"), py::arg("Rb"),

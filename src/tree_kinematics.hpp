@@ -91,13 +91,22 @@ public:
     }
   }
 
+  // The world placement (R, o) of the frame placed at (Rf, tf) in joint j, at the
+  // configuration of the last place().
+  void placement(int64_t j, const double * Rf, const double * tf, M3 & R, V3 & o) const
+  {
+    R = R_[j] * Eigen::Map<const M3>(Rf);
+    o = t_[j] + R_[j] * Eigen::Map<const V3>(tf);
+  }
+
   // The placement (4 x 4, row-major, into oMf) and the LOCAL_WORLD_ALIGNED Jacobian
   // (6 x nv, row-major, into J6, every entry written) of the frame placed at (Rf, tf) in
   // joint j, at the configuration of the last place().
   void frame(int64_t j, const double * Rf, const double * tf, double * oMf, double * J6) const
   {
-    const M3 Rw = R_[j] * Eigen::Map<const M3>(Rf);
-    const V3 o = t_[j] + R_[j] * Eigen::Map<const V3>(tf);
+    M3 Rw;
+    V3 o;
+    placement(j, Rf, tf, Rw, o);
     Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf);
     M.setZero();
     M.topLeftCorner<3, 3>() = Rw;
@@ -142,7 +151,7 @@ public:
     const double * local, int64_t base, const double * Rb, const double * tb)
   : tree_(std::move(tree)), fparent_(fparent, fparent + p), Rf_(Rf, Rf + 9 * p),
     tf_(tf, tf + 3 * p), local_(Eigen::Map<const Points>(local, p, 3)), base_(base),
-    Rb_(Rb, Rb + 9), tb_(tb, tb + 3), oMf_(16), J6_(6 * tree_.nv())
+    Rb_(Rb, Rb + 9), tb_(tb, tb + 3)
   {
     for (int64_t j : fparent_) {
       if (j < 0 || j >= tree_.joints()) {
@@ -163,17 +172,14 @@ public:
     tree_.place(q);
     const int64_t p = size();
     out.resize(p, 3);
+    M3 R;
+    V3 o;
     for (int64_t i = 0; i < p; ++i) {
-      tree_.frame(fparent_[i], Rf_.data() + 9 * i, tf_.data() + 3 * i, oMf_.data(), J6_.data());
-      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf_.data());
-      out.row(i) = (M.topLeftCorner<3, 3>() * local_.row(i).transpose() +
-        M.topRightCorner<3, 1>()).transpose();
+      tree_.placement(fparent_[i], Rf_.data() + 9 * i, tf_.data() + 3 * i, R, o);
+      out.row(i) = (R * local_.row(i).transpose() + o).transpose();
     }
     if (base_ >= 0) {
-      tree_.frame(base_, Rb_.data(), tb_.data(), oMf_.data(), J6_.data());
-      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> M(oMf_.data());
-      const M3 R = M.topLeftCorner<3, 3>();
-      const V3 o = M.topRightCorner<3, 1>();
+      tree_.placement(base_, Rb_.data(), tb_.data(), R, o);
       for (int64_t i = 0; i < p; ++i) {
         out.row(i) = ((out.row(i).transpose() - o).transpose() * R);
       }
@@ -207,7 +213,7 @@ private:
   std::vector<double> Rf_, tf_;
   Points local_;
   int64_t base_;
-  std::vector<double> Rb_, tb_, oMf_, J6_;
+  std::vector<double> Rb_, tb_;
 };
 
 }  // namespace

@@ -55,7 +55,7 @@ from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.margin import planned_friction
 from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.core.tau_qp import BOX_MARGIN, QR_RTOL
-from grasp_torque_opt.core.tree_kinematics import supported as tree_supported, TreeKinematics
+from grasp_torque_opt.core.tree_kinematics import TreeKinematics
 from grasp_torque_opt.methods.batch import contact_arrays
 from grasp_torque_opt.native.loader import fast_cycle, IMPORT_ERROR
 import numpy as np
@@ -187,8 +187,11 @@ class CompiledCycle:
         if previous is not None and previous._made_for[0] is hand \
                 and previous.module is self.module:
             self.tree, self._tree_checked = previous.tree, previous._tree_checked
-        elif not tree_supported(hand.model):
-            self.tree = TreeKinematics(hand.model, self.module)
+        else:
+            try:
+                self.tree = TreeKinematics(hand.model, self.module)
+            except ValueError:  # not a tree of 1-DoF joints: Pinocchio's, in Python
+                pass
         if self.tree is not None:
             self._cycle.use_tree(*self.tree.tables, hand.model.nq, hand.model.nv)
         self._no_offset = np.zeros(0)

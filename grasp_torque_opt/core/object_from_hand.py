@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 
 from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.scenario_fields import ContactSpec
-from grasp_torque_opt.core.tree_kinematics import supported, TreeKinematics
+from grasp_torque_opt.core.tree_kinematics import TreeKinematics
 import numpy as np
 import pinocchio as pin
 
@@ -118,8 +118,8 @@ class ObjectFromHand:
         model = hand.model
         self._data = model.createData()
         self._frames = [model.getFrameId(c.link) for c in contacts]
-        self._local = np.array([np.asarray(c.position, dtype=float) for c in contacts])
-        self._local = self._local.reshape(-1, 3)
+        self._local = np.array([np.asarray(c.position, dtype=float)
+                                for c in contacts]).reshape(-1, 3)
         self._base = None if hand.base_link is None else model.getFrameId(hand.base_link)
         #: The compiled points and fit (None: numpy's and Pinocchio's).
         self.compiled = None if module is None else self._compiled(module, q0)
@@ -128,9 +128,12 @@ class ObjectFromHand:
     def _compiled(self, module, q0: np.ndarray):
         """Return the module's points of this hand's contacts, if it takes them (else None)."""
         model = self.hand.model
-        if not self._frames or supported(model):
+        if not self._frames:
             return None
-        tree = TreeKinematics(model)
+        try:
+            tree = TreeKinematics(model)
+        except ValueError:  # not a tree of 1-DoF joints (its own check: supported)
+            return None
         base = (-1, np.eye(3), np.zeros(3)) if self._base is None else \
             (b[0] for b in tree.frame_tables((self._base,)))
         points = module.TreePoints(*tree.tables, model.nq, model.nv,
