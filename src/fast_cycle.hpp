@@ -39,6 +39,7 @@
 
 #include <proxsuite/proxqp/dense/dense.hpp>
 
+#include "object_loop.hpp"
 #include "tree_kinematics.hpp"
 
 namespace py = pybind11;
@@ -1114,7 +1115,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 7;
+  mod.attr("API") = 8;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -1337,6 +1338,39 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
         to_array(residuals));
     }, py::arg("q"), py::arg("p0"),
     "(R, t, points, residuals): the rigid motion carrying p0 to the points at q.");
+  mod.def("loop_step", [](TreePoints & tp, Array q, Array p0, Array origin, Array slow,
+    Array rate, Array error, Array integral, double dt, Array gains, double weight,
+    double lever, bool certified, bool at_limit) {
+      expect(q.size() == tp.nq(), "q of the wrong shape");
+      expect(p0.ndim() == 2 && p0.shape(0) == tp.size() && p0.shape(1) == 3,
+        "p0 of the wrong shape");
+      expect(
+        origin.size() == 3 && slow.ndim() == 1 && rate.size() == 6 && error.size() == 6 &&
+        integral.size() == 6, "loop state of the wrong shape");
+      expect(gains.size() == LoopSettings::size, "gains of the wrong size");
+      expect(dt > 0.0, "dt must be positive");
+      LoopState st;
+      st.slow = Eigen::Map<const Vec>(slow.data(), slow.size());
+      st.rate = Eigen::Map<const Vec6>(rate.data());
+      st.error = Eigen::Map<const Vec6>(error.data());
+      st.integral = Eigen::Map<const Vec6>(integral.data());
+      const Frozen frozen = loop_step(
+        tp, q.data(), Eigen::Map<const TreePoints::Points>(p0.data(), tp.size(), 3),
+        Eigen::Map<const Tree::V3>(origin.data()), dt, LoopSettings(gains.data()), weight,
+        lever, certified, at_limit, st);
+      return py::make_tuple(
+        to_array(Vec(st.wrench)), to_array(Vec(st.integral)), to_array(Vec(st.error)),
+        to_array(Vec(st.rate)), to_array(st.residual), to_array(st.slip), to_array(st.slow),
+        static_cast<int>(frozen));
+    }, py::arg("points"), py::arg("q"), py::arg("p0"), py::arg("origin"), py::arg("slow"),
+    py::arg("rate"), py::arg("error"), py::arg("integral"), py::arg("dt"), py::arg("gains"),
+    py::arg("weight"), py::arg("lever"), py::arg("certified"), py::arg("at_limit"),
+    "(wrench, integral, error, rate, residual, slip, slow, frozen): one engaged step of "
+    "the object loop.");
+  mod.def("rotation_vector", [](Array R) {
+      expect(R.ndim() == 2 && R.shape(0) == 3 && R.shape(1) == 3, "R of the wrong shape");
+      return to_array(Vec(rotation_vector(Eigen::Map<const Tree::M3>(R.data()))));
+    }, py::arg("R"), "The rotation vector of a rotation matrix (pinocchio.log3).");
   mod.def("rigid_fit", [](Array p0, Array p) {
       expect(p0.ndim() == 2 && p0.shape(1) == 3 && p.ndim() == 2 && p.shape(1) == 3 &&
         p.shape(0) == p0.shape(0) && p.shape(0) > 0, "p0 or p of the wrong shape");

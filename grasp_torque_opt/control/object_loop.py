@@ -64,6 +64,11 @@ torque or tactile sensing can measure; another source (a tactile
 plug-in's per-contact normal and tangential forces) sets it with
 :meth:`Squeeze.measured` and its time, and is used while fresh. The minimum normal force
 moves in steps of ``STEP`` (the compiled cycle is built again for each).
+
+**Compiled.** Where the fingertips' estimate is compiled (the hand a tree the module
+takes), the engaged step (estimate, slip, rate, integral, wrench) is one call of the
+compiled module's ``loop_step`` (src/object_loop.hpp), by the rules above; this numpy
+code is its reference (``ObjectLoop.compiled`` False), held to it in the tests.
 """
 
 from __future__ import annotations
@@ -83,6 +88,8 @@ import pinocchio as pin
 LIMIT_FRACTION = 0.98
 #: The squeeze's minimum normal force moves in steps of this [N].
 STEP = 0.02
+#: Why the integral did not move, by the compiled step's code (0: it moved).
+FROZEN = ('', 'no certified command', 'at a torque limit', 'a contact slips')
 
 
 @dataclass(frozen=True)
@@ -140,6 +147,13 @@ class LoopGains:
                 np.repeat([self.damping, self.rotational_damping], 3),
                 np.repeat([self.integral, self.rotational_integral], 3))
 
+    @cached_property
+    def packed(self) -> np.ndarray:
+        """Give the settings the compiled step takes (src/object_loop.hpp's LoopSettings)."""
+        return np.concatenate((*self.per_axis, (
+            self.slip_memory, self.velocity_filter, self.unwind_time, self.slip_residual,
+            self.max_integral_ratio, self.max_force_ratio)))
+
 
 def scales(w: np.ndarray, force: float, lever: float) -> tuple[float, float]:
     """
@@ -187,6 +201,9 @@ class ObjectLoop:
         """Start with no reference."""
         self.tracker: ObjectFromHand | None = None
         self.changes = 0
+        #: The engaged step in one compiled call where the estimate is compiled (False:
+        #: numpy's, the reference).
+        self.compiled = True
         self.reset()
         self.squeeze = Squeeze()
 
@@ -238,6 +255,8 @@ class ObjectLoop:
             self.engaged = now - self._start >= gains.settle_time
             self.residual = self.slip = self._slow = np.zeros(len(contacts))
             return self.wrench
+        if self.tracker.compiled is not None and self.compiled:
+            return self._compiled_step(q, dt, origin, weight, gains)
         est = self.tracker.estimate(q)
         residual = est.residuals  # each point's distance from the rigid motion carried
         if self._slow.shape != residual.shape:
@@ -254,6 +273,19 @@ class ObjectLoop:
         k, d, ki = gains.per_axis
         w = -(k * error + d * self.rate + self._integral_wrench(ki, gains, weight, lever))
         self.wrench = bounded(w, gains.max_force_ratio * weight, lever)
+        return self.wrench
+
+    def _compiled_step(self, q: np.ndarray, dt: float, origin: np.ndarray, weight: float,
+                       gains: LoopGains) -> np.ndarray:
+        """Take the engaged step of :meth:`update` in one compiled call (its numpy rules)."""
+        tracker = self.tracker
+        certified, at_limit = self._previous
+        (self.wrench, self.integral, self.error, self.rate, self.residual, self.slip,
+         self._slow, frozen) = fast_cycle.loop_step(
+            tracker.compiled, q, tracker.points0, tracker.pose0.translation, self._slow,
+            self.rate, self.error, self.integral, dt, gains.packed, weight,
+            self._lever_of(origin), certified, at_limit)
+        self.why_frozen = FROZEN[frozen]
         return self.wrench
 
     def _lever_of(self, origin: np.ndarray) -> float:
@@ -280,11 +312,11 @@ class ObjectLoop:
         certified, at_limit = self._previous
         slipping = self.slip.size and float(self.slip.max()) > gains.slip_residual
         if not certified or at_limit:
-            self.why_frozen = 'no certified command' if not certified else 'at a torque limit'
+            self.why_frozen = FROZEN[2 if certified else 1]
             self.integral = self.integral * (gains.unwind_time / (gains.unwind_time + dt))
             return
         if slipping:
-            self.why_frozen = 'a contact slips'
+            self.why_frozen = FROZEN[3]
             return
         self.why_frozen = ''
         self.integral = self.integral + error * dt

@@ -20,6 +20,7 @@ from conftest import ALLEGRO
 from grasp_torque_opt.control.object_loop import LIMIT_FRACTION, LoopGains, ObjectLoop
 from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.scenario import load_scenario
+from grasp_torque_opt.native import loader
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -35,6 +36,19 @@ GAINS = LoopGains(stiffness=300.0, rotational_stiffness=0.3, integral=3000.0,
                   rotational_integral=3.0, max_integral_ratio=0.6, max_force_ratio=1.0,
                   settle_time=0.02, velocity_filter=0.01, unwind_time=0.1,
                   slip_residual=1e-3)
+
+
+@pytest.fixture(params=['compiled', 'numpy'])
+def new_loop(request):
+    """Make object loops whose engaged step is compiled, or numpy's (the reference)."""
+    if request.param == 'compiled' and loader.fast_cycle is None:
+        pytest.skip(f'compiled module not built: {loader.IMPORT_ERROR}')
+
+    def make():
+        loop = ObjectLoop()
+        loop.compiled = request.param == 'compiled'
+        return loop
+    return make
 
 
 def carried(dx):
@@ -83,8 +97,8 @@ def wound_up(loop, n):
     return q, t + n * DT
 
 
-def test_wrench_is_stiffness_and_integral_against_the_displacement():
-    loop = ObjectLoop()
+def test_wrench_is_stiffness_and_integral_against_the_displacement(new_loop):
+    loop = new_loop()
     t = settled(loop, SETUP.q)
     dx = np.array([-1e-3, 0.0, 0.0, 0.0, 0.0, 0.0])  # 1 mm along -x (the scenario's gravity)
     q = carried(dx)
@@ -100,8 +114,8 @@ def test_wrench_is_stiffness_and_integral_against_the_displacement():
     assert np.linalg.norm(w[1:3]) < 0.02 * w[0]
 
 
-def test_integral_is_bounded_by_its_ratio_of_the_weight():
-    loop = ObjectLoop()
+def test_integral_is_bounded_by_its_ratio_of_the_weight(new_loop):
+    loop = new_loop()
     t = settled(loop, SETUP.q)
     q = carried(np.array([-1.5e-3, 0.0, 0.0, 0.0, 0.0, 0.0]))
     for k in range(400):  # 1.6 s of a 1.5 mm sag: Ki e t would be 7 N
@@ -117,8 +131,8 @@ def test_integral_is_bounded_by_its_ratio_of_the_weight():
 
 
 @pytest.mark.parametrize('outcome', ['limit', 'uncertified'])
-def test_integral_unwinds_at_a_limit_and_without_a_certified_command(outcome):
-    loop = ObjectLoop()
+def test_integral_unwinds_at_a_limit_and_without_a_certified_command(outcome, new_loop):
+    loop = new_loop()
     q, t = wound_up(loop, 50)
     wound = loop.integral.copy()
     assert np.linalg.norm(wound[:3]) > 0
@@ -137,8 +151,8 @@ def test_integral_unwinds_at_a_limit_and_without_a_certified_command(outcome):
                                else 'no certified command')
 
 
-def test_integral_frozen_while_a_contact_slips():
-    loop = ObjectLoop()
+def test_integral_frozen_while_a_contact_slips(new_loop):
+    loop = new_loop()
     q, t = wound_up(loop, 20)
     before = loop.integral.copy()
     slipped = q.copy()
@@ -149,8 +163,8 @@ def test_integral_frozen_while_a_contact_slips():
     np.testing.assert_array_equal(loop.integral, before)
 
 
-def test_reference_retaken_when_the_contact_set_changes():
-    loop = ObjectLoop()
+def test_reference_retaken_when_the_contact_set_changes(new_loop):
+    loop = new_loop()
     t = settled(loop, SETUP.q)
     q = carried(np.array([-1e-3, 0.0, 0.0, 0.0, 0.0, 0.0]))
     step(loop, q, t)
@@ -159,6 +173,65 @@ def test_reference_retaken_when_the_contact_set_changes():
     w = loop.update(HAND, SETUP.contacts[:3], q, t + DT, ORIGIN, WEIGHT, GAINS, 0.05)
     assert loop.changes == changes + 1 and not loop.engaged
     np.testing.assert_array_equal(w, np.zeros(6))
+
+
+def test_the_compiled_step_is_the_numpy_one():
+    """Both steps over every branch: free, clamped, unwound at a limit and uncertified, slip."""
+    if loader.fast_cycle is None:
+        pytest.skip(f'compiled module not built: {loader.IMPORT_ERROR}')
+    fast, slow = ObjectLoop(), ObjectLoop()
+    slow.compiled = False
+    at_limit = np.zeros_like(LIMITS)
+    at_limit[3] = LIMIT_FRACTION * LIMITS[3]
+    slipped = carried(np.array([-1e-3, 0.0, 0.0, 0.0, 0.0, 0.0]))
+    slipped[HAND.idx_q[0]] += 0.1
+    rng = np.random.default_rng(3)
+    t = settled(slow, SETUP.q)
+    assert settled(fast, SETUP.q) == t
+    assert fast.tracker.compiled is not None  # else both ran numpy's
+    frozen = set()
+    for k in range(300):
+        if k % 50 == 40:
+            q, certified, command = slipped, True, None
+        else:  # a sag and a turn that wind the integral up to its bound, and back
+            dx = np.array([-1.5e-3, 0.4e-3, 0.0, 0.0, 0.01, 0.02]) * np.sin(k / 40.0)
+            q = carried(dx + 1e-5 * rng.standard_normal(6))
+            certified, command = k % 37 != 5, at_limit if k % 23 == 7 else None
+        # The object origin moved off the reference's (an object pose input): the lever
+        # is the new origin's, the estimate about the reference's.
+        origin = ORIGIN + np.array([0.0, 0.0, 2e-3]) * (k > 150)
+        for loop in (fast, slow):
+            loop.after(certified, np.zeros_like(LIMITS) if command is None else command,
+                       LIMITS)
+            loop.update(HAND, SETUP.contacts, q, t, origin, WEIGHT, GAINS, 0.05)
+        t += DT * (1.0 + 0.3 * rng.random())  # uneven periods, as joint states arrive
+        for name in ('wrench', 'integral', 'error', 'rate', 'residual', 'slip', '_slow'):
+            np.testing.assert_allclose(getattr(fast, name), getattr(slow, name),
+                                       rtol=1e-9, atol=1e-12, err_msg=f'{name} at {k}')
+        assert fast.why_frozen == slow.why_frozen
+        frozen.add(slow.why_frozen)
+    assert frozen == {'', 'no certified command', 'at a torque limit', 'a contact slips'}
+    bound = GAINS.max_integral_ratio * WEIGHT  # the clamp was reached too
+    assert np.linalg.norm(GAINS.integral * slow.integral[:3]) < bound * (1 + 1e-9)
+
+
+def test_the_compiled_rotation_vector_is_pinocchios_log3():
+    """Random rotations, small ones and ones near pi, against pinocchio.log3."""
+    if loader.fast_cycle is None:
+        pytest.skip(f'compiled module not built: {loader.IMPORT_ERROR}')
+    rng = np.random.default_rng(5)
+    axes = rng.standard_normal((200, 3))
+    axes /= np.linalg.norm(axes, axis=1)[:, None]
+    angles = np.concatenate((rng.uniform(0, np.pi, 50), 10.0 ** rng.uniform(-12, -2, 50),
+                             np.pi - 10.0 ** rng.uniform(-9, -1, 50), np.zeros(1),
+                             np.full(49, np.pi / 2)))
+    for axis, angle in zip(axes, angles):
+        R = pin.exp3(angle * axis)
+        got, want = loader.fast_cycle.rotation_vector(R), pin.log3(R)
+        if angle > np.pi - 1e-6:  # the axis's sign is not defined at pi: either one
+            assert min(np.abs(got - want).max(), np.abs(got + want).max()) < 1e-6
+        else:
+            np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-14)
 
 
 def test_squeeze_rises_with_usage_and_relaxes_within_its_bounds():
