@@ -91,7 +91,8 @@ def fast_cycle_extensions() -> list[Extension]:
     common = ['-std=c++17', '-O3', '-DNDEBUG', '-fvisibility=hidden', '-g0', '-fno-trapping-math',
               '-isystem', eigen, '-isystem', proxsuite]
     header = [_source('src/fast_cycle.hpp'), _source('src/fast_batch.hpp'),
-              _source('src/vertex_lp.hpp'), _source('src/tree_kinematics.hpp')]
+              _source('src/vertex_lp.hpp'), _source('src/tree_kinematics.hpp'),
+              _source('src/object_loop.hpp')]
     out = [Extension('grasp_torque_opt.native._fast_cycle', [_source('src/fast_cycle.cpp')],
                      include_dirs=[pybind11.get_include()], language='c++',
                      extra_compile_args=common, depends=header, optional=True)]
