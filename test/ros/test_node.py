@@ -315,14 +315,39 @@ def test_stamped_command_carries_the_joint_states_stamp(planar):
         msg = JointState(name=list(planar.hand.joints),
                          position=[float(planar.q[i]) for i in planar.hand.idx_q])
         msg.header.stamp.sec, msg.header.stamp.nanosec = 1234, 5678
-        h.js_pub.publish(msg)
-        assert h.spin_until(lambda: stamped and h.commands, 5.0)
-        out = stamped[-1]
-        assert (out.header.stamp.sec, out.header.stamp.nanosec) == (1234, 5678)
-        assert list(out.name) == list(planar.hand.joints)
-        np.testing.assert_array_equal(out.effort, h.commands[-1][1])
+        for sec in (1234, 1235):  # the second read by the first's layout
+            h.js_pub.publish(msg)
+            assert h.spin_until(lambda: len(stamped) == sec - 1233 and h.commands, 5.0)
+            out = stamped[-1]
+            assert (out.header.stamp.sec, out.header.stamp.nanosec) == (sec, 5678)
+            assert list(out.name) == list(planar.hand.joints)
+            assert out.header.frame_id == planar.hand.base_frame
+            np.testing.assert_array_equal(out.effort, h.commands[-1][1])
+            msg.header.stamp.sec += 1
+        assert h.node.root.inputs.layout.read_here >= 1
     finally:
         h.close()
+
+
+def test_joint_states_read_by_their_layout_command_as_rclpys_reading(planar_node, planar):
+    """A driver's messages after its first are read from their bytes: the same commands."""
+    h, layout = planar_node, planar_node.node.root.inputs.layout
+    names, pos = joint_state(planar)
+    read_before = layout.read_here
+    for k in range(4):
+        q = planar.q.copy()
+        q[planar.hand.idx_q[1]] += 0.004 * k
+        h.send_joint_state(*joint_state(planar, q))
+        cmd = h.next_command()
+        assert cmd is not None, k
+        np.testing.assert_allclose(cmd, solve(dataclasses.replace(planar, q=q)).tau,
+                                   atol=1e-9)
+    assert layout.read_here - read_before >= 3  # all but the first, by the layout
+    # A NaN read from the bytes is refused as rclpy's reading of it is.
+    h.send_joint_state(names, [pos[0], float('nan')] + pos[2:])
+    assert h.spin_until(lambda: h.diagnostics and h.diagnostics[-1]['last_rejection'] ==
+                        "joint_states: position of 'joint2' is not finite", 2.0)
+    assert layout.read_here - read_before >= 4
 
 
 def test_stopping_applies_the_policy_in_process(planar):

@@ -42,6 +42,7 @@ from grasp_torque_opt.control.parameters.snapshot import value_of
 from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.ros.node.qos import JOINT_STATE_QOS
 from grasp_torque_opt.ros.node.throttle import Throttle
+from grasp_torque_opt.ros.node.wire import JointStateLayout
 from grasp_torque_opt.ros.peers import quiet_subscription
 import numpy as np
 from rclpy.qos import qos_profile_sensor_data
@@ -78,6 +79,8 @@ class Inputs:
         self.root = root
         self.node = root.node
         self.joint_states_topic = ''  # remapped and resolved, once subscribed
+        #: The joint states' layout (read without rclpy where the bytes fit it).
+        self.layout = JointStateLayout()
         # use_sim_time is fixed after start (DeclaredParameters): read once.
         self.sim_time = bool(root.node.get_parameter('use_sim_time').value)
         self._rejections = Throttle(1.0)
@@ -93,9 +96,12 @@ class Inputs:
                                                                 given.enabled)):
                 continue
             msg_type = MESSAGES[name][0]
-            take = self.on_joint_state if name == 'joint_states' else (
-                lambda msg, receipt, name=name: self.on_message(name, msg, receipt))
-            callback = self._callback(name, msg_type, take)
+            if name == 'joint_states':
+                callback = self.on_joint_state_bytes if self.root.message_info else (
+                    lambda data: self.on_joint_state_bytes(data, None))
+            else:
+                callback = self._callback(name, msg_type, lambda msg, receipt, name=name:
+                                          self.on_message(name, msg, receipt))
             qos = JOINT_STATE_QOS if given.qos == 'joint_states' else qos_profile_sensor_data
             sub = self.node.create_subscription(msg_type, name, callback, qos, raw=True,
                                                 event_callbacks=quiet_subscription())
@@ -163,6 +169,31 @@ class Inputs:
                 return
         take(deserialize_message(data, msg_type), receipt)
 
+    def on_joint_state_bytes(self, data: bytes, info: dict | None) -> None:
+        """
+        Take a joint state as the middleware delivered it (as :meth:`on_serialized`).
+
+        Its length is checked; then it is read by the layout of the last joint state
+        rclpy read (:class:`~grasp_torque_opt.ros.node.wire.JointStateLayout`: the same
+        bytes but for the stamp and the values), else deserialized by rclpy.
+        """
+        receipt = received(info) if info is not None and not self.sim_aged else None
+        with self.root.lock:
+            ctrl = self.root.controller
+            if ctrl is None:
+                return  # released (the managed node's cleanup) while it waited
+            try:
+                ctrl.check_bytes('joint_states', len(data))
+            except InputError as e:
+                self._rejected(e)
+                return
+        read = self.layout.read(data)
+        if read is None:
+            msg = deserialize_message(data, JointState)
+            self.layout.learn(data, msg)
+            read = msg.header.stamp, msg.name, msg.position, msg.effort
+        self.joint_state(*read, receipt)
+
     def on_joint_state(self, msg: JointState, receipt: float | None = None) -> None:
         """
         Take a joint state and, while the node commands, run one cycle on it.
@@ -171,8 +202,12 @@ class Inputs:
             msg: the joint state.
             receipt: when the middleware received it (monotonic [s]; None: now).
         """
+        self.joint_state(msg.header.stamp, msg.name, msg.position, msg.effort, receipt)
+
+    def joint_state(self, header: Any, names: Any, positions: Any, efforts: Any,
+                    receipt: float | None = None) -> None:
+        """Take a joint state's stamp, names, positions and efforts (:meth:`on_joint_state`)."""
         now = self.now()
-        header = msg.header.stamp
         stamp = stamp_seconds(header.sec, header.nanosec)
         if self.sim_aged:
             # /clock and joint_states are two topics: no order between them is sure, and
@@ -187,7 +222,7 @@ class Inputs:
                 return
             try:
                 # The store checks the sizes first (the bytes are bounded already).
-                ctrl.take('joint_states', JointStateReading(msg.name, msg.position, msg.effort),
+                ctrl.take('joint_states', JointStateReading(names, positions, efforts),
                           receipt, stamp, self.clock_now())
             except InputError as e:
                 self._rejected(e)

@@ -33,6 +33,7 @@ from grasp_torque_opt.control.fault_policy import CycleResult
 from grasp_torque_opt.control.geometry import placements_at
 from grasp_torque_opt.ros.node.qos import COMMAND_QOS
 from grasp_torque_opt.ros.node.throttle import Throttle
+from grasp_torque_opt.ros.node.wire import Serialized
 from grasp_torque_opt.ros.peers import quiet_publisher
 import numpy as np
 from rclpy.duration import Duration
@@ -58,6 +59,10 @@ class Outputs:
         #: The one Float64MultiArray every command leaves in (its data set each time:
         #: rclpy converts a message when it is published, so none is kept half-written).
         self._array = Float64MultiArray()
+        #: The commands' bytes by their layouts (:class:`.wire.Serialized`; None: the
+        #: layout could not be learnt, messages are published), by (kind, joint names,
+        #: frame).
+        self._wire: dict[tuple, Serialized | None] = {}
         self._no_command = Throttle(1.0)
 
     def start(self) -> list[tuple[str, Any]]:
@@ -131,17 +136,42 @@ class Outputs:
             return
         self._publish_output(out, data, stamp)
         if self.stamped_pub is not None:
+            stamp = stamp if stamp is not None else self.node.get_clock().now().to_msg()
+            wire = self._layout('stamped', hand)
+            if wire is not None:
+                self.stamped_pub.publish(wire.write(data, stamp))
+                return
             msg = JointState(name=list(hand.joints), effort=data)
-            msg.header.stamp = stamp if stamp is not None else \
-                self.node.get_clock().now().to_msg()
+            msg.header.stamp = stamp
             msg.header.frame_id = hand.base_frame
             self.stamped_pub.publish(msg)
+
+    def _layout(self, kind: str, hand: Any) -> Serialized | None:
+        """Return the bytes' layout of a command (``array`` or ``stamped``) of this hand."""
+        key = (kind, tuple(hand.joints), hand.base_frame)
+        if key not in self._wire:
+            if kind == 'array':
+                msg, field, stamped = Float64MultiArray(), 'data', False
+            else:
+                msg, field, stamped = JointState(name=list(hand.joints)), 'effort', True
+                msg.header.frame_id = hand.base_frame
+            try:
+                self._wire[key] = Serialized(msg, field, hand.m, stamped)
+            except ValueError as e:  # never expected: messages are published then
+                self.node.get_logger().warn(f'commands published as messages: {e}')
+                self._wire[key] = None
+        return self._wire[key]
 
     def _publish_output(self, out: Command, data: Any = None, stamp: Any = None) -> None:
         """Publish a command in its interface's message (effort: ``data``, the torques)."""
         if out.position is None:  # Float64MultiArray
             values = data if out.interface == 'effort' and data is not None else \
                 array('d', np.ascontiguousarray(out.values, dtype=float).tobytes())
+            hand = self.root.controller.setup.hand
+            wire = self._layout('array', hand) if len(values) == hand.m else None
+            if wire is not None:
+                self.command_pub.publish(wire.write(values))
+                return
             msg = self._array
             msg.data = values
             self.command_pub.publish(msg)
