@@ -191,15 +191,27 @@ class Outputs:
         return True
 
     def on_markers(self) -> None:
-        """Publish the last solution's contact forces as arrows (none when it has none)."""
+        """
+        Publish the last solution's contact forces as arrows (none when it has none).
+
+        Each of the two topics only while something subscribes to it (RViz, a logger):
+        at 10 Hz their making and sending cost the 1 kHz cycle a joint state now and
+        then, for no reader.
+        """
         root = self.root
+        arrows = self.marker_pub.get_subscription_count() > 0
+        per_link = self.wrench_pub.get_subscription_count() > 0
+        if not (arrows or per_link):
+            return
         stamp = self.node.get_clock().now().to_msg()
         with root.lock:
             last = root.controller.last if root.commanding else None
             hand = root.controller.setup.hand
-            wrenches = link_wrenches(last, hand)
-        self.marker_pub.publish(markers(last, hand.base_frame, stamp,
-                                        root.params.marker_scale, root.params.marker_period))
+            wrenches = link_wrenches(last, hand) if per_link else []
+        if arrows:
+            self.marker_pub.publish(markers(last, hand.base_frame, stamp,
+                                            root.params.marker_scale,
+                                            root.params.marker_period))
         for link, w in wrenches:
             msg = WrenchStamped()
             msg.header.frame_id, msg.header.stamp = link, stamp
