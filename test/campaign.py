@@ -27,6 +27,7 @@ import importlib
 from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 import numpy as np
+from rclpy.serialization import deserialize_message
 
 #: Counts of the whole run, printed by conftest's terminal summary.
 COUNTS = {'inputs': 0, 'commands': 0, 'broken': 0, 'pulling': 0, 'chattering': 0, 'late': 0}
@@ -245,3 +246,8 @@ class TrueGrasp:
                   > w[:, 2] + self.tol):
             return 'outside the cone'
         return 'weak' if np.any(w[:, 2] < self.f_min - self.tol) else 'ok'
+
+
+def as_message(msg, kind):
+    """Return what a publisher was given as a message: the node publishes bytes (wire.py)."""
+    return deserialize_message(msg, kind) if isinstance(msg, bytes) else msg

@@ -24,7 +24,7 @@ import json
 import math
 import time
 
-from campaign import broken, CAMPAIGN, check_command, COUNTS, FLOATS, mutated
+from campaign import as_message, broken, CAMPAIGN, check_command, COUNTS, FLOATS, mutated
 from conftest import ALLEGRO, PLANAR
 from cycle_inputs import base_poses, FAULT_MODES, Injected, joint_state
 from geometry_msgs.msg import Pose, PoseArray, WrenchStamped
@@ -43,6 +43,7 @@ from rclpy.parameter import Parameter
 from rclpy.task import Future
 from ros_harness import DOMAIN
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
 import yaml
 
 #: No cycle may take longer than this, whatever the input: its solvers stop by its budget
@@ -69,7 +70,8 @@ class Recorder:
         ctrl = self.node.controller  # publish follows the cycle at once: same inputs
         # The controller as it is now (a shallow copy keeps this setup and config): a
         # parameter change after the command must not be held against it.
-        self.seen.append((np.array(msg.data), ctrl.last, ctrl.inputs, copy.copy(ctrl),
+        data = as_message(msg, Float64MultiArray).data
+        self.seen.append((np.array(data), ctrl.last, ctrl.inputs, copy.copy(ctrl),
                           time.monotonic()))
 
     def __getattr__(self, name: str):

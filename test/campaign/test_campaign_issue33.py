@@ -41,7 +41,7 @@ import math
 from pathlib import Path
 import time
 
-from campaign import COUNTS, ISSUE33, TrueGrasp
+from campaign import as_message, COUNTS, ISSUE33, TrueGrasp
 from conftest import ALLEGRO, ALLEGRO_URDF
 from cycle_inputs import base_poses, joint_state, phantom as shared_phantom
 from geometry_msgs.msg import PoseStamped
@@ -57,6 +57,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from ros_harness import Harness
 from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import Float64MultiArray
 
 SCENARIO = load_scenario(ALLEGRO)
 SETUP = GraspSetup.from_file(ALLEGRO)
@@ -107,12 +108,13 @@ class Rig(Harness):
             stamped = outputs.stamped_pub.publish
 
             def publish_stamped(msg):
-                self.published[-1][1] = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+                stamp = as_message(msg, JointState).header.stamp
+                self.published[-1][1] = (stamp.sec, stamp.nanosec)
                 stamped(msg)
             outputs.stamped_pub.publish = publish_stamped
 
         def publish(msg):
-            self.published.append([np.array(msg.data), None])
+            self.published.append([np.array(as_message(msg, Float64MultiArray).data), None])
             command(msg)
         outputs.command_pub.publish = publish
 
