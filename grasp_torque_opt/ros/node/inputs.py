@@ -157,17 +157,24 @@ class Inputs:
 
         Its length is checked, then it is deserialized and taken (``take(msg, receipt)``).
         """
+        admitted, receipt = self._admitted(topic, data, info)
+        if admitted:
+            take(deserialize_message(data, msg_type), receipt)
+
+    def _admitted(self, topic: str, data: bytes, info: dict | None
+                  ) -> tuple[bool, float | None]:
+        """Check a message's length while the node runs; give (taken, its receipt time)."""
         receipt = received(info) if info is not None and not self.sim_aged else None
         with self.root.lock:
             ctrl = self.root.controller
             if ctrl is None:
-                return  # released (the managed node's cleanup) while it waited
+                return False, receipt  # released (the managed node's cleanup) meanwhile
             try:
                 ctrl.check_bytes(topic, len(data))
             except InputError as e:
                 self._rejected(e)
-                return
-        take(deserialize_message(data, msg_type), receipt)
+                return False, receipt
+        return True, receipt
 
     def on_joint_state_bytes(self, data: bytes, info: dict | None) -> None:
         """
@@ -177,16 +184,9 @@ class Inputs:
         rclpy read (:class:`~grasp_torque_opt.ros.node.wire.JointStateLayout`: the same
         bytes but for the stamp and the values), else deserialized by rclpy.
         """
-        receipt = received(info) if info is not None and not self.sim_aged else None
-        with self.root.lock:
-            ctrl = self.root.controller
-            if ctrl is None:
-                return  # released (the managed node's cleanup) while it waited
-            try:
-                ctrl.check_bytes('joint_states', len(data))
-            except InputError as e:
-                self._rejected(e)
-                return
+        admitted, receipt = self._admitted('joint_states', data, info)
+        if not admitted:
+            return
         read = self.layout.read(data)
         if read is None:
             msg = deserialize_message(data, JointState)
