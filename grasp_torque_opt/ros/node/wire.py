@@ -47,6 +47,8 @@ from rclpy.serialization import deserialize_message, serialize_message
 #: the 4 bytes of the CDR encapsulation, int32 seconds and uint32 nanoseconds.
 STAMP = struct.Struct('<iI')
 STAMP_AT = 4
+#: A CDR length or count.
+U32 = struct.Struct('<I')
 #: The encapsulation this module reads and writes: CDR, little-endian.
 CDR_LE = b'\x00\x01'
 
@@ -86,8 +88,6 @@ def marked(msg: Any, fields: tuple[str, ...], lengths: tuple[int, ...]
         spans.append((at, at + len(block)) if n else None)
     return raw, spans
 
-
-U32 = struct.Struct('<I')
 
 
 def _joint_state_walk(data: bytes) -> tuple[list, list, list] | None:
