@@ -89,7 +89,6 @@ def marked(msg: Any, fields: tuple[str, ...], lengths: tuple[int, ...]
     return raw, spans
 
 
-
 def _joint_state_walk(data: bytes) -> tuple[list, list, list] | None:
     """
     Return where a little-endian CDR sensor_msgs/JointState's fields are, or None.
