@@ -61,32 +61,24 @@ def _only(data: bytes, block: bytes) -> int:
     return at
 
 
-def marked(msg: Any, fields: tuple[str, ...], lengths: tuple[int, ...]
-           ) -> tuple[bytes, list[tuple[int, int] | None]]:
+def marked(msg: Any, field: str, n: int) -> tuple[bytes, tuple[int, int]]:
     """
-    Serialize ``msg`` by rclpy with marked float64 values in ``fields``; find the marks.
+    Serialize ``msg`` by rclpy with ``n`` marked float64 values in ``field``; find them.
 
-    Each field gets ``lengths[k]`` marks (tiny distinct doubles no reading gives); it is
-    set on ``msg``. Returns the bytes and each field's (start, end) in them (None for an
-    empty field).
+    The marks are tiny distinct doubles no reading gives; they are set on ``msg``.
+    Returns the bytes and the marks' (start, end) in them.
 
     Raises:
-        ValueError: the bytes are not little-endian CDR, or a field's marks are not
-            found exactly once.
+        ValueError: the bytes are not little-endian CDR, or the marks are not found
+            exactly once.
     """
-    for k, (field, n) in enumerate(zip(fields, lengths)):
-        setattr(msg, field, array('d', [1.0e-300 * (3 + 7 * i + 1000 * k) for i in range(n)]))
+    setattr(msg, field, array('d', [1.0e-300 * (3 + 7 * i) for i in range(n)]))
     raw = serialize_message(msg)
-    if raw[:2] != CDR_LE:
-        raise ValueError('not little-endian CDR')
-    spans: list[tuple[int, int] | None] = []
-    for field, n in zip(fields, lengths):
-        block = getattr(msg, field).tobytes()
-        at = _only(raw, block) if n else -1
-        if n and at < 0:
-            raise ValueError(f'the marks of {field} are not found once')
-        spans.append((at, at + len(block)) if n else None)
-    return raw, spans
+    block = getattr(msg, field).tobytes()
+    at = _only(raw, block) if n else -1
+    if raw[:2] != CDR_LE or at < 0:
+        raise ValueError(f'the marks of {field} are not found once in little-endian CDR')
+    return raw, (at, at + len(block))
 
 
 def _joint_state_walk(data: bytes) -> tuple[list, list, list] | None:
@@ -246,8 +238,8 @@ class Serialized:
     def __init__(self, msg: Any, field: str, n: int, stamped: bool = False) -> None:
         """Serialize ``msg`` (its ``field`` and stamp set here) with marks; check a test value."""
         self._n, self._stamped = n, stamped
-        raw, (span,) = marked(msg, (field,), (n,))
-        if span is None or (stamped and span[0] < STAMP_AT + STAMP.size):
+        raw, span = marked(msg, field, n)
+        if stamped and span[0] < STAMP_AT + STAMP.size:
             raise ValueError('the command layout cannot be learnt')
         self._head, self._tail = raw[:span[0]], raw[span[1]:]
         test = array('d', [0.25 * (i + 1) for i in range(n)])
