@@ -218,6 +218,8 @@ struct QPData
   Vec g, b, l, u, l_box, u_box;
   Mat pinv;  // [M1 M2] = pinv([G; J^T]), 4p x (6 + m)
   Vec w, tau_min, tau_max;
+  Mat qr, Q;  // the build's work: [G; J^T]'s QR (householder_qr) and its Q
+  Vec qr_tau;
 
   int n_eq() const {return static_cast<int>(A.rows());}
   auto M1() const {return pinv.leftCols(6);}
@@ -248,6 +250,81 @@ struct Answer
   double solve_time_s = 0.0;
   double t_maps = 0.0, t_build = 0.0, t_solve = 0.0, t_certify = 0.0;
 };
+
+// Householder QR of a (rows >= cols) in place, as LAPACK's dgeqr2 (numpy's QR, via
+// dgeqrf) and Eigen's HouseholderQR write it: R on and above the diagonal, each
+// reflector's essential part below it, its coefficient in tau (H_k = I - tau_k v v^T,
+// v = [1; essential]); a column already zero below its diagonal takes tau 0. Written
+// here, not Eigen's, for the sizes of a hand (22 x 16 for the Allegro): Eigen's
+// dynamic-size kernels spend more on their dispatch than on the arithmetic, and this
+// with the Q below took half the time of Eigen's in bench (about 3 against 6 us).
+void householder_qr(Mat & a, Vec & tau)
+{
+  const int rows = static_cast<int>(a.rows()), cols = static_cast<int>(a.cols());
+  tau.resize(cols);
+  for (int k = 0; k < cols; ++k) {
+    double * v = a.col(k).data() + k;
+    const int n = rows - k;
+    double tail = 0.0;
+    for (int i = 1; i < n; ++i) {
+      tail += v[i] * v[i];
+    }
+    const double c0 = v[0];
+    if (tail <= std::numeric_limits<double>::min()) {
+      tau(k) = 0.0;
+      for (int i = 1; i < n; ++i) {
+        v[i] = 0.0;
+      }
+      continue;
+    }
+    const double beta = c0 >= 0.0 ? -std::sqrt(c0 * c0 + tail) : std::sqrt(c0 * c0 + tail);
+    const double scale = 1.0 / (c0 - beta);
+    for (int i = 1; i < n; ++i) {
+      v[i] *= scale;
+    }
+    const double t = (beta - c0) / beta;
+    tau(k) = t;
+    v[0] = beta;
+    for (int j = k + 1; j < cols; ++j) {
+      double * d = a.col(j).data() + k;
+      double s = d[0];
+      for (int i = 1; i < n; ++i) {
+        s += v[i] * d[i];
+      }
+      s *= t;
+      d[0] -= s;
+      for (int i = 1; i < n; ++i) {
+        d[i] -= s * v[i];
+      }
+    }
+  }
+}
+
+// Q (rows x rows) of householder_qr's reflectors, H_0 H_1 ... H_(cols-1) (LAPACK's
+// dorgqr, Eigen's householderQ()): applied from the last to the identity, each only
+// where it can change it.
+void householder_q(const Mat & a, const Vec & tau, Mat & Q)
+{
+  const int rows = static_cast<int>(a.rows()), cols = static_cast<int>(a.cols());
+  Q.setIdentity(rows, rows);
+  for (int k = cols - 1; k >= 0; --k) {
+    const double * v = a.col(k).data() + k;
+    const double t = tau(k);
+    const int n = rows - k;
+    for (int j = k; j < rows; ++j) {
+      double * d = Q.col(j).data() + k;
+      double s = d[0];
+      for (int i = 1; i < n; ++i) {
+        s += v[i] * d[i];
+      }
+      s *= t;
+      d[0] -= s;
+      for (int i = 1; i < n; ++i) {
+        d[i] -= s * v[i];
+      }
+    }
+  }
+}
 
 // A Tree from the joint tables as Python passes them (TreeKinematics.tables); a
 // ValueError where their shapes do not agree (Tree checks their values).
@@ -537,23 +614,25 @@ public:
       why = "A = [G; J^T] has more columns than rows";
       return false;
     }
-    Mat A_full(rows, cols);
-    A_full.topRows(6) = G;
-    A_full.bottomRows(m) = J.transpose();
-    if (!A_full.allFinite()) {
+    Mat & packed = qp.qr;
+    packed.resize(rows, cols);
+    packed.topRows(6) = G;
+    packed.bottomRows(m) = J.transpose();
+    if (!packed.allFinite()) {
       why = "maps not finite";
       return false;
     }
-    Eigen::HouseholderQR<Mat> qr(A_full);
-    const Mat & packed = qr.matrixQR();
+    householder_qr(packed, qp.qr_tau);
     const Vec d = packed.diagonal().head(cols).cwiseAbs();
     if (!(d.minCoeff() > s_.qr_rtol * d.maxCoeff())) {
       why = "A = [G; J^T] is not of full column rank";
       return false;
     }
-    const Mat Q = qr.householderQ();  // rows x rows
+    Mat & Q = qp.Q;
+    householder_q(packed, qp.qr_tau, Q);  // rows x rows
     const auto Rup = packed.topRows(cols).triangularView<Eigen::Upper>();
-    qp.pinv = Rup.solve(Q.leftCols(cols).transpose());  // cols x rows
+    qp.pinv = Q.leftCols(cols).transpose();
+    Rup.solveInPlace(qp.pinv);  // cols x rows
     const auto U_perp = Q.rightCols(rows - cols);
     const auto M1 = qp.M1();
     const auto M2 = qp.M2();
