@@ -70,3 +70,27 @@ def test_staleness_names_the_oldest_input(planar):
     assert s.stale(0.2).startswith('joint_states stale')
     s.take('joint_states', JointStateReading(*joint_state(planar)), 0.55)
     assert s.stale(0.6).startswith('external_wrench stale')
+
+
+def test_a_known_layout_is_held_to_every_position_rule(planar):
+    # After a first state, the same names take the one-comparison path: each rule it
+    # stands for still refuses, with the full check's words, and a new tolerance counts.
+    s = store(planar, joint_limit_tolerance=0.1)
+    names, positions = joint_state(planar)
+    s.take('joint_states', JointStateReading(names, positions), 1.0)
+    for value, words in ((2.15, "position of 'joint1' is 2.15, beyond its URDF limits "
+                                '[-2, 2] by more than joint_limit_tolerance (0.1)'),
+                         (1e6, "position of 'joint1' is 1e+06, beyond +-"),
+                         (float('nan'), "position of 'joint1' is not finite"),
+                         (-2.15, "position of 'joint1' is -2.15, beyond its URDF limits")):
+        kept = s.inputs
+        moved = [value] + list(positions[1:])
+        with pytest.raises(InputError) as e:
+            s.take('joint_states', JointStateReading(names, moved), 2.0)
+        assert words in str(e.value)
+        assert s.inputs is kept
+    s.take('joint_states', JointStateReading(names, [2.05] + list(positions[1:])), 3.0)
+    assert s.inputs.q[0] == 2.05
+    s.config = CycleConfig(joint_limit_tolerance=0.2)
+    s.take('joint_states', JointStateReading(names, [2.15] + list(positions[1:])), 4.0)
+    assert s.inputs.q[0] == 2.15

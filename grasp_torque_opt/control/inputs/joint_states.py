@@ -79,22 +79,22 @@ class JointStates:
         names, positions = reading.names, reading.positions
         self.size(store, max(len(names), len(positions)))
         q = (store.setup.q if store.inputs.q is None else store.inputs.q).copy()
-        known, checked, values = store.joint_names, None, None
+        known = store.joint_names
+        lower, upper = store.position_limits()
         if known is not None and known[3] is store.setup.hand.joints and \
                 len(positions) == len(names) and names == known[0]:
             # The same names as the last accepted state (a driver's every message): their
-            # checks hold; one array comparison checks the positions (NaN fails it, and
-            # then the full check below names the position).
+            # checks hold; one comparison with the used joints' bounds (within the URDF
+            # limits and the magnitude bound) checks the positions. NaN fails it, and
+            # then the full checks below name the position and the rule.
             values = np.asarray(positions, dtype=float)[known[1]]
-            if not (np.abs(values) <= MAX_ABS_JOINT_POSITION).all():
-                values = None
-        if values is not None:
-            q[known[2]] = values
-        else:
-            checked = check_joint_names(names, positions, q, store.model_joints,
-                                        store.setup.hand.joints)
-        lower, upper = store.position_limits()
-        check_joint_limits(q, (checked or known)[2], lower, upper, store.q_names,
+            low, high = used_bounds(store, known, lower, upper)
+            if ((values >= low) & (values <= high)).all():
+                q[known[2]] = values
+                return q, None, reading
+        checked = check_joint_names(names, positions, q, store.model_joints,
+                                    store.setup.hand.joints)
+        check_joint_limits(q, checked[2], lower, upper, store.q_names,
                            store.config.joint_limit_tolerance)
         return q, checked, reading
 
@@ -119,6 +119,26 @@ class JointStates:
             return 'no joint state yet'
         age, timeout = now - inputs.q_time, config.joint_state_timeout
         return f'joint_states stale ({age:.3f} s > {timeout} s)' if age > timeout else ''
+
+
+def used_bounds(store, known: tuple, lower: np.ndarray, upper: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Return the bounds a known layout's used positions must lie within (cached per layout).
+
+    Each is its joint's URDF limit widened by ``joint_limit_tolerance``, within
+    +-:data:`~grasp_torque_opt.control.checks.MAX_ABS_JOINT_POSITION`: a position
+    inside them passes both rules, one outside fails one of them.
+    """
+    cached = store.joint_bounds
+    if cached is not None and cached[0] is known and cached[1] is lower \
+            and cached[2] is upper:
+        return cached[3], cached[4]
+    used = known[2]
+    low = np.maximum(lower[used], -MAX_ABS_JOINT_POSITION)
+    high = np.minimum(upper[used], MAX_ABS_JOINT_POSITION)
+    store.joint_bounds = (known, lower, upper, low, high)
+    return low, high
 
 
 JOINT_STATES = JointStates()

@@ -146,6 +146,8 @@ class InputStore:
         #: their indices in q, and the commanded joints it was checked against (a state
         #: with the same names skips the name checks).
         self.joint_names: tuple | None = None
+        #: The bounds of that layout's used positions (joint_states.used_bounds' cache).
+        self.joint_bounds: tuple | None = None
         self.imu = ImuTracker()
         #: The receipt time of the message being taken [s] (a check comparing it with the
         #: input's earlier messages reads it).
