@@ -306,7 +306,9 @@ class Cycle:
         """
         # The compiled cycle is made for the squeeze's friction (:meth:`squeezed`); made
         # again when this cycle's grasp moved it.
-        fast = self._compiled(replaced(self.setup, friction=self.squeezed()))
+        friction = self.squeezed()
+        fast = self._compiled(self.setup if friction is self.setup.friction else
+                              replaced(self.setup, friction=friction))
         # The joint Jacobians for the compiled call, unless it computes its kinematics.
         jacobians = fast is not None and fast.tree is None
         setup, g = self.grasp_at(inputs, jacobians=jacobians)
