@@ -119,15 +119,22 @@ class PeerWatch:
     """
     The node's topics, checked against the graph; each peer found is told once.
 
-    :meth:`check` gives every incompatible peer now and the ones not seen at the last
-    check (to log). What it remembers is the last check's peers only: bounded by the
-    graph.
+    :meth:`check` checks every topic at once; :meth:`check_next` one topic a call, in
+    turn (the node's graph timer: a few graph queries a tick, never all in one
+    callback). Both give every incompatible peer known and the ones not seen at that
+    topic's last check (to log). What it remembers is each topic's last check only:
+    bounded by the graph.
     """
 
     def __init__(self) -> None:
         """Watch nothing yet."""
         self._watched: list[tuple[Any, type]] = []
-        self._seen: set[tuple[str, tuple[int, ...]]] = set()
+        self._found: dict[int, list[Peer]] = {}  # watched index -> its last check's peers
+        self._next = 0
+
+    def __len__(self) -> int:
+        """Give how many topics are watched."""
+        return len(self._watched)
 
     def watch(self, entity: Any, msg_type: type) -> None:
         """Add a publisher or a subscription of the node, made with ``msg_type``."""
@@ -136,16 +143,43 @@ class PeerWatch:
     def clear(self) -> None:
         """Forget the entities (destroyed) and the peers told."""
         self._watched.clear()
-        self._seen.clear()
+        self._found.clear()
+        self._next = 0
 
     def check(self, node: Any) -> tuple[list[Peer], list[Peer]]:
-        """Give (every incompatible peer, those new since the last check)."""
-        peers = [p for entity, msg_type in self._watched
-                 for p in incompatible(node, entity, msg_type)]
-        keys = {(p.topic, p.gid) for p in peers}
-        new = [p for p in peers if (p.topic, p.gid) not in self._seen]
-        self._seen = keys
-        return peers, new
+        """Check every topic; give (every incompatible peer, those new since the last check)."""
+        new = []
+        for k in range(len(self._watched)):
+            new += self._check(node, k)
+        return self.peers(), new
+
+    def check_next(self, node: Any) -> tuple[list[Peer], list[Peer]]:
+        """Check the next topic in turn; give (every incompatible peer known, its new ones)."""
+        if not self._watched:
+            return [], []
+        k = self._next % len(self._watched)
+        self._next = k + 1
+        return self.peers(), self._check(node, k)
+
+    def checked(self) -> int:
+        """Give how many of the watched topics were checked."""
+        return len(self._found)
+
+    def checked_all(self) -> bool:
+        """Tell whether every watched topic was checked."""
+        return len(self._found) == len(self._watched)
+
+    def peers(self) -> list[Peer]:
+        """Give the incompatible peers of each topic's last check, in the topics' order."""
+        return [p for k in sorted(self._found) for p in self._found[k]]
+
+    def _check(self, node: Any, k: int) -> list[Peer]:
+        """Check topic ``k``; keep its peers; give those its last check did not find."""
+        entity, msg_type = self._watched[k]
+        found = incompatible(node, entity, msg_type)
+        before = {(p.topic, p.gid) for p in self._found.get(k, ())}
+        self._found[k] = found
+        return [p for p in found if (p.topic, p.gid) not in before]
 
 
 def summary(peers: list[Peer]) -> str:

@@ -666,6 +666,35 @@ def test_incompatible_peers_are_found_from_the_graph_and_told_once(planar_node):
         rclpy.shutdown(context=context)
 
 
+def test_the_graph_is_asked_a_step_a_tick_never_all_in_one_callback(planar_node):
+    # The graph's endpoint queries went from /diagnostics' callback (some thirty of them,
+    # about half a millisecond) to the graph timer, one topic a tick: the same findings.
+    h = planar_node
+    node, status = h.node, h.node.root.status
+    asked = []
+    for name in ('get_publishers_info_by_topic', 'get_subscriptions_info_by_topic'):
+        query = getattr(node, name)
+        setattr(node, name, lambda topic, query=query: asked.append(topic) or query(topic))
+    try:
+        watched = len(node.root.peers)
+        assert watched >= 5  # the planar node's topics: inputs, outputs, /diagnostics
+        for _ in range(2 * (watched + 1)):
+            asked.clear()
+            status.on_graph()
+            assert 1 <= len(asked) <= 2, asked  # one topic: its publishers, subscriptions
+        asked.clear()
+        status.on_diagnostics()
+        assert asked == []
+        assert node.root.peers.checked_all()
+        d_before = len(h.diagnostics)
+        assert h.spin_until(lambda: len(h.diagnostics) > d_before, 2.0)
+        assert h.diagnostics[-1]['incompatible_peers'] == 'none'
+        assert h.diagnostics[-1]['command_topic.other_publishers'] == 'none'
+    finally:
+        for name in ('get_publishers_info_by_topic', 'get_subscriptions_info_by_topic'):
+            vars(node).pop(name, None)
+
+
 def _fifo_threads(pid: int) -> dict[int, int]:
     """Give {thread id: SCHED_FIFO priority} of a process's SCHED_FIFO threads, from /proc."""
     out = {}

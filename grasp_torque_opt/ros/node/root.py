@@ -38,7 +38,7 @@ from grasp_torque_opt.ros.node.inputs import Inputs
 from grasp_torque_opt.ros.node.outputs import Outputs
 from grasp_torque_opt.ros.node.parameters import check_all, hand_context, scenario_defaults
 from grasp_torque_opt.ros.node.service import SolveService
-from grasp_torque_opt.ros.node.status import Status
+from grasp_torque_opt.ros.node.status import GRAPH_STEPS, Status
 from grasp_torque_opt.ros.node.tf_gravity import TfGravity
 from grasp_torque_opt.ros.peers import PeerWatch
 import numpy as np
@@ -231,6 +231,7 @@ class GraspTorque:
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         for period, callback in ((p.watchdog_period, self.on_watchdog),
                                  (p.diagnostics_period, self.status.on_diagnostics),
+                                 (p.diagnostics_period / GRAPH_STEPS, self.status.on_graph),
                                  (p.marker_period, self.outputs.on_markers)):
             made.append(('timer', self.node.create_timer(period, callback, clock=steady)))
         self._changed = self.node.create_timer(1e-6, self.on_changed, clock=steady)

@@ -28,6 +28,11 @@ from grasp_torque_opt.ros.peers import quiet_publisher, summary
 if TYPE_CHECKING:
     from grasp_torque_opt.ros.node.root import GraspTorque
 
+#: Steps of the graph checks per diagnostics period (:meth:`Status.on_graph`): with the
+#: Allegro's thirteen watched topics and the command topic, a whole round takes about
+#: 1.4 periods.
+GRAPH_STEPS = 10
+
 
 class Status:
     """The /diagnostics publisher and the graph checks it reports."""
@@ -38,6 +43,12 @@ class Status:
         self.node = root.node
         self.pub = None
         self.duplicates = 0  # other nodes of this name, at the last report
+        #: What the graph timer found (:meth:`on_graph`), read by the report: the other
+        #: publishers on the command topic, and the incompatible peers (None: not yet).
+        self.rivals: list[str] | None = None
+        self.peers: list | None = None
+        self._graph_step = 0
+        self._pending = None  # the status being made (_status_steps), None: none
 
     def start(self) -> list:
         """Make the publisher; give it for the root to destroy."""
@@ -47,8 +58,11 @@ class Status:
         return [self.pub]
 
     def stop(self) -> None:
-        """Forget the publisher (destroyed by the root)."""
+        """Forget the publisher (destroyed by the root) and what the graph checks found."""
         self.pub = None
+        self.rivals = self.peers = None
+        self._graph_step = 0
+        self._pending = None
 
     def count_duplicates(self) -> int:
         """Count the other nodes of this node's name and namespace that the graph shows."""
@@ -87,8 +101,54 @@ class Status:
                 for i in node.get_publishers_info_by_topic(topic)
                 if (i.node_namespace, i.node_name) != me]
 
+    def on_graph(self) -> None:
+        """
+        Take one step of the graph checks (the graph timer).
+
+        The steps go round: the command topic's other publishers, then each watched topic's
+        incompatible peers (:meth:`PeerWatch.check_next`). One or two graph queries a
+        tick: the whole check, some thirty queries and the QoS profiles they make, took
+        about half a millisecond in one callback, and a 1 kHz joint state arriving then
+        was overwritten by the next (the subscription keeps the last one only).
+        """
+        if self.step_status():  # a status being made goes first
+            return
+        node, log = self.node, self.node.get_logger()
+        step = self._graph_step
+        self._graph_step += 1
+        if step % (len(self.root.peers) + 1) == 0:
+            self.rivals = self.command_rivals()
+            return
+        self.peers, new = self.root.peers.check_next(node)
+        for peer in new:
+            log.warn(f'{peer.describe()}: no messages will pass between it and this node')
+
     def on_diagnostics(self) -> None:
-        """Publish one diagnostic status (the diagnostics timer)."""
+        """
+        Start one diagnostic status (the diagnostics timer): the controller's report now.
+
+        The status is made in steps (:meth:`_status_steps`), the first here, the others
+        on the graph timer's next ticks (:meth:`on_graph`), a few tenths of a
+        millisecond each: made whole, the report, its eighty-odd key-value pairs and
+        their publishing took about half a millisecond, and a 1 kHz joint state
+        arriving then was overwritten by the next.
+        """
+        if self._pending is not None:  # the last one's steps not all taken: finish it
+            for _ in self._pending:
+                pass
+        self._pending = self._status_steps()
+        self.step_status()
+
+    def step_status(self) -> bool:
+        """Take the next step of the status being made; tell whether one was taken."""
+        if self._pending is None:
+            return False
+        if next(self._pending, None) is None:
+            self._pending = None
+        return True
+
+    def _status_steps(self):
+        """Make and publish one status, yielding between its steps (:meth:`on_diagnostics`)."""
         root, node = self.root, self.node
         log = node.get_logger()
         with root.lock:
@@ -97,6 +157,8 @@ class Status:
             gravity_time = root.controller.inputs.gravity_time
             # The hand's name from its URDF (e.g. allegro_hand_right), as hardware_id asks.
             hand = root.controller.setup.hand.model.name
+        stamp = node.get_clock().now().to_msg()  # the report's time, not the publishing's
+        yield True
         # Two sources of joint states are followed as one stream (the stamp rule keeps
         # either from locking the other out); say so, as the node cannot tell them apart.
         topic = root.inputs.joint_states_topic
@@ -120,8 +182,9 @@ class Status:
             level = diagnostics.ERROR
             message = f'another node named {name} is on this domain; {message}'
         values.append(('duplicate_nodes', str(self.duplicates)))
-        others = self.command_rivals()
-        values.append(('command_topic.other_publishers', ', '.join(others) or 'none'))
+        others = self.rivals or []
+        values.append(('command_topic.other_publishers', 'not checked yet' if self.rivals is None
+                       else ', '.join(others) or 'none'))
         if others:
             topic = root.outputs.command_pub.topic_name
             log.error(f'another publisher on {topic}: {", ".join(others)}; the effort '
@@ -129,18 +192,21 @@ class Status:
             level = diagnostics.ERROR
             message = f'another publisher on {topic} ({", ".join(others)}); {message}'
         values.append(('executor_thread', realtime.describe()))  # this callback's thread
-        # What rclpy's default QoS event handlers would have logged, found from the graph.
-        peers, new = root.peers.check(node)
-        for peer in new:
-            log.warn(f'{peer.describe()}: no messages will pass between it and this node')
-        values.append(('incompatible_peers', summary(peers)))
+        # What rclpy's default QoS event handlers would have logged, found from the graph
+        # (told when found, by on_graph).
+        peers = self.peers or []
+        watch = root.peers
+        values.append(('incompatible_peers', summary(peers) if peers or watch.checked_all()
+                       else f'none in {watch.checked()} of {len(watch)} topics so far'))
         if peers:
             level = max(level, diagnostics.WARN)  # at least WARN (STALE and ERROR stay)
             message = f'{len(peers)} incompatible peer(s) on its topics; {message}'
+        yield True
         # The fully qualified name: two nodes in two namespaces are told apart.
         status = DiagnosticStatus(level=bytes([level]), name=f'{node.get_fully_qualified_name()}'
                                   ': grasp torques', message=message, hardware_id=hand,
                                   values=[KeyValue(key=k, value=v) for k, v in values])
         msg = DiagnosticArray(status=[status])
-        msg.header.stamp = node.get_clock().now().to_msg()
+        msg.header.stamp = stamp
+        yield True
         self.pub.publish(msg)
