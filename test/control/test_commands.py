@@ -18,6 +18,7 @@ counters and reason say so.
 """
 
 from cycle_inputs import fresh, joint_state
+from grasp_torque_opt.control.commands.base import Command
 from grasp_torque_opt.control.commands.registry import COMMAND_INTERFACES, make_interface
 from grasp_torque_opt.control.diagnostics import report
 from grasp_torque_opt.control.inputs.joint_states import JointStateReading
@@ -147,3 +148,13 @@ def test_an_interface_without_its_constants_is_refused_by_name(allegro, config, 
         make_interface(CycleConfig(**config), allegro.hand)
     with pytest.raises(InputError, match=match):
         fresh(allegro, **config)
+
+
+def test_well_formed_checks_every_array_but_the_one_the_caller_checked():
+    good, bad = np.ones(3), np.array([1.0, np.nan, 1.0])
+    assert Command('effort', good, good).well_formed(3, good)
+    assert not Command('effort', good, bad).well_formed(3, good)  # the torque still checked
+    assert not Command('hybrid', good, good, bad, np.zeros(3)).well_formed(3, good)
+    assert not Command('hybrid', good, good, good, np.zeros(2)).well_formed(3, good)
+    assert not Command('effort', bad, bad).well_formed(3)
+    assert Command('effort', bad, bad).well_formed(3, bad)  # the caller's word is taken

@@ -49,11 +49,19 @@ class Command:
     position: np.ndarray | None = None
     velocity: np.ndarray | None = None
 
-    def well_formed(self, m: int) -> bool:
-        """Whether every array has m finite entries (the node's promise on each message)."""
-        arrays = [self.values, self.torque] + [a for a in (self.position, self.velocity)
-                                               if a is not None]
-        return all(a.shape == (m,) and bool(np.all(np.isfinite(a))) for a in arrays)
+    def well_formed(self, m: int, checked: np.ndarray | None = None) -> bool:
+        """
+        Whether every array has m finite entries (the node's promise on each message).
+
+        ``checked``: an array the caller has just checked so (the certified torque,
+        which an effort command's values and torque are): not checked again.
+        """
+        for a in (self.values, self.torque, self.position, self.velocity):
+            if a is None or a is checked:
+                continue
+            if a.shape != (m,) or not np.isfinite(a).all():
+                return False
+        return True
 
 
 class CommandInterface(Protocol):

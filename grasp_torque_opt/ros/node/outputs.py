@@ -130,7 +130,7 @@ class Outputs:
         if out is None and self.root.params.command_interface == 'effort':
             out = Command('effort', cmd, cmd)  # a result made without its interface's output
         if out is None or out.interface != self.root.params.command_interface or \
-                not out.well_formed(hand.m):
+                not out.well_formed(hand.m, cmd):
             if out is not None:
                 self.node.get_logger().error('refused to publish a malformed command')
             return
