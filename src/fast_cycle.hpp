@@ -485,6 +485,31 @@ public:
     return a;
   }
 
+  // The contact list of the cycles to come, as solve_q takes it (held, not copied:
+  // the caller does not change these arrays), for solve_bound.
+  void bind_contacts(
+    py::array_t<int64_t> fparent, Array Rf, Array tf, Array points, Array normals,
+    py::array_t<bool> has_normal, Array tangents, py::array_t<bool> has_tangent)
+  {
+    bound_ = std::make_unique<Bound>(
+      Bound{fparent, Rf, tf, points, normals, has_normal, tangents, has_tangent});
+  }
+
+  // solve_q on the contacts of bind_contacts: the cycle's own arrays only (q, the object
+  // origin, the load, the torque offset) cross from Python.
+  Answer solve_bound(Array q, Array c, Array w_ext, Array offset, double time_left)
+  {
+    if (bound_ == nullptr) {
+      Answer a;
+      a.message = "no contacts bound (bind_contacts)";
+      return a;
+    }
+    const Bound & b = *bound_;
+    return solve_q(
+      q, b.fparent, b.Rf, b.tf, b.points, b.normals, b.has_normal, b.tangents, b.has_tangent,
+      c, w_ext, offset, time_left);
+  }
+
   // run() on checked inputs (w_ext of 6, offset of m or none), the GIL released.
   void run_released(
     Answer & a, const Kinematics & k, const Array & w_ext, const Array & offset,
@@ -1124,6 +1149,16 @@ private:
   std::vector<int> sense0_, active_, sense_;
   bool have_active_ = false;
   std::unique_ptr<Tree> tree_;  // use_tree's; solve_q's kinematics
+  // bind_contacts' arrays, for solve_bound.
+  struct Bound
+  {
+    py::array_t<int64_t> fparent;
+    Array Rf, tf, points, normals;
+    py::array_t<bool> has_normal;
+    Array tangents;
+    py::array_t<bool> has_tangent;
+  };
+  std::unique_ptr<Bound> bound_;
   std::vector<double> oMf_, J6_;
 };
 
@@ -1194,7 +1229,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 8;
+  mod.attr("API") = 9;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -1240,7 +1275,15 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
   .def_readonly("solve_time_s", &Answer::solve_time_s)
   .def_property_readonly("timings", [](const Answer & a) {
       return py::make_tuple(a.t_maps, a.t_build, a.t_solve, a.t_certify);
-    });
+    })
+  .def_property_readonly("parts", [](const Answer & a) {
+      const Certificate & c = a.cert;
+      return py::make_tuple(
+        to_array(a.tau), to_array(a.f), to_array(a.maps.G), to_array(a.maps.J),
+        to_array(a.maps.positions), to_rotations(a.maps.rotations), to_array(a.usage),
+        py::make_tuple(c.r[0], c.r[1], c.r[2], c.r[3], c.r[4], c.finite),
+        py::make_tuple(a.t_maps, a.t_build, a.t_solve, a.t_certify));
+    }, "(tau, f, G, J, positions, rotations, usage, certificate, timings) in one call.");
 
   py::class_<FastCycle>(mod, "FastCycle")
   .def(py::init<py::array_t<int64_t>, Array, Array, Array, Array, double, double, double,
@@ -1264,6 +1307,13 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     py::arg("tf"), py::arg("points"), py::arg("normals"), py::arg("has_normal"),
     py::arg("tangents"), py::arg("has_tangent"), py::arg("c"), py::arg("w_ext"),
     py::arg("offset"), py::arg("time_left"))
+  .def("bind_contacts", &FastCycle::bind_contacts, py::arg("fparent"), py::arg("Rf"),
+    py::arg("tf"), py::arg("points"), py::arg("normals"), py::arg("has_normal"),
+    py::arg("tangents"), py::arg("has_tangent"),
+    "Hold the contact list of the cycles to come (solve_q's arrays), for solve_bound.")
+  .def("solve_bound", &FastCycle::solve_bound, py::arg("q"), py::arg("c"), py::arg("w_ext"),
+    py::arg("offset"), py::arg("time_left"),
+    "solve_q on the contacts of bind_contacts.")
   .def_property_readonly("uses_tree", &FastCycle::uses_tree)
   .def_property_readonly("uses_daqp", &FastCycle::uses_daqp)
   .def_property_readonly("inits", &FastCycle::dims_changes)

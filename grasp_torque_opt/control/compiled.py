@@ -230,6 +230,8 @@ class CompiledCycle:
             specs=setup.contacts, frame_ids=fids, links=links, points=points,
             normals=normals, has_normal=has_n, tangents=tangents, has_tangent=has_t,
             frames=self._frames(setup, fids))
+        if c.frames is not None:  # held by the compiled cycle until the list changes
+            self._cycle.bind_contacts(*c.frames, points, normals, has_n, tangents, has_t)
         return c
 
     def _frames(self, setup: GraspSetup, fids: tuple[int, ...]
@@ -293,9 +295,8 @@ class CompiledCycle:
         offset = self._no_offset if setup.torque_offset is None else setup.torque_offset
         budget = -1.0 if time_left is None else time_left
         if c.frames is not None:
-            a = self._cycle.solve_q(setup.q, *c.frames, c.points, c.normals, c.has_normal,
-                                    c.tangents, c.has_tangent, setup.object_origin,
-                                    setup.external_wrench, offset, budget)
+            a = self._cycle.solve_bound(setup.q, setup.object_origin, setup.external_wrench,
+                                        offset, budget)
         else:
             oMf, J6 = self.kinematics(setup, kinematics)
             a = self._cycle.solve(oMf, J6, c.points, c.normals, c.has_normal, c.tangents,
@@ -318,13 +319,14 @@ class CompiledCycle:
         self._rank_misses = 0
         self.solves += 1
         self.last_reason = ''
-        maps = GraspMaps(G=a.G, J=a.J, links=c.links, frame_ids=c.frame_ids,
-                         positions=a.positions, rotations=a.rotations,
+        tau, f, G, J, positions, rotations, usage, certificate, timings = a.parts
+        maps = GraspMaps(G=G, J=J, links=c.links, frame_ids=c.frame_ids,
+                         positions=positions, rotations=rotations,
                          object_origin=np.asarray(setup.object_origin, dtype=float))
-        t_maps, t_build, t_solve, t_certify = a.timings
-        eq, torque, cone, normal, limit, finite = a.certificate
+        t_maps, t_build, t_solve, t_certify = timings
+        eq, torque, cone, normal, limit, finite = certificate
         sol = Solution(status=OPTIMAL, method='tau-qp', joints=list(self._joints),
-                       tau=a.tau, wrenches=a.f.reshape(-1, 4), iterations=a.iterations,
+                       tau=tau, wrenches=f.reshape(-1, 4), iterations=a.iterations,
                        solve_time_s=a.solve_time_s,
                        certificate=Certificate(eq, torque, cone, normal, limit, finite,
                                                self.tolerance),
@@ -332,6 +334,6 @@ class CompiledCycle:
                        timings={'maps': t_maps, 'build': t_build, 'solve': t_solve,
                                 'certify': t_certify},
                        backend=solver.name, objective=setup.objective,
-                       friction_margin=setup.friction.margin, friction_usage=a.usage,
+                       friction_margin=setup.friction.margin, friction_usage=usage,
                        max_torque_ratio=a.max_torque_ratio)
         return sol, maps

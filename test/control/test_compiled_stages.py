@@ -332,3 +332,26 @@ def test_the_compiled_kinematics_refuse_tables_that_do_not_fit(allegro):
                                  c.tangents, c.has_tangent, at.object_origin,
                                  at.external_wrench, np.zeros(0), -1.0)
         assert a.code == loader.fast_cycle.NOT_HANDLED and 'wrong shape' in a.message
+
+
+def test_the_bound_contacts_answer_as_the_arrays_given_each_call(allegro, module):
+    # solve_bound holds what solve_q is given each call; the two compiled cycles, one fed
+    # each way, give the same answers bit for bit, and the parts are the attributes.
+    bound, given = cycle_for(allegro, module), cycle_for(allegro, module)
+    a = bound._cycle.solve_bound(allegro.q, allegro.object_origin, allegro.external_wrench,
+                                 np.zeros(0), -1.0)
+    assert a.code == module.NOT_HANDLED and 'no contacts bound' in a.message
+    c = given._arrays(allegro)
+    bound._arrays(allegro)  # binds its contact list
+    for at in states(allegro, count=4, scale=0.2):
+        x = bound._cycle.solve_bound(at.q, at.object_origin, at.external_wrench, np.zeros(0),
+                                     -1.0)
+        y = given._cycle.solve_q(at.q, *c.frames, c.points, c.normals, c.has_normal,
+                                 c.tangents, c.has_tangent, at.object_origin,
+                                 at.external_wrench, np.zeros(0), -1.0)
+        assert x.code == y.code == module.CERTIFIED, (x.message, y.message)
+        tau, f, G, J, positions, rotations, usage, cert, timings = x.parts
+        for got, ref in ((tau, y.tau), (f, y.f), (G, y.G), (J, y.J), (positions, y.positions),
+                         (rotations, y.rotations), (usage, y.usage)):
+            assert np.array_equal(got, ref)
+        assert cert == x.certificate and len(timings) == 4
