@@ -40,6 +40,9 @@ topics (reliable, depth ``RECEIVER_DEPTH``: deeper than the node's 1, so that
 the receiver never drops). A command is matched to its joint state by stamp;
 a joint state of the measured window without a stamped command within the
 drain time is a dropped cycle. Latency is stamp-to-receipt on the system clock.
+The JSON keeps each dropped joint state's send time from the window's start
+(``dropped_at_s``): a loss at the same phase of every second is a periodic
+stall of the node (it found the 1 Hz diagnostics' half a millisecond).
 With ``--load-priority 50`` the load process's spinning thread is SCHED_FIFO 50,
 as the controller_manager loop that would send joint states and take the
 commands on a ros2_control hand (the default: normal scheduling, as any process).
@@ -324,6 +327,7 @@ def _figures(received: _Received, window: _Window, foreign: dict) -> dict:
         'wrong_length_commands': received.bad_length,
         'time_to_first_command_s': window.times['warm'] - window.t_start,
         'graph_at_end': foreign,
+        'dropped_at_s': [round(now - t0, 6) for s, now in sent if s not in stamped],
     }
 
 
