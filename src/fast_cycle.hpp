@@ -251,13 +251,28 @@ struct Answer
   double t_maps = 0.0, t_build = 0.0, t_solve = 0.0, t_certify = 0.0;
 };
 
+// d (n entries) times the reflector I - t v v^T, v = [1; v[1:n]] (v[0] is not read).
+inline void reflect(const double * v, double t, int n, double * d)
+{
+  double s = d[0];
+  for (int i = 1; i < n; ++i) {
+    s += v[i] * d[i];
+  }
+  s *= t;
+  d[0] -= s;
+  for (int i = 1; i < n; ++i) {
+    d[i] -= s * v[i];
+  }
+}
+
 // Householder QR of a (rows >= cols) in place, as LAPACK's dgeqr2 (numpy's QR, via
 // dgeqrf) and Eigen's HouseholderQR write it: R on and above the diagonal, each
 // reflector's essential part below it, its coefficient in tau (H_k = I - tau_k v v^T,
 // v = [1; essential]); a column already zero below its diagonal takes tau 0. Written
 // here, not Eigen's, for the sizes of a hand (22 x 16 for the Allegro): Eigen's
-// dynamic-size kernels spend more on their dispatch than on the arithmetic, and this
-// with the Q below took half the time of Eigen's in bench (about 3 against 6 us).
+// dynamic-size kernels spend more on their dispatch than on the arithmetic: with this
+// and the Q below, the build stage's own timings fell from 15-19 to 10-11 us on the
+// bundled params file (docs/benchmarks.md, item 4 at c033dea).
 void householder_qr(Mat & a, Vec & tau)
 {
   const int rows = static_cast<int>(a.rows()), cols = static_cast<int>(a.cols());
@@ -286,16 +301,7 @@ void householder_qr(Mat & a, Vec & tau)
     tau(k) = t;
     v[0] = beta;
     for (int j = k + 1; j < cols; ++j) {
-      double * d = a.col(j).data() + k;
-      double s = d[0];
-      for (int i = 1; i < n; ++i) {
-        s += v[i] * d[i];
-      }
-      s *= t;
-      d[0] -= s;
-      for (int i = 1; i < n; ++i) {
-        d[i] -= s * v[i];
-      }
+      reflect(v, t, n, a.col(j).data() + k);
     }
   }
 }
@@ -312,16 +318,7 @@ void householder_q(const Mat & a, const Vec & tau, Mat & Q)
     const double t = tau(k);
     const int n = rows - k;
     for (int j = k; j < rows; ++j) {
-      double * d = Q.col(j).data() + k;
-      double s = d[0];
-      for (int i = 1; i < n; ++i) {
-        s += v[i] * d[i];
-      }
-      s *= t;
-      d[0] -= s;
-      for (int i = 1; i < n; ++i) {
-        d[i] -= s * v[i];
-      }
+      reflect(v, t, n, Q.col(j).data() + k);
     }
   }
 }

@@ -336,7 +336,9 @@ def test_the_compiled_kinematics_refuse_tables_that_do_not_fit(allegro):
 
 def test_the_bound_contacts_answer_as_the_arrays_given_each_call(allegro, module):
     # solve_bound holds what solve_q is given each call; the two compiled cycles, one fed
-    # each way, give the same answers bit for bit, and the parts are the attributes.
+    # each way, give the same answers (to rounding: two objects' Eigen storage may be
+    # aligned apart, and vector loops round in another order), and the parts are the
+    # answer's attributes bit for bit.
     bound, given = cycle_for(allegro, module), cycle_for(allegro, module)
     a = bound._cycle.solve_bound(allegro.q, allegro.object_origin, allegro.external_wrench,
                                  np.zeros(0), -1.0)
@@ -351,7 +353,9 @@ def test_the_bound_contacts_answer_as_the_arrays_given_each_call(allegro, module
                                  at.external_wrench, np.zeros(0), -1.0)
         assert x.code == y.code == module.CERTIFIED, (x.message, y.message)
         tau, f, G, J, positions, rotations, usage, cert, timings = x.parts
-        for got, ref in ((tau, y.tau), (f, y.f), (G, y.G), (J, y.J), (positions, y.positions),
-                         (rotations, y.rotations), (usage, y.usage)):
-            assert np.array_equal(got, ref)
-        assert cert == x.certificate and len(timings) == 4
+        for name, got in (('tau', tau), ('f', f), ('G', G), ('J', J),
+                          ('positions', positions), ('rotations', rotations),
+                          ('usage', usage)):
+            assert np.array_equal(got, getattr(x, name)), name
+            assert_near(got, getattr(y, name), name)
+        assert cert == x.certificate and timings == x.timings
