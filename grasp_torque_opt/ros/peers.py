@@ -119,11 +119,10 @@ class PeerWatch:
     """
     The node's topics, checked against the graph; each peer found is told once.
 
-    :meth:`check` checks every topic at once; :meth:`check_next` one topic a call, in
-    turn (the node's graph timer: a few graph queries a tick, never all in one
-    callback). Both give every incompatible peer known and the ones not seen at that
-    topic's last check (to log). What it remembers is each topic's last check only:
-    bounded by the graph.
+    :meth:`check_next` checks one topic a call, in turn (the node's graph timer: a few
+    graph queries a tick, never all in one callback), and gives the peers that topic's
+    last check did not find (to log); :meth:`peers` gives every incompatible peer known.
+    What it remembers is each topic's last check only: bounded by the graph.
     """
 
     def __init__(self) -> None:
@@ -146,20 +145,13 @@ class PeerWatch:
         self._found.clear()
         self._next = 0
 
-    def check(self, node: Any) -> tuple[list[Peer], list[Peer]]:
-        """Check every topic; give (every incompatible peer, those new since the last check)."""
-        new = []
-        for k in range(len(self._watched)):
-            new += self._check(node, k)
-        return self.peers(), new
-
-    def check_next(self, node: Any) -> tuple[list[Peer], list[Peer]]:
-        """Check the next topic in turn; give (every incompatible peer known, its new ones)."""
+    def check_next(self, node: Any) -> list[Peer]:
+        """Check the next topic in turn; give the peers its last check did not find."""
         if not self._watched:
-            return [], []
+            return []
         k = self._next % len(self._watched)
         self._next = k + 1
-        return self.peers(), self._check(node, k)
+        return self._check(node, k)
 
     def checked(self) -> int:
         """Give how many of the watched topics were checked."""

@@ -43,10 +43,9 @@ class Status:
         self.node = root.node
         self.pub = None
         self.duplicates = 0  # other nodes of this name, at the last report
-        #: What the graph timer found (:meth:`on_graph`), read by the report: the other
-        #: publishers on the command topic, and the incompatible peers (None: not yet).
+        #: The other publishers on the command topic, as the graph timer last found them
+        #: (:meth:`on_graph`; None: not checked yet). The peers are the PeerWatch's.
         self.rivals: list[str] | None = None
-        self.peers: list | None = None
         self._graph_step = 0
         self._pending = None  # the status being made (_status_steps), None: none
 
@@ -60,7 +59,7 @@ class Status:
     def stop(self) -> None:
         """Forget the publisher (destroyed by the root) and what the graph checks found."""
         self.pub = None
-        self.rivals = self.peers = None
+        self.rivals = None
         self._graph_step = 0
         self._pending = None
 
@@ -119,8 +118,7 @@ class Status:
         if step % (len(self.root.peers) + 1) == 0:
             self.rivals = self.command_rivals()
             return
-        self.peers, new = self.root.peers.check_next(node)
-        for peer in new:
+        for peer in self.root.peers.check_next(node):
             log.warn(f'{peer.describe()}: no messages will pass between it and this node')
 
     def on_diagnostics(self) -> None:
@@ -194,8 +192,8 @@ class Status:
         values.append(('executor_thread', realtime.describe()))  # this callback's thread
         # What rclpy's default QoS event handlers would have logged, found from the graph
         # (told when found, by on_graph).
-        peers = self.peers or []
         watch = root.peers
+        peers = watch.peers()
         values.append(('incompatible_peers', summary(peers) if peers or watch.checked_all()
                        else f'none in {watch.checked()} of {len(watch)} topics so far'))
         if peers:
