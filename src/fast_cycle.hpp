@@ -381,10 +381,12 @@ public:
 
   // Solve with DAQP (backends/daqp.DaqpSolver) instead of ProxSuite: its C entry
   // daqp_quadprog at address quadprog, daqp_default_settings at defaults (as
-  // backends/daqp.daqp_entry finds them), with its primal_tol and iter_limit, and
-  // iteration_s the time per iteration assumed before one is measured (daqp.ITERATION_S).
+  // backends/daqp.daqp_entry finds them), with its primal_tol, iter_limit and
+  // eq_reduction (daqp.DaqpSettings), and iteration_s the time per iteration assumed
+  // before one is measured (daqp.ITERATION_S).
   void use_daqp(
-    int64_t quadprog, int64_t defaults, double primal_tol, int iter_limit, double iteration_s)
+    int64_t quadprog, int64_t defaults, double primal_tol, int iter_limit, int eq_reduction,
+    double iteration_s)
   {
     if (quadprog == 0 || defaults == 0 || iter_limit < 1) {
       throw std::invalid_argument("use_daqp: no DAQP entry, or an iteration cap below 1");
@@ -393,6 +395,7 @@ public:
     reinterpret_cast<DaqpDefaults>(defaults)(&daqp_settings_);
     daqp_settings_.primal_tol = primal_tol;
     daqp_settings_.iter_limit = iter_limit;
+    daqp_settings_.eq_reduction = eq_reduction;
     daqp_settings_.eps_prox = 0.0;  // H = 2 diag(w) is positive definite: no z here
     daqp_iteration_s_ = iteration_s;
     dims_ = {-1, -1, -1};
@@ -1226,7 +1229,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 9;
+  mod.attr("API") = 10;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -1294,8 +1297,8 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
          py::arg("has_tangent"), py::arg("c"), py::arg("w_ext"), py::arg("offset"),
          py::arg("time_left"))
   .def("use_daqp", &FastCycle::use_daqp, py::arg("quadprog"), py::arg("defaults"),
-    py::arg("primal_tol"), py::arg("iter_limit"), py::arg("iteration_s"),
-    "Solve with DAQP's C entry (its addresses) instead of ProxSuite.")
+    py::arg("primal_tol"), py::arg("iter_limit"), py::arg("eq_reduction"),
+    py::arg("iteration_s"), "Solve with DAQP's C entry (its addresses) instead of ProxSuite.")
   .def("use_tree", &FastCycle::use_tree, py::arg("parents"), py::arg("kinds"),
     py::arg("axes"), py::arg("Rp"), py::arg("tp"), py::arg("idx_q"), py::arg("idx_v"),
     py::arg("nq"), py::arg("nv"),

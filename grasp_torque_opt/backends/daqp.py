@@ -108,10 +108,16 @@ class DaqpSettings:
         primal_tol: DAQP's primal feasibility tolerance (``primal_tol``).
         iter_limit: cap on DAQP's iterations per solve (``iter_limit``; one cycle can
             never stall).
+        eq_reduction: DAQP's ``eq_reduction``: -1 keeps the equalities as always-active
+            rows, 0 lets DAQP decide, 1 eliminates them first. Off (-1) by default: on
+            the Allegro's tau-QP (16 torques, 6 equalities, 68 cone rows) DAQP's
+            automatic choice reduced them, and its setup took 8 us against 4 us,
+            answers equal to 1e-13 (docs/design.md section 2.2).
     """
 
     primal_tol: float = ProxSuiteSettings.eps_abs
     iter_limit: int = ProxSuiteSettings.max_iter
+    eq_reduction: int = -1
 
     @classmethod
     def from_proxsuite(cls, settings: ProxSuiteSettings) -> DaqpSettings:
@@ -229,13 +235,14 @@ class DaqpSolver:
         """
         if self._dims != dims:
             self._model = self._daqp.Model()
+            s = self._model.settings  # before the setup, which reads eq_reduction
+            s.update(primal_tol=self.settings.primal_tol, iter_limit=limit,
+                     eps_prox=0.0 if n == qp.m else -1e-6,
+                     eq_reduction=self.settings.eq_reduction)
+            self._model.settings = s
             flag, _ = self._model.setup(H, qp.g, A, upper, lower, sense)
             if flag < 0:
                 return None, flag, {}, 0
-            s = self._model.settings
-            s.update(primal_tol=self.settings.primal_tol, iter_limit=limit,
-                     eps_prox=0.0 if n == qp.m else -1e-6)
-            self._model.settings = s
             self._dims = dims
             self._limit = limit
             warm = False

@@ -177,7 +177,8 @@ class CompiledCycle:
             friction.min_normal_force, solver.warm_start, s)
         if daqp:
             self._cycle.use_daqp(*daqp_backend.daqp_entry(), solver.settings.primal_tol,
-                                 solver.settings.iter_limit, daqp_backend.ITERATION_S)
+                                 solver.settings.iter_limit, solver.settings.eq_reduction,
+                                 daqp_backend.ITERATION_S)
         self._joints = list(hand.joints)
         self._contacts: _Contacts | None = None
         #: The hand's tree for the kinematics in the compiled call (None: Pinocchio's, in
