@@ -110,9 +110,10 @@ class DaqpSettings:
             never stall).
         eq_reduction: DAQP's ``eq_reduction``: -1 keeps the equalities as always-active
             rows, 0 lets DAQP decide, 1 eliminates them first. Off (-1) by default: on
-            the Allegro's tau-QP (16 torques, 6 equalities, 68 cone rows) DAQP's
-            automatic choice reduced them, and its setup took 8 us against 4 us,
-            answers equal to 1e-13 (docs/design.md section 2.2).
+            the Allegro's tau-QP (16 torques, 6 equalities, 68 cone rows) the automatic
+            choice of DAQP's one-shot entry (the compiled cycle's) reduced them, and a
+            warm setup took 8 us against 4 us, answers equal to 1e-13 (docs/design.md
+            section 2.2). Set before the workspace's setup, which reads it.
     """
 
     primal_tol: float = ProxSuiteSettings.eps_abs
