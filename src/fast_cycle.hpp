@@ -1229,7 +1229,7 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
 {
   mod.doc() = "The node's tau-QP cycle compiled (grasp_torque_opt.control.compiled).";
   // What compiled.py expects; a module built from an older source is not used.
-  mod.attr("API") = 10;
+  mod.attr("API") = 11;
   mod.attr("CERTIFIED") = CERTIFIED;
   mod.attr("NOT_HANDLED") = NOT_HANDLED;
   mod.attr("BAD_DATA") = BAD_DATA;
@@ -1496,6 +1496,76 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     py::arg("weight"), py::arg("lever"), py::arg("certified"), py::arg("at_limit"),
     "(wrench, integral, error, rate, residual, slip, slow, frozen): one engaged step of "
     "the object loop.");
+  // The cycle's checks of a command on the way out (control/checks.py, where their numpy
+  // forms are; these give the same answers in one call instead of five numpy calls).
+  mod.def("gate_command", [](Array tau, Array offset, Array limits, double fraction) {
+      expect(
+        tau.ndim() == 1 && limits.ndim() == 1 && tau.size() == limits.size() &&
+        (offset.size() == 0 || offset.size() == tau.size()), "gate_command: sizes differ");
+      const py::ssize_t n = tau.size();
+      const double * t = tau.data();
+      const double * g = offset.size() ? offset.data() : nullptr;
+      const double * lim = limits.data();
+      py::array_t<double> cmd(n);
+      double * c = cmd.mutable_data();
+      bool finite = true, at_limit = false;
+      py::ssize_t worst = -1;
+      double most = 0.0;
+      for (py::ssize_t i = 0; i < n; ++i) {
+        c[i] = g ? t[i] + g[i] : t[i];
+        const double a = std::abs(c[i]);
+        finite = finite && std::isfinite(c[i]);
+        at_limit = at_limit || a >= fraction * lim[i];
+        const double over = a - lim[i];  // > 0 exactly when a > lim[i]; NaN: not
+        if (over > 0.0 && (worst == -1 || over > most)) {
+          worst = i;
+          most = over;
+        }
+      }
+      return py::make_tuple(cmd, finite ? worst : py::ssize_t{-2}, at_limit);
+    }, py::arg("tau"), py::arg("offset"), py::arg("limits"), py::arg("fraction"),
+    "(tau + offset, -1 if within the limits, -2 if not finite, else the joint most over "
+    "its limit, whether a joint is at fraction of its limit or more).");
+  mod.def("within_step", [](Array start, Array target, double step) {
+      if (start.ndim() != target.ndim() || start.size() != target.size()) {
+        return false;
+      }
+      const double * a = start.data();
+      const double * b = target.data();
+      for (py::ssize_t i = 0; i < start.size(); ++i) {
+        if (!(std::abs(b[i] - a[i]) <= step)) {
+          return false;  // NaN as well
+        }
+      }
+      return true;
+    }, py::arg("start"), py::arg("target"), py::arg("step"),
+    "Whether no value of target is farther than step from start's (False for NaN).");
+  mod.def("take_positions", [](Array positions, py::array_t<std::int64_t> pick, Array low,
+    Array high, py::array_t<double> q, py::array_t<std::int64_t> put) {
+      const py::ssize_t n = pick.size(), size = positions.size(), nq = q.size();
+      expect(
+        low.size() == n && high.size() == n && put.size() == n && q.ndim() == 1 &&
+        q.writeable(), "take_positions: sizes differ");
+      const double * p = positions.data();
+      const std::int64_t * from = pick.data();
+      const std::int64_t * to = put.data();
+      for (py::ssize_t k = 0; k < n; ++k) {
+        expect(from[k] >= 0 && from[k] < size && to[k] >= 0 && to[k] < nq,
+          "take_positions: an index out of range");
+        const double v = p[from[k]];
+        if (!(v >= low.data()[k] && v <= high.data()[k])) {
+          return false;  // NaN as well; q untouched
+        }
+      }
+      auto out = q.mutable_unchecked<1>();
+      for (py::ssize_t k = 0; k < n; ++k) {
+        out(to[k]) = p[from[k]];
+      }
+      return true;
+    }, py::arg("positions"), py::arg("pick"), py::arg("low"), py::arg("high"),
+    py::arg("q").noconvert(), py::arg("put"),
+    "Put positions[pick] into q[put] if each lies within [low, high] (True), else "
+    "leave q as it is (False; NaN is not within).");
   mod.def("rotation_vector", [](Array R) {
       expect(R.ndim() == 2 && R.shape(0) == 3 && R.shape(1) == 3, "R of the wrong shape");
       return to_array(Vec(rotation_vector(Eigen::Map<const Tree::M3>(R.data()))));

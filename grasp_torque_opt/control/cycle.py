@@ -33,7 +33,7 @@ from grasp_torque_opt.control.geometry import geometry_of
 from grasp_torque_opt.control.inputs.store import Counters, Inputs, replaced
 from grasp_torque_opt.control.motion import Motion
 from grasp_torque_opt.control.named_contacts import topic_contacts
-from grasp_torque_opt.control.object_loop import LoopGains, ObjectLoop
+from grasp_torque_opt.control.object_loop import LIMIT_FRACTION, LoopGains, ObjectLoop
 from grasp_torque_opt.control.parameters.generated import CycleConfig
 from grasp_torque_opt.core.exceptions import GraspTorqueError, InputError
 from grasp_torque_opt.core.grasp_maps import GraspMaps
@@ -41,6 +41,7 @@ from grasp_torque_opt.core.grasp_setup import GraspSetup
 from grasp_torque_opt.core.solution import OPTIMAL, Solution
 from grasp_torque_opt.methods.adaptive import AdaptiveSettings, Refiner
 from grasp_torque_opt.methods.dispatch import solve
+from grasp_torque_opt.native.loader import fast_cycle
 import numpy as np
 import pinocchio as pin
 
@@ -88,6 +89,8 @@ class Cycle:
         #: ``estimating``: this cycle updates it (the loop's; the service's reads it).
         self.effort_load = EffortLoad()
         self.estimating = True
+        #: The last command the gate passed has a joint at ``LIMIT_FRACTION`` of its limit.
+        self.at_limit = False
         #: The object loop (:mod:`.object_loop`): the restoring wrench and the squeeze,
         #: moved by the loop's cycles (``estimating``), read by the service's.
         self.object_loop = ObjectLoop()
@@ -364,21 +367,25 @@ class Cycle:
         return self.refiner
 
     def gate(self, solution: Solution, g: np.ndarray | None) -> tuple[np.ndarray | None, str]:
-        """Check a command last before it leaves: certified, finite, sized, within limits."""
+        """
+        Check a command last before it leaves: certified, finite, sized, within limits.
+
+        Also notes whether a joint of it is at :data:`~.object_loop.LIMIT_FRACTION` of its
+        limit or beyond (:attr:`at_limit`, for the object loop's anti-windup).
+        """
+        self.at_limit = False
         if not solution.optimal:
             return None, f'no certified solution ({solution.status}: {solution.message})'
-        cmd = solution.tau + (0.0 if g is None else g)
         lim = self.setup.hand.torque_limits
-        if cmd.shape != lim.shape:
-            return None, f'command has {cmd.size} values for {lim.size} joints'
-        if (np.abs(cmd) <= lim).all():  # False for NaN as well
+        cmd, worst, self.at_limit = checked_command(solution.tau, g, lim, LIMIT_FRACTION)
+        if worst == -1:
             return cmd, ''
-        if not np.all(np.isfinite(cmd)):
+        self.at_limit = False
+        if worst == SIZES_DIFFER:
+            return None, f'command has {cmd.size} values for {lim.size} joints'
+        if worst == NOT_FINITE:
             return None, 'command not finite'
-        if np.any(np.abs(cmd) > lim):
-            k = int(np.argmax(np.abs(cmd) - lim))
-            return None, f'command over the limit at {self.setup.hand.joints[k]}'
-        return cmd, ''
+        return None, f'command over the limit at {self.setup.hand.joints[worst]}'
 
     def gravity_torque(self, inputs: Inputs) -> np.ndarray:
         """
@@ -435,9 +442,10 @@ class Cycle:
             kind ``none`` whose ``fault`` says why there is none.
         """
         result = self._attempt(inputs, deadline)
-        if self.estimating:
-            self.object_loop.after(result.kind == 'solution', result.command,
-                                   self.setup.hand.torque_limits)
+        if self.estimating and self.config.object_loop:  # off: a loop turned on settles anew
+            certified = result.kind == 'solution'
+            self.object_loop.after(certified, result.command, self.setup.hand.torque_limits,
+                                   self.at_limit if certified else None)
         return result
 
     def _attempt(self, inputs: Inputs, deadline: float | None) -> CycleResult:
@@ -460,6 +468,46 @@ class Cycle:
         if cmd is None:
             return CycleResult(None, 'none', sol, maps, g, why)
         return CycleResult(cmd, 'solution', sol, maps, g, q=inputs.q)
+
+
+#: :func:`checked_command`'s ``worst`` for a command of the wrong size, or not finite.
+SIZES_DIFFER, NOT_FINITE = -3, -2
+_NO_OFFSET = np.zeros(0)
+
+
+def checked_command(tau: np.ndarray, g: np.ndarray | None, limits: np.ndarray,
+                    fraction: float) -> tuple[np.ndarray, int, bool]:
+    """
+    Return the command ``tau + g``, how it meets the limits, and whether it is at a limit.
+
+    Returns:
+        (the command; -1 when every joint is within its limit,
+        :data:`NOT_FINITE` or :data:`SIZES_DIFFER`, else the joint farthest over its
+        limit; whether a joint is at ``fraction`` of its limit or beyond). In one
+        compiled call where the compiled module is built (the gate of every cycle: five
+        numpy calls took 2 us), else :func:`checked_command_numpy`; the same answer.
+    """
+    if fast_cycle is not None and tau.shape == limits.shape and (
+            g is None or g.shape == limits.shape):
+        return fast_cycle.gate_command(tau, _NO_OFFSET if g is None else g, limits, fraction)
+    return checked_command_numpy(tau, g, limits, fraction)
+
+
+def checked_command_numpy(tau: np.ndarray, g: np.ndarray | None, limits: np.ndarray,
+                          fraction: float) -> tuple[np.ndarray, int, bool]:
+    """Give :func:`checked_command` in numpy."""
+    cmd = tau + (0.0 if g is None else g)
+    if cmd.shape != limits.shape:
+        return cmd, SIZES_DIFFER, False
+    size = np.abs(cmd)
+    at_limit = bool((size >= fraction * limits).any())
+    if (size <= limits).all():  # False for NaN as well
+        return cmd, -1, at_limit
+    if not np.all(np.isfinite(cmd)):
+        return cmd, NOT_FINITE, at_limit
+    if np.any(size > limits):
+        return cmd, int(np.argmax(size - limits)), at_limit
+    return cmd, -1, at_limit
 
 
 def loop_gains(config: CycleConfig) -> LoopGains:

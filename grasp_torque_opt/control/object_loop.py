@@ -218,10 +218,17 @@ class ObjectLoop:
         self._previous: tuple[bool, bool] = (True, False)  # (certified, at a limit)
         self._lever: tuple | None = None  # (reference points, origin, lever): _lever_of's
 
-    def after(self, certified: bool, command: np.ndarray | None, limits: np.ndarray) -> None:
-        """Note the cycle's outcome: a certified command, and whether it was at a limit."""
-        at_limit = command is not None and bool(
-            (np.abs(command) >= LIMIT_FRACTION * limits).any())
+    def after(self, certified: bool, command: np.ndarray | None, limits: np.ndarray,
+              at_limit: bool | None = None) -> None:
+        """
+        Note the cycle's outcome: a certified command, and whether it was at a limit.
+
+        ``at_limit``: whether it was, when the gate has told (``Cycle.gate``); None: found
+        here from the command and the limits.
+        """
+        if at_limit is None:
+            at_limit = command is not None and bool(
+                (np.abs(command) >= LIMIT_FRACTION * limits).any())
         self._previous = (certified and command is not None, at_limit)
 
     def update(self, hand: Hand, contacts: list[ContactSpec], q: np.ndarray, now: float,

@@ -21,7 +21,7 @@ import importlib
 import platform
 
 #: The interface of src/fast_cycle.hpp this module speaks (its ``API``).
-API = 10
+API = 11
 
 
 def cpu_has_avx2() -> bool:

@@ -28,6 +28,7 @@ from grasp_torque_opt.control.checks import (
 )
 from grasp_torque_opt.control.motion import efforts_of
 from grasp_torque_opt.core.exceptions import InputError
+from grasp_torque_opt.native.loader import fast_cycle
 import numpy as np
 
 
@@ -86,12 +87,17 @@ class JointStates:
             # The same names as the last accepted state (a driver's every message): their
             # checks hold; one comparison with the used joints' bounds (within the URDF
             # limits and the magnitude bound) checks the positions. NaN fails it, and
-            # then the full checks below name the position and the rule.
-            values = np.asarray(positions, dtype=float)[known[1]]
+            # then the full checks below name the position and the rule. In one compiled
+            # call where the module is built (every joint state: 3 us in numpy).
             low, high = used_bounds(store, known, lower, upper)
-            if ((values >= low) & (values <= high)).all():
-                q[known[2]] = values
-                return q, None, reading
+            if fast_cycle is not None:
+                if fast_cycle.take_positions(positions, known[1], low, high, q, known[2]):
+                    return q, None, reading
+            else:
+                values = np.asarray(positions, dtype=float)[known[1]]
+                if ((values >= low) & (values <= high)).all():
+                    q[known[2]] = values
+                    return q, None, reading
         checked = check_joint_names(names, positions, q, store.model_joints,
                                     store.setup.hand.joints)
         check_joint_limits(q, checked[2], lower, upper, store.q_names,
