@@ -231,12 +231,15 @@ class TorqueController:
         was computed (checked at ``now`` plus the cycle's time).
         """
         t0 = time.perf_counter()
-        counters, policy = self.counters, self.policy
+        # The parts' own config and counters: the controller's attributes are descriptors,
+        # a Python call each, and this runs on every joint state.
+        policy = self.policy
+        config, counters = policy.config, policy.counters
         counters.cycles += 1
-        result = self._attempt(now, None if self.untimed else t0 + self.budget())
+        result = self._attempt(now, None if self.untimed else t0 + self.solving.budget())
         elapsed = time.perf_counter() - t0
         counters.max_cycle_time = max(counters.max_cycle_time, elapsed)
-        budget = self.config.cycle_budget
+        budget = config.cycle_budget
         judged = 0.0 if self.untimed else elapsed  # simulated time: the wall decides nothing
         if judged > budget:
             counters.overruns += 1
@@ -244,7 +247,7 @@ class TorqueController:
                 result = policy.faulted(now, f'cycle overrun ({1e3 * elapsed:.1f} ms > '
                                         f'cycle_budget {1e3 * budget:.1f} ms)',
                                         result.solution, result.maps, result.gravity_torque)
-        late = self.stale(now + judged) if result.kind == 'solution' else ''
+        late = self.store.stale(now + judged) if result.kind == 'solution' else ''
         if late:
             result = policy.faulted(now + judged, f'inputs went stale during the cycle: {late}',
                                     result.solution, result.maps, result.gravity_torque)
@@ -255,12 +258,12 @@ class TorqueController:
                 result = policy.faulted(now, why, result.solution, result.maps,
                                         result.gravity_torque)
         if result.kind == 'solution':
-            fallback = self.fallback
+            fallback = self.solving.fallback
             policy.committed(result, now, fallback is not None
                              and result.solution.backend == fallback.name)
-            if self.config.tactile_source != 'none':
+            if config.tactile_source != 'none':
                 self.solving.tactile = report = self.tactile_of(result, now)
-                if report is not None and self.config.object_loop and self.config.loop_squeeze:
+                if report is not None and config.object_loop and config.loop_squeeze:
                     # The squeeze follows the touch sensors' usage while it is fresh and
                     # whole (every contact read), else the slip evidence.
                     self.solving.object_loop.squeeze.measured(report.usage, now, 'tactile')
@@ -307,7 +310,8 @@ class TorqueController:
         cone, finite, with the step within the torque limits: else, or when they are not
         known, the certified command is published whole (``slew_refused``).
         """
-        policy, config = self.policy, self.config
+        policy = self.policy
+        config = policy.config
         if policy.in_force is None or policy.in_force_time is None:
             return
         gap = min(max(now - policy.in_force_time, 0.0), config.command_period)
@@ -346,10 +350,11 @@ class TorqueController:
 
     def _attempt(self, now: float, deadline: float | None) -> CycleResult:
         """Solve and gate; a certified command is returned, not yet committed."""
-        reason = self.stale(now)
+        store = self.store
+        reason = store.stale(now)
         if reason:
             return self.policy.faulted(now, reason)
-        result = self.solving.attempt(self.inputs, deadline)
+        result = self.solving.attempt(store.inputs, deadline)
         if result.kind != 'solution':
             return self.policy.faulted(now, result.fault, result.solution, result.maps,
                                        result.gravity_torque)
