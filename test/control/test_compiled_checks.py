@@ -18,13 +18,18 @@ and Inf.
 
 import os
 
+from cycle_inputs import fresh, joint_state
+from grasp_torque_opt.control import cycle, rates
 from grasp_torque_opt.control.cycle import (
     checked_command,
     checked_command_numpy,
     NOT_FINITE,
     SIZES_DIFFER,
 )
+from grasp_torque_opt.control.inputs import joint_states
+from grasp_torque_opt.control.inputs.joint_states import JointStateReading
 from grasp_torque_opt.control.rates import within_step, within_step_numpy
+from grasp_torque_opt.core.exceptions import InputError
 from grasp_torque_opt.native import loader
 import numpy as np
 import pytest
@@ -103,3 +108,50 @@ def test_take_positions_puts_only_positions_all_within_their_bounds():
         loader.fast_cycle.take_positions([0.0] * 3, pick, low, high, np.zeros(8), put)
     with pytest.raises(TypeError):  # a copy would be written, not q: refused
         loader.fast_cycle.take_positions([0.0] * 6, pick, low, high, np.zeros(8, int), put)
+
+
+def run_cycles(setup, states):
+    """Run a controller of its own on joint states a millisecond apart; what each gave."""
+    ctrl = fresh(setup, gravity_compensation=True, max_torque_rate=2.0)
+    names = joint_state(setup)[0]
+    out = []
+    for k, positions in enumerate(states):
+        now = 1.0 + 1e-3 * k
+        try:
+            ctrl.take('joint_states', JointStateReading(names, positions), now)
+        except InputError as e:
+            out.append(('rejected', str(e), None))
+            continue
+        r = ctrl.cycle(now)
+        out.append((r.kind, r.fault, None if r.command is None else r.command.copy()))
+    return out, ctrl.counters
+
+
+def test_the_cycle_is_the_same_with_the_checks_numpy_forms(allegro, monkeypatch):
+    # Where the module is not built, the numpy forms run: the same cycle, state for state,
+    # with positions rejected (NaN, beyond a limit) and steps cut by the rate rule.
+    rng = np.random.default_rng(14)
+    q0 = np.array(joint_state(allegro)[1])
+    states = []
+    for k in range(120):
+        q = q0 + 0.03 * np.sin(0.05 * k) + rng.normal(0.0, 2e-3, q0.size)
+        if k % 17 == 5:
+            q[k % q0.size] = np.nan
+        if k % 23 == 7:
+            q[k % q0.size] = 40.0  # beyond the URDF's limits
+        states.append(q.tolist())
+    compiled, counted = run_cycles(allegro, states)
+    for module in (cycle, rates, joint_states):
+        monkeypatch.setattr(module, 'fast_cycle', None)
+    numpy_forms, counted_numpy = run_cycles(allegro, states)
+    assert len(compiled) == len(numpy_forms) == len(states)
+    for a, b in zip(compiled, numpy_forms):
+        assert a[:2] == b[:2]
+        assert (a[2] is None) == (b[2] is None)
+        if a[2] is not None:  # to rounding: two runs of the same code differed by 3e-16 N m
+            np.testing.assert_allclose(a[2], b[2], rtol=0.0, atol=1e-12)
+    kinds = [a[0] for a in compiled]
+    assert kinds.count('rejected') >= 10 and kinds.count('solution') >= 90
+    assert counted.slew_limited == counted_numpy.slew_limited > 10  # both sides of the rule
+    assert counted.slew_limited < kinds.count('solution')
+    assert counted.rejected == counted_numpy.rejected
