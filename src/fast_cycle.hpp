@@ -1496,8 +1496,10 @@ PYBIND11_MODULE(FAST_CYCLE_MODULE, mod)
     py::arg("weight"), py::arg("lever"), py::arg("certified"), py::arg("at_limit"),
     "(wrench, integral, error, rate, residual, slip, slow, frozen): one engaged step of "
     "the object loop.");
-  // The cycle's checks of a command on the way out (control/checks.py, where their numpy
-  // forms are; these give the same answers in one call instead of five numpy calls).
+  // Three checks of every cycle, each the same answer as its numpy form in one call
+  // instead of four or five numpy calls: control/cycle.checked_command_numpy,
+  // control/rates.within_step_numpy and the numpy branch of
+  // control/inputs/joint_states.JointStates.check.
   mod.def("gate_command", [](Array tau, Array offset, Array limits, double fraction) {
       expect(
         tau.ndim() == 1 && limits.ndim() == 1 && tau.size() == limits.size() &&

@@ -373,14 +373,14 @@ class Cycle:
         Also notes whether a joint of it is at :data:`~.object_loop.LIMIT_FRACTION` of its
         limit or beyond (:attr:`at_limit`, for the object loop's anti-windup).
         """
-        self.at_limit = False
         if not solution.optimal:
+            self.at_limit = False
             return None, f'no certified solution ({solution.status}: {solution.message})'
         lim = self.setup.hand.torque_limits
-        cmd, worst, self.at_limit = checked_command(solution.tau, g, lim, LIMIT_FRACTION)
+        cmd, worst, at_limit = checked_command(solution.tau, g, lim, LIMIT_FRACTION)
+        self.at_limit = worst == -1 and at_limit
         if worst == -1:
             return cmd, ''
-        self.at_limit = False
         if worst == SIZES_DIFFER:
             return None, f'command has {cmd.size} values for {lim.size} joints'
         if worst == NOT_FINITE:
