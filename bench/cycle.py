@@ -34,9 +34,11 @@ The paths:
 
 With ``--params FILE`` it times only the cycle as the node makes it from a params file
 (the bundled ``config/allegro_right_node.yaml``: its backend, its object loop and
-margins), as the file says and with ``solver.backend`` ProxSuite, the compiled
-call's stages from its own timings, and the object loop's estimate from the
-fingertips per call, compiled and in numpy.
+margins), as the file says, with ``solver.backend`` ProxSuite and with the object loop
+off, each with the joint states paced at 1 kHz of the wall clock (as the node meets
+them: the caches cool between states) and back to back (the cycle's clock stepped 1 ms
+a state: the cycle's own cost), the compiled call's stages from its own timings, and
+the object loop's estimate from the fingertips per call, compiled and in numpy.
 
 With ``--geometry`` it also times the contacts from geometry per call
 (``bench/geometry.py``: the Allegro's tips against the ball by the closed form and by
@@ -183,18 +185,21 @@ def bench_core(setup: GraspSetup, variant: str, repeats: int, motion: str = 'jit
 
 
 def timed_cycles(ctrl: TorqueController, setup: GraspSetup, repeats: int, motion: str,
-                 paced: bool = False):
+                 paced: bool = False, step: float | None = None):
     """
     Yield (seconds, result) of ``repeats`` cycles after 50 of warm-up: take a state, cycle.
 
     ``paced``: one joint state a millisecond of the monotonic clock (as at 1 kHz), else
-    back to back.
+    back to back. ``step``: the cycle's clock (receipt times) advances by ``step`` seconds
+    per joint state from the first, whatever the wall clock does (back to back, the node's
+    inputs still arrive at 1 kHz for ``step`` 1e-3); None: the monotonic clock.
     """
     names = list(setup.hand.joints)
     q0 = setup.q[setup.hand.idx_q]
+    start = time.monotonic()
     for i, dq in enumerate(offsets(q0.size, repeats + 50, motion)):
         positions = (q0 + dq).tolist()
-        now = time.monotonic()
+        now = time.monotonic() if step is None else start + i * step
         t0 = time.perf_counter()
         ctrl.take('joint_states', JointStateReading(names, positions), now)
         result = ctrl.cycle(now)
@@ -285,10 +290,26 @@ def node_geometry_table(results: dict) -> str:
     return '\n'.join(lines) + '\n\n(times in us)'
 
 
-#: The params-file cycle's variants: name -> parameters over the file's (none: as is).
+#: The params-file cycle's variants: name -> parameters over the file's, each
+#: ``section.field`` (none: as is).
 PARAMS_VARIANTS = {'as the file says': {},
-                   'backend proxsuite, fallback daqp': {'backend': 'proxsuite',
-                                                        'fallback': 'daqp'}}
+                   'backend proxsuite, fallback daqp': {'solver.backend': 'proxsuite',
+                                                        'solver.fallback': 'daqp'},
+                   'object loop off': {'object_loop.enabled': False}}
+
+#: How the joint states come (bench_params): paced at 1 kHz of the wall clock, as the
+#: node meets them (its caches cooled between states), and back to back with the cycle's
+#: clock stepped 1 ms a state (the same inputs, the caches warm: the cycle's own cost).
+PACINGS = {'paced': {'paced': True}, 'back to back': {'step': 1e-3}}
+
+
+def overridden(p, over: dict):
+    """Return params ``p`` with ``over``'s ``section.field`` values replaced."""
+    for key, value in over.items():
+        section, _, name = key.partition('.')
+        p = dataclasses.replace(p, **{section: dataclasses.replace(getattr(p, section),
+                                                                   **{name: value})})
+    return p
 
 
 def bench_params(params: Path, repeats: int, motion: str) -> dict:
@@ -300,9 +321,10 @@ def bench_params(params: Path, repeats: int, motion: str) -> dict:
     it, with the scenario's load, object and weight bound as the node binds them
     (``grasp_source.bind_scenario``: the object loop and the effort estimation run as
     in the node); joint states only (no IMU, contacts or wrench messages, as
-    ``bench/node_blackbox.py`` sends them), one every millisecond of the monotonic clock.
-    Per variant: the cycle (take and cycle) median and p99, and the compiled call's
-    stages (its own timings) with the solver's iterations, medians.
+    ``bench/node_blackbox.py`` sends them), a new controller per variant and pacing
+    (:data:`PACINGS`). Per variant and pacing: the cycle (take and cycle) median and
+    p99, and the compiled call's stages (its own timings) with the solver's iterations,
+    medians.
     """
     from grasp_torque_opt.ros.node.controllers import configure
     from grasp_torque_opt.ros.node.grasp_source import bind_scenario
@@ -315,27 +337,28 @@ def bench_params(params: Path, repeats: int, motion: str) -> dict:
     out = {'params': str(params.relative_to(ROOT)) if params.is_relative_to(ROOT) else
            str(params), 'motion': motion, 'variants': {}}
     for variant, over in PARAMS_VARIANTS.items():
-        p = params_file(params, scenario, setup)
-        if over:
-            p = dataclasses.replace(p, solver=dataclasses.replace(p.solver, **over))
-        ctrl = configure(None, setup, p, obj=scenario.object)
-        bind_scenario((ctrl,), scenario, p, '')
-        samples, stages, published = [], {k: [] for k in (*STAGES, 'iterations')}, 0
-        for elapsed, result in timed_cycles(ctrl, setup, repeats, motion, paced=True):
-            samples.append(elapsed)
-            published += result.kind == 'solution'
-            sol = result.solution
-            if sol is not None and sol.timings:
-                for k in STAGES:
-                    stages[k].append(sol.timings[k])
-                stages['iterations'].append(sol.iterations)
-        fast = ctrl.compiled_cycle
-        out['variants'][variant] = {
-            'backend': ctrl.solver.name, 'total': summary(samples), 'certified': published,
-            'cycles': repeats, 'compiled_solves': fast.solves if fast is not None else 0,
-            'stages_median': {k: float(np.median(v)) if v else None for k, v in stages.items()}}
-        if not over:
-            out['estimate'] = estimate_times(ctrl, setup, repeats, motion)
+        out['variants'][variant] = {}
+        for pacing, how in PACINGS.items():
+            p = overridden(params_file(params, scenario, setup), over)
+            ctrl = configure(None, setup, p, obj=scenario.object)
+            bind_scenario((ctrl,), scenario, p, '')
+            samples, stages, published = [], {k: [] for k in (*STAGES, 'iterations')}, 0
+            for elapsed, result in timed_cycles(ctrl, setup, repeats, motion, **how):
+                samples.append(elapsed)
+                published += result.kind == 'solution'
+                sol = result.solution
+                if sol is not None and sol.timings:
+                    for k in STAGES:
+                        stages[k].append(sol.timings[k])
+                    stages['iterations'].append(sol.iterations)
+            fast = ctrl.compiled_cycle
+            out['variants'][variant][pacing] = {
+                'backend': ctrl.solver.name, 'total': summary(samples), 'certified': published,
+                'cycles': repeats, 'compiled_solves': fast.solves if fast is not None else 0,
+                'stages_median': {k: float(np.median(v)) if v else None
+                                  for k, v in stages.items()}}
+            if not over and pacing == 'paced':
+                out['estimate'] = estimate_times(ctrl, setup, repeats, motion)
     return out
 
 
@@ -370,16 +393,20 @@ def estimate_times(ctrl: TorqueController, setup: GraspSetup, repeats: int, moti
 def params_table(r: dict) -> str:
     """Format the params-file cycle's table [us]."""
     lines = [f"the cycle as the node makes it from {r['params']} ({r['motion']} motion, joint "
-             'states only):', '',
-             '| variant | backend | cycle median | cycle p99 | certified | compiled answered '
-             '| compiled maps | build | solve | certify | solver iterations (median) |',
-             '|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|']
-    for name, v in r['variants'].items():
-        st = v['stages_median']
-        us = ' | '.join('-' if st[k] is None else f'{1e6 * st[k]:.1f}' for k in STAGES)
-        lines.append(f"| {name} | {v['backend']} | {1e6 * v['total']['median_s']:.0f} | "
-                     f"{1e6 * v['total']['p99_s']:.0f} | {v['certified']} of {v['cycles']} | "
-                     f"{v['compiled_solves']} | {us} | {st['iterations'] or '-'} |")
+             'states only; paced: one a millisecond of the wall clock; back to back: the '
+             "cycle's clock stepped 1 ms a state):", '',
+             '| variant | joint states | backend | cycle median | cycle p99 | certified '
+             '| compiled answered | compiled maps | build | solve | certify '
+             '| solver iterations (median) |',
+             '|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|']
+    for name, paced in r['variants'].items():
+        for pacing, v in paced.items():
+            st = v['stages_median']
+            us = ' | '.join('-' if st[k] is None else f'{1e6 * st[k]:.1f}' for k in STAGES)
+            lines.append(f"| {name} | {pacing} | {v['backend']} | "
+                         f"{1e6 * v['total']['median_s']:.0f} | "
+                         f"{1e6 * v['total']['p99_s']:.0f} | {v['certified']} of {v['cycles']} "
+                         f"| {v['compiled_solves']} | {us} | {st['iterations'] or '-'} |")
     e = r.get('estimate')
     if e is not None:
         lines += ['', "the object loop's estimate from the fingertips, per call (the same "
