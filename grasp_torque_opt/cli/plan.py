@@ -28,7 +28,7 @@ from grasp_torque_opt.core.object_geometry import ObjectShape
 from grasp_torque_opt.core.resources import find_config
 from grasp_torque_opt.core.scenario import load_scenario
 from grasp_torque_opt.methods.plan import (CONTACT_MODES, ORIENTATIONS, plan_grasps, PlanResult,
-                                           PlanSettings)
+                                           PlanSettings, SHAPES)
 import numpy as np
 
 #: Sizes of each primitive's ``--size``.
@@ -87,6 +87,9 @@ def add_parser(sub) -> None:
                    help='IKs at most per candidate asked')
     p.add_argument('--contacts', choices=CONTACT_MODES, default=d.contacts,
                    help='points: write each point and normal; links: the links only')
+    p.add_argument('--shapes', choices=SHAPES, default=d.shapes,
+                   help="hand: the hand's own links are kept clear of the object (a robot's "
+                   'arm, torso and legs are not read); robot: every link of the URDF')
     p.add_argument('--out', help='write the candidates here (JSON Lines) instead of stdout')
 
 
@@ -119,7 +122,8 @@ def plan(args: argparse.Namespace) -> PlanResult:
         rotate=not args.no_rotate, orientation=args.orientation,
         hold_margin=None if args.keep_unheld else args.hold_margin,
         clearance=args.clearance, tolerance=args.tolerance,
-        attempts=args.attempts, contacts=args.contacts, extra_load=args.load)
+        attempts=args.attempts, contacts=args.contacts, extra_load=args.load,
+        shapes=args.shapes)
     return plan_grasps(scenario, settings, shape, args.mass)
 
 

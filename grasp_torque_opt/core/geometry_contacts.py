@@ -137,8 +137,35 @@ def _document(urdf: str | Path, urdf_dir: Path | None) -> tuple[str, Path | None
     return bounded_urdf(text, 'hand.urdf'), urdf_dir or path.resolve().parent
 
 
-def collision_model(hand: Hand, urdf: str | Path, urdf_dir: Path | None = None
-                    ) -> pin.GeometryModel:
+def hand_links(hand: Hand) -> set[str]:
+    """
+    Return the links of the hand itself within its URDF (every link when it is the hand).
+
+    The hand is what hangs from its mount: the joint above the last joint that carries
+    every actuated joint (on a G1 the fingers branch from the wrist's yaw joint, whose
+    link holds the palm, so the mount is the wrist's pitch joint). Its links and every
+    link beyond them are the hand: on a G1 the wrist's two last links, the palm and the
+    fingers, not the arm, the torso, the legs or the other hand. Where the fingers branch
+    from the URDF's root (an Allegro, a finger_edu), that is every link.
+    """
+    model = hand.model
+    common: list[int] | None = None
+    for name in hand.joints:
+        chain = list(model.supports[model.getJointId(name)])
+        if common is None:
+            common = chain
+            continue
+        n = 0
+        while n < min(len(common), len(chain)) and common[n] == chain[n]:
+            n += 1
+        common = common[:n]
+    mount = model.parents[common[-1]] if common else 0
+    return {f.name for f in model.frames if f.type == pin.FrameType.BODY
+            and (mount == 0 or mount in model.supports[f.parentJoint])}
+
+
+def collision_model(hand: Hand, urdf: str | Path, urdf_dir: Path | None = None,
+                    links: set[str] | None = None) -> pin.GeometryModel:
     """
     Return the hand's collision shapes: Pinocchio's GeometryModel of the URDF.
 
@@ -146,6 +173,8 @@ def collision_model(hand: Hand, urdf: str | Path, urdf_dir: Path | None = None
         hand: the hand, whose model the URDF built.
         urdf: the URDF file, or its document (e.g. ``robot_description``).
         urdf_dir: the folder relative mesh paths are in (default: the file's).
+        links: only these links' shapes (their meshes alone are read: a whole robot's
+            take about 1.4 s on a G1, its hand's 0.35); None: every link's.
 
     Raises:
         InputError: the URDF cannot be read or a mesh is not found (``hand.urdf``).
@@ -155,6 +184,11 @@ def collision_model(hand: Hand, urdf: str | Path, urdf_dir: Path | None = None
         root = ET.fromstring(xml)
     except ET.ParseError as e:
         raise InputError('hand.urdf', f'cannot parse the URDF: {e}') from e
+    if links is not None:
+        for link in root.iter('link'):
+            if link.get('name') not in links:
+                for shape in link.findall('collision'):
+                    link.remove(shape)
     resolve_meshes(root, folder)
     try:
         with quiet_fd2():  # urdfdom's own lines; the InputError below says it
@@ -232,7 +266,10 @@ class GeometryContacts:
         shape = ObjectShape.from_spec(obj) if isinstance(obj, ObjectSpec) else obj
         target = coal_shape(shape)
         model = hand.model
-        geom = geometry if geometry is not None else collision_model(hand, urdf, urdf_dir)
+        if geometry is None:  # the candidate links' meshes alone when they are named
+            geometry = collision_model(hand, urdf, urdf_dir,
+                                       None if links is None else set(links))
+        geom = geometry
         by_link: dict[str, list] = {}
         for g in geom.geometryObjects:
             by_link.setdefault(model.frames[g.parentFrame].name, []).append(g)

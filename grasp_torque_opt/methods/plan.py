@@ -39,7 +39,7 @@ from typing import Any
 
 import coal
 from grasp_torque_opt.core.exceptions import GeometryError, InputError
-from grasp_torque_opt.core.geometry_contacts import collision_model, GeometryContacts
+from grasp_torque_opt.core.geometry_contacts import collision_model, GeometryContacts, hand_links
 from grasp_torque_opt.core.grasp_setup import bind_for_candidates
 from grasp_torque_opt.core.hand import resolve_urdf
 from grasp_torque_opt.core.object_geometry import ObjectShape
@@ -58,6 +58,8 @@ EDGE = 3e-3
 CONTACT_MODES = ('points', 'links')
 #: How a box's or cylinder's orientation is drawn (docs/planner.md, "Planning candidates").
 ORIENTATIONS = ('opposed', 'random')
+#: Whose collision shapes the planner reads (PlanSettings.shapes).
+SHAPES = ('hand', 'robot')
 #: Standard deviation of the tilt about the opposed orientation [rad].
 TILT = 0.1
 #: The friction margin a kept candidate's own load is held at, by default [-].
@@ -90,6 +92,10 @@ class PlanSettings:
         contacts: ``points`` (each contact's point and normal written) or ``links``
             (the link only: ``score`` finds them from geometry).
         extra_load: a wrench added to the object's weight [N, N m], or None.
+        shapes: whose collision shapes the IK keeps clear of the object and the check
+            reads: ``hand`` (the hand's own links, :func:`hand_links`, and the contact
+            links: the rest of a robot's URDF is not read) or ``robot`` (every link of
+            the URDF, a G1's legs and torso too).
     """
 
     count: int = 10
@@ -107,6 +113,7 @@ class PlanSettings:
     attempts: int = 50
     contacts: str = 'points'
     extra_load: tuple[float, ...] | None = None
+    shapes: str = 'hand'
 
     def __post_init__(self) -> None:
         """Refuse a setting out of its range, naming it."""
@@ -124,6 +131,9 @@ class PlanSettings:
         if not (isinstance(self.attempts, int) and 1 <= self.attempts <= 1000):
             raise InputError('attempts', f'must be an integer in [1, 1000], got '
                              f'{self.attempts!r}')
+        if self.shapes not in SHAPES:
+            raise InputError('shapes', f"must be one of {', '.join(SHAPES)}, got "
+                             f'{self.shapes!r}')
         if self.orientation not in ORIENTATIONS:
             raise InputError('orientation', f"must be one of {', '.join(ORIENTATIONS)}, got "
                              f'{self.orientation!r}')
@@ -219,7 +229,9 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     if not links:
         raise InputError('links', 'no contact links: give them (the base scenario has none)')
     urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
-    geom = collision_model(hand, urdf)  # the meshes read once, for the check and the IK
+    # The meshes read once, for the check and the IK: the hand's, or the whole URDF's.
+    geom = collision_model(hand, urdf, links=None if settings.shapes == 'robot'
+                           else hand_links(hand) | set(links))
     _refuse_mesh_on_mesh(hand, geom, shape, links)
     check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
                                   max_penetration=1.0, field='links', geometry=geom)
