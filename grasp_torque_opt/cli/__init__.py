@@ -9,8 +9,8 @@
 """
 Command line: ``grasp-torque-opt solve|compare|plan|init-node SCENARIO``, ``... score CANDIDATES``.
 
-One module per subcommand (:data:`COMMANDS`), each with ``add_parser(sub)`` and
-``run(args) -> exit code``; every error becomes its exit code by one table,
+One module per subcommand (:data:`COMMANDS`, imported when it is asked), each with
+``add_parser(sub)`` and ``run(args) -> exit code``; every error becomes its exit code by one table,
 :data:`grasp_torque_opt.core.command_line.ERRORS` (0 optimal, 2 bad input with one
 line on stderr naming the field, 3 infeasible, 4 nothing certifiable or any other
 error of the package, 5 fewer candidates planned than asked).
@@ -19,27 +19,41 @@ error of the package, 5 fewer candidates planned than asked).
 from __future__ import annotations
 
 import argparse
+import importlib
+import sys
 
-from grasp_torque_opt.backends import single_threaded_math
-from grasp_torque_opt.cli import compare, init_node, plan, score, solve
 from grasp_torque_opt.cli.args import EPILOG, PROG
 from grasp_torque_opt.core.command_line import add_version, HelpFormatter, run_command
 
-#: Subcommand -> its module, in the order of --help.
-COMMANDS = {'solve': solve, 'compare': compare, 'score': score, 'plan': plan,
-            'init-node': init_node}
+#: The subcommands: name -> its module in this package.
+COMMANDS = {'solve': 'solve', 'compare': 'compare', 'score': 'score', 'plan': 'plan',
+            'init-node': 'init_node'}
 
 
-def parser() -> argparse.ArgumentParser:
-    """Return the command line's parser, every subcommand's options in it."""
+def command_module(name: str):
+    """Return subcommand ``name``'s module (imported on first use)."""
+    return importlib.import_module(f'{__name__}.{COMMANDS[name]}')
+
+
+def parser(command: str | None = None) -> argparse.ArgumentParser:
+    """
+    Return the command line's parser: every subcommand's options, or ``command``'s alone.
+
+    A subcommand's module (and what it imports: solvers, the node's schema) is imported
+    only for its options: ``plan`` starts without ``solve``'s and ``init-node``'s
+    imports, about a tenth of a second (issue 36). The others are then listed by name.
+    """
     p = argparse.ArgumentParser(prog=PROG, formatter_class=HelpFormatter, description=(
         'Minimum-effort joint torques for a grasp (linearized soft-finger cones, '
         'certified against the exact cone): solve one scenario, compare every method, '
         'or score many candidate grasps.'), epilog=EPILOG)
     add_version(p)
     sub = p.add_subparsers(dest='command', required=True)
-    for module in COMMANDS.values():
-        module.add_parser(sub)
+    for name in COMMANDS:
+        if command in (None, name):
+            command_module(name).add_parser(sub)
+        else:
+            sub.add_parser(name)
     return p
 
 
@@ -48,10 +62,16 @@ def main(argv: list[str] | None = None) -> int:
     args = argparse.Namespace(where=None)
 
     def body() -> int:
-        parser().parse_args(argv, namespace=args)
+        # The first word that is not an option names the subcommand (the top level's
+        # only options, --help and --version, take no value).
+        words = sys.argv[1:] if argv is None else argv
+        named = next((w for w in words if not w.startswith('-')), None)
+        parser(named if named in COMMANDS else None).parse_args(argv, namespace=args)
         if args.where is None and hasattr(args, 'scenario') and args.command != 'score':
             args.where = args.scenario
+        from grasp_torque_opt.backends import single_threaded_math
+
         single_threaded_math()
-        return COMMANDS[args.command].run(args)
+        return command_module(args.command).run(args)
 
     return run_command(PROG, body, lambda: args.where)
