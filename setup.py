@@ -142,6 +142,9 @@ setup(
         'threadpoolctl',
         # The score command's progress bar.
         'tqdm',
+        # The batch scorer's JSON Lines reader (grasp_torque_opt.methods.batch; optional:
+        # the standard library's json without it).
+        'orjson',
     ],
     extras_require={
         # ROS 2 Jazzy from the registry's ros-jazzy-* wheels; optional so that the

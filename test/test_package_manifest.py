@@ -57,6 +57,7 @@ PIP_ONLY = {
     'threadpoolctl': 'threadpoolctl',
     'mujoco': 'mujoco',
     'dask': 'dask',
+    'orjson': 'orjson',
 }
 
 #: Manifest entries no import names, each with why it is there.

@@ -72,6 +72,30 @@ class _Skip(Exception):
     """The cheap parse does not take this line: the single path scores it."""
 
 
+try:  # a line read in 5 us instead of the standard library's 20 (a planned Allegro line)
+    from orjson import loads as _orjson_loads
+except ImportError:  # optional: the standard library's then
+    _orjson_loads = None
+
+
+def loads(text: str) -> Any:
+    """
+    Return the JSON value of ``text`` as the standard library reads it, by orjson if installed.
+
+    A line orjson refuses (NaN or Infinity, a number beyond a double, nesting deeper than
+    1,024) raises ValueError: the batch stages skip it and the single path reads it with
+    the standard library, as every line was read before. orjson reads an integer beyond
+    64 bits as a float: a line whose ``id`` came out a float is read again by the
+    standard library, so that its id is written back as given.
+    """
+    if _orjson_loads is None:
+        return json.loads(text)
+    data = _orjson_loads(text)
+    if isinstance(data, dict) and type(data.get('id')) is float:
+        return json.loads(text)
+    return data
+
+
 #: Markers of :meth:`BatchScorer.parse`: the base has no load section, and a zero one.
 _NO_LOAD = object()
 _ZERO_LOAD = [0.0] * 6
@@ -342,7 +366,7 @@ class BatchScorer:
             if len(text) > MAX_LINE:
                 raise _Skip
             try:
-                data = json.loads(text)
+                data = loads(text)
             except (ValueError, RecursionError) as e:
                 raise _Skip from e
         elif isinstance(text, dict):
