@@ -38,6 +38,7 @@ independent check of :mod:`.plan` judges it either way.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 
 import coal
 from grasp_torque_opt.core.geometry_contacts import collision_model
@@ -219,15 +220,17 @@ class SurfaceIK:
         every mesh within the band is taken at its hull's distance.
         """
         oMg = self.gdata.oMg[i]
-        tg = coal.Transform3s(oMg.rotation, oMg.translation)
         res = self.results[i]
+        far = band is not None and self._far[i]
+        if far:
+            # |a| as numpy's norm takes it (sqrt of a.a), without its dispatch
+            between = oMg.act(self._centres[i]) - centre
+            gap = (math.sqrt(between.dot(between)) - self._radii[i] - self._object_radius
+                   - BOUND_SLACK)
+            if gap >= band:
+                return gap, False
+        tg = coal.Transform3s(oMg.rotation, oMg.translation)  # made only when measured
         if band is not None:
-            far = self._far[i]
-            if far:
-                gap = (np.linalg.norm(oMg.act(self._centres[i]) - centre) - self._radii[i]
-                       - self._object_radius - BOUND_SLACK)
-                if gap >= band:
-                    return float(gap), False
             hull = self._hull_of(i)
             if hull is not None:
                 res.clear()
@@ -259,7 +262,7 @@ class SurfaceIK:
         model, data, res = self.model, self.data, self.results[i]
         joint = self.geom.geometryObjects[i].parentJoint
         n = np.asarray(res.normal, dtype=float)
-        n = n / max(np.linalg.norm(n), 1e-12)
+        n = n / max(math.sqrt(n.dot(n)), 1e-12)
         p1 = np.asarray(res.getNearestPoint1(), dtype=float)
         p2 = np.asarray(res.getNearestPoint2(), dtype=float)
         J = pin.getJointJacobian(model, data, joint, pin.LOCAL_WORLD_ALIGNED)
