@@ -147,6 +147,7 @@ class SurfaceIK:
         self._object_centre = np.array(self._owner.aabb_center, dtype=float)
         self._object_radius = float(self._owner.aabb_radius)
         self._far = [i in self.other_shapes for i in range(len(frames))]
+        self._joint = [g.parentJoint for g in self.geom.geometryObjects]
         self._hulls: dict[int, object] = {}
         self._hulls_only = False
         self._contact_hulls = any(self._hull_of(i) is not None
@@ -260,7 +261,7 @@ class SurfaceIK:
     def _derivatives(self, i: int, d: float, oMb: pin.SE3, oMo: pin.SE3, Jb) -> tuple:
         """Return shape i's row from its last coal result (see :meth:`evaluate`)."""
         model, data, res = self.model, self.data, self.results[i]
-        joint = self.geom.geometryObjects[i].parentJoint
+        joint = self._joint[i]
         n = np.asarray(res.normal, dtype=float)
         n = n / max(math.sqrt(n.dot(n)), 1e-12)
         p1 = np.asarray(res.getNearestPoint1(), dtype=float)
