@@ -229,9 +229,8 @@ def plan_grasps(scenario: Scenario | str | Path, settings: PlanSettings = PlanSe
     if not links:
         raise InputError('links', 'no contact links: give them (the base scenario has none)')
     urdf = resolve_urdf(scenario.urdf, scenario.base_dir)
-    # The meshes read once, for the check and the IK: the hand's, or the whole URDF's.
-    geom = collision_model(hand, urdf, links=None if settings.shapes == 'robot'
-                           else hand_links(hand) | set(links))
+    keep = None if settings.shapes == 'robot' else hand_links(hand) | set(links)
+    geom = collision_model(hand, urdf, links=keep)  # read once, for the check and the IK
     _refuse_mesh_on_mesh(hand, geom, shape, links)
     check = GeometryContacts.bind(hand, urdf, shape, settings.tolerance, links=links,
                                   max_penetration=1.0, field='links', geometry=geom)
