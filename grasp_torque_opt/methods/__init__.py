@@ -21,7 +21,7 @@ def __getattr__(name: str):
     Give ``METHODS`` and ``solve`` from :mod:`.dispatch`, imported on first use.
 
     Importing a module of this package (``methods.plan``, ``methods.score``) no longer
-    imports every method's solvers: ``plan`` starts about 50 ms sooner.
+    imports :mod:`.dispatch` and every method's solvers with it.
     """
     if name in __all__:
         from grasp_torque_opt.methods import dispatch
