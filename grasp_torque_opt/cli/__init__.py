@@ -62,11 +62,11 @@ def main(argv: list[str] | None = None) -> int:
     args = argparse.Namespace(where=None)
 
     def body() -> int:
-        # The first word that is not an option names the subcommand (the top level's
-        # only options, --help and --version, take no value).
+        # The first word names the subcommand; an option first (--help, --version) is the
+        # top level's, whose help lists every subcommand with its line.
         words = sys.argv[1:] if argv is None else argv
-        named = next((w for w in words if not w.startswith('-')), None)
-        parser(named if named in COMMANDS else None).parse_args(argv, namespace=args)
+        named = words[0] if words and words[0] in COMMANDS else None
+        parser(named).parse_args(argv, namespace=args)
         if args.where is None and hasattr(args, 'scenario') and args.command != 'score':
             args.where = args.scenario
         from grasp_torque_opt.backends import single_threaded_math

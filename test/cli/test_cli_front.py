@@ -95,6 +95,16 @@ def test_every_console_script_has_a_version(name):
     assert out.split()[:2] == [name, metadata.version('grasp_torque_opt')]
 
 
+@pytest.mark.parametrize('argv', [['--help'], ['-h', 'plan'], ['--help', 'solve']])
+def test_the_top_level_help_gives_every_subcommands_line(argv):
+    code, out, _ = script('grasp-torque-opt', *argv)
+    text = ' '.join(out.split())
+    assert code == 0 and 'exit codes:' in out
+    for line in ('every method side by side', 'candidate grasps of an object',
+                 "write the node's params file"):
+        assert line in text, line
+
+
 def test_solve_method_has_help():
     _, out, _ = cli('solve', '--help')
     assert 'force-qp: the QP over contact forces' in ' '.join(out.split())
