@@ -32,7 +32,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-import scipy.linalg
 
 
 def cone_rows(mu1: float, mu2: float, sides: int) -> np.ndarray:
@@ -159,7 +158,10 @@ def friction_matrix(p: int, mu1: float, mu2: float, sides: int,
         S, shape ((2N + 1) p, 4p), and b, shape ((2N + 1) p,): S f <= b.
     """
     S_i, b_i = contact_block(mu1, mu2, sides, min_normal_force)
-    S, b = scipy.linalg.block_diag(*([S_i] * p)), np.tile(b_i, p)
+    rows, cols = S_i.shape
+    S, b = np.zeros((rows * p, cols * p)), np.tile(b_i, p)
+    for i in range(p):  # block diagonal (SciPy's block_diag: its import is 0.2 s)
+        S[i * rows:(i + 1) * rows, i * cols:(i + 1) * cols] = S_i
     S.flags.writeable = b.flags.writeable = False
     return S, b
 

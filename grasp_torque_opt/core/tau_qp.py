@@ -40,7 +40,6 @@ from grasp_torque_opt.core.friction import friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
 import numpy as np
-from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
 
 #: Relative singular-value threshold for the rank of A.
 RANK_RTOL = 1e-10
@@ -111,6 +110,9 @@ def decompose(A_full: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Returns:
         (pinv, shape (cols, rows); N, shape (cols, k); U_perp, shape (rows, rows - rank)).
     """
+    # SciPy's LAPACK on first use: its import (0.2 s) stays out of the planner's start-up.
+    from scipy.linalg.lapack import dgeqrf, dorgqr, dtrtrs
+
     rows, cols = A_full.shape
     if rows >= cols > 0:
         qr, tau, _, info = dgeqrf(A_full)

@@ -36,7 +36,6 @@ from grasp_torque_opt.backends.daqp import (
     kkt_violation,
 )
 import numpy as np
-from scipy.optimize import linprog
 
 #: DAQP's primal tolerance on these LPs (the backends' default eps_abs).
 PRIMAL_TOL = 1e-9
@@ -174,6 +173,7 @@ def _highs(c, A, lower, upper, time_limit: float | None = None) -> _Highs:
     b_ub = np.concatenate((up_r[has_up], -lo_r[has_lo]))
     bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(up) else up)
               for lo, up in zip(lower[:n], upper[:n])]
+    from scipy.optimize import linprog  # on first use: 0.3 s of imports
     res = linprog(c, A_ub=A_ub if A_ub.size else None, b_ub=b_ub if b_ub.size else None,
                   A_eq=A[eq] if eq.any() else None, b_eq=up_r[eq] if eq.any() else None,
                   bounds=bounds, method='highs',

@@ -48,7 +48,6 @@ from grasp_torque_opt.methods.capacity import load_capacity
 from grasp_torque_opt.methods.plan_ik import SurfaceIK
 import numpy as np
 import pinocchio as pin
-from scipy.spatial.transform import Rotation
 
 #: Most candidates one call plans.
 MAX_COUNT = 100_000
@@ -339,7 +338,11 @@ def _draw_orientation(kind: str, box_size, settings: PlanSettings, frame, rng
     if not settings.rotate or kind == 'sphere':
         return np.eye(3)
     if settings.orientation == 'random' or frame is None or kind not in ('box', 'cylinder'):
-        return Rotation.random(random_state=rng).as_matrix()
+        # Uniform over rotations: a unit quaternion (x, y, z, w) from four normals, as
+        # SciPy's Rotation.random draws it (pinocchio's is taken to keep SciPy's
+        # rotations out of the planner's start-up).
+        x, y, z, w = rng.normal(size=4)
+        return pin.Quaternion(w, x, y, z).normalized().toRotationMatrix()
     frame, span = frame
     d, e = frame[:, 0], frame[:, 1]
     if kind == 'box':
@@ -357,9 +360,9 @@ def _draw_orientation(kind: str, box_size, settings: PlanSettings, frame, rng
         if np.linalg.det(R) < 0.0:
             R[:, perm[2]] *= -1.0
     else:
-        turn = Rotation.from_rotvec(e * rng.uniform(0.0, 2.0 * math.pi)).as_matrix()
+        turn = pin.exp3(e * rng.uniform(0.0, 2.0 * math.pi))
         R = turn @ np.column_stack([d, np.cross(e, d), e])
-    tilt = Rotation.from_rotvec(rng.normal(0.0, TILT, 3)).as_matrix()
+    tilt = pin.exp3(rng.normal(0.0, TILT, 3))
     return tilt @ R
 
 

@@ -10,8 +10,8 @@
 The planner's IK: contact links onto the object's surface, every other shape clear of it.
 
 One problem per candidate, over the actuated joint positions theta and the object's
-position p (its orientation fixed), solved by SciPy's ``least_squares`` (trust region
-reflective, with bounds) with an analytic Jacobian:
+position p (its orientation fixed), solved by a bounded Levenberg-Marquardt
+(:func:`levenberg_marquardt`) with an analytic Jacobian:
 
     residuals  d_c(theta, p)                        each contact link's signed distance
                max(0, clearance' - d_k(theta, p))   every other collision shape (palm too)
@@ -29,10 +29,17 @@ already past the clearance band is not measured: its row is 0 either way, so the
 residuals are those of every distance measured. With meshes on the contact links, the
 IK runs first on every mesh's convex hull, then, from where that met the stop test, on
 the meshes themselves. One evaluation gives the residuals and their Jacobian (the rows
-that are not 0 only), which least_squares' next Jacobian call at that point reuses.
-The IK stops at the first point that meets the check's tolerances with a margin
-(:meth:`SurfaceIK.solve`'s ``tolerance``) rather than run to least_squares' own: the
-independent check of :mod:`.plan` judges it either way.
+that are not 0 only). The IK stops at the first point that meets the check's
+tolerances with a margin (:meth:`SurfaceIK.solve`'s ``tolerance``) rather than run to
+the solver's own: the independent check of :mod:`.plan` judges it either way.
+
+Why a solver of its own (issue 36): SciPy's ``least_squares`` (trust region
+reflective) spent as long in its own Python per IK as the residuals did (an SVD and a
+trust-region subproblem per step, about 3.4 ms of an Allegro IK's 7), and importing
+``scipy.optimize`` took 0.3 s of the planner's start-up. These problems are small (the
+Allegro: 19 unknowns, about 40 rows) and end at the stop test within a few steps, so
+a damped Gauss-Newton step on the free variables, projected onto the bounds, does the
+job in a few dozen lines.
 """
 
 from __future__ import annotations
@@ -46,7 +53,6 @@ from grasp_torque_opt.core.hand import Hand
 from grasp_torque_opt.core.object_geometry import coal_shape, ObjectShape
 import numpy as np
 import pinocchio as pin
-from scipy.optimize import least_squares
 
 #: Weight of the pull towards the sampled joint positions [m/rad].
 PULL_JOINTS = 2e-3
@@ -62,6 +68,11 @@ BOUND_SLACK = 1e-6
 #: The IK stops at a point with every contact within this share of the tolerance of
 #: the surface, the other rows within this share of their slack (SurfaceIK._meets).
 STOP_SHARE = 0.5
+#: levenberg_marquardt's tolerances: the projected gradient, the step (relative to x)
+#: and the relative decrease of the cost it ends at (as least_squares' were).
+GTOL = XTOL = FTOL = 1e-10
+#: The first damping, relative to the largest diagonal entry of J^T J [-].
+DAMPING = 1e-3
 
 
 @dataclass(frozen=True)
@@ -94,14 +105,60 @@ class _Done(Exception):
         self.x, self.cost = x, cost
 
 
-def _run(fun, jac, x0: np.ndarray, bounds: tuple, evaluations: int) -> tuple:
-    """Run least_squares from x0; return (x, cost, success, whether the stop test ended it)."""
-    try:
-        sol = least_squares(fun, x0, jac=jac, bounds=bounds, method='trf',
-                            max_nfev=evaluations, xtol=1e-10, ftol=1e-10, gtol=1e-10)
-        return sol.x, float(sol.cost), sol.status > 0, False
-    except _Done as done:
-        return done.x, done.cost, True, True
+def levenberg_marquardt(evaluate, x: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                        evaluations: int) -> tuple[np.ndarray, float, bool]:
+    """
+    Minimize 0.5 |f(x)|^2 over lower <= x <= upper from x (within the bounds).
+
+    Each step solves (J_F^T J_F + mu I) s = -J_F^T f over the free variables F (those
+    not held at a bound by the gradient); x + s is clipped to the bounds. A step that
+    lowers the cost is taken and mu follows Nielsen's rule; one that does not doubles
+    its growth (Madsen, Nielsen and Tingleff, Methods for non-linear least squares
+    problems, 2004, section 3.2). The damping is Levenberg's, not Marquardt's diagonal
+    scaling: a joint that only its pull row moves has a curvature of 4e-6, and
+    Marquardt's scaling let it take steps of radians (more than twice the IKs failed).
+
+    Args:
+        evaluate: x -> (f, J), the residuals and their Jacobian.
+        evaluations: evaluations of ``evaluate`` at most.
+
+    Returns:
+        (x, cost, converged): converged when the projected gradient, the step or the
+        relative decrease of the cost fell below :data:`GTOL`, :data:`XTOL` or
+        :data:`FTOL`; not when the evaluations ran out.
+    """
+    f, J = evaluate(x)
+    cost, mu, nu = 0.5 * float(f @ f), -1.0, 2.0
+    for _ in range(evaluations - 1):
+        g, A = J.T @ f, J.T @ J
+        free = ~(((x <= lower) & (g > 0.0)) | ((x >= upper) & (g < 0.0)))
+        if not free.any() or np.max(np.abs(g[free])) <= GTOL:
+            return x, cost, True
+        Af = A[np.ix_(free, free)]
+        if mu < 0.0:
+            mu = DAMPING * float(Af.diagonal().max())
+        step = np.zeros_like(x)
+        Af.flat[::Af.shape[0] + 1] += mu
+        step[free] = np.linalg.solve(Af, -g[free])
+        trial = np.clip(x + step, lower, upper)
+        s = trial - x
+        if math.sqrt(s @ s) <= XTOL * (math.sqrt(x @ x) + XTOL):
+            return x, cost, True
+        predicted = -float(g @ s + 0.5 * (s @ A @ s))
+        f_new, J_new = evaluate(trial)
+        new = 0.5 * float(f_new @ f_new)
+        rho = (cost - new) / predicted if predicted > 0.0 else -1.0
+        if rho > 0.0:
+            decrease = cost - new
+            x, f, J, cost = trial, f_new, J_new, new
+            mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+            nu = 2.0
+            if decrease <= FTOL * (cost + decrease):
+                return x, cost, True
+        else:
+            mu *= nu
+            nu *= 2.0
+    return x, cost, False
 
 
 class SurfaceIK:
@@ -338,26 +395,20 @@ class SurfaceIK:
             tolerance: stop at the first point that meets the stop test
                 (:meth:`_meets`: every contact within :data:`STOP_SHARE` of it) [m],
                 every mesh within the band measured first by its convex hull, then,
-                from there, by itself; None: run least_squares to its own tolerances, the
-                contact meshes beyond :data:`APPROACH` by their hulls.
+                from there, by itself; None: run to :func:`levenberg_marquardt`'s own
+                tolerances, the contact meshes beyond :data:`APPROACH` by their hulls.
         """
         m = self.hand.m
         target = 1.25 * clearance  # a little more than asked: the check is strict
         stop = None if tolerance is None else STOP_SHARE * tolerance
         cache: dict = {'n': 0}
 
-        def fun(x):
+        def evaluate(x):
             cache['n'] += 1
             f, J = self._residuals(x, theta0, p0, rotation, q_base, target)
-            cache['x'], cache['J'] = x.copy(), J
             if stop is not None and self._meets(f, stop, clearance):
                 raise _Done(x.copy(), 0.5 * float(f @ f))
-            return f
-
-        def jac(x):  # least_squares asks at a point whose residuals it has: reuse them
-            if 'x' not in cache or not np.array_equal(cache['x'], x):
-                fun(x)
-            return cache['J']
+            return f, J
 
         lower = np.concatenate([bounds[0], region[0]])
         upper = np.concatenate([bounds[1], region[1]])
@@ -368,10 +419,13 @@ class SurfaceIK:
             # that stopped on the meshes themselves (most often met at once).
             for only in ((True, False) if hulls else (False,)):
                 self._hulls_only = only
-                x, cost, success, stopped = _run(fun, jac, x, (lower, upper),
-                                                 max(max_evaluations - cache['n'], 1))
-                if not stopped:
+                try:
+                    x, cost, success = levenberg_marquardt(
+                        evaluate, x, lower, upper, max(max_evaluations - cache['n'], 1))
+                    stopped = False
                     break
+                except _Done as done:
+                    x, cost, success, stopped = done.x, done.cost, True, True
         finally:
             self._hulls_only = False
         return IKResult(theta=x[:m], position=x[m:], cost=cost, success=success,

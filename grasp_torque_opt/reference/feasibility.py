@@ -22,7 +22,6 @@ from grasp_torque_opt.core.friction import circumscribed_rows, friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
 import numpy as np
-from scipy.optimize import linprog
 
 
 def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np.ndarray,
@@ -45,6 +44,7 @@ def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np
         block = np.vstack((circumscribed_rows(friction.mu1, friction.mu2, friction.sides),
                            [0.0, 0.0, -1.0, 0.0]))
         S = np.kron(np.eye(maps.p), block)
+    from scipy.optimize import linprog  # on first use: 0.3 s of imports
     res = linprog(np.zeros(G.shape[1]), A_ub=np.vstack((S, J.T, -J.T)),
                   b_ub=np.concatenate((b_S, tau_max, -tau_min)),
                   A_eq=G, b_eq=-external_wrench, bounds=(None, None), method='highs')

@@ -201,3 +201,40 @@ def test_planned_g1_candidates_touch_with_their_links_and_nothing_else(iks):
                 assert abs(d) <= settings.tolerance, (k, d)
             else:
                 assert d >= settings.clearance, (k, d)
+
+
+def rosenbrock(x):
+    """Rosenbrock's residuals and their Jacobian."""
+    return (np.array([10.0 * (x[1] - x[0] ** 2), 1.0 - x[0]]),
+            np.array([[-20.0 * x[0], 10.0], [-1.0, 0.0]]))
+
+
+@pytest.mark.parametrize('box', [((-2.0, -2.0), (2.0, 2.0)), ((-2.0, -2.0), (0.5, 2.0)),
+                                 ((-2.0, 1.5), (2.0, 3.0))])
+def test_the_ik_solver_finds_what_scipys_least_squares_finds(box):
+    """Rosenbrock within bounds (free, and its optimum cut off by each bound) vs SciPy."""
+    from scipy.optimize import least_squares
+    lower, upper = np.array(box[0]), np.array(box[1])
+    x0 = np.clip(np.array([-1.2, 1.0]), lower, upper)
+    x, cost, converged = plan_ik.levenberg_marquardt(rosenbrock, x0, lower, upper, 500)
+    ref = least_squares(lambda v: rosenbrock(v)[0], x0, jac=lambda v: rosenbrock(v)[1],
+                        bounds=(lower, upper), xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    assert converged
+    assert np.all((lower <= x) & (x <= upper))
+    np.testing.assert_allclose(x, ref.x, atol=1e-6)
+    assert cost == pytest.approx(ref.cost, abs=1e-10)
+
+
+def test_the_ik_solver_keeps_to_its_evaluations():
+    """Out of evaluations it says so, and never asks for one more."""
+    calls = []
+
+    def counted(x):
+        calls.append(x.copy())
+        return rosenbrock(x)
+
+    lower, upper = np.full(2, -2.0), np.full(2, 2.0)
+    x, _, converged = plan_ik.levenberg_marquardt(counted, np.array([-1.2, 1.0]), lower,
+                                                  upper, 5)
+    assert len(calls) == 5 and not converged
+    assert any(np.array_equal(x, c) for c in calls)
