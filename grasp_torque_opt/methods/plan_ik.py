@@ -71,8 +71,8 @@ STOP_SHARE = 0.5
 #: levenberg_marquardt's tolerances: the projected gradient, the step (relative to x)
 #: and the relative decrease of the cost it ends at (as least_squares' were).
 GTOL = XTOL = FTOL = 1e-10
-#: The first damping, relative to the largest diagonal entry of J^T J [-].
-DAMPING = 1e-3
+#: The first damping, relative to the largest diagonal entry of D J^T J D [-].
+DAMPING = 3e-2
 
 
 @dataclass(frozen=True)
@@ -110,41 +110,47 @@ def levenberg_marquardt(evaluate, x: np.ndarray, lower: np.ndarray, upper: np.nd
     """
     Minimize 0.5 |f(x)|^2 over lower <= x <= upper from x (within the bounds).
 
-    Each step solves (J_F^T J_F + mu I) s = -J_F^T f over the free variables F (those
-    not held at a bound by the gradient); x + s is clipped to the bounds. A step that
-    lowers the cost is taken and mu follows Nielsen's rule; one that does not doubles
-    its growth (Madsen, Nielsen and Tingleff, Methods for non-linear least squares
-    problems, 2004, section 3.2). The damping is Levenberg's, not Marquardt's diagonal
-    scaling: a joint that only its pull row moves has a curvature of 4e-6, and
-    Marquardt's scaling let it take steps of radians (more than twice the IKs failed).
+    Each step solves (D J^T J D + mu I) h = -D J^T f and moves by s = D h, clipped to
+    the bounds. D is Coleman and Li's scaling, as SciPy's trust region reflective
+    method takes it: D_i = sqrt(v_i), v_i the distance to the bound that the gradient
+    points x_i towards (1 where that bound is infinite), so that a variable slows as it
+    nears the bound it is pushed to and stops at it. A step that lowers the cost is
+    taken and mu follows Nielsen's rule; one that does not doubles its growth (Madsen,
+    Nielsen and Tingleff, Methods for non-linear least squares problems, 2004, section
+    3.2). Without the scaling (steps clipped to the bounds) a third more evaluations
+    were needed on the bundled Allegro, and more IKs failed.
 
     Args:
         evaluate: x -> (f, J), the residuals and their Jacobian.
         evaluations: evaluations of ``evaluate`` at most.
 
     Returns:
-        (x, cost, converged): converged when the projected gradient, the step or the
+        (x, cost, converged): converged when the scaled gradient, the step or the
         relative decrease of the cost fell below :data:`GTOL`, :data:`XTOL` or
         :data:`FTOL`; not when the evaluations ran out.
     """
     f, J = evaluate(x)
     cost, mu, nu = 0.5 * float(f @ f), -1.0, 2.0
     for _ in range(evaluations - 1):
-        g, A = J.T @ f, J.T @ J
-        free = ~(((x <= lower) & (g > 0.0)) | ((x >= upper) & (g < 0.0)))
-        if not free.any() or np.max(np.abs(g[free])) <= GTOL:
+        g = J.T @ f
+        v = np.ones_like(x)
+        up, lo = (g < 0.0) & np.isfinite(upper), (g > 0.0) & np.isfinite(lower)
+        v[up], v[lo] = upper[up] - x[up], x[lo] - lower[lo]
+        d = np.sqrt(v)
+        gh = d * g
+        if np.max(np.abs(gh)) <= GTOL:
             return x, cost, True
-        Af = A[np.ix_(free, free)]
+        Jh = J * d
+        A = Jh.T @ Jh
         if mu < 0.0:
-            mu = DAMPING * float(Af.diagonal().max())
-        step = np.zeros_like(x)
-        Af.flat[::Af.shape[0] + 1] += mu
-        step[free] = np.linalg.solve(Af, -g[free])
-        trial = np.clip(x + step, lower, upper)
+            mu = DAMPING * float(A.diagonal().max())
+        A.flat[::A.shape[0] + 1] += mu
+        trial = np.clip(x + d * np.linalg.solve(A, -gh), lower, upper)
         s = trial - x
         if math.sqrt(s @ s) <= XTOL * (math.sqrt(x @ x) + XTOL):
             return x, cost, True
-        predicted = -float(g @ s + 0.5 * (s @ A @ s))
+        Js = J @ s
+        predicted = -float(g @ s + 0.5 * (Js @ Js))
         f_new, J_new = evaluate(trial)
         new = 0.5 * float(f_new @ f_new)
         rho = (cost - new) / predicted if predicted > 0.0 else -1.0
