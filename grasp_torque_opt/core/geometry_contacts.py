@@ -269,9 +269,8 @@ class GeometryContacts:
         if geometry is None:  # the candidate links' meshes alone when they are named
             geometry = collision_model(hand, urdf, urdf_dir,
                                        None if links is None else set(links))
-        geom = geometry
         by_link: dict[str, list] = {}
-        for g in geom.geometryObjects:
+        for g in geometry.geometryObjects:
             by_link.setdefault(model.frames[g.parentFrame].name, []).append(g)
         if links is None:
             names = [n for n in frame_names(model) if n in by_link and moved_by_joint(hand, n)]
@@ -302,7 +301,7 @@ class GeometryContacts:
             out.append(_Link(name, fid, frame.parentJoint, frame.placement.copy(), shapes))
         bound = cls(hand, out, shape, float(tolerance), float(max_penetration))
         # coal's ComputeDistance keeps pointers to both shapes: keep their owners alive.
-        bound._owners = (geom, target)
+        bound._owners = (geometry, target)
         return bound
 
     def contacts(self, q: np.ndarray, object_pose: pin.SE3,
