@@ -31,9 +31,13 @@ import numpy as np
 import pytest
 import yaml
 
-#: Objects planned (seed 7): their shapes, masses [kg] and how many candidates.
-OBJECTS = {'box': (ObjectShape('box', np.array([0.05, 0.04, 0.06])), 0.10, 4),
-           'cylinder': (ObjectShape('cylinder', np.array([0.025, 0.08])), 0.12, 12)}
+#: Objects planned: their shapes, masses [kg], how many candidates and the seed. A
+#: cylinder grasp that cannot hold zero load but holds its weight is rare (one seed in
+#: five gives one in 12 candidates); seed 10's include one with the IK of 5beab3a. A
+#: planner change that loses it fails the last test below, saying so: then pick a seed
+#: whose candidates have both kinds again.
+OBJECTS = {'box': (ObjectShape('box', np.array([0.05, 0.04, 0.06])), 0.10, 4, 7),
+           'cylinder': (ObjectShape('cylinder', np.array([0.025, 0.08])), 0.12, 12, 10)}
 #: Below 1: the largest multiple checked sits just inside the capacity.
 INSIDE = 1 - 1e-6
 
@@ -43,10 +47,10 @@ def planned():
     """(object, friction margin, candidate line, record) of every planned candidate."""
     out = []
     base = yaml.safe_load(ALLEGRO.read_text())
-    for kind, (shape, mass, count) in OBJECTS.items():
+    for kind, (shape, mass, count, seed) in OBJECTS.items():
         # Uniform orientations, every touching candidate kept (the planner's defaults
         # keep only held ones): the grasps that only balance their weight are wanted here.
-        plan = plan_grasps(ALLEGRO, PlanSettings(count=count, seed=7, orientation='random',
+        plan = plan_grasps(ALLEGRO, PlanSettings(count=count, seed=seed, orientation='random',
                                                  hold_margin=None), shape=shape, mass=mass)
         assert len(plan.candidates) == count
         for margin in (0.0, 0.3):
@@ -114,4 +118,5 @@ def test_a_held_load_has_capacity_one_unless_zero_load_is_not_held(planned):
             assert set(rec['capacities'].values()) == {0.0}, where
             kinds.add((kind, rec['status']))
     # The plans hold both kinds of such grasps: one whose load is held, one whose not.
-    assert ('cylinder', 'optimal') in kinds and ('cylinder', 'infeasible') in kinds
+    assert ('cylinder', 'optimal') in kinds and ('cylinder', 'infeasible') in kinds, (
+        f'the planned cylinders lack a kind of grasp that cannot hold zero load: {kinds}')
