@@ -165,9 +165,10 @@ class CapacityLP:
     """
 
     def __init__(self, setup: GraspSetup, maps: GraspMaps,
-                 tolerance: float = DEFAULT_TOLERANCE, explain: bool = True) -> None:
+                 tolerance: float = DEFAULT_TOLERANCE, explain: bool = True,
+                 confirm: bool = True) -> None:
         self.setup, self.maps, self.tolerance = setup, maps, tolerance
-        self.explain = explain
+        self.explain, self.confirm = explain, confirm
         self.friction = fr = planned_friction(setup.friction)
         G, J = maps.G, maps.J
         self.S, b_S = friction_matrix(maps.p, fr.mu1, fr.mu2, fr.sides, fr.min_normal_force)
@@ -212,10 +213,17 @@ class CapacityLP:
         return self._zero[highs_only]
 
     def _zero_load(self, highs_only: bool) -> Capacity | None:
+        confirm = self.confirm or highs_only
         res = solve_lp(self.c, self.A, self.lower, self.zero_upper, highs_only=highs_only,
-                       form=self.zero_form)
+                       form=self.zero_form, fallback=confirm)
         if res.status == 'optimal' and self._holds_zero(res.x[:self.nf]):
             return None
+        if not confirm:  # DAQP's verdict alone (load_capacity's ``confirm``)
+            if res.status == 'infeasible':
+                return Capacity('infeasible', 0.0, '-', solver=res.solver, message=(
+                    'not even zero load can be held, by DAQP alone (not confirmed)'))
+            return Capacity('failed', None, '-', solver=res.solver,
+                            message=f'zero load: {res.message} (not confirmed)')
         if res.solver == 'daqp' and not highs_only:
             res = solve_lp(self.c, self.A, self.lower, self.zero_upper, highs_only=True)
             if res.status == 'optimal' and self._holds_zero(res.x[:self.nf]):
@@ -333,7 +341,7 @@ class CapacityLP:
 
 def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
                   load: np.ndarray | None = None, highs_only: bool = False,
-                  explain: bool = True) -> Capacity:
+                  explain: bool = True, confirm: bool = True) -> Capacity:
     """
     How many times over the grasp holds its load (alpha [-], certified).
 
@@ -345,8 +353,15 @@ def load_capacity(setup: GraspSetup, maps: GraspMaps | None = None,
         explain: name what binds, or the conflict when not even zero load is held
             (False: the same verdict, certified the same way, unnamed; the planner's
             filter).
+        confirm: a zero load DAQP does not hold is confirmed by HiGHS (as the rest of
+            the LPs' fallback) and by the independent feasibility LP before it is called
+            ``infeasible``. False: DAQP's verdict alone (``infeasible`` on its exit
+            flag, else ``failed``), no SciPy imported: for a filter that only drops
+            what is not certified held (the planner's, which keeps only a certified
+            capacity of at least 1). Every other answer is the same either way.
     """
-    lp = CapacityLP(setup, maps if maps is not None else setup.maps(), explain=explain)
+    lp = CapacityLP(setup, maps if maps is not None else setup.maps(), explain=explain,
+                    confirm=confirm)
     return lp.solve(setup.external_wrench if load is None else load, '-', highs_only,
                     binding=explain)
 

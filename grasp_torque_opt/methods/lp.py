@@ -86,7 +86,7 @@ class DaqpForm:
 
 def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
              highs_only: bool = False, form: DaqpForm | None = None,
-             deadline: float | None = None) -> LPResult:
+             deadline: float | None = None, fallback: bool = True) -> LPResult:
     """
     Minimize c^T x subject to the bounds and rows of the module docstring.
 
@@ -101,6 +101,9 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
             budget): DAQP's iterations fitted to the time left at an estimate of its
             time per iteration, HiGHS's ``time_limit`` the time left, none started
             past it (``failed``, "time budget spent"). None: the caps alone.
+        fallback: HiGHS behind DAQP; False: DAQP's answer alone (``optimal``,
+            KKT-checked; ``infeasible`` on its exit flag, which nothing confirms; else
+            ``failed``), SciPy not imported.
     """
     t0 = time.perf_counter()
     why = ''
@@ -114,6 +117,9 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
             return LPResult('optimal', out[1], out[2], 'daqp', out[3],
                             time.perf_counter() - t0)
         why = out[3] if out is not None else 'DAQP raised'
+        if not fallback:
+            return LPResult(out[0] if out is not None else 'failed', None, None, 'daqp', why,
+                            time.perf_counter() - t0)
     spent = _spent(deadline)
     if spent:
         return LPResult('failed', None, None, 'daqp', f'{spent[3]} (after DAQP: {why})',
@@ -146,7 +152,7 @@ def _daqp(c, A, form: DaqpForm, limit: int | None = None):
     except (RuntimeError, ValueError) as e:
         return ('failed', None, None, f'DAQP raised: {e}')
     if flag not in (1, 2) or x is None or not np.isfinite(x).all():
-        return ('failed', None, None, f'DAQP exit flag {flag}')
+        return ('infeasible' if flag == -1 else 'failed', None, None, f'DAQP exit flag {flag}')
     lam = np.asarray(info['lam'], dtype=float)
     violation = kkt_violation(H, c, A, bl, bu, x, lam)
     if not violation <= KKT_TOLERANCE:

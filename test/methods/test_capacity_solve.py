@@ -21,7 +21,7 @@ import json
 
 from conftest import ALLEGRO
 from grasp_torque_opt.core.object_geometry import ObjectShape
-from grasp_torque_opt.methods.capacity import DIRECTIONS
+from grasp_torque_opt.methods.capacity import DIRECTIONS, load_capacity
 from grasp_torque_opt.methods.dispatch import solve
 from grasp_torque_opt.methods.engines import score_batch
 from grasp_torque_opt.methods.plan import plan_grasps, PlanSettings
@@ -120,3 +120,25 @@ def test_a_held_load_has_capacity_one_unless_zero_load_is_not_held(planned):
     # The plans hold both kinds of such grasps: one whose load is held, one whose not.
     assert ('cylinder', 'optimal') in kinds and ('cylinder', 'infeasible') in kinds, (
         f'the planned cylinders lack a kind of grasp that cannot hold zero load: {kinds}')
+
+
+def test_the_planners_unconfirmed_capacity_is_the_confirmed_one(planned):
+    """
+    ``confirm=False`` (the planner's filter: DAQP alone on zero load) gives HiGHS's verdict.
+
+    Each planned grasp's capacity with and without the confirmation (HiGHS behind DAQP,
+    the independent feasibility LP) has the same status and value, zero load not held
+    among them.
+    """
+    statuses = []
+    for kind, margin, setup, rec in planned:
+        alone = load_capacity(setup, explain=False, confirm=False)
+        confirmed = load_capacity(setup, explain=False)
+        where = (kind, margin, rec['id'], alone.message, confirmed.message)
+        assert alone.status == confirmed.status, where
+        if confirmed.value is None:
+            assert alone.value is None, where
+        else:
+            assert alone.value == pytest.approx(confirmed.value, rel=1e-6, abs=1e-9), where
+        statuses.append(confirmed.status)
+    assert statuses.count('infeasible') >= 3 and statuses.count('optimal') >= 3, statuses
