@@ -127,7 +127,8 @@ def levenberg_marquardt(evaluate, x: np.ndarray, lower: np.ndarray, upper: np.nd
     Returns:
         (x, cost, converged): converged when the scaled gradient, the step or the
         relative decrease of the cost fell below :data:`GTOL`, :data:`XTOL` or
-        :data:`FTOL`; not when the evaluations ran out.
+        :data:`FTOL`; not when the evaluations ran out or the residuals or their
+        Jacobian stopped being finite (the last finite point is returned).
     """
     f, J = evaluate(x)
     cost, mu, nu = 0.5 * float(f @ f), -1.0, 2.0
@@ -145,7 +146,13 @@ def levenberg_marquardt(evaluate, x: np.ndarray, lower: np.ndarray, upper: np.nd
         if mu < 0.0:
             mu = DAMPING * float(A.diagonal().max())
         A.flat[::A.shape[0] + 1] += mu
-        trial = np.clip(x + d * np.linalg.solve(A, -gh), lower, upper)
+        try:
+            h = np.linalg.solve(A, -gh)
+        except np.linalg.LinAlgError:
+            h = None
+        if h is None or not np.isfinite(h).all():  # not finite here: stop where it is
+            return x, cost, False
+        trial = np.clip(x + d * h, lower, upper)
         s = trial - x
         if math.sqrt(s @ s) <= XTOL * (math.sqrt(x @ x) + XTOL):
             return x, cost, True
@@ -153,6 +160,8 @@ def levenberg_marquardt(evaluate, x: np.ndarray, lower: np.ndarray, upper: np.nd
         predicted = -float(g @ s + 0.5 * (Js @ Js))
         f_new, J_new = evaluate(trial)
         new = 0.5 * float(f_new @ f_new)
+        if not math.isfinite(new):  # not finite there: stop at the last finite point
+            return x, cost, False
         rho = (cost - new) / predicted if predicted > 0.0 else -1.0
         if rho > 0.0:
             decrease = cost - new

@@ -238,3 +238,19 @@ def test_the_ik_solver_keeps_to_its_evaluations():
                                                   upper, 5)
     assert len(calls) == 5 and not converged
     assert any(np.array_equal(x, c) for c in calls)
+
+
+@pytest.mark.parametrize('where', ['start', 'steps'])
+def test_the_ik_solver_stops_at_residuals_that_are_not_finite(where):
+    """Residuals that are not finite (at the start, or at a step tried) end it, unconverged."""
+    start = np.array([-1.2, 1.0])
+
+    def broken(x):
+        if where == 'start' or not np.array_equal(x, start):
+            return np.full(2, np.nan), np.full((2, 2), np.nan)
+        return rosenbrock(x)
+
+    lower, upper = np.full(2, -2.0), np.full(2, 2.0)
+    x, cost, converged = plan_ik.levenberg_marquardt(broken, start, lower, upper, 30)
+    assert not converged and np.array_equal(x, start)
+    assert (cost == rosenbrock(start)[0] @ rosenbrock(start)[0] / 2) == (where == 'steps')
