@@ -149,12 +149,17 @@ def test_the_preset_runs_the_imu_reads_the_base_and_efforts_are_published():
 
 
 def test_a_driver_that_reports_its_command_publishes_the_command_as_effort():
-    """--effort-report commanded: joint_states' effort is the last command (the preset's)."""
+    """
+    --effort-report commanded: joint_states' effort is the last command (the preset's).
+
+    Tried again, at most three times, when discovery matched so late that ten joint
+    states or fewer were heard (as the test above: a fresh clone's run heard a few).
+    """
     args = ['--controller', 'preset', '--preset-level', '1.0', '--duration', '0.3',
             '--settle', '1', '--effort-report', 'commanded', '--no-picture']
     for attempt in range(3):
         _, states, out, err, code = listen(args, ros_domains.domain('sim_commanded', attempt))
-        if states:
+        if len(states) > 10:
             break
     assert code in (0, 1), out + err
     assert 'efforts reported: commanded' in out.splitlines()[0]
