@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from grasp_torque_opt.core.friction import friction_matrix
 from grasp_torque_opt.core.grasp_maps import GraspMaps
 from grasp_torque_opt.core.scenario import Friction
+from grasp_torque_opt.methods.lp import linprog
 import numpy as np
 
 #: A multiplier is part of the certificate above this share of the largest one.
@@ -97,7 +98,6 @@ class Conflict:
 
 
 def _feasible(A_ub: np.ndarray, b_ub: np.ndarray, G: np.ndarray) -> bool | None:
-    from scipy.optimize import linprog  # on first use: 0.3 s of imports
     res = linprog(np.zeros(G.shape[1]), A_ub=A_ub if A_ub.size else None,
                   b_ub=b_ub if A_ub.size else None, A_eq=G, b_eq=np.zeros(G.shape[0]),
                   bounds=(None, None), method='highs')
@@ -126,7 +126,6 @@ def zero_load_conflict(maps: GraspMaps, friction: Friction, joints: list[str],
     A = np.vstack((J.T[fin_up], -J.T[fin_lo], S))
     b = np.concatenate((tau_max[fin_up], -tau_min[fin_lo], b_S))
     rows = A.shape[0]
-    from scipy.optimize import linprog  # on first use: 0.3 s of imports
     res = linprog(np.concatenate((np.zeros(nf), np.ones(rows))),
                   A_ub=np.hstack((A, -np.eye(rows))), b_ub=b,
                   A_eq=np.hstack((G, np.zeros((G.shape[0], rows)))), b_eq=np.zeros(6),

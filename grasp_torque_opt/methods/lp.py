@@ -130,6 +130,13 @@ def solve_lp(c: np.ndarray, A: np.ndarray, lower: np.ndarray, upper: np.ndarray,
     return LPResult(res.status, res.x, res.lam, 'highs', msg, time.perf_counter() - t0)
 
 
+def linprog(*args, **kwargs):
+    """Run SciPy's ``linprog`` (HiGHS), imported on first use: 0.3 s a plan never needs."""
+    from scipy.optimize import linprog as highs
+
+    return highs(*args, **kwargs)
+
+
 def _spent(deadline: float | None):
     """Return the failure of an LP not started past ``deadline`` (None if there is time)."""
     if deadline is not None and time.perf_counter() >= deadline:
@@ -179,7 +186,6 @@ def _highs(c, A, lower, upper, time_limit: float | None = None) -> _Highs:
     b_ub = np.concatenate((up_r[has_up], -lo_r[has_lo]))
     bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(up) else up)
               for lo, up in zip(lower[:n], upper[:n])]
-    from scipy.optimize import linprog  # on first use: 0.3 s of imports
     res = linprog(c, A_ub=A_ub if A_ub.size else None, b_ub=b_ub if b_ub.size else None,
                   A_eq=A[eq] if eq.any() else None, b_eq=up_r[eq] if eq.any() else None,
                   bounds=bounds, method='highs',

@@ -35,11 +35,11 @@ the solver's own: the independent check of :mod:`.plan` judges it either way.
 
 Why a solver of its own (issue 36): SciPy's ``least_squares`` (trust region
 reflective) spent as long in its own Python per IK as the residuals did (an SVD and a
-trust-region subproblem per step, about 3.4 ms of an Allegro IK's 7), and importing
+trust-region subproblem per step, about 3 ms of an Allegro IK's 6), and importing
 ``scipy.optimize`` took 0.3 s of the planner's start-up. These problems are small (the
 Allegro: 19 unknowns, about 40 rows) and end at the stop test within a few steps, so
-a damped Gauss-Newton step on the free variables, projected onto the bounds, does the
-job in a few dozen lines.
+a damped Gauss-Newton step scaled as SciPy's method scales it at the bounds, clipped
+to them, does the job in a few dozen lines.
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ BOUND_SLACK = 1e-6
 #: The IK stops at a point with every contact within this share of the tolerance of
 #: the surface, the other rows within this share of their slack (SurfaceIK._meets).
 STOP_SHARE = 0.5
-#: levenberg_marquardt's tolerances: the projected gradient, the step (relative to x)
+#: levenberg_marquardt's tolerances: the scaled gradient, the step (relative to x)
 #: and the relative decrease of the cost it ends at (as least_squares' were).
 GTOL = XTOL = FTOL = 1e-10
 #: The first damping, relative to the largest diagonal entry of D J^T J D [-].

@@ -44,6 +44,7 @@ def linearized_feasible(maps: GraspMaps, friction: Friction, external_wrench: np
         block = np.vstack((circumscribed_rows(friction.mu1, friction.mu2, friction.sides),
                            [0.0, 0.0, -1.0, 0.0]))
         S = np.kron(np.eye(maps.p), block)
+    # Imported here, not from methods.lp's lazy one: the reference stays apart from methods.
     from scipy.optimize import linprog  # on first use: 0.3 s of imports
     res = linprog(np.zeros(G.shape[1]), A_ub=np.vstack((S, J.T, -J.T)),
                   b_ub=np.concatenate((b_S, tau_max, -tau_min)),
