@@ -663,10 +663,10 @@ struct CapacitySolver
 // vertex, DAQP solves them all, the axes first.
 // Returns a dict: passes (N, 2 + L: KKT-checked, below alpha_max, certified; the zero-load
 // LP first, then the load's, then the axes'), alpha (N, 2 + L; NaN where none was found),
-// iterations (N, 2 + L: pivots or DAQP's iterations), vertex (N, 2 + L: answered by the
-// vertex method). Without phase 1, the zero-load LP is solved only where the axes'
-// answers do not already certify wrenches that hold zero load (its entry then says
-// passes, 0 iterations).
+// iterations (N, 2 + L: pivots or DAQP's iterations; 0 for a load's LP answered by its
+// axis's, below), vertex (N, 2 + L: answered by the vertex method). Without phase 1, the
+// zero-load LP is solved only where the axes' answers do not already certify wrenches
+// that hold zero load (its entry then says passes, 0 iterations).
 template<int Size>
 py::dict capacity_batch_n(
   const FastCycle & fc, int64_t quadprog, int64_t defaults, Array G, Array J, Array W,
@@ -711,6 +711,22 @@ py::dict capacity_batch_n(
     py::gil_scoped_release release;
     RowMat A = RowMat::Zero(rows, n);
     A.bottomLeftCorner(S.shape(0), nf) = Eigen::Map<const RowMat>(S.data(), S.shape(0), nf);
+    // The axes' answers by the vertex method (x, lam) for the load's LP: where the load's
+    // direction W / max |W| is exactly one of the axes (a weight at the object's origin,
+    // as every planned line has: (0, 0, -1, 0, 0, 0)), its LP is that axis's LP, the
+    // same rows and bounds, so the axis's answer is its answer; it is checked for the
+    // load (the KKT check, alpha = x_alpha / max |W|, the certificate at alpha W) and
+    // not solved again. Its iterations entry says 0.
+    std::vector<std::vector<double>> axis_x(L), axis_lam(L);
+    std::vector<bool> axis_good(L, false);
+    auto same_axis = [&](const Wrench & direction) {
+        for (py::ssize_t j = 0; j < L; ++j) {
+          if (axis_good[j] && direction == Eigen::Map<const Wrench>(axes.data() + 6 * j)) {
+            return static_cast<int>(j);
+          }
+        }
+        return -1;
+      };
     for (py::ssize_t i = 0; i < N; ++i) {
       const RowMat Gi = Eigen::Map<const RowMat>(G.data() + 6 * nf * i, 6, nf);
       const RowMat Ji = Eigen::Map<const RowMat>(J.data() + nf * m * i, nf, m);
@@ -733,9 +749,20 @@ py::dict capacity_batch_n(
           int it = 0;
           if (k != 1 || (std::isfinite(scale) && scale > 0.0)) {
             A.topRightCorner(6, 1) = load / s;  // the zero-load LP: alpha fixed at 0
-            if (k > 0 && from_zero) {
+            const int same = k == 1 && from_zero ? same_axis(load / s) : -1;
+            if (same >= 0) {  // that axis's LP: its answer, checked for this load
+              std::copy(axis_x[same].begin(), axis_x[same].end(), solver.x.begin());
+              std::copy(axis_lam[same].begin(), axis_lam[same].end(), solver.lam.begin());
+              good = solver.check(A, Gi, Ji, load, s, solver.bu, solver.bl, a);
+              by_vertex.mutable_data()[K * i + k] = good;
+            } else if (k > 0 && from_zero) {
               good = solver.vertex(A, Gi, Ji, load, s, a, it);
               by_vertex.mutable_data()[K * i + k] = good;
+              if (good && k > 1) {
+                axis_x[k - 2].assign(solver.x.begin(), solver.x.end());
+                axis_lam[k - 2].assign(solver.lam.begin(), solver.lam.end());
+                axis_good[k - 2] = true;
+              }
             }
             if (!good) {
               good = solver.solve(A, Gi, Ji, load, s, k == 0, a, it);
@@ -756,9 +783,11 @@ py::dict capacity_batch_n(
         alpha.mutable_data()[K * i] = 0.0;
         iterations.mutable_data()[K * i] = it0;
         by_vertex.mutable_data()[K * i] = true;
-        for (py::ssize_t k = 1; k < K; ++k) {
+        std::fill(axis_good.begin(), axis_good.end(), false);
+        for (py::ssize_t k = 2; k < K; ++k) {  // the axes, then the load
           lp(k);
         }
+        lp(1);
         continue;
       }
       // Else DAQP, the axes first: zero load is held, certified, where an axis LP's answer holds

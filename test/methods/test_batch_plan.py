@@ -160,6 +160,14 @@ def test_the_vertex_method_answers_the_compiled_lps_as_daqp_does(planned):
         assert by_daqp['passes'].all() and not by_daqp['vertex'].any()
         np.testing.assert_allclose(by_vertex['alpha'], by_daqp['alpha'],
                                    rtol=1e-7, atol=1e-12)
+        # A load along an axis (the weight at the object's origin) is that axis's LP:
+        # its answer taken (no pivots of its own), checked, and DAQP's alpha above.
+        W, axes = args[4], args[5]
+        direction = W / np.abs(W).max(axis=1, keepdims=True)
+        along = (direction[:, None, :] == axes[None]).all(axis=2).any(axis=1)
+        assert along.any() and not along.all()
+        assert (by_vertex['iterations'][along, 1] == 0).all()
+        assert (by_vertex['iterations'][~along, 1] > 0).all()
 
 
 def test_fewer_contacts_take_the_vertex_method_at_their_own_size():
