@@ -51,3 +51,13 @@ def test_the_certificate_of_a_non_finite_candidate_is_strict_json(planar):
     assert out['certificate']['ok'] is False
     # Python's own json would have written Infinity here.
     assert 'Infinity' in json.dumps(solution_dict(sol, maps))
+
+
+def test_finite_data_is_written_as_the_null_conversion_writes_it():
+    # Written directly when every number is finite: the same text as through the
+    # conversion (tuples as lists, NumPy floats, nesting, key order), byte for byte.
+    from grasp_torque_opt.core.report import _finite_or_null
+    data = {'z': (1.5, [np.float64(0.1), 2]), 'a': {'b': [1e-05, -0.0, 5e-324]},
+            'k': 'x', 'n': None, 't': True}
+    assert strict_json(data) == json.dumps(_finite_or_null(data), allow_nan=False)
+    assert strict_json([np.float64('nan')]) == '[null]'
