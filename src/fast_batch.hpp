@@ -716,12 +716,14 @@ py::dict capacity_batch_n(
     // as every planned line has: (0, 0, -1, 0, 0, 0)), its LP is that axis's LP, the
     // same rows and bounds, so the axis's answer is its answer; it is checked for the
     // load (the KKT check, alpha = x_alpha / max |W|, the certificate at alpha W) and
-    // not solved again. Its iterations entry says 0.
+    // not solved again. Its iterations entry says 0. An axis answered by the vertex
+    // method for candidate i is by_vertex[i, 2 + j].
     std::vector<std::vector<double>> axis_x(L), axis_lam(L);
-    std::vector<bool> axis_good(L, false);
-    auto same_axis = [&](const Wrench & direction) {
+    auto same_axis = [&](py::ssize_t i, const Wrench & direction) {
         for (py::ssize_t j = 0; j < L; ++j) {
-          if (axis_good[j] && direction == Eigen::Map<const Wrench>(axes.data() + 6 * j)) {
+          if (by_vertex.data()[K * i + 2 + j] &&
+            direction == Eigen::Map<const Wrench>(axes.data() + 6 * j))
+          {
             return static_cast<int>(j);
           }
         }
@@ -749,7 +751,7 @@ py::dict capacity_batch_n(
           int it = 0;
           if (k != 1 || (std::isfinite(scale) && scale > 0.0)) {
             A.topRightCorner(6, 1) = load / s;  // the zero-load LP: alpha fixed at 0
-            const int same = k == 1 && from_zero ? same_axis(load / s) : -1;
+            const int same = k == 1 && from_zero ? same_axis(i, load / s) : -1;
             if (same >= 0) {  // that axis's LP: its answer, checked for this load
               std::copy(axis_x[same].begin(), axis_x[same].end(), solver.x.begin());
               std::copy(axis_lam[same].begin(), axis_lam[same].end(), solver.lam.begin());
@@ -761,7 +763,6 @@ py::dict capacity_batch_n(
               if (good && k > 1) {
                 axis_x[k - 2].assign(solver.x.begin(), solver.x.end());
                 axis_lam[k - 2].assign(solver.lam.begin(), solver.lam.end());
-                axis_good[k - 2] = true;
               }
             }
             if (!good) {
@@ -783,7 +784,6 @@ py::dict capacity_batch_n(
         alpha.mutable_data()[K * i] = 0.0;
         iterations.mutable_data()[K * i] = it0;
         by_vertex.mutable_data()[K * i] = true;
-        std::fill(axis_good.begin(), axis_good.end(), false);
         for (py::ssize_t k = 2; k < K; ++k) {  // the axes, then the load
           lp(k);
         }
